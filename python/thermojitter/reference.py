@@ -1,0 +1,360 @@
+"""Pure NumPy/SciPy reference implementation of the thermo-mechanical jitter model.
+
+This module is the test oracle: it restates the equations of ``MODEL.md`` (Parisse &
+Angeletti 2024, eqs. 1, 2, 20, 28) independently of the Rust engine. All quantities are SI;
+angles are in radians. Inputs are duck-typed: ``panel`` carries the Table 1 attributes,
+``orbit`` carries ``radius``, ``earth_radius`` and ``period``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from itertools import pairwise
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import solve_ivp
+from scipy.optimize import fsolve
+
+STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4)
+
+FloatArray = NDArray[np.float64]
+StateFun = Callable[[float, FloatArray, float], FloatArray]
+
+
+# --------------------------------------------------------------------------- orbit / shadow
+
+
+def _shadow_half_angle(orbit: Any) -> float:
+    """Half-width of the cylindrical-shadow arc in orbit phase [rad]."""
+    return math.asin(orbit.earth_radius / orbit.radius)
+
+
+def shadow_intervals(orbit: Any, t0: float, t1: float) -> list[tuple[float, float]]:
+    """Eclipses (t_enter, t_exit) [s] overlapping [t0, t1], clipped to it, in time order."""
+    period = float(orbit.period)
+    half = _shadow_half_angle(orbit) * period / (2.0 * math.pi)  # half eclipse duration [s]
+    # Eclipse k is centred at (k + 1/2) * period (phase beta = pi).
+    k_first = math.floor((t0 + half) / period - 0.5)
+    k_last = math.ceil((t1 - half) / period - 0.5)
+    intervals = []
+    for k in range(k_first, k_last + 1):
+        centre = (k + 0.5) * period
+        enter, leave = max(centre - half, t0), min(centre + half, t1)
+        if enter < leave:
+            intervals.append((enter, leave))
+    return intervals
+
+
+def illumination(orbit: Any, t: float) -> float:
+    """Illuminated fraction s(t): 0.0 in the cylindrical shadow, 1.0 in sunlight."""
+    beta = (2.0 * math.pi * t / orbit.period) % (2.0 * math.pi)
+    return 0.0 if abs(beta - math.pi) < _shadow_half_angle(orbit) else 1.0
+
+
+# --------------------------------------------------------------------------- model equations
+
+
+def _arm(panel: Any) -> float:
+    """Half-length of one rigid half, l = L/4 [m]."""
+    return panel.length / 4.0
+
+
+def hinge_inertia(panel: Any) -> float:
+    """Linearised hinge inertia I_B = 2 m l^3 / 3 [kg m^2] (per unit width)."""
+    return 2.0 * panel.mass_per_length * _arm(panel) ** 3 / 3.0
+
+
+def thermal_moment(panel: Any, T_front: ArrayLike, T_back: ArrayLike) -> Any:
+    """Thermal bending moment M_T = chi a E I (T_f - T_b) / d [N m]; works on arrays."""
+    chi = getattr(panel, "moment_scale", 1.0)
+    gain = chi * panel.expansion_coeff * panel.youngs_modulus * panel.bending_inertia
+    return gain * (np.asarray(T_front) - np.asarray(T_back)) / panel.thickness
+
+
+def rhs_one_node(t: float, y: Sequence[float], panel: Any, s: float) -> FloatArray:
+    """Eq. 1: dT/dt [K/s] of the isothermal plate, y = [T]."""
+    (T,) = y
+    eps = panel.emissivity_front + panel.emissivity_back
+    net = panel.absorptivity * panel.solar_constant * s - STEFAN_BOLTZMANN * eps * T**4
+    return np.array([net / (panel.mass_per_length * panel.specific_heat)])
+
+
+def rhs_two_layer(
+    t: float, y: Sequence[float], panel: Any, s: float, cos_theta: float = 1.0
+) -> FloatArray:
+    """Eq. 2: [dT_f/dt, dT_b/dt] [K/s], each layer holding half the heat capacity."""
+    T_f, T_b = y[0], y[1]
+    half_cap = 0.5 * panel.mass_per_length * panel.specific_heat
+    conduction = panel.conductance * (T_f - T_b)
+    absorbed = panel.absorptivity * panel.solar_constant * s * cos_theta
+    q_f = absorbed - conduction - STEFAN_BOLTZMANN * panel.emissivity_front * T_f**4
+    q_b = conduction - STEFAN_BOLTZMANN * panel.emissivity_back * T_b**4
+    return np.array([q_f / half_cap, q_b / half_cap])
+
+
+def _hinge_accel(panel: Any, theta: float, theta_dot: float, moment: float, model: str) -> float:
+    """Hinge angular acceleration [rad/s^2]: eq. 20 ("nonlinear") or eq. 28 ("linear")."""
+    if model == "linear":
+        torque = moment - panel.damping * theta_dot - panel.hinge_stiffness * theta
+        return torque / hinge_inertia(panel)
+    if model == "nonlinear":
+        ml3 = panel.mass_per_length * _arm(panel) ** 3
+        sin_t, cos_t = math.sin(theta), math.cos(theta)
+        torque = moment - panel.damping * theta_dot - panel.hinge_stiffness * theta
+        num = 1.5 * torque / ml3 - 3.0 * theta_dot**2 * sin_t * cos_t
+        return num / (1.0 + 3.0 * sin_t**2)
+    raise ValueError(f"unknown hinge model {model!r} (use 'nonlinear' or 'linear')")
+
+
+def rhs_coupled(
+    t: float,
+    y: Sequence[float],
+    panel: Any,
+    s: float,
+    model: str = "nonlinear",
+    coupled: bool = True,
+) -> FloatArray:
+    """Derivative of y = [T_f, T_b, theta, theta_dot] [K/s, K/s, rad/s, rad/s^2]."""
+    T_f, T_b, theta, theta_dot = (float(v) for v in y)
+    # coupled=False freezes the projected area (cos theta -> 1), paper Fig. 18.
+    cos_theta = math.cos(theta) if coupled else 1.0
+    dT_f, dT_b = rhs_two_layer(t, (T_f, T_b), panel, s, cos_theta)
+    moment = float(thermal_moment(panel, T_f, T_b))
+    accel = _hinge_accel(panel, theta, theta_dot, moment, model)
+    return np.array([dT_f, dT_b, theta_dot, accel])
+
+
+def hinge_energy(
+    panel: Any, theta: ArrayLike, theta_dot: ArrayLike, moment: float, model: str = "nonlinear"
+) -> Any:
+    """Hinge energy [J] (kinetic + spring - work of constant M), conserved if c_d = 0."""
+    th, thd = np.asarray(theta), np.asarray(theta_dot)
+    if model == "nonlinear":
+        ml3 = panel.mass_per_length * _arm(panel) ** 3
+        kinetic = ml3 / 3.0 * thd**2 * (1.0 + 3.0 * np.sin(th) ** 2)
+    elif model == "linear":
+        kinetic = 0.5 * hinge_inertia(panel) * thd**2
+    else:
+        raise ValueError(f"unknown hinge model {model!r} (use 'nonlinear' or 'linear')")
+    return kinetic + 0.5 * panel.hinge_stiffness * th**2 - moment * th
+
+
+# --------------------------------------------------------------------------- equilibria
+
+
+def one_node_equilibrium(panel: Any, s: float = 1.0) -> float:
+    """Equilibrium temperature [K] of eq. 1 under illumination s."""
+    eps = panel.emissivity_front + panel.emissivity_back
+    return (panel.absorptivity * panel.solar_constant * s / (STEFAN_BOLTZMANN * eps)) ** 0.25
+
+
+def steady_state(panel: Any, coupled: bool = True) -> tuple[float, float, float]:
+    """Sunlit equilibrium (T_f [K], T_b [K], theta [rad]) with theta_dot = 0, s = 1."""
+    T0 = one_node_equilibrium(panel)
+    # Initial split: the back face re-radiates what conducts through, K dT = sigma eps_b T^4.
+    split = STEFAN_BOLTZMANN * panel.emissivity_back * T0**4 / panel.conductance
+    T_f0, T_b0 = T0 + 0.5 * split, T0 - 0.5 * split
+    theta0 = float(thermal_moment(panel, T_f0, T_b0)) / panel.hinge_stiffness
+    half_cap = 0.5 * panel.mass_per_length * panel.specific_heat
+
+    def residual(x: FloatArray) -> FloatArray:
+        # Heat balances in W/m^2, hinge balance in N m (static for both models).
+        cos_theta = math.cos(x[2]) if coupled else 1.0
+        dT = rhs_two_layer(0.0, x[:2], panel, 1.0, cos_theta)
+        static = float(thermal_moment(panel, x[0], x[1])) - panel.hinge_stiffness * x[2]
+        return np.array([dT[0] * half_cap, dT[1] * half_cap, static])
+
+    x0 = [T_f0, T_b0, theta0]
+    sol, _, ier, msg = fsolve(residual, x0, xtol=1e-14, full_output=True)
+    if ier != 1 and np.max(np.abs(residual(sol))) > 1e-8:
+        raise RuntimeError(f"steady_state did not converge: {msg}")
+    return float(sol[0]), float(sol[1]), float(sol[2])
+
+
+# --------------------------------------------------------------------------- integration
+
+
+@dataclass
+class ReferenceSolution:
+    """Time history: t [s] (n,), y (k, n) whose rows are named by ``names``."""
+
+    t: FloatArray
+    y: FloatArray
+    nfev: int
+    n_steps: int  # accepted steps; -1 when t_eval was given (not observable then)
+    names: tuple[str, ...] = ("T_front", "T_back", "theta", "theta_dot")
+
+    def _row(self, name: str) -> FloatArray:
+        if name in self.names:
+            return self.y[self.names.index(name)]
+        if name in ("T_front", "T_back") and "T" in self.names:
+            return self.y[self.names.index("T")]  # isothermal plate: both faces at T
+        raise AttributeError(f"solution has no component {name!r} (has {self.names})")
+
+    @property
+    def T_front(self) -> FloatArray:
+        """Front-face temperature [K]."""
+        return self._row("T_front")
+
+    @property
+    def T_back(self) -> FloatArray:
+        """Back-face temperature [K]."""
+        return self._row("T_back")
+
+    @property
+    def theta(self) -> FloatArray:
+        """Hinge angle [rad]."""
+        return self._row("theta")
+
+    @property
+    def theta_dot(self) -> FloatArray:
+        """Hinge angular rate [rad/s]."""
+        return self._row("theta_dot")
+
+
+def _integrate_segments(
+    fun: StateFun,
+    y0: ArrayLike,
+    t_span: tuple[float, float],
+    orbit: Any | None,
+    rtol: float,
+    atol: float,
+    t_eval: ArrayLike | None,
+    method: str,
+    names: tuple[str, ...],
+) -> ReferenceSolution:
+    """Integrate fun(t, y, s) with one solve_ivp call per shadow-free segment."""
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    if not t1 > t0:
+        raise ValueError("t_span must satisfy t_span[0] < t_span[1]")
+    cuts = [t0, t1]
+    if orbit is not None:
+        for enter, leave in shadow_intervals(orbit, t0, t1):
+            cuts += [enter, leave]
+    edges = sorted({c for c in cuts if t0 <= c <= t1})
+
+    requested = None
+    if t_eval is not None:
+        requested = np.asarray(t_eval, dtype=float)
+        if requested.size and (requested[0] < t0 or requested[-1] > t1):
+            raise ValueError("t_eval must lie inside t_span")
+        if np.any(np.diff(requested) < 0):
+            raise ValueError("t_eval must be sorted")
+
+    y = np.asarray(y0, dtype=float)
+    ts, ys = [], []
+    nfev, n_steps = 0, 0
+    for i, (a, b) in enumerate(pairwise(edges)):
+        s = illumination(orbit, 0.5 * (a + b)) if orbit is not None else 1.0
+        seg_eval = None
+        if requested is not None:
+            # A boundary time belongs to the segment ending there (t_span[0] to the first).
+            lo = 0 if i == 0 else np.searchsorted(requested, a, side="right")
+            hi = np.searchsorted(requested, b, side="right")
+            mine = requested[lo:hi]
+            # solve_ivp needs strictly increasing times; b is always included because its
+            # state starts the next segment.
+            seg_eval = np.union1d(mine, [b])
+        sol = solve_ivp(
+            fun, (a, b), y, method=method, t_eval=seg_eval, args=(s,), rtol=rtol, atol=atol
+        )
+        if not sol.success:
+            raise RuntimeError(f"solve_ivp failed on [{a}, {b}]: {sol.message}")
+        nfev += int(sol.nfev)
+        y = sol.y[:, -1]
+        if requested is None:
+            n_steps += len(sol.t) - 1
+            skip = 0 if i == 0 else 1  # the boundary point is already stored
+            ts.append(sol.t[skip:])
+            ys.append(sol.y[:, skip:])
+        else:
+            ts.append(mine)
+            ys.append(sol.y[:, np.searchsorted(seg_eval, mine)])
+    return ReferenceSolution(
+        t=np.concatenate(ts),
+        y=np.concatenate(ys, axis=1),
+        nfev=nfev,
+        n_steps=n_steps if requested is None else -1,
+        names=names,
+    )
+
+
+def simulate(
+    panel: Any,
+    orbit: Any,
+    t_span: tuple[float, float],
+    *,
+    model: str = "nonlinear",
+    coupled: bool = True,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    t_eval: ArrayLike | None = None,
+    y0: ArrayLike | None = None,
+    method: str = "RK45",
+) -> ReferenceSolution:
+    """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses."""
+    if y0 is None:
+        y0 = (*steady_state(panel, coupled), 0.0)
+
+    def fun(t: float, y: FloatArray, s: float) -> FloatArray:
+        return rhs_coupled(t, y, panel, s, model, coupled)
+
+    names = ("T_front", "T_back", "theta", "theta_dot")
+    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names)
+
+
+def simulate_thermal(
+    panel: Any,
+    orbit: Any,
+    t_span: tuple[float, float],
+    *,
+    layers: int = 2,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    t_eval: ArrayLike | None = None,
+    y0: ArrayLike | None = None,
+    method: str = "RK45",
+) -> ReferenceSolution:
+    """Thermal model alone: layers=1 is eq. 1 (y = [T]), layers=2 is eq. 2 with cos theta = 1."""
+    if layers == 1:
+        y0 = (one_node_equilibrium(panel),) if y0 is None else y0
+
+        def fun(t: float, y: FloatArray, s: float) -> FloatArray:
+            return rhs_one_node(t, y, panel, s)
+
+        names: tuple[str, ...] = ("T",)
+    elif layers == 2:
+        y0 = steady_state(panel, coupled=False)[:2] if y0 is None else y0
+
+        def fun(t: float, y: FloatArray, s: float) -> FloatArray:
+            return rhs_two_layer(t, y, panel, s, 1.0)
+
+        names = ("T_front", "T_back")
+    else:
+        raise ValueError("layers must be 1 or 2")
+    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names)
+
+
+def simulate_hinge(
+    panel: Any,
+    moment: float,
+    t_span: tuple[float, float],
+    *,
+    y0: ArrayLike = (0.0, 0.0),
+    model: str = "nonlinear",
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    t_eval: ArrayLike | None = None,
+    method: str = "RK45",
+) -> ReferenceSolution:
+    """Hinge alone, y = [theta, theta_dot], driven by a constant moment [N m]."""
+
+    def fun(t: float, y: FloatArray, s: float) -> FloatArray:
+        return np.array([y[1], _hinge_accel(panel, float(y[0]), float(y[1]), moment, model)])
+
+    names = ("theta", "theta_dot")
+    return _integrate_segments(fun, y0, t_span, None, rtol, atol, t_eval, method, names)

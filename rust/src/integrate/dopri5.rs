@@ -1,0 +1,233 @@
+//! Dormand–Prince 5(4) with error control, FSAL and Hairer's fourth-order continuous extension.
+//!
+//! The controller is the standard one (the same family as SciPy's RK45): RMS error norm scaled by
+//! atol + rtol·max(|y_old|, |y_new|), new step h·min(10, 0.9·err^(−1/5)), shrink at most 5×, no
+//! growth right after a rejection, and Hairer's initial-step estimate at the start of every segment.
+
+use super::{rms_scaled, DenseStep, Observer, OdeSystem, Stats, Tolerances};
+use crate::error::{Error, Result};
+use nalgebra::SVector;
+use std::ops::ControlFlow;
+
+// Butcher tableau.
+pub const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+pub const A21: f64 = 1.0 / 5.0;
+pub const A3: [f64; 2] = [3.0 / 40.0, 9.0 / 40.0];
+pub const A4: [f64; 3] = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
+pub const A5: [f64; 4] = [
+    19372.0 / 6561.0,
+    -25360.0 / 2187.0,
+    64448.0 / 6561.0,
+    -212.0 / 729.0,
+];
+pub const A6: [f64; 5] = [
+    9017.0 / 3168.0,
+    -355.0 / 33.0,
+    46732.0 / 5247.0,
+    49.0 / 176.0,
+    -5103.0 / 18656.0,
+];
+/// Fifth-order weights (also the seventh row: first same as last).
+pub const B: [f64; 7] = [
+    35.0 / 384.0,
+    0.0,
+    500.0 / 1113.0,
+    125.0 / 192.0,
+    -2187.0 / 6784.0,
+    11.0 / 84.0,
+    0.0,
+];
+/// Fourth-order embedded weights.
+pub const B_HAT: [f64; 7] = [
+    5179.0 / 57600.0,
+    0.0,
+    7571.0 / 16695.0,
+    393.0 / 640.0,
+    -92097.0 / 339200.0,
+    187.0 / 2100.0,
+    1.0 / 40.0,
+];
+/// Dense-output coefficients (Hairer, Nørsett & Wanner, dopri5).
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+const SAFETY: f64 = 0.9;
+const MIN_FACTOR: f64 = 0.2;
+const MAX_FACTOR: f64 = 10.0;
+const ERROR_EXPONENT: f64 = -1.0 / 5.0;
+
+/// Hairer's estimate of a first step for an order-4 error estimator.
+fn initial_step<const N: usize, S: OdeSystem<N>>(
+    system: &S,
+    t0: f64,
+    y0: &SVector<f64, N>,
+    f0: &SVector<f64, N>,
+    interval: f64,
+    tol: &Tolerances,
+    stats: &mut Stats,
+) -> f64 {
+    let scale = y0.map(|v| tol.atol + v.abs() * tol.rtol);
+    let d0 = rms_scaled(y0, &scale);
+    let d1 = rms_scaled(f0, &scale);
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    let h0 = h0.min(interval);
+    let y1 = y0 + f0 * h0;
+    let f1 = system.rhs(t0 + h0, &y1);
+    stats.n_rhs += 1;
+    let d2 = rms_scaled(&(f1 - f0), &scale) / h0;
+    let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / 5.0)
+    };
+    (100.0 * h0).min(h1).min(interval)
+}
+
+/// Integrates one segment [a, b] on which the right-hand side is smooth; `y` goes from y(a) to y(b).
+pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
+    system: &S,
+    a: f64,
+    b: f64,
+    y: &mut SVector<f64, N>,
+    tol: &Tolerances,
+    stats: &mut Stats,
+    observer: &mut O,
+) -> Result<ControlFlow<()>> {
+    let mut t = a;
+    let mut k1 = system.rhs(t, y);
+    stats.n_rhs += 1;
+    let mut h_abs = initial_step(system, t, y, &k1, b - a, tol, stats).min(tol.max_step);
+
+    while t < b {
+        let min_step = 10.0 * (next_up(t) - t);
+        if h_abs < min_step {
+            h_abs = min_step;
+        }
+        let mut rejected = false;
+        loop {
+            if stats.n_steps + stats.n_rejected >= tol.max_steps {
+                return Err(Error::Integration {
+                    t,
+                    reason: format!("max_steps = {} reached", tol.max_steps),
+                });
+            }
+            let t_new = if t + h_abs >= b { b } else { t + h_abs };
+            let h = t_new - t;
+
+            let y0 = *y;
+            let k2 = system.rhs(t + C[1] * h, &(y0 + k1 * (A21 * h)));
+            let k3 = system.rhs(t + C[2] * h, &(y0 + (k1 * A3[0] + k2 * A3[1]) * h));
+            let k4 = system.rhs(
+                t + C[3] * h,
+                &(y0 + (k1 * A4[0] + k2 * A4[1] + k3 * A4[2]) * h),
+            );
+            let k5 = system.rhs(
+                t + C[4] * h,
+                &(y0 + (k1 * A5[0] + k2 * A5[1] + k3 * A5[2] + k4 * A5[3]) * h),
+            );
+            let k6 = system.rhs(
+                t_new,
+                &(y0 + (k1 * A6[0] + k2 * A6[1] + k3 * A6[2] + k4 * A6[3] + k5 * A6[4]) * h),
+            );
+            let y_new = y0 + (k1 * B[0] + k3 * B[2] + k4 * B[3] + k5 * B[4] + k6 * B[5]) * h;
+            let k7 = system.rhs(t_new, &y_new);
+            stats.n_rhs += 6;
+
+            let err = (k1 * (B[0] - B_HAT[0])
+                + k3 * (B[2] - B_HAT[2])
+                + k4 * (B[3] - B_HAT[3])
+                + k5 * (B[4] - B_HAT[4])
+                + k6 * (B[5] - B_HAT[5])
+                + k7 * (B[6] - B_HAT[6]))
+                * h;
+            let scale = y0.zip_map(&y_new, |u, v| tol.atol + u.abs().max(v.abs()) * tol.rtol);
+            let err_norm = rms_scaled(&err, &scale);
+
+            if err_norm < 1.0 {
+                // err_norm NaN fails this test, so a non-finite state is rejected and shrinks h.
+                let mut factor = if err_norm == 0.0 {
+                    MAX_FACTOR
+                } else {
+                    MAX_FACTOR.min(SAFETY * err_norm.powf(ERROR_EXPONENT))
+                };
+                if rejected {
+                    factor = factor.min(1.0);
+                }
+                stats.n_steps += 1;
+                let dense =
+                    DenseStep::from_dopri5(t, t_new, y0, y_new, [&k1, &k3, &k4, &k5, &k6, &k7]);
+                *y = y_new;
+                t = t_new;
+                stats.t_end = t;
+                k1 = k7;
+                h_abs = (h * factor).min(tol.max_step);
+                if observer.on_step(&dense).is_break() {
+                    return Ok(ControlFlow::Break(()));
+                }
+                break;
+            }
+            stats.n_rejected += 1;
+            let shrink = if err_norm.is_finite() {
+                MIN_FACTOR.max(SAFETY * err_norm.powf(ERROR_EXPONENT))
+            } else {
+                MIN_FACTOR
+            };
+            h_abs = h * shrink;
+            rejected = true;
+            if h_abs < min_step {
+                return Err(Error::Integration {
+                    t,
+                    reason: format!(
+                        "step size {h_abs:e} s fell below the smallest resolvable step \
+                         (state {:?}); the solution is not finite or the problem is too stiff",
+                        y0.as_slice()
+                    ),
+                });
+            }
+        }
+    }
+    Ok(ControlFlow::Continue(()))
+}
+
+impl<const N: usize> DenseStep<N> {
+    /// Hairer's continuous extension of one Dormand–Prince step (k = k1, k3, k4, k5, k6, k7).
+    fn from_dopri5(
+        t0: f64,
+        t1: f64,
+        y0: SVector<f64, N>,
+        y1: SVector<f64, N>,
+        k: [&SVector<f64, N>; 6],
+    ) -> Self {
+        let h = t1 - t0;
+        let [k1, k3, k4, k5, k6, k7] = k;
+        let diff = y1 - y0;
+        let bspl = k1 * h - diff;
+        let r4 = diff - k7 * h - bspl;
+        let r5 = (k1 * D[0] + k3 * D[2] + k4 * D[3] + k5 * D[4] + k6 * D[5] + k7 * D[6]) * h;
+        DenseStep::from_parts(t0, t1, y0, y1, [y0, diff, bspl, r4, r5])
+    }
+}
+
+/// The next representable f64 above x (x finite).
+fn next_up(x: f64) -> f64 {
+    if x == 0.0 {
+        return f64::from_bits(1);
+    }
+    let bits = x.to_bits();
+    if x > 0.0 {
+        f64::from_bits(bits + 1)
+    } else {
+        f64::from_bits(bits - 1)
+    }
+}

@@ -1,0 +1,97 @@
+//! Observers that keep what the caller asked for.
+
+use super::{DenseStep, Observer};
+use nalgebra::SVector;
+use std::ops::ControlFlow;
+
+/// Keeps the state at requested times (sorted), interpolated with the step's dense output.
+#[derive(Debug, Clone)]
+pub struct Sampler<const N: usize> {
+    times: Vec<f64>,
+    next: usize,
+    pub t: Vec<f64>,
+    pub y: Vec<SVector<f64, N>>,
+}
+
+impl<const N: usize> Sampler<N> {
+    /// `times` must be sorted; times outside the integrated span are never reached.
+    pub fn new(times: Vec<f64>) -> Self {
+        let n = times.len();
+        Sampler {
+            times,
+            next: 0,
+            t: Vec::with_capacity(n),
+            y: Vec::with_capacity(n),
+        }
+    }
+
+    /// Samples every `dt` from t0 to t1, both included (the last interval may be shorter).
+    pub fn every(t0: f64, t1: f64, dt: f64) -> Self {
+        let n = ((t1 - t0) / dt).floor() as usize;
+        let mut times: Vec<f64> = (0..=n).map(|i| t0 + i as f64 * dt).collect();
+        if let Some(&last) = times.last() {
+            if t1 - last > 1e-9 * dt {
+                times.push(t1);
+            }
+        }
+        Self::new(times)
+    }
+
+    /// The requested times.
+    pub fn into_times(self) -> Vec<f64> {
+        self.times
+    }
+
+    /// Skips requested times before `t` (used when the first step starts later than them).
+    fn skip_before(&mut self, t: f64) {
+        while self.next < self.times.len() && self.times[self.next] < t {
+            self.next += 1;
+        }
+    }
+}
+
+impl<const N: usize> Observer<N> for Sampler<N> {
+    fn on_step(&mut self, step: &DenseStep<N>) -> ControlFlow<()> {
+        self.skip_before(step.t0);
+        while self.next < self.times.len() && self.times[self.next] <= step.t1 {
+            let t = self.times[self.next];
+            self.t.push(t);
+            self.y
+                .push(if t == step.t0 { step.y0 } else { step.eval(t) });
+            self.next += 1;
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+/// Keeps nothing; only lets the integration run (for benchmarks and final-state queries).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StepCounter {
+    pub steps: u64,
+}
+
+impl<const N: usize> Observer<N> for StepCounter {
+    fn on_step(&mut self, _step: &DenseStep<N>) -> ControlFlow<()> {
+        self.steps += 1;
+        ControlFlow::Continue(())
+    }
+}
+
+/// Keeps every step end (t1, y1), plus the very first point: for tests and short diagnostics.
+#[derive(Debug, Clone, Default)]
+pub struct EveryStep<const N: usize> {
+    pub t: Vec<f64>,
+    pub y: Vec<SVector<f64, N>>,
+}
+
+impl<const N: usize> Observer<N> for EveryStep<N> {
+    fn on_step(&mut self, step: &DenseStep<N>) -> ControlFlow<()> {
+        if self.t.is_empty() {
+            self.t.push(step.t0);
+            self.y.push(step.y0);
+        }
+        self.t.push(step.t1);
+        self.y.push(step.y1);
+        ControlFlow::Continue(())
+    }
+}

@@ -1,0 +1,301 @@
+//! Integrator tests on problems with exact solutions.
+
+use super::dopri5::{A21, A3, A4, A5, A6, B, B_HAT, C};
+use super::output::EveryStep;
+use super::*;
+use nalgebra::Vector2;
+
+/// Harmonic oscillator y'' = −y with a jump of the forcing at t = 1 (a breakpoint).
+struct Oscillator {
+    forcing_on_segment: f64,
+    jump_at: Option<f64>,
+}
+
+impl OdeSystem<2> for Oscillator {
+    fn rhs(&self, _t: f64, y: &Vector2<f64>) -> Vector2<f64> {
+        Vector2::new(y[1], -y[0] + self.forcing_on_segment)
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.jump_at
+            .into_iter()
+            .filter(|&t| t > t0 && t < t1)
+            .collect()
+    }
+    fn enter_segment(&mut self, a: f64, _b: f64) {
+        self.forcing_on_segment = match self.jump_at {
+            Some(tj) if a >= tj => 1.0,
+            _ => 0.0,
+        };
+    }
+}
+
+fn exact_free(t: f64) -> Vector2<f64> {
+    Vector2::new(t.cos(), -t.sin())
+}
+
+#[test]
+fn butcher_tableau_is_consistent() {
+    let rows: [&[f64]; 5] = [&[A21], &A3, &A4, &A5, &A6];
+    for (i, row) in rows.iter().enumerate() {
+        let s: f64 = row.iter().sum();
+        assert!((s - C[i + 1]).abs() < 1e-14, "row {}", i + 2);
+    }
+    let sb: f64 = B.iter().sum();
+    let sbh: f64 = B_HAT.iter().sum();
+    assert!((sb - 1.0).abs() < 1e-14 && (sbh - 1.0).abs() < 1e-14);
+    // Order conditions of the fifth-order weights up to the quadrature ones.
+    for q in 1..=5 {
+        let s: f64 = (0..7).map(|i| B[i] * C[i].powi(q - 1)).sum();
+        assert!((s - 1.0 / q as f64).abs() < 1e-14, "quadrature order {q}");
+    }
+    for q in 1..=4 {
+        let s: f64 = (0..7).map(|i| B_HAT[i] * C[i].powi(q - 1)).sum();
+        assert!(
+            (s - 1.0 / q as f64).abs() < 1e-14,
+            "embedded quadrature order {q}"
+        );
+    }
+}
+
+#[test]
+fn dopri5_meets_tolerance_on_oscillator() {
+    let mut sys = Oscillator {
+        forcing_on_segment: 0.0,
+        jump_at: None,
+    };
+    let tol = Tolerances {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..Default::default()
+    };
+    let mut obs = EveryStep::default();
+    let t1 = 20.0;
+    let (stats, y) = solve(
+        &mut sys,
+        &Method::Dopri5(tol),
+        0.0,
+        exact_free(0.0),
+        t1,
+        &mut obs,
+    )
+    .unwrap();
+    let err = (y - exact_free(t1)).amax();
+    assert!(err < 1e-8, "{err}");
+    assert_eq!(stats.n_steps as usize, obs.t.len() - 1);
+    assert_eq!(stats.n_rhs, 2 + 6 * (stats.n_steps + stats.n_rejected) + 0);
+    // Tighter tolerance -> more steps and smaller error.
+    let tol2 = Tolerances {
+        rtol: 1e-6,
+        atol: 1e-8,
+        ..Default::default()
+    };
+    let (s2, y2) = solve(
+        &mut sys,
+        &Method::Dopri5(tol2),
+        0.0,
+        exact_free(0.0),
+        t1,
+        &mut StepCounter::default(),
+    )
+    .unwrap();
+    assert!(s2.n_steps < stats.n_steps);
+    assert!((y2 - exact_free(t1)).amax() > err);
+}
+
+#[test]
+fn dense_output_is_fourth_order_accurate() {
+    let mut sys = Oscillator {
+        forcing_on_segment: 0.0,
+        jump_at: None,
+    };
+    let times: Vec<f64> = (0..=1000).map(|i| i as f64 * 0.0137).collect();
+    let mut max_err = Vec::new();
+    for rtol in [1e-6, 1e-8] {
+        let tol = Tolerances {
+            rtol,
+            atol: rtol * 1e-2,
+            ..Default::default()
+        };
+        let mut sampler = Sampler::new(times.clone());
+        solve(
+            &mut sys,
+            &Method::Dopri5(tol),
+            0.0,
+            exact_free(0.0),
+            times[1000],
+            &mut sampler,
+        )
+        .unwrap();
+        assert_eq!(sampler.t.len(), times.len());
+        let e = sampler
+            .t
+            .iter()
+            .zip(&sampler.y)
+            .map(|(t, y)| (y - exact_free(*t)).amax())
+            .fold(0.0, f64::max);
+        max_err.push(e);
+    }
+    // Interpolation error must follow the tolerance, not stay at a fixed interpolation floor.
+    assert!(max_err[0] < 5e-5, "{max_err:?}");
+    assert!(max_err[1] < max_err[0] / 20.0, "{max_err:?}");
+}
+
+#[test]
+fn rk4_converges_at_fourth_order() {
+    let mut sys = Oscillator {
+        forcing_on_segment: 0.0,
+        jump_at: None,
+    };
+    let err = |dt: f64, sys: &mut Oscillator| {
+        let (_, y) = solve(
+            sys,
+            &Method::Rk4 { dt },
+            0.0,
+            exact_free(0.0),
+            10.0,
+            &mut StepCounter::default(),
+        )
+        .unwrap();
+        (y - exact_free(10.0)).amax()
+    };
+    let e1 = err(0.1, &mut sys);
+    let e2 = err(0.05, &mut sys);
+    let ratio = e1 / e2;
+    assert!(ratio > 14.0 && ratio < 18.0, "ratio {ratio}");
+}
+
+#[test]
+fn steps_stop_exactly_at_breakpoints() {
+    // After the jump at t = 1 the oscillator is centred at 1: y = 1 + A cos(t − 1) + B sin(t − 1).
+    for method in [
+        Method::Dopri5(Tolerances {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..Default::default()
+        }),
+        Method::Rk4 { dt: 0.003 },
+    ] {
+        let mut sys = Oscillator {
+            forcing_on_segment: 0.0,
+            jump_at: Some(1.0),
+        };
+        let mut obs = EveryStep::default();
+        let (_, y) = solve(&mut sys, &method, 0.0, exact_free(0.0), 5.0, &mut obs).unwrap();
+        assert!(
+            obs.t.contains(&1.0),
+            "{method:?} did not stop at the breakpoint"
+        );
+        let y1 = exact_free(1.0);
+        let (a, b) = (y1[0] - 1.0, y1[1]);
+        let tt: f64 = 4.0;
+        let exact = Vector2::new(
+            1.0 + a * tt.cos() + b * tt.sin(),
+            -a * tt.sin() + b * tt.cos(),
+        );
+        assert!(
+            (y - exact).amax() < 1e-8,
+            "{method:?}: {}",
+            (y - exact).amax()
+        );
+    }
+}
+
+#[test]
+fn bad_settings_are_refused_with_their_name() {
+    let mut sys = Oscillator {
+        forcing_on_segment: 0.0,
+        jump_at: None,
+    };
+    let y0 = exact_free(0.0);
+    let cases: Vec<(Method, f64, f64, &str)> = vec![
+        (Method::Rk4 { dt: 0.0 }, 0.0, 1.0, "dt"),
+        (Method::Rk4 { dt: f64::NAN }, 0.0, 1.0, "dt"),
+        (
+            Method::Dopri5(Tolerances {
+                rtol: -1.0,
+                ..Default::default()
+            }),
+            0.0,
+            1.0,
+            "rtol",
+        ),
+        (
+            Method::Dopri5(Tolerances {
+                atol: 0.0,
+                ..Default::default()
+            }),
+            0.0,
+            1.0,
+            "atol",
+        ),
+        (Method::Rk4 { dt: 0.1 }, 1.0, 0.0, "t_span"),
+        (Method::Rk4 { dt: 0.1 }, 0.0, f64::INFINITY, "t_span[1]"),
+    ];
+    for (m, t0, t1, name) in cases {
+        let e = solve(&mut sys, &m, t0, y0, t1, &mut StepCounter::default()).unwrap_err();
+        assert!(e.to_string().starts_with(name), "{e}");
+    }
+    let e = solve(
+        &mut sys,
+        &Method::Rk4 { dt: 0.1 },
+        0.0,
+        Vector2::new(f64::NAN, 0.0),
+        1.0,
+        &mut StepCounter::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().starts_with("y0"));
+}
+
+#[test]
+fn step_guard_stops_runaway_integrations() {
+    let mut sys = Oscillator {
+        forcing_on_segment: 0.0,
+        jump_at: None,
+    };
+    let tol = Tolerances {
+        max_steps: 10,
+        ..Default::default()
+    };
+    let e = solve(
+        &mut sys,
+        &Method::Dopri5(tol),
+        0.0,
+        exact_free(0.0),
+        100.0,
+        &mut StepCounter::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, crate::Error::Integration { .. }), "{e}");
+}
+
+/// y' = y², blowing up at t = 1: the integrator must report an error, not return inf or NaN.
+struct BlowUp;
+impl OdeSystem<1> for BlowUp {
+    fn rhs(&self, _t: f64, y: &nalgebra::Vector1<f64>) -> nalgebra::Vector1<f64> {
+        nalgebra::Vector1::new(y[0] * y[0])
+    }
+}
+
+#[test]
+fn blow_up_is_an_error() {
+    let y0 = nalgebra::Vector1::new(1.0);
+    let r = solve(
+        &mut BlowUp,
+        &Method::Dopri5(Tolerances::default()),
+        0.0,
+        y0,
+        2.0,
+        &mut StepCounter::default(),
+    );
+    assert!(r.is_err());
+    let r = solve(
+        &mut BlowUp,
+        &Method::Rk4 { dt: 0.01 },
+        0.0,
+        y0,
+        2.0,
+        &mut StepCounter::default(),
+    );
+    assert!(r.is_err());
+}

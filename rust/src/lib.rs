@@ -1,0 +1,26 @@
+//! thermojitter: thermally induced vibration ("thermal jitter") and thermal flutter of long, thin
+//! spacecraft appendages. A two-layer thermal model of a Sun-pointing plate in orbit, two-way
+//! coupled to a one-degree-of-freedom hinge model of its first bending mode (Parisse & Angeletti
+//! 2024), integrated through eclipses.
+//!
+//! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
+
+pub mod dynamics;
+pub mod error;
+pub mod integrate;
+pub mod orbit;
+pub mod params;
+pub mod simulate;
+pub mod steady;
+pub mod system;
+pub mod thermal;
+
+#[cfg(feature = "python")]
+mod py;
+
+pub use error::{Error, Result};
+pub use orbit::Orbit;
+pub use params::Panel;
+
+/// Stefan–Boltzmann constant, W/(m² K⁴) (CODATA 2018, exact).
+pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;

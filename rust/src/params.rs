@@ -1,0 +1,304 @@
+//! The panel: every parameter of the paper's Table 1, plus the solar constant and the χ scaling of
+//! the thermal moment. Validation returns errors; nothing here panics.
+
+use crate::error::{require_non_negative, require_positive, Error, Result};
+
+/// A long, thin, Sun-pointing plate of unit width (all quantities SI).
+///
+/// The thermal equations are per unit area; the hinge model uses `mass_per_length`,
+/// `bending_inertia` and `hinge_stiffness` of the whole panel, as in the paper (width 1 m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Panel {
+    /// ε_f, emissivity of the Sun-facing side, in (0, 1].
+    pub emissivity_front: f64,
+    /// ε_b, emissivity of the back side, in (0, 1].
+    pub emissivity_back: f64,
+    /// α, solar absorptivity of the front side, in (0, 1].
+    pub absorptivity: f64,
+    /// c, specific heat, J/(kg K).
+    pub specific_heat: f64,
+    /// m, mass per unit length (unit width, so also per unit area), kg/m.
+    pub mass_per_length: f64,
+    /// a, coefficient of thermal expansion, 1/K.
+    pub expansion_coeff: f64,
+    /// L, panel length, m (hinge half-arm l = L/4).
+    pub length: f64,
+    /// E, Young's modulus, Pa.
+    pub youngs_modulus: f64,
+    /// d, thickness, m.
+    pub thickness: f64,
+    /// w, width, m.
+    pub width: f64,
+    /// K, conductance through the thickness per unit area, W/(m² K).
+    pub conductance: f64,
+    /// K_el, rotational stiffness of the hinge, N m/rad.
+    pub hinge_stiffness: f64,
+    /// I, second moment of area of the cross-section, m⁴.
+    pub bending_inertia: f64,
+    /// c_d, rotational damping of the hinge, N m s/rad (>= 0).
+    pub damping: f64,
+    /// C, solar flux at 1 au, W/m².
+    pub solar_constant: f64,
+    /// χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3); 1 by default.
+    pub moment_scale: f64,
+}
+
+impl Panel {
+    /// The paper's Table 1 panel (Case B: ε_f = 0.8 > ε_b = 0.3), C = 1361 W/m².
+    pub fn paper() -> Self {
+        Panel {
+            emissivity_front: 0.8,
+            emissivity_back: 0.3,
+            absorptivity: 0.8,
+            specific_heat: 900.0,
+            mass_per_length: 5.51,
+            expansion_coeff: 2.5e-5,
+            length: 50.0,
+            youngs_modulus: 70e9,
+            thickness: 0.04,
+            width: 1.0,
+            conductance: 25.0,
+            hinge_stiffness: 4438.0,
+            bending_inertia: 8e-7,
+            damping: 3.0,
+            solar_constant: 1361.0,
+            moment_scale: 1.0,
+        }
+    }
+
+    /// The field names, in declaration order (the Python layer and scenario files use them).
+    pub const FIELDS: [&'static str; 16] = [
+        "emissivity_front",
+        "emissivity_back",
+        "absorptivity",
+        "specific_heat",
+        "mass_per_length",
+        "expansion_coeff",
+        "length",
+        "youngs_modulus",
+        "thickness",
+        "width",
+        "conductance",
+        "hinge_stiffness",
+        "bending_inertia",
+        "damping",
+        "solar_constant",
+        "moment_scale",
+    ];
+
+    /// Sets a field by name (used by bindings and parameter sweeps).
+    pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
+        match name {
+            "emissivity_front" => self.emissivity_front = value,
+            "emissivity_back" => self.emissivity_back = value,
+            "absorptivity" => self.absorptivity = value,
+            "specific_heat" => self.specific_heat = value,
+            "mass_per_length" => self.mass_per_length = value,
+            "expansion_coeff" => self.expansion_coeff = value,
+            "length" => self.length = value,
+            "youngs_modulus" => self.youngs_modulus = value,
+            "thickness" => self.thickness = value,
+            "width" => self.width = value,
+            "conductance" => self.conductance = value,
+            "hinge_stiffness" => self.hinge_stiffness = value,
+            "bending_inertia" => self.bending_inertia = value,
+            "damping" => self.damping = value,
+            "solar_constant" => self.solar_constant = value,
+            "moment_scale" => self.moment_scale = value,
+            _ => {
+                return Err(Error::invalid(
+                    "parameter",
+                    name,
+                    "is not a panel parameter",
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads a field by name.
+    pub fn get(&self, name: &str) -> Result<f64> {
+        Ok(match name {
+            "emissivity_front" => self.emissivity_front,
+            "emissivity_back" => self.emissivity_back,
+            "absorptivity" => self.absorptivity,
+            "specific_heat" => self.specific_heat,
+            "mass_per_length" => self.mass_per_length,
+            "expansion_coeff" => self.expansion_coeff,
+            "length" => self.length,
+            "youngs_modulus" => self.youngs_modulus,
+            "thickness" => self.thickness,
+            "width" => self.width,
+            "conductance" => self.conductance,
+            "hinge_stiffness" => self.hinge_stiffness,
+            "bending_inertia" => self.bending_inertia,
+            "damping" => self.damping,
+            "solar_constant" => self.solar_constant,
+            "moment_scale" => self.moment_scale,
+            _ => {
+                return Err(Error::invalid(
+                    "parameter",
+                    name,
+                    "is not a panel parameter",
+                ))
+            }
+        })
+    }
+
+    /// Checks every parameter; the first offending one is named in the error.
+    pub fn validate(&self) -> Result<()> {
+        for name in ["emissivity_front", "emissivity_back", "absorptivity"] {
+            let v = self.get(name)?;
+            if !(v.is_finite() && v > 0.0 && v <= 1.0) {
+                return Err(Error::invalid(name, v, "must be in (0, 1]"));
+            }
+        }
+        for name in Self::FIELDS {
+            if matches!(
+                name,
+                "emissivity_front" | "emissivity_back" | "absorptivity"
+            ) {
+                continue;
+            }
+            let v = self.get(name)?;
+            if name == "damping" {
+                require_non_negative(name, v)?;
+            } else {
+                require_positive(name, v)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// l = L/4, half the length of one rigid half of the hinge model, m.
+    pub fn half_arm(&self) -> f64 {
+        self.length / 4.0
+    }
+
+    /// I_B = 2 m l³ / 3, inertia of the hinge model about its hinge, kg m².
+    pub fn hinge_inertia(&self) -> f64 {
+        let l = self.half_arm();
+        2.0 * self.mass_per_length * l * l * l / 3.0
+    }
+
+    /// Thermal moment per kelvin of gradient, χ a E I / d, N m/K.
+    pub fn moment_per_kelvin(&self) -> f64 {
+        self.moment_scale * self.expansion_coeff * self.youngs_modulus * self.bending_inertia
+            / self.thickness
+    }
+
+    /// Heat capacity per unit area, m c, J/(m² K).
+    pub fn heat_capacity(&self) -> f64 {
+        self.mass_per_length * self.specific_heat
+    }
+
+    /// Natural angular frequency of the linearised hinge, sqrt(K_el / I_B), rad/s.
+    pub fn natural_angular_frequency(&self) -> f64 {
+        (self.hinge_stiffness / self.hinge_inertia()).sqrt()
+    }
+}
+
+/// How K_el is chosen (paper Sec. 4 and 4.3; MODEL.md "Choosing K_el").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StiffnessCriterion {
+    /// Equal mid-span deflection under the steady thermal moment: K_el = M_T / asin(M_T L/(4EI)).
+    Deflection,
+    /// Small-angle limit of the deflection criterion: K_el = 4 E I / L.
+    DeflectionSmallAngle,
+    /// Equal first free–free bending frequency: K_el = (β₁L)⁴ E I I_B / (m L⁴) ≈ 5.21 E I / L.
+    Frequency,
+}
+
+/// β₁L of the first free–free bending mode of a uniform beam (root of cos x cosh x = 1).
+pub const BETA1_L: f64 = 4.730_040_744_862_704;
+
+/// First free–free bending angular frequency of the continuous panel, rad/s.
+pub fn beam_first_angular_frequency(panel: &Panel) -> f64 {
+    let ei = panel.youngs_modulus * panel.bending_inertia;
+    let l4 = panel.length.powi(4);
+    BETA1_L * BETA1_L * (ei / (panel.mass_per_length * l4)).sqrt()
+}
+
+/// K_el by `criterion`. The deflection criterion needs the thermal moment it is matched at
+/// (`moment`, N m); use the steady sunlit moment for the paper's choice.
+pub fn hinge_stiffness(panel: &Panel, criterion: StiffnessCriterion, moment: f64) -> Result<f64> {
+    panel.validate()?;
+    let ei = panel.youngs_modulus * panel.bending_inertia;
+    match criterion {
+        StiffnessCriterion::DeflectionSmallAngle => Ok(4.0 * ei / panel.length),
+        StiffnessCriterion::Frequency => {
+            let w1 = beam_first_angular_frequency(panel);
+            Ok(w1 * w1 * panel.hinge_inertia())
+        }
+        StiffnessCriterion::Deflection => {
+            let x = moment.abs() * panel.length / (4.0 * ei);
+            if !moment.is_finite() || x >= 1.0 {
+                return Err(Error::invalid(
+                    "moment",
+                    moment,
+                    "is too large for the deflection criterion (M_T L / 4EI must be < 1)",
+                ));
+            }
+            if x < 1e-12 {
+                Ok(4.0 * ei / panel.length)
+            } else {
+                Ok(moment.abs() / x.asin())
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_panel_is_valid() {
+        Panel::paper().validate().unwrap();
+    }
+
+    #[test]
+    fn every_field_round_trips_and_is_checked() {
+        for name in Panel::FIELDS {
+            let mut p = Panel::paper();
+            p.set(name, 0.5).unwrap();
+            assert_eq!(p.get(name).unwrap(), 0.5);
+            for bad in [f64::NAN, f64::INFINITY, -1.0] {
+                let mut p = Panel::paper();
+                p.set(name, bad).unwrap();
+                let err = p.validate().unwrap_err();
+                assert!(err.to_string().starts_with(name), "{err}");
+            }
+        }
+        let mut p = Panel::paper();
+        p.set("emissivity_back", 1.5).unwrap();
+        assert!(p.validate().is_err());
+        let mut p = Panel::paper();
+        p.set("damping", 0.0).unwrap();
+        assert!(p.validate().is_ok());
+        assert!(Panel::paper().set("colour", 1.0).is_err());
+    }
+
+    #[test]
+    fn stiffness_criteria_match_model_sheet() {
+        let p = Panel::paper();
+        let ei = 70e9 * 8e-7;
+        let small = hinge_stiffness(&p, StiffnessCriterion::DeflectionSmallAngle, 0.0).unwrap();
+        assert!((small - 4.0 * ei / 50.0).abs() < 1e-9);
+        let freq = hinge_stiffness(&p, StiffnessCriterion::Frequency, 0.0).unwrap();
+        assert!(
+            (freq / (ei / 50.0) - 5.21).abs() < 0.01,
+            "{}",
+            freq / (ei / 50.0)
+        );
+        // The exact deflection criterion softens the spring as the moment grows.
+        let exact = hinge_stiffness(&p, StiffnessCriterion::Deflection, 400.0).unwrap();
+        assert!(exact < small && exact > 0.99 * small);
+    }
+
+    #[test]
+    fn beam_frequency_is_the_papers() {
+        let f = beam_first_angular_frequency(&Panel::paper()) / (2.0 * std::f64::consts::PI);
+        assert!((f - 0.144).abs() < 0.0005, "{f}");
+    }
+}
