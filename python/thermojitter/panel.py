@@ -1,0 +1,130 @@
+"""The panel (paper Table 1) and the hinge parameters derived from it."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, fields
+from typing import Any, Literal
+
+from thermojitter import _core
+
+StiffnessCriterion = Literal["deflection", "deflection_small_angle", "frequency"]
+
+
+@dataclass(frozen=True)
+class Panel:
+    """A long, thin, Sun-pointing plate of unit width; every value SI.
+
+    Immutable and validated on construction: a bad value raises ``ValueError`` naming it.
+    Defaults are the paper's Table 1 (Case B), with C = 1361 W/m² and χ = 1.
+    """
+
+    emissivity_front: float = 0.8
+    """ε_f, emissivity of the Sun-facing side, in (0, 1]."""
+    emissivity_back: float = 0.3
+    """ε_b, emissivity of the back side, in (0, 1]."""
+    absorptivity: float = 0.8
+    """α, solar absorptivity of the front side, in (0, 1]."""
+    specific_heat: float = 900.0
+    """c, J/(kg K)."""
+    mass_per_length: float = 5.51
+    """m, kg/m (unit width, so also kg/m²)."""
+    expansion_coeff: float = 2.5e-5
+    """a, coefficient of thermal expansion, 1/K."""
+    length: float = 50.0
+    """L, m; the hinge model's half-arm is l = L/4."""
+    youngs_modulus: float = 70e9
+    """E, Pa."""
+    thickness: float = 0.04
+    """d, m."""
+    width: float = 1.0
+    """w, m."""
+    conductance: float = 25.0
+    """K, conductance through the thickness per unit area, W/(m² K)."""
+    hinge_stiffness: float = 4438.0
+    """K_el, N m/rad."""
+    bending_inertia: float = 8e-7
+    """I, second moment of area, m⁴."""
+    damping: float = 3.0
+    """c_d, N m s/rad (>= 0)."""
+    solar_constant: float = 1361.0
+    """C, solar flux at 1 au, W/m²."""
+    moment_scale: float = 1.0
+    """χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3)."""
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise TypeError(f"{f.name} must be a real number, not {type(value).__name__}")
+            object.__setattr__(self, f.name, float(value))
+        _core.validate_panel(self.as_dict())
+
+    @classmethod
+    def paper(cls) -> Panel:
+        """The paper's Table 1 panel (Case B: ε_f = 0.8, ε_b = 0.3)."""
+        return cls()
+
+    @classmethod
+    def case_a(cls) -> Panel:
+        """The paper's Case A: Table 1 with the emissivities swapped (ε_f = 0.3, ε_b = 0.8)."""
+        return cls(emissivity_front=0.3, emissivity_back=0.8)
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any]) -> Panel:
+        """A panel from a mapping of parameter names (missing ones take Table 1 values)."""
+        unknown = sorted(set(values) - set(cls.field_names()))
+        if unknown:
+            raise ValueError(f"unknown panel parameter(s): {', '.join(unknown)}")
+        return cls(**values)
+
+    @staticmethod
+    def field_names() -> tuple[str, ...]:
+        return tuple(f.name for f in fields(Panel))
+
+    def replace(self, **changes: float) -> Panel:
+        """A validated copy with some parameters changed."""
+        unknown = sorted(set(changes) - set(self.field_names()))
+        if unknown:
+            raise ValueError(f"unknown panel parameter(s): {', '.join(unknown)}")
+        return dataclasses.replace(self, **changes)
+
+    def as_dict(self) -> dict[str, float]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @property
+    def half_arm(self) -> float:
+        """l = L/4, m."""
+        return self.length / 4.0
+
+    @property
+    def hinge_inertia(self) -> float:
+        """I_B = 2 m l³/3, kg m²."""
+        return float(_core.derived(self.as_dict())["hinge_inertia"])
+
+
+def natural_frequency(panel: Panel) -> float:
+    """Natural frequency of the linearised hinge, sqrt(K_el/I_B)/2π, Hz."""
+    return float(_core.derived(panel.as_dict())["natural_frequency_hz"])
+
+
+def beam_frequency(panel: Panel) -> float:
+    """First free–free bending frequency of the continuous panel, (β₁L)² sqrt(EI/(mL⁴))/2π, Hz."""
+    return float(_core.derived(panel.as_dict())["beam_frequency_hz"])
+
+
+def hinge_stiffness(panel: Panel, criterion: StiffnessCriterion = "deflection") -> float:
+    """K_el (N m/rad) by one of the paper's criteria.
+
+    - ``"deflection"``: equal mid-span deflection under the panel's steady sunlit thermal moment,
+      K_el = M_T / asin(M_T L / 4EI).
+    - ``"deflection_small_angle"``: its small-angle limit, 4EI/L.
+    - ``"frequency"``: equal first free–free frequency, (β₁L)⁴ EI I_B/(m L⁴) ≈ 5.21 EI/L.
+    """
+    moment = 0.0
+    if criterion == "deflection":
+        from thermojitter.simulate import steady_state
+
+        moment = steady_state(panel).thermal_moment
+    return float(_core.stiffness(panel.as_dict(), criterion, moment))
+

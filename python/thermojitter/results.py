@@ -1,0 +1,141 @@
+"""Result objects: NumPy arrays in small frozen containers, with table exports."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """The sunlit steady state: temperatures (K), hinge angle (rad) and thermal moment (N m)."""
+
+    T_front: float
+    T_back: float
+    theta: float
+    thermal_moment: float
+
+    @property
+    def delta_T(self) -> float:
+        """T_front − T_back, K."""
+        return self.T_front - self.T_back
+
+    @property
+    def theta_deg(self) -> float:
+        return math.degrees(self.theta)
+
+
+@dataclass(frozen=True)
+class _Run:
+    """Counters common to every run (names as in scipy's solve_ivp where they exist)."""
+
+    t: Array
+    n_steps: int
+    n_rejected: int
+    n_rhs: int
+    method: str
+    settings: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def nfev(self) -> int:
+        """Right-hand-side evaluations (alias of n_rhs)."""
+        return self.n_rhs
+
+    def _columns(self) -> dict[str, Array]:
+        raise NotImplementedError
+
+    def to_pandas(self) -> Any:
+        """A pandas DataFrame indexed by time (s); needs pandas."""
+        try:
+            import pandas as pd
+        except ImportError as exc:  # pragma: no cover - depends on the environment
+            raise ImportError("to_pandas() needs pandas: pip install 'thermojitter[dataframes]'") from exc
+        frame = pd.DataFrame(self._columns(), index=pd.Index(self.t, name="t"))
+        return frame
+
+    def to_xarray(self) -> Any:
+        """An xarray Dataset over the time coordinate t (s); needs xarray."""
+        try:
+            import xarray as xr
+        except ImportError as exc:  # pragma: no cover
+            raise ImportError("to_xarray() needs xarray: pip install 'thermojitter[dataframes]'") from exc
+        return xr.Dataset(
+            {name: ("t", values) for name, values in self._columns().items()},
+            coords={"t": self.t},
+            attrs={"method": self.method, **{k: str(v) for k, v in self.settings.items()}},
+        )
+
+
+@dataclass(frozen=True)
+class Solution(_Run):
+    """The coupled thermo-structural solution at the reported times.
+
+    Temperatures in K, angles in rad, θ̇ in rad/s, the thermal moment in N m, ``sunlit`` the
+    illuminated fraction s(t).
+    """
+
+    T_front: Array = field(default_factory=lambda: np.empty(0))
+    T_back: Array = field(default_factory=lambda: np.empty(0))
+    theta: Array = field(default_factory=lambda: np.empty(0))
+    theta_dot: Array = field(default_factory=lambda: np.empty(0))
+    thermal_moment: Array = field(default_factory=lambda: np.empty(0))
+    sunlit: Array = field(default_factory=lambda: np.empty(0))
+    y_end: Array = field(default_factory=lambda: np.empty(0))
+
+    @property
+    def y(self) -> Array:
+        """The state (T_front, T_back, theta, theta_dot) as a (4, n) array."""
+        return np.vstack([self.T_front, self.T_back, self.theta, self.theta_dot])
+
+    @property
+    def delta_T(self) -> Array:
+        return self.T_front - self.T_back
+
+    def _columns(self) -> dict[str, Array]:
+        return {
+            "T_front": self.T_front,
+            "T_back": self.T_back,
+            "theta": self.theta,
+            "theta_dot": self.theta_dot,
+            "thermal_moment": self.thermal_moment,
+            "sunlit": self.sunlit,
+        }
+
+
+@dataclass(frozen=True)
+class ThermalSolution(_Run):
+    """A thermal model alone: ``T`` for one node, ``T_front``/``T_back`` for two layers (K)."""
+
+    layers: int = 2
+    T: Array | None = None
+    T_front: Array | None = None
+    T_back: Array | None = None
+
+    @property
+    def delta_T(self) -> Array:
+        if self.T_front is None or self.T_back is None:
+            raise AttributeError("delta_T needs the two-layer model (layers=2)")
+        return self.T_front - self.T_back
+
+    def _columns(self) -> dict[str, Array]:
+        if self.T is not None:
+            return {"T": self.T}
+        assert self.T_front is not None and self.T_back is not None
+        return {"T_front": self.T_front, "T_back": self.T_back}
+
+
+@dataclass(frozen=True)
+class HingeSolution(_Run):
+    """The hinge alone under a prescribed moment: θ (rad) and θ̇ (rad/s)."""
+
+    theta: Array = field(default_factory=lambda: np.empty(0))
+    theta_dot: Array = field(default_factory=lambda: np.empty(0))
+
+    def _columns(self) -> dict[str, Array]:
+        return {"theta": self.theta, "theta_dot": self.theta_dot}

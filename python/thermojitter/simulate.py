@@ -1,0 +1,209 @@
+"""Running the models: the coupled system, the thermal models alone, the hinge alone."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from thermojitter import _core
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
+
+Model = Literal["nonlinear", "linear"]
+Method = Literal["rk45", "rk4"]
+
+DEFAULT_DT_OUT = 0.5
+"""Default reporting interval, s: 16 samples per period of the paper panel's ~8 s jitter."""
+
+
+def _check_type(name: str, value: Any, kind: type | tuple[type, ...]) -> None:
+    if isinstance(value, bool) and kind is not bool or not isinstance(value, kind):
+        raise TypeError(f"{name} must be {getattr(kind, '__name__', kind)}, not {type(value).__name__}")
+
+
+def _span(t_span: Sequence[float]) -> tuple[float, float]:
+    try:
+        t0, t1 = (float(v) for v in t_span)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"t_span = {t_span!r} is invalid: must be two numbers (t0, t1) in s") from exc
+    return t0, t1
+
+
+def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
+    if t_eval is None:
+        return None
+    arr = np.ascontiguousarray(np.asarray(t_eval, dtype=float).ravel())
+    return arr
+
+
+def _solver_args(
+    method: str, rtol: float, atol: float, dt: float | None, max_step: float, max_steps: int,
+    t_eval: ArrayLike | None, dt_out: float | None,
+) -> dict[str, Any]:
+    _check_type("method", method, str)
+    if t_eval is None and dt_out is None:
+        dt_out = DEFAULT_DT_OUT
+    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
+        raise ValueError(f"max_steps = {max_steps!r} is invalid: must be an integer >= 1")
+    return {
+        "method_name": method,
+        "rtol": float(rtol),
+        "atol": float(atol),
+        "dt": None if dt is None else float(dt),
+        "max_step": float(max_step),
+        "max_steps": int(max_steps),
+        "t_eval": _times(t_eval),
+        "dt_out": None if dt_out is None else float(dt_out),
+    }
+
+
+def _check_inputs(panel: Panel, orbit: Orbit | None = None) -> None:
+    if not isinstance(panel, Panel):
+        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    if orbit is not None and not isinstance(orbit, Orbit):
+        raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
+
+
+def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:
+    """The sunlit equilibrium of the coupled system (θ̇ = 0, all rates zero).
+
+    ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
+    (1: nominal; e.g. 1.033 at perihelion).
+    """
+    _check_inputs(panel)
+    pd = panel.as_dict()
+    tf, tb, th = _core.steady_state(pd, bool(coupled), float(flux))
+    moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
+    return Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
+
+
+def simulate(
+    panel: Panel,
+    orbit: Orbit,
+    t_span: Sequence[float],
+    *,
+    model: Model = "nonlinear",
+    coupled: bool = True,
+    method: Method = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    t_eval: ArrayLike | None = None,
+    dt_out: float | None = None,
+    y0: Sequence[float] | None = None,
+    max_step: float = float("inf"),
+    max_steps: int = 500_000_000,
+) -> Solution:
+    """Integrates the coupled thermo-structural model over ``t_span`` (s).
+
+    - ``model``: ``"nonlinear"`` hinge (paper eq. 20) or ``"linear"`` (eq. 28).
+    - ``coupled``: absorbed flux ∝ cos θ (two-way coupling); ``False`` freezes the projected area
+      (paper Fig. 18).
+    - ``method``: ``"rk45"`` (Dormand–Prince 5(4), error control by ``rtol``/``atol``) or ``"rk4"``
+      (classical, fixed step ``dt`` in s).
+    - Reporting: at ``t_eval`` (sorted times inside the span, from the dense output), or every
+      ``dt_out`` s (default 0.5 s). Every step is never kept.
+    - ``y0``: (T_front K, T_back K, θ rad, θ̇ rad/s); default the sunlit equilibrium.
+
+    Steps stop exactly at every shadow entry and exit. Raises ``ValueError`` naming a bad input,
+    ``IntegrationError`` if the integrator cannot finish.
+    """
+    _check_inputs(panel, orbit)
+    t0, t1 = _span(t_span)
+    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    raw = _core.simulate(
+        panel.as_dict(), orbit.as_dict(), t0, t1, model=model, coupled=bool(coupled),
+        y0=None if y0 is None else [float(v) for v in y0], **args,
+    )
+    return Solution(
+        t=raw["t"], n_steps=raw["n_steps"], n_rejected=raw["n_rejected"], n_rhs=raw["n_rhs"],
+        method=method, settings={"rtol": rtol, "atol": atol, "dt": dt, "model": model,
+                                 "coupled": coupled},
+        T_front=raw["T_front"], T_back=raw["T_back"], theta=raw["theta"],
+        theta_dot=raw["theta_dot"], thermal_moment=raw["thermal_moment"], sunlit=raw["sunlit"],
+        y_end=raw["y_end"],
+    )
+
+
+def simulate_thermal(
+    panel: Panel,
+    orbit: Orbit,
+    t_span: Sequence[float],
+    *,
+    layers: Literal[1, 2] = 2,
+    method: Method = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    t_eval: ArrayLike | None = None,
+    dt_out: float | None = None,
+    y0: Sequence[float] | None = None,
+    max_step: float = float("inf"),
+    max_steps: int = 500_000_000,
+) -> ThermalSolution:
+    """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
+    (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
+    _check_inputs(panel, orbit)
+    if layers not in (1, 2) or isinstance(layers, bool):
+        raise ValueError(f"layers = {layers!r} is invalid: must be 1 or 2")
+    t0, t1 = _span(t_span)
+    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    raw = _core.simulate_thermal(
+        panel.as_dict(), orbit.as_dict(), t0, t1, layers=int(layers),
+        y0=None if y0 is None else [float(v) for v in y0], **args,
+    )
+    return ThermalSolution(
+        t=raw["t"], n_steps=raw["n_steps"], n_rejected=raw["n_rejected"], n_rhs=raw["n_rhs"],
+        method=method, layers=int(layers), T=raw.get("T"), T_front=raw.get("T_front"),
+        T_back=raw.get("T_back"),
+    )
+
+
+def simulate_hinge(
+    panel: Panel,
+    moment: float | ArrayLike,
+    t_span: Sequence[float],
+    *,
+    moment_t: ArrayLike | None = None,
+    model: Model = "nonlinear",
+    y0: Sequence[float] = (0.0, 0.0),
+    method: Method = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    t_eval: ArrayLike | None = None,
+    dt_out: float | None = None,
+    max_step: float = float("inf"),
+    max_steps: int = 500_000_000,
+) -> HingeSolution:
+    """The hinge alone under a prescribed thermal moment (N m): a constant, or samples
+    ``moment`` at times ``moment_t`` (linear in between, held beyond the ends).
+    ``y0`` = (θ rad, θ̇ rad/s)."""
+    _check_inputs(panel)
+    t0, t1 = _span(t_span)
+    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    m = np.ascontiguousarray(np.atleast_1d(np.asarray(moment, dtype=float)).ravel())
+    mt = None if moment_t is None else _times(moment_t)
+    raw = _core.simulate_hinge(
+        panel.as_dict(), t0, t1, model=model, moment=m, moment_t=mt,
+        y0=[float(v) for v in y0], **args,
+    )
+    return HingeSolution(
+        t=raw["t"], n_steps=raw["n_steps"], n_rejected=raw["n_rejected"], n_rhs=raw["n_rhs"],
+        method=method, theta=raw["theta"], theta_dot=raw["theta_dot"],
+    )
+
+
+def hinge_energy(
+    panel: Panel, theta: ArrayLike, theta_dot: ArrayLike, moment: float, *, model: Model = "nonlinear"
+) -> np.ndarray:
+    """Energy of the hinge in a constant moment field (kinetic + spring − M θ), J.
+    Conserved when c_d = 0."""
+    _check_inputs(panel)
+    th = np.ascontiguousarray(np.atleast_1d(np.asarray(theta, dtype=float)))
+    om = np.ascontiguousarray(np.atleast_1d(np.asarray(theta_dot, dtype=float)))
+    return np.asarray(_core.energy(panel.as_dict(), model, th, om, float(moment)))

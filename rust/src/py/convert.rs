@@ -1,0 +1,123 @@
+//! Python values to engine types, with errors that name the parameter.
+
+use super::to_py;
+use crate::dynamics::HingeModel;
+use crate::integrate::{Method, Tolerances};
+use crate::simulate::Output;
+use crate::{Orbit, Panel};
+use nalgebra::SVector;
+use numpy::PyReadonlyArray1;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A float entry of a mapping, named in any error.
+fn float_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<f64> {
+    let v = d
+        .get_item(key)?
+        .ok_or_else(|| PyValueError::new_err(format!("{key} is missing")))?;
+    v.extract::<f64>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{key} must be a number, not {}",
+            v.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })
+}
+
+pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
+    let mut p = Panel::paper();
+    for name in Panel::FIELDS {
+        p.set(name, float_item(d, name)?).map_err(to_py)?;
+    }
+    p.validate().map_err(to_py)?;
+    Ok(p)
+}
+
+pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
+    let o = Orbit {
+        radius: float_item(d, "radius")?,
+        earth_radius: float_item(d, "earth_radius")?,
+        period: float_item(d, "period")?,
+        phase0: float_item(d, "phase0")?,
+    };
+    o.validate().map_err(to_py)?;
+    Ok(o)
+}
+
+pub fn hinge_model(name: &str) -> PyResult<HingeModel> {
+    match name {
+        "nonlinear" => Ok(HingeModel::Nonlinear),
+        "linear" => Ok(HingeModel::Linear),
+        other => Err(PyValueError::new_err(format!(
+            "model = {other:?} is invalid: must be 'nonlinear' or 'linear'"
+        ))),
+    }
+}
+
+pub fn method(
+    name: &str,
+    rtol: f64,
+    atol: f64,
+    dt: Option<f64>,
+    max_step: f64,
+    max_steps: u64,
+) -> PyResult<Method> {
+    let m = match name {
+        "rk45" => Method::Dopri5(Tolerances {
+            rtol,
+            atol,
+            max_step,
+            max_steps,
+        }),
+        "rk4" => match dt {
+            Some(dt) => Method::Rk4 { dt },
+            None => {
+                return Err(PyValueError::new_err(
+                    "dt is required with method='rk4' (the fixed step, s)",
+                ))
+            }
+        },
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "method = {other:?} is invalid: must be 'rk45' or 'rk4'"
+            )))
+        }
+    };
+    m.validate().map_err(to_py)?;
+    Ok(m)
+}
+
+pub fn output(
+    t_eval: Option<PyReadonlyArray1<'_, f64>>,
+    dt_out: Option<f64>,
+    t0: f64,
+    t1: f64,
+) -> PyResult<Output> {
+    crate::integrate::check_span(t0, t1).map_err(to_py)?;
+    let out = match (t_eval, dt_out) {
+        (Some(_), Some(_)) => return Err(PyValueError::new_err("give t_eval or dt_out, not both")),
+        (Some(ts), None) => Output::Times(ts.as_array().to_vec()),
+        (None, Some(dt)) => Output::Every(dt),
+        (None, None) => return Err(PyValueError::new_err("t_eval or dt_out is required")),
+    };
+    out.sample_times(t0, t1).map_err(to_py)?;
+    Ok(out)
+}
+
+pub fn state<const N: usize>(v: &[f64]) -> PyResult<SVector<f64, N>> {
+    if v.len() != N {
+        return Err(PyValueError::new_err(format!(
+            "y0 has {} components; expected {N}",
+            v.len()
+        )));
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "y0 = {v:?} is invalid: component {x} is not finite"
+        )));
+    }
+    Ok(SVector::from_column_slice(v))
+}
