@@ -26,8 +26,16 @@ def panels(draw: st.DrawFn, spread: float = 0.3) -> tj.Panel:
     changes = {
         name: getattr(PAPER, name) * draw(factor)
         for name in (
-            "specific_heat", "mass_per_length", "expansion_coeff", "length", "youngs_modulus",
-            "thickness", "conductance", "hinge_stiffness", "bending_inertia", "damping",
+            "specific_heat",
+            "mass_per_length",
+            "expansion_coeff",
+            "length",
+            "youngs_modulus",
+            "thickness",
+            "conductance",
+            "hinge_stiffness",
+            "bending_inertia",
+            "damping",
             "solar_constant",
         )
     }

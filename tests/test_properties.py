@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 import pytest
-from conftest import ENTRY, EXIT, GEO, PAPER, panels
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import thermojitter as tj
+from conftest import ENTRY, EXIT, GEO, PAPER, panels
 
 
 def test_paper_numbers() -> None:
@@ -38,7 +38,9 @@ def test_one_orbit_reports_entry_and_exit_transients() -> None:
 
 
 def _theta_end_rk4(dt: float, span: tuple[float, float], y0: tuple[float, ...]) -> float:
-    return float(tj.simulate(PAPER, GEO, span, method="rk4", dt=dt, y0=y0, t_eval=[span[1]]).theta[-1])
+    return float(
+        tj.simulate(PAPER, GEO, span, method="rk4", dt=dt, y0=y0, t_eval=[span[1]]).theta[-1]
+    )
 
 
 def test_rk4_converges_at_fourth_order_through_shadow_entry() -> None:
@@ -64,8 +66,9 @@ def test_undamped_hinge_conserves_energy(
     panel: tj.Panel, moment: float, theta0: float, rate0: float, model: str
 ) -> None:
     p = panel.replace(damping=0.0)
-    sol = tj.simulate_hinge(p, moment, (0.0, 200.0), y0=(theta0, rate0), model=model,
-                            rtol=1e-11, atol=1e-13, dt_out=1.0)
+    sol = tj.simulate_hinge(
+        p, moment, (0.0, 200.0), y0=(theta0, rate0), model=model, rtol=1e-11, atol=1e-13, dt_out=1.0
+    )
     energy = tj.hinge_energy(p, sol.theta, sol.theta_dot, moment, model=model)
     scale = 0.5 * p.hinge_stiffness * max(np.max(np.abs(sol.theta)), 1e-3) ** 2
     assert np.max(np.abs(energy - energy[0])) < 1e-7 * scale
@@ -85,10 +88,21 @@ def test_sunlit_equilibrium_is_a_fixed_point(panel: tj.Panel, coupled: bool, mod
     y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
 
     def drift(rtol: float) -> tuple[float, float]:
-        sol = tj.simulate(panel, GEO, (0.0, 0.9 * ENTRY), model=model, coupled=coupled, y0=y0,
-                          dt_out=100.0, rtol=rtol, atol=rtol * 1e-2)
-        return (float(np.max(np.abs(sol.theta - eq.theta))),
-                float(np.max(np.abs(sol.T_front - eq.T_front))))
+        sol = tj.simulate(
+            panel,
+            GEO,
+            (0.0, 0.9 * ENTRY),
+            model=model,
+            coupled=coupled,
+            y0=y0,
+            dt_out=100.0,
+            rtol=rtol,
+            atol=rtol * 1e-2,
+        )
+        return (
+            float(np.max(np.abs(sol.theta - eq.theta))),
+            float(np.max(np.abs(sol.T_front - eq.T_front))),
+        )
 
     loose, tight = drift(1e-8), drift(1e-11)
     # At a true fixed point the only motion is integration error, which follows the tolerance.
@@ -149,8 +163,14 @@ def test_linear_and_nonlinear_agree_for_the_paper_panel() -> None:
 def test_exports() -> None:
     sol = tj.simulate(PAPER, GEO, (0.0, 100.0), dt_out=10.0)
     frame = sol.to_pandas()
-    assert list(frame.columns) == ["T_front", "T_back", "theta", "theta_dot", "thermal_moment",
-                                   "sunlit"]
+    assert list(frame.columns) == [
+        "T_front",
+        "T_back",
+        "theta",
+        "theta_dot",
+        "thermal_moment",
+        "sunlit",
+    ]
     assert len(frame) == 11 and frame.index.name == "t"
     ds = sol.to_xarray()
     assert ds["theta"].shape == (11,)

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import ENTRY, EXIT, GEO, PAPER, panels
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import thermojitter as tj
+from conftest import ENTRY, EXIT, GEO, PAPER, panels
 from thermojitter import reference as ref
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
@@ -50,8 +50,9 @@ def test_random_panels_and_spans_match_reference(
     y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
     t_eval = np.linspace(*span, 401)
     sol = tj.simulate(panel, GEO, span, model=model, coupled=coupled, y0=y0, t_eval=t_eval, **TIGHT)
-    want = ref.simulate(panel, GEO, span, model=model, coupled=coupled, y0=y0, t_eval=t_eval,
-                        **REF_TIGHT)
+    want = ref.simulate(
+        panel, GEO, span, model=model, coupled=coupled, y0=y0, t_eval=t_eval, **REF_TIGHT
+    )
     assert np.max(np.abs(sol.theta - want.theta)) < 1e-6
     assert np.max(np.abs(sol.T_front - want.T_front)) < 1e-6 * np.max(want.T_front)
     assert np.max(np.abs(sol.T_back - want.T_back)) < 1e-6 * np.max(want.T_back)
@@ -61,8 +62,9 @@ def test_random_panels_and_spans_match_reference(
 def test_thermal_models_match_reference(layers: int) -> None:
     t_eval = np.linspace(0.0, GEO.period, 2001)
     sol = tj.simulate_thermal(PAPER, GEO, (0.0, GEO.period), layers=layers, t_eval=t_eval, **TIGHT)
-    want = ref.simulate_thermal(PAPER, GEO, (0.0, GEO.period), layers=layers, t_eval=t_eval,
-                                **REF_TIGHT)
+    want = ref.simulate_thermal(
+        PAPER, GEO, (0.0, GEO.period), layers=layers, t_eval=t_eval, **REF_TIGHT
+    )
     got = sol.T if layers == 1 else sol.T_front
     assert got is not None
     assert np.max(np.abs(got - want.y[0])) < 1e-6

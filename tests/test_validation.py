@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 import pytest
-from conftest import GEO, PAPER
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import thermojitter as tj
+from conftest import GEO, PAPER
 
 BAD_POSITIVE = [math.nan, math.inf, -math.inf, 0.0, -1.0]
 

@@ -127,4 +127,3 @@ def hinge_stiffness(panel: Panel, criterion: StiffnessCriterion = "deflection") 
 
         moment = steady_state(panel).thermal_moment
     return float(_core.stiffness(panel.as_dict(), criterion, moment))
-

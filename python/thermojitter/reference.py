@@ -75,7 +75,7 @@ def thermal_moment(panel: Any, T_front: ArrayLike, T_back: ArrayLike) -> Any:
     return gain * (np.asarray(T_front) - np.asarray(T_back)) / panel.thickness
 
 
-def rhs_one_node(t: float, y: Sequence[float], panel: Any, s: float) -> FloatArray:
+def rhs_one_node(t: float, y: Sequence[float] | FloatArray, panel: Any, s: float) -> FloatArray:
     """Eq. 1: dT/dt [K/s] of the isothermal plate, y = [T]."""
     (T,) = y
     eps = panel.emissivity_front + panel.emissivity_back
@@ -84,7 +84,7 @@ def rhs_one_node(t: float, y: Sequence[float], panel: Any, s: float) -> FloatArr
 
 
 def rhs_two_layer(
-    t: float, y: Sequence[float], panel: Any, s: float, cos_theta: float = 1.0
+    t: float, y: Sequence[float] | FloatArray, panel: Any, s: float, cos_theta: float = 1.0
 ) -> FloatArray:
     """Eq. 2: [dT_f/dt, dT_b/dt] [K/s], each layer holding half the heat capacity."""
     T_f, T_b = y[0], y[1]
@@ -112,7 +112,7 @@ def _hinge_accel(panel: Any, theta: float, theta_dot: float, moment: float, mode
 
 def rhs_coupled(
     t: float,
-    y: Sequence[float],
+    y: Sequence[float] | FloatArray,
     panel: Any,
     s: float,
     model: str = "nonlinear",
@@ -273,6 +273,7 @@ def _integrate_segments(
             ys.append(sol.y[:, skip:])
         else:
             ts.append(mine)
+            assert seg_eval is not None
             ys.append(sol.y[:, np.searchsorted(seg_eval, mine)])
     return ReferenceSolution(
         t=np.concatenate(ts),

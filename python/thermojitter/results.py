@@ -55,7 +55,9 @@ class _Run:
         try:
             import pandas as pd
         except ImportError as exc:  # pragma: no cover - depends on the environment
-            raise ImportError("to_pandas() needs pandas: pip install 'thermojitter[dataframes]'") from exc
+            raise ImportError(
+                "to_pandas() needs pandas: pip install 'thermojitter[dataframes]'"
+            ) from exc
         frame = pd.DataFrame(self._columns(), index=pd.Index(self.t, name="t"))
         return frame
 
@@ -64,7 +66,9 @@ class _Run:
         try:
             import xarray as xr
         except ImportError as exc:  # pragma: no cover
-            raise ImportError("to_xarray() needs xarray: pip install 'thermojitter[dataframes]'") from exc
+            raise ImportError(
+                "to_xarray() needs xarray: pip install 'thermojitter[dataframes]'"
+            ) from exc
         return xr.Dataset(
             {name: ("t", values) for name, values in self._columns().items()},
             coords={"t": self.t},

@@ -22,14 +22,18 @@ DEFAULT_DT_OUT = 0.5
 
 def _check_type(name: str, value: Any, kind: type | tuple[type, ...]) -> None:
     if isinstance(value, bool) and kind is not bool or not isinstance(value, kind):
-        raise TypeError(f"{name} must be {getattr(kind, '__name__', kind)}, not {type(value).__name__}")
+        raise TypeError(
+            f"{name} must be {getattr(kind, '__name__', kind)}, not {type(value).__name__}"
+        )
 
 
 def _span(t_span: Sequence[float]) -> tuple[float, float]:
     try:
         t0, t1 = (float(v) for v in t_span)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"t_span = {t_span!r} is invalid: must be two numbers (t0, t1) in s") from exc
+        raise ValueError(
+            f"t_span = {t_span!r} is invalid: must be two numbers (t0, t1) in s"
+        ) from exc
     return t0, t1
 
 
@@ -41,8 +45,14 @@ def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
 
 
 def _solver_args(
-    method: str, rtol: float, atol: float, dt: float | None, max_step: float, max_steps: int,
-    t_eval: ArrayLike | None, dt_out: float | None,
+    method: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_eval: ArrayLike | None,
+    dt_out: float | None,
 ) -> dict[str, Any]:
     _check_type("method", method, str)
     if t_eval is None and dt_out is None:
@@ -116,15 +126,28 @@ def simulate(
     t0, t1 = _span(t_span)
     args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     raw = _core.simulate(
-        panel.as_dict(), orbit.as_dict(), t0, t1, model=model, coupled=bool(coupled),
-        y0=None if y0 is None else [float(v) for v in y0], **args,
+        panel.as_dict(),
+        orbit.as_dict(),
+        t0,
+        t1,
+        model=model,
+        coupled=bool(coupled),
+        y0=None if y0 is None else [float(v) for v in y0],
+        **args,
     )
     return Solution(
-        t=raw["t"], n_steps=raw["n_steps"], n_rejected=raw["n_rejected"], n_rhs=raw["n_rhs"],
-        method=method, settings={"rtol": rtol, "atol": atol, "dt": dt, "model": model,
-                                 "coupled": coupled},
-        T_front=raw["T_front"], T_back=raw["T_back"], theta=raw["theta"],
-        theta_dot=raw["theta_dot"], thermal_moment=raw["thermal_moment"], sunlit=raw["sunlit"],
+        t=raw["t"],
+        n_steps=raw["n_steps"],
+        n_rejected=raw["n_rejected"],
+        n_rhs=raw["n_rhs"],
+        method=method,
+        settings={"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled},
+        T_front=raw["T_front"],
+        T_back=raw["T_back"],
+        theta=raw["theta"],
+        theta_dot=raw["theta_dot"],
+        thermal_moment=raw["thermal_moment"],
+        sunlit=raw["sunlit"],
         y_end=raw["y_end"],
     )
 
@@ -153,12 +176,23 @@ def simulate_thermal(
     t0, t1 = _span(t_span)
     args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     raw = _core.simulate_thermal(
-        panel.as_dict(), orbit.as_dict(), t0, t1, layers=int(layers),
-        y0=None if y0 is None else [float(v) for v in y0], **args,
+        panel.as_dict(),
+        orbit.as_dict(),
+        t0,
+        t1,
+        layers=int(layers),
+        y0=None if y0 is None else [float(v) for v in y0],
+        **args,
     )
     return ThermalSolution(
-        t=raw["t"], n_steps=raw["n_steps"], n_rejected=raw["n_rejected"], n_rhs=raw["n_rhs"],
-        method=method, layers=int(layers), T=raw.get("T"), T_front=raw.get("T_front"),
+        t=raw["t"],
+        n_steps=raw["n_steps"],
+        n_rejected=raw["n_rejected"],
+        n_rhs=raw["n_rhs"],
+        method=method,
+        layers=int(layers),
+        T=raw.get("T"),
+        T_front=raw.get("T_front"),
         T_back=raw.get("T_back"),
     )
 
@@ -189,17 +223,33 @@ def simulate_hinge(
     m = np.ascontiguousarray(np.atleast_1d(np.asarray(moment, dtype=float)).ravel())
     mt = None if moment_t is None else _times(moment_t)
     raw = _core.simulate_hinge(
-        panel.as_dict(), t0, t1, model=model, moment=m, moment_t=mt,
-        y0=[float(v) for v in y0], **args,
+        panel.as_dict(),
+        t0,
+        t1,
+        model=model,
+        moment=m,
+        moment_t=mt,
+        y0=[float(v) for v in y0],
+        **args,
     )
     return HingeSolution(
-        t=raw["t"], n_steps=raw["n_steps"], n_rejected=raw["n_rejected"], n_rhs=raw["n_rhs"],
-        method=method, theta=raw["theta"], theta_dot=raw["theta_dot"],
+        t=raw["t"],
+        n_steps=raw["n_steps"],
+        n_rejected=raw["n_rejected"],
+        n_rhs=raw["n_rhs"],
+        method=method,
+        theta=raw["theta"],
+        theta_dot=raw["theta_dot"],
     )
 
 
 def hinge_energy(
-    panel: Panel, theta: ArrayLike, theta_dot: ArrayLike, moment: float, *, model: Model = "nonlinear"
+    panel: Panel,
+    theta: ArrayLike,
+    theta_dot: ArrayLike,
+    moment: float,
+    *,
+    model: Model = "nonlinear",
 ) -> np.ndarray:
     """Energy of the hinge in a constant moment field (kinetic + spring − M θ), J.
     Conserved when c_d = 0."""

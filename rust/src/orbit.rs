@@ -8,11 +8,11 @@ use crate::error::{require_finite, require_positive, Error, Result};
 use std::f64::consts::PI;
 
 /// GEO radius, m.
-pub const GEO_RADIUS: f64 = 42_164.17e3;
+pub const GEO_RADIUS: f64 = 42_164_170.0;
 /// Equatorial Earth radius, m.
-pub const EARTH_RADIUS: f64 = 6_378.137e3;
+pub const EARTH_RADIUS: f64 = 6_378_137.0;
 /// One sidereal day, s.
-pub const SIDEREAL_DAY: f64 = 86_164.0905;
+pub const SIDEREAL_DAY: f64 = 86_164.090_5;
 
 /// A circular orbit with a cylindrical Earth shadow, the Sun in the orbit plane (equinox).
 #[derive(Debug, Clone, Copy, PartialEq)]

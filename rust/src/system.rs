@@ -196,7 +196,10 @@ impl MomentHistory {
                         "needs at least two (time, moment) samples of equal length",
                     ));
                 }
-                if let Some(i) = t.windows(2).position(|w| !(w[1] > w[0])) {
+                if let Some(i) = t
+                    .windows(2)
+                    .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+                {
                     return Err(Error::invalid(
                         "moment_t",
                         t[i + 1],

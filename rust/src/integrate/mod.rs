@@ -138,7 +138,7 @@ impl Method {
                         "must be >= 1e-14 (double precision)",
                     ));
                 }
-                if !(tol.max_step > 0.0) || tol.max_step.is_nan() {
+                if tol.max_step.is_nan() || tol.max_step <= 0.0 {
                     return Err(Error::invalid("max_step", tol.max_step, "must be > 0"));
                 }
                 if tol.max_steps == 0 {

@@ -1,0 +1,98 @@
+"""Typed stub of the native engine module (built from rust/src/py by maturin)."""
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+_F = NDArray[np.float64]
+
+__all__ = [
+    "ConvergenceError",
+    "IntegrationError",
+    "PANEL_FIELDS",
+    "STEFAN_BOLTZMANN",
+    "derived",
+    "energy",
+    "illumination",
+    "moment",
+    "shadow_intervals",
+    "simulate",
+    "simulate_hinge",
+    "simulate_thermal",
+    "steady_state",
+    "stiffness",
+    "validate_orbit",
+    "validate_panel",
+]
+
+PANEL_FIELDS: list[str]
+STEFAN_BOLTZMANN: float
+
+class IntegrationError(RuntimeError): ...
+class ConvergenceError(RuntimeError): ...
+
+def validate_panel(panel: dict[str, float]) -> None: ...
+def validate_orbit(orbit: dict[str, Any]) -> None: ...
+def steady_state(
+    panel: dict[str, float], coupled: bool = True, flux: float = 1.0
+) -> tuple[float, float, float]: ...
+def stiffness(panel: dict[str, float], criterion: str, moment: float = 0.0) -> float: ...
+def derived(panel: dict[str, float]) -> dict[str, float]: ...
+def shadow_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[float, float]]: ...
+def illumination(orbit: dict[str, Any], t: _F) -> _F: ...
+def moment(panel: dict[str, float], t_front: _F, t_back: _F) -> _F: ...
+def energy(panel: dict[str, float], model: str, theta: _F, theta_dot: _F, moment: float) -> _F: ...
+def simulate(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    model: str,
+    coupled: bool,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: list[float] | None,
+) -> dict[str, Any]: ...
+def simulate_thermal(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    layers: int,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: list[float] | None,
+) -> dict[str, Any]: ...
+def simulate_hinge(
+    panel: dict[str, float],
+    t0: float,
+    t1: float,
+    *,
+    model: str,
+    moment: _F,
+    moment_t: _F | None,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: list[float],
+) -> dict[str, Any]: ...
