@@ -7,6 +7,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 """
 
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.flutter import FlutterResult, flutter
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -23,6 +24,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ConvergenceError",
     "Equilibrium",
+    "FlutterResult",
     "HingeSolution",
     "IntegrationError",
     "Orbit",
@@ -30,6 +32,7 @@ __all__ = [
     "Solution",
     "ThermalSolution",
     "beam_frequency",
+    "flutter",
     "hinge_energy",
     "hinge_stiffness",
     "natural_frequency",

@@ -14,6 +14,7 @@ __all__ = [
     "STEFAN_BOLTZMANN",
     "derived",
     "energy",
+    "flutter",
     "illumination",
     "moment",
     "shadow_intervals",
@@ -95,4 +96,9 @@ def simulate_hinge(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float],
+) -> dict[str, Any]: ...
+
+# --- flutter analysis ---------------------------------------------------------------------------
+def flutter(
+    panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
 ) -> dict[str, Any]: ...

@@ -7,6 +7,7 @@
 
 pub mod dynamics;
 pub mod error;
+pub mod flutter;
 pub mod integrate;
 pub mod orbit;
 pub mod params;

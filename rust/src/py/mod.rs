@@ -2,6 +2,7 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod convert;
+mod flutter;
 
 use crate::dynamics::hinge_energy;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
@@ -387,5 +388,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
+    flutter::register(m)?;
     Ok(())
 }
