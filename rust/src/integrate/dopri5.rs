@@ -94,6 +94,57 @@ fn initial_step<const N: usize, S: OdeSystem<N>>(
     (100.0 * h0).min(h1).min(interval)
 }
 
+/// One trial step: the new state, the stage slopes k1..k7 (k7 = f(t_new, y_new)) and the
+/// difference between the fifth- and fourth-order solutions.
+#[derive(Debug, Clone, Copy)]
+pub struct Step<const N: usize> {
+    pub y_new: SVector<f64, N>,
+    pub k: [SVector<f64, N>; 7],
+    pub err: SVector<f64, N>,
+}
+
+/// The stages of one Dormand–Prince step from (t, y) to t_new, given k1 = f(t, y).
+#[inline(always)]
+pub fn step<const N: usize, S: OdeSystem<N>>(
+    system: &S,
+    t: f64,
+    t_new: f64,
+    y0: &SVector<f64, N>,
+    k1: &SVector<f64, N>,
+) -> Step<N> {
+    let h = t_new - t;
+    let y0 = *y0;
+    let k1 = *k1;
+    let k2 = system.rhs(t + C[1] * h, &(y0 + k1 * (A21 * h)));
+    let k3 = system.rhs(t + C[2] * h, &(y0 + (k1 * A3[0] + k2 * A3[1]) * h));
+    let k4 = system.rhs(
+        t + C[3] * h,
+        &(y0 + (k1 * A4[0] + k2 * A4[1] + k3 * A4[2]) * h),
+    );
+    let k5 = system.rhs(
+        t + C[4] * h,
+        &(y0 + (k1 * A5[0] + k2 * A5[1] + k3 * A5[2] + k4 * A5[3]) * h),
+    );
+    let k6 = system.rhs(
+        t_new,
+        &(y0 + (k1 * A6[0] + k2 * A6[1] + k3 * A6[2] + k4 * A6[3] + k5 * A6[4]) * h),
+    );
+    let y_new = y0 + (k1 * B[0] + k3 * B[2] + k4 * B[3] + k5 * B[4] + k6 * B[5]) * h;
+    let k7 = system.rhs(t_new, &y_new);
+    let err = (k1 * (B[0] - B_HAT[0])
+        + k3 * (B[2] - B_HAT[2])
+        + k4 * (B[3] - B_HAT[3])
+        + k5 * (B[4] - B_HAT[4])
+        + k6 * (B[5] - B_HAT[5])
+        + k7 * (B[6] - B_HAT[6]))
+        * h;
+    Step {
+        y_new,
+        k: [k1, k2, k3, k4, k5, k6, k7],
+        err,
+    }
+}
+
 /// Integrates one segment [a, b] on which the right-hand side is smooth; `y` goes from y(a) to y(b).
 pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
     system: &S,
@@ -126,31 +177,8 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
             let h = t_new - t;
 
             let y0 = *y;
-            let k2 = system.rhs(t + C[1] * h, &(y0 + k1 * (A21 * h)));
-            let k3 = system.rhs(t + C[2] * h, &(y0 + (k1 * A3[0] + k2 * A3[1]) * h));
-            let k4 = system.rhs(
-                t + C[3] * h,
-                &(y0 + (k1 * A4[0] + k2 * A4[1] + k3 * A4[2]) * h),
-            );
-            let k5 = system.rhs(
-                t + C[4] * h,
-                &(y0 + (k1 * A5[0] + k2 * A5[1] + k3 * A5[2] + k4 * A5[3]) * h),
-            );
-            let k6 = system.rhs(
-                t_new,
-                &(y0 + (k1 * A6[0] + k2 * A6[1] + k3 * A6[2] + k4 * A6[3] + k5 * A6[4]) * h),
-            );
-            let y_new = y0 + (k1 * B[0] + k3 * B[2] + k4 * B[3] + k5 * B[4] + k6 * B[5]) * h;
-            let k7 = system.rhs(t_new, &y_new);
+            let Step { y_new, k, err } = step(system, t, t_new, &y0, &k1);
             stats.n_rhs += 6;
-
-            let err = (k1 * (B[0] - B_HAT[0])
-                + k3 * (B[2] - B_HAT[2])
-                + k4 * (B[3] - B_HAT[3])
-                + k5 * (B[4] - B_HAT[4])
-                + k6 * (B[5] - B_HAT[5])
-                + k7 * (B[6] - B_HAT[6]))
-                * h;
             let scale = y0.zip_map(&y_new, |u, v| tol.atol + u.abs().max(v.abs()) * tol.rtol);
             let err_norm = rms_scaled(&err, &scale);
 
@@ -165,8 +193,8 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
                     factor = factor.min(1.0);
                 }
                 stats.n_steps += 1;
-                let dense =
-                    DenseStep::from_dopri5(t, t_new, y0, y_new, [&k1, &k3, &k4, &k5, &k6, &k7]);
+                let [_, _, k3, k4, k5, k6, k7] = k;
+                let dense = DenseStep::dopri5(t, t_new, y0, y_new, [k1, k3, k4, k5, k6, k7]);
                 *y = y_new;
                 t = t_new;
                 stats.t_end = t;
@@ -200,23 +228,19 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
     Ok(ControlFlow::Continue(()))
 }
 
-impl<const N: usize> DenseStep<N> {
-    /// Hairer's continuous extension of one Dormand–Prince step (k = k1, k3, k4, k5, k6, k7).
-    fn from_dopri5(
-        t0: f64,
-        t1: f64,
-        y0: SVector<f64, N>,
-        y1: SVector<f64, N>,
-        k: [&SVector<f64, N>; 6],
-    ) -> Self {
-        let h = t1 - t0;
-        let [k1, k3, k4, k5, k6, k7] = k;
-        let diff = y1 - y0;
-        let bspl = k1 * h - diff;
-        let r4 = diff - k7 * h - bspl;
-        let r5 = (k1 * D[0] + k3 * D[2] + k4 * D[3] + k5 * D[4] + k6 * D[5] + k7 * D[6]) * h;
-        DenseStep::from_parts(t0, t1, y0, y1, [y0, diff, bspl, r4, r5])
-    }
+/// Hairer's continuous extension of one step: the coefficients r1..r5 of the interpolant in
+/// [`DenseStep`] from y0, diff = y1 − y0 and the slopes (k1, k3, k4, k5, k6, k7).
+pub(super) fn dense_coefficients<const N: usize>(
+    h: f64,
+    y0: &SVector<f64, N>,
+    diff: &SVector<f64, N>,
+    k: &[SVector<f64, N>; 6],
+) -> [SVector<f64, N>; 5] {
+    let [k1, k3, k4, k5, k6, k7] = k;
+    let bspl = k1 * h - diff;
+    let r4 = diff - k7 * h - bspl;
+    let r5 = (k1 * D[0] + k3 * D[2] + k4 * D[3] + k5 * D[4] + k6 * D[5] + k7 * D[6]) * h;
+    [*y0, *diff, bspl, r4, r5]
 }
 
 /// The next representable f64 above x (x finite).

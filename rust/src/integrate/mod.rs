@@ -11,6 +11,7 @@ pub mod rk4;
 
 use crate::error::{require_positive, Error, Result};
 use nalgebra::SVector;
+use std::cell::OnceCell;
 use std::ops::ControlFlow;
 
 pub use output::{Sampler, StepCounter};
@@ -31,14 +32,25 @@ pub trait OdeSystem<const N: usize> {
 /// One accepted step [t0, t1] and its continuous extension.
 ///
 /// The interpolant is y(t0 + θh) = r1 + θ(r2 + (1−θ)(r3 + θ(r4 + (1−θ) r5))): Dormand–Prince's
-/// fourth-order dense output, or (with r5 = 0) the cubic Hermite interpolant for RK4.
+/// fourth-order dense output, or (with r5 = 0) the cubic Hermite interpolant for RK4. The step
+/// keeps the stage slopes and builds r1..r5 on the first call of [`DenseStep::eval`], so steps
+/// that no observer samples cost nothing more.
 #[derive(Debug, Clone)]
 pub struct DenseStep<const N: usize> {
     pub t0: f64,
     pub t1: f64,
     pub y0: SVector<f64, N>,
     pub y1: SVector<f64, N>,
-    r: [SVector<f64, N>; 5],
+    /// (f0, f1) for Hermite; (k1, k3, k4, k5, k6, k7) for Dormand–Prince.
+    slopes: [SVector<f64, N>; 6],
+    kind: Interpolant,
+    r: OnceCell<[SVector<f64, N>; 5]>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Interpolant {
+    Hermite,
+    Dopri5,
 }
 
 impl<const N: usize> DenseStep<N> {
@@ -51,27 +63,50 @@ impl<const N: usize> DenseStep<N> {
         f0: &SVector<f64, N>,
         f1: &SVector<f64, N>,
     ) -> Self {
-        let h = t1 - t0;
-        let diff = y1 - y0;
-        let r3 = f0 * h - diff;
-        let r4 = diff - f1 * h - r3;
+        let zero = SVector::zeros();
         DenseStep {
             t0,
             t1,
             y0,
             y1,
-            r: [y0, diff, r3, r4, SVector::zeros()],
+            slopes: [*f0, *f1, zero, zero, zero, zero],
+            kind: Interpolant::Hermite,
+            r: OnceCell::new(),
         }
     }
 
-    pub(crate) fn from_parts(
+    /// Dormand–Prince's continuous extension from the slopes k1, k3, k4, k5, k6, k7.
+    pub(crate) fn dopri5(
         t0: f64,
         t1: f64,
         y0: SVector<f64, N>,
         y1: SVector<f64, N>,
-        r: [SVector<f64, N>; 5],
+        slopes: [SVector<f64, N>; 6],
     ) -> Self {
-        DenseStep { t0, t1, y0, y1, r }
+        DenseStep {
+            t0,
+            t1,
+            y0,
+            y1,
+            slopes,
+            kind: Interpolant::Dopri5,
+            r: OnceCell::new(),
+        }
+    }
+
+    /// The interpolant's coefficients r1..r5.
+    fn coefficients(&self) -> [SVector<f64, N>; 5] {
+        let h = self.t1 - self.t0;
+        let diff = self.y1 - self.y0;
+        match self.kind {
+            Interpolant::Hermite => {
+                let [f0, f1, ..] = &self.slopes;
+                let r3 = f0 * h - diff;
+                let r4 = diff - f1 * h - r3;
+                [self.y0, diff, r3, r4, SVector::zeros()]
+            }
+            Interpolant::Dopri5 => dopri5::dense_coefficients(h, &self.y0, &diff, &self.slopes),
+        }
     }
 
     /// Value of the interpolant at t in [t0, t1].
@@ -81,7 +116,7 @@ impl<const N: usize> DenseStep<N> {
         }
         let th = (t - self.t0) / (self.t1 - self.t0);
         let th1 = 1.0 - th;
-        let [r1, r2, r3, r4, r5] = &self.r;
+        let [r1, r2, r3, r4, r5] = self.r.get_or_init(|| self.coefficients());
         r1 + (r2 + (r3 + (r4 + r5 * th1) * th) * th1) * th
     }
 }

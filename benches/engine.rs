@@ -1,0 +1,127 @@
+//! Engine micro-benchmarks with std-only timing (no harness): the coupled right-hand side, one
+//! Dormand–Prince step, and one GEO orbit at rtol 1e-8 / atol 1e-10.
+//!
+//!     cargo bench --bench engine
+//!
+//! Each figure is the median over several batches, in ns per call (per step for the orbit).
+//! A word after `--` keeps only the benches whose name contains it: rhs, step, orbit-none,
+//! orbit-end, orbit-every (`-- orbit` runs the three orbits).
+
+use nalgebra::Vector4;
+use std::hint::black_box;
+use std::time::Instant;
+use thermojitter::dynamics::HingeModel;
+use thermojitter::integrate::dopri5;
+use thermojitter::integrate::{solve, Method, OdeSystem, Sampler, StepCounter, Tolerances};
+use thermojitter::steady::equilibrium;
+use thermojitter::system::{Coupled, Coupling};
+use thermojitter::{Orbit, Panel};
+
+/// Median over `batches` of the time per call of `f`, run `per_batch` times a batch, ns.
+fn median_ns(batches: usize, per_batch: u64, mut f: impl FnMut()) -> f64 {
+    let mut times: Vec<f64> = (0..batches)
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..per_batch {
+                f();
+            }
+            start.elapsed().as_nanos() as f64 / per_batch as f64
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[batches / 2]
+}
+
+fn main() {
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    let wanted = |name: &str| filter.is_empty() || filter.iter().any(|f| name.contains(f.as_str()));
+    let panel = Panel::paper();
+    let orbit = Orbit::geo_equinox();
+    let eq = equilibrium(&panel, Coupling::ProjectedArea, 1.0).expect("equilibrium");
+    let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+    let mut sys = Coupled::new(panel, orbit, HingeModel::Nonlinear, Coupling::ProjectedArea);
+    let (a, b) = (0.0, orbit.breakpoints(0.0, orbit.period)[0]);
+    sys.enter_segment(a, b);
+
+    // A state slightly off equilibrium so that the hinge terms are all non-trivial.
+    let y = y0 + Vector4::new(0.5, -0.3, 1e-3, 2e-4);
+    if wanted("rhs") {
+        let rhs = median_ns(21, 1_000_000, || {
+            black_box(sys.rhs(black_box(100.0), black_box(&y)));
+        });
+        println!("rhs (coupled, nonlinear)        {rhs:8.1} ns/call");
+    }
+
+    if wanted("step") {
+        let k1 = sys.rhs(100.0, &y);
+        let step = median_ns(21, 200_000, || {
+            black_box(dopri5::step(
+                &sys,
+                black_box(100.0),
+                black_box(100.37),
+                black_box(&y),
+                black_box(&k1),
+            ));
+        });
+        println!("dopri5 step (6 rhs)             {step:8.1} ns/step");
+    }
+
+    let method = Method::Dopri5(Tolerances::default());
+    let orbit_run = |key: &str, name: &str, observe: &mut dyn FnMut() -> u64| {
+        if !wanted(key) {
+            return;
+        }
+        let mut steps = 0;
+        let ns = median_ns(7, 1, || steps = observe());
+        println!(
+            "one GEO orbit, {name:<19} {:8.3} ms, {steps} steps, {:.1} ns/step",
+            ns * 1e-6,
+            ns / steps as f64
+        );
+    };
+    orbit_run("orbit-none", "no output", &mut || {
+        let mut counter = StepCounter::default();
+        let (stats, y_end) = solve(
+            &mut sys,
+            &method,
+            0.0,
+            black_box(y0),
+            orbit.period,
+            &mut counter,
+        )
+        .expect("orbit");
+        black_box(y_end);
+        stats.n_steps
+    });
+    orbit_run("orbit-end", "sampled at the end", &mut || {
+        let mut sampler = Sampler::new(vec![orbit.period]);
+        let (stats, _) = solve(
+            &mut sys,
+            &method,
+            0.0,
+            black_box(y0),
+            orbit.period,
+            &mut sampler,
+        )
+        .expect("orbit");
+        black_box(&sampler.y);
+        stats.n_steps
+    });
+    orbit_run("orbit-every", "sampled every 0.5 s", &mut || {
+        let mut sampler = Sampler::every(0.0, orbit.period, 0.5);
+        let (stats, _) = solve(
+            &mut sys,
+            &method,
+            0.0,
+            black_box(y0),
+            orbit.period,
+            &mut sampler,
+        )
+        .expect("orbit");
+        black_box(&sampler.y);
+        stats.n_steps
+    });
+}
