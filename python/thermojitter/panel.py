@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, fields
+from functools import cached_property
 from typing import Any, Literal
 
 from thermojitter import _core
@@ -89,8 +90,14 @@ class Panel:
             raise ValueError(f"unknown panel parameter(s): {', '.join(unknown)}")
         return dataclasses.replace(self, **changes)
 
-    def as_dict(self) -> dict[str, float]:
+    @cached_property
+    def _values(self) -> dict[str, float]:
+        """The parameters by name, built once: the panel is immutable, and every call into the
+        engine passes them."""
         return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def as_dict(self) -> dict[str, float]:
+        return dict(self._values)
 
     @property
     def half_arm(self) -> float:

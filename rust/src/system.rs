@@ -1,7 +1,7 @@
 //! The right-hand sides: the thermal models alone, the coupled thermo-structural system, and the
 //! hinge driven by a prescribed moment. Each implements [`OdeSystem`] on a fixed-size state.
 
-use crate::dynamics::{hinge_acceleration, HingeModel};
+use crate::dynamics::{hinge_acceleration, sin_cos, HingeModel};
 use crate::integrate::OdeSystem;
 use crate::orbit::Orbit;
 use crate::params::Panel;
@@ -172,13 +172,13 @@ impl Coupled {
     /// The same equations as [`two_layer_rates`], [`crate::dynamics::thermal_moment`] and
     /// [`hinge_acceleration`],
     /// with sin θ and cos θ computed once and the coefficients taken from [`Rates`].
-    #[inline]
+    #[inline(always)]
     pub fn rhs_at_flux(&self, flux: f64, y: &Vector4<f64>) -> Vector4<f64> {
         let r = &self.rates;
         let (tf, tb, th, om) = (y[0], y[1], y[2], y[3]);
         let (sin, cos) = match (self.coupling, self.model) {
             (Coupling::Frozen, HingeModel::Linear) => (0.0, 1.0),
-            _ => th.sin_cos(),
+            _ => sin_cos(th),
         };
         let area = match self.coupling {
             Coupling::ProjectedArea => cos,
@@ -207,7 +207,7 @@ impl Coupled {
 }
 
 impl OdeSystem<4> for Coupled {
-    #[inline]
+    #[inline(always)]
     fn rhs(&self, t: f64, y: &Vector4<f64>) -> Vector4<f64> {
         self.rhs_at_flux(self.sun.flux(t), y)
     }

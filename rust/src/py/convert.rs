@@ -9,10 +9,15 @@ use nalgebra::SVector;
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyString};
 
-/// A float entry of a mapping, named in any error.
-fn float_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<f64> {
+/// A float entry of a mapping, named in any error. The key may be an interned Python string, so
+/// that the lookup neither builds nor hashes a new string.
+fn float_item<'py, K>(d: &Bound<'py, PyDict>, key: K) -> PyResult<f64>
+where
+    K: IntoPyObject<'py> + std::fmt::Display + Copy,
+{
     let v = d
         .get_item(key)?
         .ok_or_else(|| PyValueError::new_err(format!("{key} is missing")))?;
@@ -27,10 +32,20 @@ fn float_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<f64> {
     })
 }
 
+/// The panel's field names as interned Python strings, built once.
+static PANEL_KEYS: PyOnceLock<Vec<Py<PyString>>> = PyOnceLock::new();
+
 pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
+    let py = d.py();
+    let keys = PANEL_KEYS.get_or_init(py, || {
+        Panel::FIELDS
+            .iter()
+            .map(|name| PyString::intern(py, name).unbind())
+            .collect()
+    });
     let mut p = Panel::paper();
-    for name in Panel::FIELDS {
-        p.set(name, float_item(d, name)?).map_err(to_py)?;
+    for (name, key) in Panel::FIELDS.iter().zip(keys) {
+        p.set(name, float_item(d, key.bind(py))?).map_err(to_py)?;
     }
     p.validate().map_err(to_py)?;
     Ok(p)

@@ -15,6 +15,7 @@ use nalgebra::SVector;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::f64::consts::PI;
@@ -56,12 +57,15 @@ fn run_info<'py, const N: usize>(
     traj: &Trajectory<N>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("t", array(py, traj.t.clone()))?;
-    d.set_item("n_steps", traj.stats.n_steps)?;
-    d.set_item("n_rejected", traj.stats.n_rejected)?;
-    d.set_item("n_rhs", traj.stats.n_rhs)?;
-    d.set_item("t_end", traj.stats.t_end)?;
-    d.set_item("y_end", array(py, traj.y_end.as_slice().to_vec()))?;
+    d.set_item(intern!(py, "t"), array(py, traj.t.clone()))?;
+    d.set_item(intern!(py, "n_steps"), traj.stats.n_steps)?;
+    d.set_item(intern!(py, "n_rejected"), traj.stats.n_rejected)?;
+    d.set_item(intern!(py, "n_rhs"), traj.stats.n_rhs)?;
+    d.set_item(intern!(py, "t_end"), traj.stats.t_end)?;
+    d.set_item(
+        intern!(py, "y_end"),
+        array(py, traj.y_end.as_slice().to_vec()),
+    )?;
     Ok(d)
 }
 
@@ -240,12 +244,12 @@ fn simulate<'py>(
         .map(|(&f, &b)| thermal_moment(&p, f, b))
         .collect();
     let sunlit: Vec<f64> = traj.t.iter().map(|&t| o.illumination(t)).collect();
-    d.set_item("T_front", array(py, tf))?;
-    d.set_item("T_back", array(py, tb))?;
-    d.set_item("theta", array(py, column(&traj, 2)))?;
-    d.set_item("theta_dot", array(py, column(&traj, 3)))?;
-    d.set_item("thermal_moment", array(py, mt))?;
-    d.set_item("sunlit", array(py, sunlit))?;
+    d.set_item(intern!(py, "T_front"), array(py, tf))?;
+    d.set_item(intern!(py, "T_back"), array(py, tb))?;
+    d.set_item(intern!(py, "theta"), array(py, column(&traj, 2)))?;
+    d.set_item(intern!(py, "theta_dot"), array(py, column(&traj, 3)))?;
+    d.set_item(intern!(py, "thermal_moment"), array(py, mt))?;
+    d.set_item(intern!(py, "sunlit"), array(py, sunlit))?;
     Ok(d)
 }
 
