@@ -31,7 +31,7 @@ pub fn hinge_acceleration(
         HingeModel::Linear => generalised / panel.hinge_inertia(),
         HingeModel::Nonlinear => {
             // eq. 20 with 3/(2 m l³) = 1/I_B factored out
-            let (s, c) = theta.sin_cos();
+            let (s, c) = sin_cos(theta);
             let forced = generalised / panel.hinge_inertia() - 3.0 * theta_dot * theta_dot * s * c;
             forced / (1.0 + 3.0 * s * s)
         }
