@@ -50,8 +50,10 @@ impl<const N: usize> Sampler<N> {
     }
 }
 
-impl<const N: usize> Observer<N> for Sampler<N> {
-    fn on_step(&mut self, step: &DenseStep<N>) -> ControlFlow<()> {
+impl<const N: usize> Sampler<N> {
+    /// Keeps the requested times inside `step` (the slow path, out of the step loop).
+    #[inline(never)]
+    fn sample(&mut self, step: &DenseStep<N>) {
         self.skip_before(step.t0);
         while self.next < self.times.len() && self.times[self.next] <= step.t1 {
             let t = self.times[self.next];
@@ -59,6 +61,17 @@ impl<const N: usize> Observer<N> for Sampler<N> {
             self.y
                 .push(if t == step.t0 { step.y0 } else { step.eval(t) });
             self.next += 1;
+        }
+    }
+}
+
+impl<const N: usize> Observer<N> for Sampler<N> {
+    /// Most steps hold no requested time: that test is inlined into the step loop, and only a
+    /// step that holds one builds its interpolant.
+    #[inline]
+    fn on_step(&mut self, step: &DenseStep<N>) -> ControlFlow<()> {
+        if self.times.get(self.next).is_some_and(|&t| t <= step.t1) {
+            self.sample(step);
         }
         ControlFlow::Continue(())
     }
