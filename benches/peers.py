@@ -42,11 +42,16 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-from scipy.integrate import solve_ivp
+# One BLAS thread: the solvers here never need more, and idle OpenBLAS workers spinning on the
+# second of two cores would tax whichever solver runs next. Set before NumPy loads.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-import thermojitter as tj
-from thermojitter import reference as ref
+import numpy as np  # noqa: E402
+from scipy.integrate import solve_ivp  # noqa: E402
+
+import thermojitter as tj  # noqa: E402
+from thermojitter import reference as ref  # noqa: E402
 
 RTOL, ATOL = 1e-8, 1e-10
 STEFAN_BOLTZMANN = 5.670374419e-8

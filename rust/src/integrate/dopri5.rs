@@ -196,16 +196,17 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
             let weight = y0.zip_map(&y_new, |u, v| {
                 1.0 / (tol.atol + u.abs().max(v.abs()) * tol.rtol)
             });
+            // err_norm² (the RMS norm squared): err_norm < 1 when this is < 1 (but for the one
+            // double just below 1, whose root rounds to 1), so the root is taken on rejection only.
             let mean_square = err.component_mul(&weight).norm_squared() / N as f64;
-            let err_norm = mean_square.sqrt();
 
-            if err_norm < 1.0 {
-                // err_norm NaN fails this test, so a non-finite state is rejected and shrinks h.
+            if mean_square < 1.0 {
+                // NaN fails this test, so a non-finite state is rejected and shrinks h.
                 // The growth factor is a heuristic capped at 10: single precision is plenty for
                 // it and its pow is about twice as cheap (err_norm^(−1/5) = mean_square^(−1/10);
                 // an underflow to 0 gives +inf, capped like err_norm = 0). Accept/reject
-                // decisions still use the double-precision err_norm.
-                let mut factor = if err_norm == 0.0 {
+                // decisions stay in double precision.
+                let mut factor = if mean_square == 0.0 {
                     MAX_FACTOR
                 } else {
                     let grow = (mean_square as f32).powf(0.5 * ERROR_EXPONENT as f32);
@@ -228,6 +229,7 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
                 break;
             }
             stats.n_rejected += 1;
+            let err_norm = mean_square.sqrt();
             let shrink = if err_norm.is_finite() {
                 MIN_FACTOR.max(SAFETY * err_norm.powf(ERROR_EXPONENT))
             } else {
