@@ -8,6 +8,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.flutter import FlutterResult, flutter
+from thermojitter.longrun import OrbitSummaries, simulate_orbits
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -28,6 +29,7 @@ __all__ = [
     "HingeSolution",
     "IntegrationError",
     "Orbit",
+    "OrbitSummaries",
     "Panel",
     "Solution",
     "ThermalSolution",
@@ -38,6 +40,7 @@ __all__ = [
     "natural_frequency",
     "simulate",
     "simulate_hinge",
+    "simulate_orbits",
     "simulate_thermal",
     "steady_state",
 ]

@@ -17,6 +17,7 @@ __all__ = [
     "flutter",
     "illumination",
     "moment",
+    "run_orbits",
     "shadow_intervals",
     "simulate",
     "simulate_hinge",
@@ -101,4 +102,26 @@ def simulate_hinge(
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(
     panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
+) -> dict[str, Any]: ...
+
+# --- long runs ----------------------------------------------------------------------------------
+def run_orbits(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    model: str,
+    coupled: bool,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_start: float,
+    first_index: int,
+    n_orbits: int,
+    y0: list[float],
+    window: float,
+    theta_limit: float,
+    stop_at_limit: bool,
 ) -> dict[str, Any]: ...

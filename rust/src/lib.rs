@@ -13,6 +13,7 @@ pub mod orbit;
 pub mod params;
 pub mod simulate;
 pub mod steady;
+pub mod summary;
 pub mod system;
 pub mod thermal;
 
