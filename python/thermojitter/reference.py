@@ -226,6 +226,7 @@ def _integrate_segments(
     t_eval: ArrayLike | None,
     method: str,
     names: tuple[str, ...],
+    max_step: float = np.inf,
 ) -> ReferenceSolution:
     """Integrate fun(t, y, s) with one solve_ivp call per shadow-free segment."""
     t0, t1 = float(t_span[0]), float(t_span[1])
@@ -260,7 +261,15 @@ def _integrate_segments(
             # state starts the next segment.
             seg_eval = np.union1d(mine, [b])
         sol = solve_ivp(
-            fun, (a, b), y, method=method, t_eval=seg_eval, args=(s,), rtol=rtol, atol=atol
+            fun,
+            (a, b),
+            y,
+            method=method,
+            t_eval=seg_eval,
+            args=(s,),
+            rtol=rtol,
+            atol=atol,
+            max_step=max_step,
         )
         if not sol.success:
             raise RuntimeError(f"solve_ivp failed on [{a}, {b}]: {sol.message}")
@@ -296,8 +305,13 @@ def simulate(
     t_eval: ArrayLike | None = None,
     y0: ArrayLike | None = None,
     method: str = "RK45",
+    max_step: float = np.inf,
 ) -> ReferenceSolution:
-    """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses."""
+    """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses.
+
+    ``max_step`` (s) caps solve_ivp's step; near an equilibrium its steps can otherwise span
+    several hinge periods, and its interpolant between them does not resolve the oscillation.
+    """
     if y0 is None:
         y0 = (*steady_state(panel, coupled), 0.0)
 
@@ -305,7 +319,7 @@ def simulate(
         return rhs_coupled(t, y, panel, s, model, coupled)
 
     names = ("T_front", "T_back", "theta", "theta_dot")
-    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names)
+    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names, max_step)
 
 
 def simulate_thermal(
