@@ -359,7 +359,7 @@ pub fn respond(
             e += h * y[i];
         }
         let s = 2.0 * e / beam.length;
-        if !(s.abs() <= 1.0) {
+        if s.is_nan() || s.abs() > 1.0 {
             return Err(Error::Integration {
                 t: *t,
                 reason: format!("tip deflection η = {e} m exceeds L/2: θ_f is undefined"),

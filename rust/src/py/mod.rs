@@ -1,6 +1,7 @@
 //! The pyo3 layer: converts Python values to engine types, maps engine errors to exceptions and
 //! releases the GIL around every integration. It holds no physics.
 
+mod beam;
 mod convert;
 
 use crate::dynamics::hinge_energy;
@@ -387,5 +388,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
+    beam::register(m)?;
     Ok(())
 }
