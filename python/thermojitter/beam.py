@@ -1,0 +1,349 @@
+"""The finite-element comparator of the hinge model (paper Sec. 4.3, Figs. 21–24).
+
+A free–free Euler–Bernoulli beam with the panel's L, EI and m (Hermite cubic elements, consistent
+mass, 100 elements by default) is loaded at its two free ends by the thermal moment ±M_T(t) of a
+hinge-model run and solved by modal transient response (rigid-body modes set apart, the first
+eight excited elastic modes integrated, the rest added quasi-statically). Its equivalent hinge
+angle is θ_f = asin(2η_f/L), η_f the tip deflection relative to the centre node — the hinge
+model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly comparable.
+
+    beam = tj.beam.FreeFreeBeam(panel)
+    beam.natural_frequencies(3)                      # Hz, elastic modes only
+    cmp = tj.compare_with_beam(panel, orbit, criterion="frequency")
+    cmp.rmse_deg, cmp.hinge_frequency, cmp.beam_frequency
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from thermojitter import _core
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel, hinge_stiffness
+from thermojitter.simulate import Method, Model, _check_inputs, _solver_args, _span, simulate
+
+Array = NDArray[np.float64]
+Criterion = Literal["deflection", "deflection_small_angle", "frequency"]
+
+DEFAULT_MARGIN = 1200.0
+"""Time before shadow entry and after shadow exit in the default comparison window, s."""
+DEFAULT_F_MIN = 0.02
+"""Lowest frequency searched for the dominant jitter frequency, Hz (above the orbital drift)."""
+
+
+def default_damping_ratio(panel: Panel) -> float:
+    """The hinge model's damping ratio, ζ = c_d / (2 sqrt(K_el I_B)), used for every beam mode."""
+    return panel.damping / (2.0 * math.sqrt(panel.hinge_stiffness * panel.hinge_inertia))
+
+
+@dataclass(frozen=True)
+class BeamResponse:
+    """The beam under end moments ±M(t): η (m, tips relative to the centre) and θ_f (rad)."""
+
+    t: Array
+    eta: Array
+    theta_f: Array
+    damping_ratio: float
+    n_steps: int
+    n_rhs: int
+
+    @property
+    def theta_f_deg(self) -> Array:
+        return np.degrees(self.theta_f)
+
+
+class FreeFreeBeam:
+    """The panel as a free–free Euler–Bernoulli beam of ``n_elements`` Hermite cubic elements
+    (even, so that the centre is a node; 2 to 1000)."""
+
+    def __init__(self, panel: Panel, n_elements: int = 100) -> None:
+        _check_inputs(panel)
+        if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)):
+            raise TypeError(f"n_elements must be an int, not {type(n_elements).__name__}")
+        self.panel = panel
+        self.n_elements = int(n_elements)
+        self._modes = _core.beam_modes(panel.as_dict(), self.n_elements, 1)
+
+    def __repr__(self) -> str:
+        return f"FreeFreeBeam(n_elements={self.n_elements}, L={self.panel.length} m)"
+
+    def _check_n(self, n: int) -> int:
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+            raise TypeError(f"n must be an int, not {type(n).__name__}")
+        return int(n)
+
+    def natural_frequencies(self, n: int = 3) -> Array:
+        """The first ``n`` elastic free–free frequencies, Hz (rigid-body modes excluded)."""
+        d = _core.beam_modes(self.panel.as_dict(), self.n_elements, self._check_n(n))
+        return np.asarray(d["frequencies_hz"])
+
+    def mode_shapes(self, n: int = 3) -> tuple[Array, Array]:
+        """Node positions x (m) and the deflections of the first ``n`` elastic modes at the nodes,
+        shape (nodes, n), mass-normalised (φᵀMφ = 1, in 1/sqrt(kg)), positive at x = 0."""
+        d = _core.beam_modes(self.panel.as_dict(), self.n_elements, self._check_n(n))
+        return np.asarray(d["x"]), np.asarray(d["shapes"])
+
+    @property
+    def rigid_eigenvalues(self) -> Array:
+        """ω² of the two rigid-body modes, (rad/s)²: zero up to rounding."""
+        return np.asarray(self._modes["rigid_eigenvalues"])
+
+    @property
+    def total_mass(self) -> float:
+        """uᵀ M u for a unit rigid translation u: the mass the mesh carries, kg."""
+        return float(self._modes["total_mass"])
+
+    @property
+    def residual_fraction(self) -> float:
+        """Share of the static end-moment flexibility carried by the modes not integrated."""
+        return float(self._modes["residual_flexibility"] / self._modes["flexibility"])
+
+    def static_tip_deflection(self, moment: float) -> float:
+        """η (m) under steady end moments ±``moment`` (N m); exact value M L²/(8EI)."""
+        return float(_core.beam_static(self.panel.as_dict(), self.n_elements, float(moment)))
+
+    def response(
+        self,
+        times: ArrayLike,
+        moments: ArrayLike,
+        *,
+        t_span: Sequence[float] | None = None,
+        damping_ratio: float | None = None,
+        residual: bool = True,
+        method: Method = "rk45",
+        rtol: float = 1e-8,
+        atol: float = 1e-10,
+        dt: float | None = None,
+        t_eval: ArrayLike | None = None,
+        dt_out: float | None = None,
+        max_step: float = float("inf"),
+        max_steps: int = 500_000_000,
+    ) -> BeamResponse:
+        """Modal transient response to end moments ±M(t), M given as samples ``moments`` (N m)
+        at ``times`` (s, increasing; linear in between, held beyond the ends).
+
+        Starts at rest in the static deflection under M(t0). ``t_span`` defaults to the sample
+        span and the output to the sample times. ``damping_ratio`` ζ applies to every mode
+        (default: the hinge model's, :func:`default_damping_ratio`). ``residual=False`` drops
+        the quasi-static part of the modes not integrated.
+        """
+        ts = np.ascontiguousarray(np.asarray(times, dtype=float).ravel())
+        ms = np.ascontiguousarray(np.asarray(moments, dtype=float).ravel())
+        if ts.size < 2 or ts.size != ms.size:
+            raise ValueError(
+                f"times/moments hold {ts.size}/{ms.size} values: need two or more, equal lengths"
+            )
+        t0, t1 = (float(ts[0]), float(ts[-1])) if t_span is None else _span(t_span)
+        if t_eval is None and dt_out is None:
+            t_eval = ts[(ts >= t0) & (ts <= t1)]
+        zeta = default_damping_ratio(self.panel) if damping_ratio is None else damping_ratio
+        args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+        raw = _core.beam_response(
+            self.panel.as_dict(),
+            self.n_elements,
+            ts,
+            ms,
+            t0,
+            t1,
+            damping_ratio=float(zeta),
+            residual=bool(residual),
+            **args,
+        )
+        return BeamResponse(
+            t=raw["t"],
+            eta=raw["eta"],
+            theta_f=raw["theta_f"],
+            damping_ratio=float(zeta),
+            n_steps=raw["n_steps"],
+            n_rhs=raw["n_rhs"],
+        )
+
+    def theta_f(self, times: ArrayLike, moments: ArrayLike, **kwargs: Any) -> Array:
+        """θ_f(t) = asin(2η/L) (rad) at ``times`` for the moment history; see :meth:`response`."""
+        return self.response(times, moments, **kwargs).theta_f
+
+
+def spectrum(t: ArrayLike, x: ArrayLike) -> tuple[Array, Array]:
+    """One-sided amplitude spectrum of a uniformly sampled signal (mean removed, Hann window):
+    frequencies (Hz) and amplitudes (same unit as x)."""
+    ts = np.asarray(t, dtype=float)
+    xs = np.asarray(x, dtype=float)
+    if ts.size < 8 or ts.size != xs.size:
+        raise ValueError(f"t holds {ts.size} samples: need 8 or more, as many as x")
+    steps = np.diff(ts)
+    if not np.allclose(steps, steps[0], rtol=1e-6, atol=0.0):
+        raise ValueError("t must be uniformly spaced for the FFT")
+    window = np.hanning(xs.size)
+    amp = np.abs(np.fft.rfft((xs - xs.mean()) * window)) * 2.0 / window.sum()
+    return np.fft.rfftfreq(xs.size, steps[0]), amp
+
+
+def dominant_frequency(t: ArrayLike, x: ArrayLike, f_min: float = DEFAULT_F_MIN) -> float:
+    """The frequency (Hz) of the largest spectral peak above ``f_min``, refined by a parabola
+    through the peak bin and its neighbours."""
+    f, a = spectrum(t, x)
+    idx = np.nonzero(f >= f_min)[0]
+    if idx.size < 3:
+        raise ValueError(f"f_min = {f_min} is invalid: leaves fewer than 3 frequency bins")
+    k = int(idx[np.argmax(a[idx])])
+    if 0 < k < a.size - 1:
+        y0, y1, y2 = np.log(a[k - 1 : k + 2] + 1e-300)
+        denom = y0 - 2.0 * y1 + y2
+        shift = 0.5 * (y0 - y2) / denom if denom != 0 else 0.0
+        return float(f[k] + shift * (f[1] - f[0]))
+    return float(f[k])
+
+
+@dataclass(frozen=True)
+class BeamComparison:
+    """The hinge model and the beam through an eclipse (paper Figs. 22–24).
+
+    Angles in rad (``*_deg`` for degrees), frequencies in Hz, the moment in N m (the physical
+    a E I ΔT/d that loads the beam, without χ).
+    """
+
+    t: Array
+    theta: Array
+    theta_f: Array
+    moment: Array
+    rmse_deg: float
+    hinge_frequency: float
+    """Dominant frequency of θ (FFT), Hz."""
+    beam_frequency: float
+    """Dominant frequency of θ_f (FFT), Hz."""
+    natural_frequency: float
+    """f_n, the beam's first elastic frequency (finite elements), Hz."""
+    hinge_natural_frequency: float
+    """sqrt(K_el/I_B)/2π of the hinge model, Hz."""
+    hinge_stiffness: float
+    moment_scale: float
+    damping_ratio: float
+    criterion: str
+    settings: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def frequency_mismatch(self) -> float:
+        """(f_hinge − f_n)/f_n of the dominant jitter frequency of θ."""
+        return (self.hinge_frequency - self.natural_frequency) / self.natural_frequency
+
+    @property
+    def theta_deg(self) -> Array:
+        return np.degrees(self.theta)
+
+    @property
+    def theta_f_deg(self) -> Array:
+        return np.degrees(self.theta_f)
+
+    def summary(self) -> dict[str, float | str]:
+        """The comparison numbers (JSON-ready)."""
+        return {
+            "criterion": self.criterion,
+            "hinge_stiffness": self.hinge_stiffness,
+            "moment_scale": self.moment_scale,
+            "damping_ratio": self.damping_ratio,
+            "rmse_deg": self.rmse_deg,
+            "hinge_frequency_hz": self.hinge_frequency,
+            "beam_frequency_hz": self.beam_frequency,
+            "natural_frequency_hz": self.natural_frequency,
+            "hinge_natural_frequency_hz": self.hinge_natural_frequency,
+            "frequency_mismatch": self.frequency_mismatch,
+            "t_start": float(self.t[0]),
+            "t_end": float(self.t[-1]),
+        }
+
+
+def _flexural_stiffness(panel: Panel) -> float:
+    """4EI/L, the small-angle deflection-criterion K_el, N m/rad."""
+    return 4.0 * panel.youngs_modulus * panel.bending_inertia / panel.length
+
+
+def eclipse_window(orbit: Orbit, margin: float = DEFAULT_MARGIN) -> tuple[float, float]:
+    """The first eclipse of the orbit with ``margin`` seconds of sunlight on each side, s."""
+    intervals = orbit.shadow_intervals(0.0, orbit.period)
+    if not intervals:
+        raise ValueError("orbit has no eclipse in its first period: give t_span")
+    enter, leave = intervals[0]
+    return max(0.0, enter - margin), leave + margin
+
+
+def compare_with_beam(
+    panel: Panel,
+    orbit: Orbit,
+    *,
+    criterion: Criterion | None = None,
+    scale_moment: bool = False,
+    t_span: Sequence[float] | None = None,
+    dt_out: float = 0.5,
+    n_elements: int = 100,
+    damping_ratio: float | None = None,
+    model: Model = "nonlinear",
+    coupled: bool = True,
+    f_min: float = DEFAULT_F_MIN,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+) -> BeamComparison:
+    """Runs the hinge model and the beam through an eclipse and compares θ(t) with θ_f(t).
+
+    - ``criterion``: ``None`` keeps the panel's own ``hinge_stiffness``; otherwise K_el is set by
+      :func:`thermojitter.hinge_stiffness` (``"deflection"``, ``"deflection_small_angle"``,
+      ``"frequency"`` ≈ 5.21 EI/L).
+    - ``scale_moment``: also scale the thermal moment of the hinge model by
+      χ = K_el L/(4EI) (paper Sec. 4.3: 5.21/4 ≈ 1.3 with the frequency criterion). The beam is
+      always loaded by the physical moment a E I ΔT/d.
+    - ``t_span``: default the first eclipse with :data:`DEFAULT_MARGIN` of sunlight either side;
+      the hinge model starts from its sunlit equilibrium, the beam at rest in its static shape.
+    - ``damping_ratio``: of every beam mode; default the hinge's ζ = c_d/(2 sqrt(K_el I_B)).
+
+    ``rmse_deg`` is the RMS of θ − θ_f over the window; the dominant frequencies come from the
+    FFT of each signal above ``f_min`` (Hz).
+    """
+    _check_inputs(panel, orbit)
+    hinge_panel = panel
+    if criterion is not None:
+        hinge_panel = panel.replace(hinge_stiffness=hinge_stiffness(panel, criterion))
+    if scale_moment:
+        chi = hinge_panel.hinge_stiffness / _flexural_stiffness(panel)
+        hinge_panel = hinge_panel.replace(moment_scale=chi)
+    span = eclipse_window(orbit) if t_span is None else _span(t_span)
+    if not (math.isfinite(dt_out) and dt_out > 0):
+        raise ValueError(f"dt_out = {dt_out!r} is invalid: must be finite and > 0")
+    if span[1] - span[0] < 16 * dt_out:
+        raise ValueError(f"t_span = {span!r} is invalid: shorter than 16 samples of dt_out")
+    # Uniform samples (the FFT needs them): the last one may fall short of t_span[1].
+    samples = span[0] + dt_out * np.arange(int((span[1] - span[0]) / dt_out) + 1)
+    sol = simulate(
+        hinge_panel, orbit, span, model=model, coupled=coupled, t_eval=samples, rtol=rtol, atol=atol
+    )
+    physical = np.asarray(sol.thermal_moment) / hinge_panel.moment_scale
+    beam = FreeFreeBeam(panel.replace(moment_scale=1.0), n_elements)
+    zeta = default_damping_ratio(hinge_panel) if damping_ratio is None else damping_ratio
+    resp = beam.response(sol.t, physical, damping_ratio=zeta, rtol=rtol, atol=atol)
+    theta = np.asarray(sol.theta)
+    diff = theta - resp.theta_f
+    f_n = float(beam.natural_frequencies(1)[0])
+    i_b = hinge_panel.hinge_inertia
+    return BeamComparison(
+        t=np.asarray(sol.t),
+        theta=theta,
+        theta_f=resp.theta_f,
+        moment=physical,
+        rmse_deg=float(np.degrees(np.sqrt(np.mean(diff**2)))),
+        hinge_frequency=dominant_frequency(sol.t, theta, f_min),
+        beam_frequency=dominant_frequency(resp.t, resp.theta_f, f_min),
+        natural_frequency=f_n,
+        hinge_natural_frequency=math.sqrt(hinge_panel.hinge_stiffness / i_b) / (2 * math.pi),
+        hinge_stiffness=hinge_panel.hinge_stiffness,
+        moment_scale=hinge_panel.moment_scale,
+        damping_ratio=zeta,
+        criterion="panel" if criterion is None else criterion,
+        settings={"model": model, "coupled": coupled, "n_elements": n_elements, "dt_out": dt_out},
+    )
