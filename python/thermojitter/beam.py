@@ -347,3 +347,194 @@ def compare_with_beam(
         criterion="panel" if criterion is None else criterion,
         settings={"model": model, "coupled": coupled, "n_elements": n_elements, "dt_out": dt_out},
     )
+
+
+PAPER_NUMBERS = {"natural_frequency_hz": 0.144, "rmse_deg": 0.93, "frequency_mismatch": 0.12}
+"""What the paper reports for Table 1 (Sec. 4.3): f_n, RMSE of θ − θ_f with K_el = 5.21 EI/L,
+and the jitter-frequency mismatch with the deflection criterion (about 12%)."""
+
+FIGURES = {
+    "fig22": "fig22_theta_deflection.png",
+    "fig22b": "fig22b_theta_frequency.png",
+    "fig23": "fig23_fft_deflection.png",
+    "fig24": "fig24_fft_frequency.png",
+}
+"""File names written by :func:`beam_comparison_figures`."""
+
+
+def frequency_convergence(
+    panel: Panel, element_counts: Sequence[int] = (4, 8, 16, 32, 64, 100)
+) -> list[dict[str, float]]:
+    """First elastic frequency (Hz) for each element count, beside the closed form
+    (β₁L)² sqrt(EI/(mL⁴))/2π, with the relative error."""
+    from thermojitter.panel import beam_frequency
+
+    exact = beam_frequency(panel)
+    rows = []
+    for n in element_counts:
+        f = float(FreeFreeBeam(panel, n).natural_frequencies(1)[0])
+        rows.append({"n_elements": n, "frequency_hz": f, "relative_error": (f - exact) / exact})
+    return rows
+
+
+def _calibrations(cmp: BeamComparison, panel: Panel, orbit: Orbit) -> dict[str, Any]:
+    """Fits of the hinge model to the beam's θ_f over the first 600 s after shadow entry."""
+    from thermojitter.calibrate import calibrate
+
+    enter = orbit.shadow_intervals(cmp.t[0], cmp.t[-1])[0][0]
+    m = (cmp.t >= enter - 60.0) & (cmp.t <= enter + 600.0)
+    ei_l = panel.youngs_modulus * panel.bending_inertia / panel.length
+    out: dict[str, Any] = {"window": [float(cmp.t[m][0]), float(cmp.t[m][-1])]}
+    freq = hinge_stiffness(panel, "frequency")
+    cases: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
+        "stiffness_damping": (("hinge_stiffness", "damping"), {}),
+        "stiffness_damping_chi": (
+            ("hinge_stiffness", "damping", "moment_scale"),
+            {"hinge_stiffness": freq, "moment_scale": freq / (4.0 * ei_l)},
+        ),
+    }
+    for name, (fit, initial) in cases.items():
+        r = calibrate(cmp.t[m], cmp.theta_f[m], panel=panel, orbit=orbit, fit=fit, initial=initial)
+        summary = r.summary()
+        summary["initial"] = {k: float(getattr(panel, k)) for k in fit} | initial
+        summary["hinge_stiffness_over_EI_L"] = r.parameters["hinge_stiffness"] / ei_l
+        out[name] = summary
+    out["criteria"] = {
+        "deflection": hinge_stiffness(panel, "deflection"),
+        "deflection_small_angle": 4.0 * ei_l,
+        "frequency": freq,
+    }
+    return out
+
+
+def beam_comparison_figures(
+    panel: Panel | None = None,
+    orbit: Orbit | None = None,
+    out_dir: str | Path = ".",
+    *,
+    n_elements: int = 100,
+    t_span: Sequence[float] | None = None,
+    calibrate: bool = True,
+) -> dict[str, Any]:
+    """Paper Figs. 22–24 as PNG files in ``out_dir`` and the comparison numbers.
+
+    Cases: ``"deflection"`` (the panel's own K_el — Table 1's 4438 N m/rad is the deflection
+    criterion), ``"frequency"`` (K_el = 5.21 EI/L) and ``"frequency_scaled"`` (5.21 EI/L with
+    M_T scaled by χ). Figures (:data:`FIGURES`): θ and θ_f for the first two, and the spectra of
+    θ and θ_f with f_n marked. Returns a JSON-ready dict: ``figures`` (paths), ``cases``
+    (:meth:`BeamComparison.summary` of each), ``beam`` (frequencies and their convergence with
+    the element count), ``paper`` (:data:`PAPER_NUMBERS`) and, with ``calibrate``, the hinge
+    parameters fitted to the beam's θ_f (``calibration``).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    panel = Panel.paper() if panel is None else panel
+    orbit = Orbit.geo_equinox() if orbit is None else orbit
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    kw: dict[str, Any] = {"n_elements": n_elements, "t_span": t_span}
+    cases = {
+        "deflection": compare_with_beam(panel, orbit, **kw),
+        "frequency": compare_with_beam(panel, orbit, criterion="frequency", **kw),
+        "frequency_scaled": compare_with_beam(
+            panel, orbit, criterion="frequency", scale_moment=True, **kw
+        ),
+    }
+    figures: dict[str, str] = {}
+
+    def save(fig: Any, key: str) -> None:
+        path = out / FIGURES[key]
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        figures[key] = str(path)
+
+    for key, case in (("fig22", cases["deflection"]), ("fig22b", cases["frequency"])):
+        fig, ax = plt.subplots(figsize=(8, 4))
+        minutes = (case.t - case.t[0]) / 60.0
+        ax.plot(minutes, case.theta_deg, lw=0.6, label="hinge model θ")
+        ax.plot(minutes, case.theta_f_deg, lw=0.6, label="beam θ_f (finite elements)")
+        ax.set_xlabel(f"time from t = {case.t[0]:.0f} s (min)")
+        ax.set_ylabel("angle (deg)")
+        ax.set_title(
+            f"K_el = {case.hinge_stiffness:.0f} N m/rad ({case.criterion}); "
+            f"RMSE {case.rmse_deg:.2f}°"
+        )
+        ax.legend(loc="best")
+        ax.grid(alpha=0.3)
+        save(fig, key)
+
+    for key, case in (("fig23", cases["deflection"]), ("fig24", cases["frequency"])):
+        fig, ax = plt.subplots(figsize=(8, 4))
+        for signal, label in ((case.theta_deg, "θ (hinge)"), (case.theta_f_deg, "θ_f (beam)")):
+            f, a = spectrum(case.t, signal)
+            keep = f <= 0.5
+            ax.semilogy(f[keep], a[keep], lw=0.8, label=label)
+        ax.axvline(case.natural_frequency, color="k", ls="--", lw=0.8)
+        ax.text(
+            case.natural_frequency,
+            ax.get_ylim()[1],
+            f" f_n = {case.natural_frequency:.3f} Hz",
+            va="top",
+            fontsize=8,
+        )
+        ax.set_xlabel("frequency (Hz)")
+        ax.set_ylabel("amplitude (deg)")
+        ax.set_title(
+            f"FFT, K_el = {case.hinge_stiffness:.0f} N m/rad: θ peak "
+            f"{case.hinge_frequency:.4f} Hz ({100 * case.frequency_mismatch:+.1f}% vs f_n)"
+        )
+        ax.legend(loc="best")
+        ax.grid(alpha=0.3, which="both")
+        save(fig, key)
+
+    beam = FreeFreeBeam(panel, n_elements)
+    from thermojitter.panel import beam_frequency
+
+    result: dict[str, Any] = {
+        "figures": figures,
+        "cases": {name: case.summary() for name, case in cases.items()},
+        "beam": {
+            "n_elements": n_elements,
+            "natural_frequencies_hz": [float(f) for f in beam.natural_frequencies(3)],
+            "closed_form_first_hz": beam_frequency(panel),
+            "convergence": frequency_convergence(panel),
+            "rigid_eigenvalues": [float(v) for v in beam.rigid_eigenvalues],
+            "total_mass": beam.total_mass,
+            "residual_fraction": beam.residual_fraction,
+        },
+        "paper": dict(PAPER_NUMBERS),
+    }
+    if calibrate:
+        result["calibration"] = _calibrations(cases["deflection"], panel, orbit)
+    return result
+
+
+def main_beam(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``thermojitter beam``: the paper's beam comparison (Figs. 22–24) for
+    Table 1, written to ``--out`` with ``beam_summary.json``."""
+    parser = argparse.ArgumentParser(
+        prog="thermojitter beam",
+        description="Compare the hinge model with a finite-element free-free beam (paper 4.3).",
+    )
+    parser.add_argument("--out", default="beam-out", help="output directory (default: beam-out)")
+    parser.add_argument("--elements", type=int, default=100, help="beam elements (even)")
+    parser.add_argument("--no-calibrate", action="store_true", help="skip the hinge fits")
+    args = parser.parse_args(None if argv is None else list(argv))
+    result = beam_comparison_figures(
+        out_dir=args.out, n_elements=args.elements, calibrate=not args.no_calibrate
+    )
+    path = Path(args.out) / "beam_summary.json"
+    path.write_text(json.dumps(result, indent=2))
+    for name, case in result["cases"].items():
+        print(
+            f"{name:17s} K_el = {case['hinge_stiffness']:8.1f} N m/rad  chi = "
+            f"{case['moment_scale']:.3f}  RMSE = {case['rmse_deg']:.3f} deg  "
+            f"f_hinge = {case['hinge_frequency_hz']:.4f} Hz  "
+            f"mismatch = {100 * case['frequency_mismatch']:+.1f}%"
+        )
+    print(f"beam f_n = {result['beam']['natural_frequencies_hz'][0]:.4f} Hz; wrote {path}")
+    return 0
