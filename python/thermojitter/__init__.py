@@ -6,7 +6,10 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
+from thermojitter import beam
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
+from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -21,15 +24,22 @@ from thermojitter.simulate import (
 __version__ = "0.1.0"
 
 __all__ = [
+    "BeamComparison",
+    "CalibrationResult",
     "ConvergenceError",
     "Equilibrium",
+    "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
     "Orbit",
     "Panel",
     "Solution",
     "ThermalSolution",
+    "beam",
     "beam_frequency",
+    "calibrate",
+    "calibrate_from_csv",
+    "compare_with_beam",
     "hinge_energy",
     "hinge_stiffness",
     "natural_frequency",
