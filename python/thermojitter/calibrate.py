@@ -154,7 +154,7 @@ def calibrate(
     res = least_squares(
         residual,
         x0,
-        x_scale=scale,
+        x_scale="jac",
         bounds=(lower, np.full_like(x0, np.inf)),
         diff_step=diff_step,
         method="trf",
