@@ -178,3 +178,14 @@ def test_beam_command_writes_figures_and_summary(tmp_path: object) -> None:
             assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
     assert set(summary["cases"]) == {"deflection", "frequency", "frequency_scaled"}
     assert summary["beam"]["convergence"][-1]["relative_error"] < 1e-3
+    with open(f"{out}/beam_report.md") as fh:
+        report = fh.read()
+    assert "0.93°" in report and "about 12%" in report
+
+
+def test_default_damping_matches_the_hinge_decay_rate() -> None:
+    # ζ ω₁ = c_d/(2 I_B): equal to the hinge's ζ with the frequency-criterion K_el
+    k_freq = tj.hinge_stiffness(PAPER, "frequency")
+    expected = PAPER.damping / (2 * math.sqrt(k_freq * PAPER.hinge_inertia))
+    assert tj.beam.default_damping_ratio(PAPER) == pytest.approx(expected, rel=1e-9)
+    assert tj.beam.default_damping_ratio(PAPER.replace(damping=0.0)) == 0.0
