@@ -6,7 +6,10 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
+from thermojitter import beam
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
+from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.flutter import FlutterResult, flutter
 from thermojitter.longrun import OrbitSummaries, simulate_orbits
 from thermojitter.orbit import Orbit
@@ -23,9 +26,12 @@ from thermojitter.simulate import (
 __version__ = "0.1.0"
 
 __all__ = [
+    "BeamComparison",
+    "CalibrationResult",
     "ConvergenceError",
     "Equilibrium",
     "FlutterResult",
+    "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
     "Orbit",
@@ -33,8 +39,12 @@ __all__ = [
     "Panel",
     "Solution",
     "ThermalSolution",
+    "beam",
     "beam_frequency",
     "flutter",
+    "calibrate",
+    "calibrate_from_csv",
+    "compare_with_beam",
     "hinge_energy",
     "hinge_stiffness",
     "natural_frequency",

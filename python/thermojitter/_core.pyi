@@ -12,6 +12,9 @@ __all__ = [
     "IntegrationError",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
+    "beam_modes",
+    "beam_response",
+    "beam_static",
     "derived",
     "energy",
     "flutter",
@@ -124,4 +127,28 @@ def run_orbits(
     window: float,
     theta_limit: float,
     stop_at_limit: bool,
+) -> dict[str, Any]: ...
+
+# --- finite-element beam comparator (rust/src/py/beam.rs) ---
+
+def beam_modes(panel: dict[str, float], n_elements: int, n_modes: int) -> dict[str, Any]: ...
+def beam_static(panel: dict[str, float], n_elements: int, moment: float) -> float: ...
+def beam_response(
+    panel: dict[str, float],
+    n_elements: int,
+    moment_t: _F,
+    moment: _F,
+    t0: float,
+    t1: float,
+    *,
+    damping_ratio: float,
+    residual: bool,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_eval: _F | None,
+    dt_out: float | None,
 ) -> dict[str, Any]: ...

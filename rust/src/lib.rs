@@ -5,6 +5,7 @@
 //!
 //! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
 
+pub mod beam;
 pub mod dynamics;
 pub mod error;
 pub mod flutter;

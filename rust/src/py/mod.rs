@@ -1,6 +1,7 @@
 //! The pyo3 layer: converts Python values to engine types, maps engine errors to exceptions and
 //! releases the GIL around every integration. It holds no physics.
 
+mod beam;
 mod convert;
 mod flutter;
 mod longrun;
@@ -391,5 +392,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
     flutter::register(m)?;
     longrun::register(m)?;
+    beam::register(m)?;
     Ok(())
 }
