@@ -66,7 +66,7 @@ def _chunks(t0: float, t1: float, period: float) -> list[tuple[float, float]]:
     """[t0, t1] cut at every whole orbit after t0 (one progress step per orbit)."""
     n = max(1, math.ceil((t1 - t0) / period - 1e-9))
     edges = [t0 + k * period for k in range(n)] + [t1]
-    return [(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+    return [(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
 
 
 def simulate_scenario(
@@ -134,8 +134,7 @@ def simulate_scenario(
             bar.close()
     names = ("t", *COLUMNS)
     columns = {
-        name: np.concatenate([p[name] for p in pieces]) if pieces else np.empty(0)
-        for name in names
+        name: np.concatenate([p[name] for p in pieces]) if pieces else np.empty(0) for name in names
     }
     return columns, counters, interrupted
 
@@ -144,7 +143,9 @@ def _write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
     try:
         import pandas as pd
     except ImportError:
-        raise UserError("writing time series needs pandas: pip install 'thermojitter[cli]'") from None
+        raise UserError(
+            "writing time series needs pandas: pip install 'thermojitter[cli]'"
+        ) from None
     frame = pd.DataFrame(columns)
     if fmt == "parquet":
         target = path.with_suffix(".parquet")
@@ -154,7 +155,7 @@ def _write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
             raise UserError("Parquet output needs pyarrow: pip install pyarrow") from None
     else:
         target = path.with_suffix(".csv")
-        frame.to_csv(target, index=False, float_format="%.12g")
+        frame.to_csv(target, index=False)  # shortest round-trip representation
     return target
 
 
@@ -176,6 +177,7 @@ def _run(args: argparse.Namespace) -> int:
         title = Path(scenario.source).stem
         written += [p.name for p in run_figures(out, t, columns, intervals, title=title)]
     sim = scenario.simulation
+    files = [*written, "run.json"]
     meta = {
         "scenario": scenario.source,
         "interrupted": interrupted,
@@ -204,16 +206,20 @@ def _run(args: argparse.Namespace) -> int:
         },
         "theta_min_deg": float(np.degrees(columns["theta"].min())) if len(t) else None,
         "theta_max_deg": float(np.degrees(columns["theta"].max())) if len(t) else None,
-        "files": written + ["run.json"],
+        "files": files,
         "wall_time_s": round(time.perf_counter() - started, 2),
     }
     (out / "run.json").write_text(json.dumps(meta, indent=2) + "\n")
     if interrupted:
-        print(f"interrupted: kept {len(t)} samples up to t = {t[-1] if len(t) else 0:.0f} s",
-              file=sys.stderr)
+        print(
+            f"interrupted: kept {len(t)} samples up to t = {t[-1] if len(t) else 0:.0f} s",
+            file=sys.stderr,
+        )
         raise KeyboardInterrupt
-    print(f"wrote {', '.join(meta['files'])} to {args.out} ({len(t)} samples, "
-          f"{counters['n_steps']} steps, {meta['wall_time_s']} s)")
+    print(
+        f"wrote {', '.join(files)} to {args.out} ({len(t)} samples, "
+        f"{counters['n_steps']} steps, {meta['wall_time_s']} s)"
+    )
     return 0
 
 
@@ -297,7 +303,7 @@ def build_parser() -> argparse.ArgumentParser:
             "(timeseries.csv or .parquet: t [s], T_front, T_back [K], theta [rad], "
             "theta_dot [rad/s], thermal_moment [N m], sunlit), run.json (settings, step counts) "
             "and plots (temperatures.png, theta.png) into --out. Tables: [panel] any Panel "
-            "field; [orbit] preset = \"geo_equinox\" and/or radius, earth_radius, period, "
+            'field; [orbit] preset = "geo_equinox" and/or radius, earth_radius, period, '
             "phase0; [simulation] t_start, t_end or orbits, model (nonlinear|linear), coupled, "
             "method (rk45|rk4), rtol, atol, dt, dt_out; [output] format (csv|parquet), plots."
         ),

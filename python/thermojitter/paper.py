@@ -282,9 +282,14 @@ def thermal_section(ctx: PaperContext) -> SectionResult:
     res.summary["one_node_T_min_K"] = float(one.T.min())
 
     cases = {
-        "A": (ctx.panel.replace(
-            emissivity_front=ctx.panel.emissivity_back, emissivity_back=ctx.panel.emissivity_front
-        ), 3, 5),
+        "A": (
+            ctx.panel.replace(
+                emissivity_front=ctx.panel.emissivity_back,
+                emissivity_back=ctx.panel.emissivity_front,
+            ),
+            3,
+            5,
+        ),
         "B": (ctx.panel, 4, 6),
     }
     lines = []
@@ -335,15 +340,23 @@ def thermal_section(ctx: PaperContext) -> SectionResult:
         )
     a, b = res.summary["case_a"], res.summary["case_b"]
     res.rows.append(
-        ("Case A: ΔT in the eclipse", "stays > 0, falls towards 0",
-         f"min {a['delta_T_eclipse_min_K']:+.2f} K", "as stated" if a["delta_T_eclipse_min_K"] > 0
-         else "differs: goes negative")
+        (
+            "Case A: ΔT in the eclipse",
+            "stays > 0, falls towards 0",
+            f"min {a['delta_T_eclipse_min_K']:+.2f} K",
+            "as stated" if a["delta_T_eclipse_min_K"] > 0 else "differs: goes negative",
+        )
     )
     res.rows.append(
-        ("Case B: ΔT in the eclipse", "much smaller than A, negative while cooling, overshoots",
-         f"{b['delta_T_sunlit_K']:.1f} K in Sun, min {b['delta_T_eclipse_min_K']:+.2f} K, "
-         f"peak after exit {b['delta_T_max_after_exit_K']:.1f} K",
-         "as stated" if b["delta_T_eclipse_min_K"] < 0 < a["delta_T_eclipse_min_K"] else "differs")
+        (
+            "Case B: ΔT in the eclipse",
+            "much smaller than A, negative while cooling, overshoots",
+            f"{b['delta_T_sunlit_K']:.1f} K in Sun, min {b['delta_T_eclipse_min_K']:+.2f} K, "
+            f"peak after exit {b['delta_T_max_after_exit_K']:.1f} K",
+            "as stated"
+            if b["delta_T_eclipse_min_K"] < 0 < a["delta_T_eclipse_min_K"]
+            else "differs",
+        )
     )
     res.text = (
         f"One node: T swings between {one.T.min():.0f} K and {one.T.max():.0f} K (Fig. 2), cooling "
@@ -361,22 +374,28 @@ def kinematics_section(ctx: PaperContext) -> SectionResult:
     res = SectionResult()
     plt = plots.pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10.0, 5.0))
-    l = ctx.panel.half_arm
+    arm = ctx.panel.half_arm
     theta = np.radians(np.linspace(-90.0, 90.0, 721))
-    for zeta in np.arange(0.0, 2.0 * l + 1e-9, 2.5):
-        x = (l - zeta) * np.sin(theta)
+    for zeta in np.arange(0.0, 2.0 * arm + 1e-9, 2.5):
+        x = (arm - zeta) * np.sin(theta)
         for sign in (1.0, -1.0):
             ax1.plot(x, sign * zeta * np.cos(theta), lw=0.8, color="C0")
-    zeta = np.linspace(0.0, 2.0 * l, 2)
+    zeta = np.linspace(0.0, 2.0 * arm, 2)
     th = ctx.equilibrium.theta
     for sign in (1.0, -1.0):
-        ax1.plot((l - zeta) * np.sin(th), sign * zeta * np.cos(th), lw=2.5, color="k",
-                 label=f"panel at θ = {math.degrees(th):.1f}° (sunlit)" if sign > 0 else None)
+        ax1.plot(
+            (arm - zeta) * np.sin(th),
+            sign * zeta * np.cos(th),
+            lw=2.5,
+            color="k",
+            label=f"panel at θ = {math.degrees(th):.1f}° (sunlit)" if sign > 0 else None,
+        )
     ax1.set_aspect("equal")
     ax1.set_xlabel("x, normal to the panel [m]")
     ax1.set_ylabel("y, along the panel [m]")
-    ax1.set_title("Fig. 12 — paths of points Q, −90° ≤ θ ≤ 90°,\nζ = 0 … 2l every 2.5 m",
-                  fontsize=10)
+    ax1.set_title(
+        "Fig. 12 — paths of points Q, −90° ≤ θ ≤ 90°,\nζ = 0 … 2l every 2.5 m", fontsize=10
+    )
     ax1.legend(loc="lower left", fontsize=8)
     ax1.grid(alpha=0.3)
 
@@ -388,9 +407,10 @@ def kinematics_section(ctx: PaperContext) -> SectionResult:
     ax2.legend(loc="lower right", fontsize=8)
     ax2.set_xlabel(r"$\theta$ [deg]")
     ax2.set_ylabel(r"$\dot\theta$ [deg/s]")
-    ax2.set_title("(added) phase plane θ–θ̇, shadow entry to 1 h after exit\n"
-                  "(Table 1, non-linear, coupled)",
-                  fontsize=10)
+    ax2.set_title(
+        "(added) phase plane θ–θ̇, shadow entry to 1 h after exit\n(Table 1, non-linear, coupled)",
+        fontsize=10,
+    )
     ax2.grid(alpha=0.3)
     res.figures.append(ctx.save(fig, "fig12_kinematics.png"))
     res.text = (
@@ -453,6 +473,7 @@ def jitter_section(ctx: PaperContext) -> SectionResult:
         c: hinge_stiffness(p, c) for c in ("deflection", "deflection_small_angle", "frequency")
     }
     mismatch = (f_fft - f_beam) / f_beam
+    ei = p.youngs_modulus * p.bending_inertia
     # the residual jitter in sunlight at the end of the orbit (1 h before the end)
     _, late = window(run.t, theta, ctx.orbit.period - 3600.0, ctx.orbit.period)
     res.summary.update(
@@ -478,24 +499,50 @@ def jitter_section(ctx: PaperContext) -> SectionResult:
         }
     )
     res.rows += [
-        ("steady sunlit angle θ", "about 5°", f"{eq.theta_deg:.2f}°",
-         f"{eq.theta_deg - PAPER_THETA_DEG:+.2f}°"),
-        ("θ in 10 min after entry / exit", "reverses sign, then back",
-         f"min {after_entry.min():+.2f}° / max {after_exit.max():+.2f}°",
-         "as stated" if after_entry.min() < 0 < after_exit.max() else "differs"),
-        ("beam first free–free frequency f_n", f"{PAPER_BEAM_FREQUENCY_HZ} Hz", f"{f_beam:.4f} Hz",
-         _pct(f_beam, PAPER_BEAM_FREQUENCY_HZ)),
-        ("jitter frequency (measured, FFT of θ in eclipse)", "≈ 12% off f_n",
-         f"{f_fft:.4f} Hz ({100 * mismatch:+.1f}% vs f_n)",
-         f"{100 * (abs(mismatch) - PAPER_FREQUENCY_MISMATCH):+.1f} points"),
-        ("hinge model natural frequency", "–", f"{f_hinge:.4f} Hz",
-         _pct(f_fft, f_hinge) + " measured vs model"),
-        ("K_el, deflection criterion", f"{PAPER_K_EL:g} N m/rad (Table 1)",
-         f"{stiffness['deflection']:.0f} (exact), {stiffness['deflection_small_angle']:.0f} "
-         "(4EI/L)", _pct(stiffness["deflection"], PAPER_K_EL)),
-        ("K_el, frequency criterion", "≈ 5.21 EI/L", f"{stiffness['frequency']:.0f} N m/rad "
-         f"= {stiffness['frequency'] * p.length / (p.youngs_modulus * p.bending_inertia):.2f} EI/L",
-         "–"),
+        (
+            "steady sunlit angle θ",
+            "about 5°",
+            f"{eq.theta_deg:.2f}°",
+            f"{eq.theta_deg - PAPER_THETA_DEG:+.2f}°",
+        ),
+        (
+            "θ in 10 min after entry / exit",
+            "reverses sign, then back",
+            f"min {after_entry.min():+.2f}° / max {after_exit.max():+.2f}°",
+            "as stated" if after_entry.min() < 0 < after_exit.max() else "differs",
+        ),
+        (
+            "beam first free–free frequency f_n",
+            f"{PAPER_BEAM_FREQUENCY_HZ} Hz",
+            f"{f_beam:.4f} Hz",
+            _pct(f_beam, PAPER_BEAM_FREQUENCY_HZ),
+        ),
+        (
+            "jitter frequency (measured, FFT of θ in eclipse)",
+            "≈ 12% off f_n",
+            f"{f_fft:.4f} Hz ({100 * mismatch:+.1f}% vs f_n)",
+            f"{100 * (abs(mismatch) - PAPER_FREQUENCY_MISMATCH):+.1f} points",
+        ),
+        (
+            "hinge model natural frequency",
+            "–",
+            f"{f_hinge:.4f} Hz",
+            _pct(f_fft, f_hinge) + " measured vs model",
+        ),
+        (
+            "K_el, deflection criterion",
+            f"{PAPER_K_EL:g} N m/rad (Table 1)",
+            f"{stiffness['deflection']:.0f} (exact), {stiffness['deflection_small_angle']:.0f} "
+            "(4EI/L)",
+            _pct(stiffness["deflection"], PAPER_K_EL),
+        ),
+        (
+            "K_el, frequency criterion",
+            "≈ 5.21 EI/L",
+            f"{stiffness['frequency']:.0f} N m/rad "
+            f"= {stiffness['frequency'] * p.length / ei:.2f} EI/L",
+            "–",
+        ),
     ]
     res.text = (
         f"With Table 1 (K_el = {p.hinge_stiffness:g} N m/rad) the sunlit equilibrium is "
@@ -535,13 +582,24 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
         hours = (run.t - entry) / 3600.0
         plots.line(ax1, hours, theta, lw=0.5)
         ax1.set_ylabel(r"$\theta$ [deg]")
-        ax2.semilogy((centres - entry) / 3600.0, np.maximum(amps, 1e-6), "o-", ms=2.5, lw=0.8,
-                     color="C1", label="half peak-to-peak of θ per 10 min (with the thermal drift)")
+        ax2.semilogy(
+            (centres - entry) / 3600.0,
+            np.maximum(amps, 1e-6),
+            "o-",
+            ms=2.5,
+            lw=0.8,
+            color="C1",
+            label="half peak-to-peak of θ per 10 min (with the thermal drift)",
+        )
         if math.isfinite(rate) and coupled:
             c = centres[fit]
-            ax2.semilogy((c - entry) / 3600.0, np.exp(np.polyval(
-                np.polyfit(c, np.log(amps[fit]), 1), c)), "k--", lw=1.0,
-                label=f"fit: e-folding {1 / rate / 3600:.2f} h")
+            ax2.semilogy(
+                (c - entry) / 3600.0,
+                np.exp(np.polyval(np.polyfit(c, np.log(amps[fit]), 1), c)),
+                "k--",
+                lw=1.0,
+                label=f"fit: e-folding {1 / rate / 3600:.2f} h",
+            )
         ax2.axhline(20.0, color="C3", lw=0.8, ls=":", label="20°: beyond modest angles")
         ax2.set_ylim(bottom=0.01)
         ax2.set_ylabel("oscillation amplitude [deg]")
@@ -551,13 +609,16 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
             ax.grid(alpha=0.3)
         ax2.legend(loc="lower right", fontsize=8)
         if coupled:
-            ax1.set_title("Fig. 17 — thermal flutter, c_d = 0, projected area ∝ cos θ: "
-                          "θ grows", fontsize=10)
+            ax1.set_title(
+                "Fig. 17 — thermal flutter, c_d = 0, projected area ∝ cos θ: θ grows", fontsize=10
+            )
         else:
-            ax1.set_title("Fig. 18 — c_d = 0, projected area frozen (cos θ → 1): "
-                          "no growth", fontsize=10)
-        res.figures.append(ctx.save(fig, f"fig{number}_flutter_"
-                                         f"{'coupled' if coupled else 'frozen'}.png"))
+            ax1.set_title(
+                "Fig. 18 — c_d = 0, projected area frozen (cos θ → 1): no growth", fontsize=10
+            )
+        res.figures.append(
+            ctx.save(fig, f"fig{number}_flutter_{'coupled' if coupled else 'frozen'}.png")
+        )
         late = amps[centres > t_first_exit + 3600.0]
         out["coupled" if coupled else "frozen"] = {
             "theta_equilibrium_deg": eq.theta_deg,
@@ -573,14 +634,21 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
     res.summary["flutter"] = out
     co, fr = out["coupled"], out["frozen"]
     res.rows += [
-        ("c_d = 0, coupled (Fig. 17)", "amplitude grows progressively",
-         f"{co['amplitude_1h_after_exit_deg']:.3f}° → {co['amplitude_end_deg']:.1f}° in "
-         f"{opts.flutter_hours:g} h (e-folding {co['e_folding_time_h']:.2f} h)",
-         "grows, faster than 'over orbits'"),
-        ("c_d = 0, frozen area (Fig. 18)", "keeps the residual amplitude",
-         f"{fr['amplitude_1h_after_exit_deg']:.3f}° → {fr['amplitude_end_deg']:.3f}°",
-         "as stated" if fr["amplitude_end_deg"] < 1.5 * fr["amplitude_1h_after_exit_deg"]
-         else "differs"),
+        (
+            "c_d = 0, coupled (Fig. 17)",
+            "amplitude grows progressively",
+            f"{co['amplitude_1h_after_exit_deg']:.3f}° → {co['amplitude_end_deg']:.1f}° in "
+            f"{opts.flutter_hours:g} h (e-folding {co['e_folding_time_h']:.2f} h)",
+            "grows, faster than 'over orbits'",
+        ),
+        (
+            "c_d = 0, frozen area (Fig. 18)",
+            "keeps the residual amplitude",
+            f"{fr['amplitude_1h_after_exit_deg']:.3f}° → {fr['amplitude_end_deg']:.3f}°",
+            "as stated"
+            if fr["amplitude_end_deg"] < 1.5 * fr["amplitude_1h_after_exit_deg"]
+            else "differs",
+        ),
     ]
     res.text = (
         f"With c_d = 0 and the projected area following cos θ, the jitter left by the eclipse "
@@ -610,8 +678,9 @@ def linearity_section(ctx: PaperContext) -> SectionResult:
         x = nl.t[mask] - t_event
         fig, (ax1, ax2) = plots.figure(2, height=5.5)
         ax1.plot(x, np.degrees(nl.theta[mask]), lw=1.6, label="non-linear (eq. 20)")
-        ax1.plot(x, np.degrees(li.theta[mask]), lw=1.0, ls="--", color="C3",
-                 label="linearised (eq. 28)")
+        ax1.plot(
+            x, np.degrees(li.theta[mask]), lw=1.0, ls="--", color="C3", label="linearised (eq. 28)"
+        )
         ax1.set_ylabel(r"$\theta$ [deg]")
         ax1.legend(loc="best", fontsize=8)
         ax2.plot(x, diff[mask], lw=0.8, color="k")
@@ -640,10 +709,14 @@ def linearity_section(ctx: PaperContext) -> SectionResult:
         }
     )
     res.rows.append(
-        ("linear vs non-linear θ (Figs. 19–20)", "almost indistinguishable",
-         f"max |Δθ| {np.abs(zoom_e).max():.1e}° / {np.abs(zoom_x).max():.1e}° in the first 2 min;"
-         f" {np.abs(dwin).max():.3f}° over the eclipse + 10 min",
-         f"{100 * np.abs(dwin).max() / swing:.1f}% of the {swing:.1f}° swing")
+        (
+            "linear vs non-linear θ (Figs. 19–20)",
+            "almost indistinguishable",
+            f"max |Δθ| {np.abs(zoom_e).max():.1e}° / {np.abs(zoom_x).max():.1e}° "
+            "in the first 2 min;"
+            f" {np.abs(dwin).max():.3f}° over the eclipse + 10 min",
+            f"{100 * np.abs(dwin).max() / swing:.1f}% of the {swing:.1f}° swing",
+        )
     )
     res.text = (
         "The linearised hinge differs from the non-linear one only through 1 + 3 sin²θ and the "
@@ -698,8 +771,9 @@ def _write_json(path: Path, data: dict[str, Any]) -> None:
     tmp.replace(path)
 
 
-def _report(ctx: PaperContext, results: list[tuple[Section, SectionResult]],
-            summary: dict[str, Any]) -> str:
+def _report(
+    ctx: PaperContext, results: list[tuple[Section, SectionResult]], summary: dict[str, Any]
+) -> str:
     p = ctx.panel
     lines = [
         "# thermojitter — reproduction of Parisse & Angeletti 2024 (Table 1 panel, GEO equinox)",

@@ -171,7 +171,9 @@ def _validated(path: Path, section: str, build: Any, base: Any, values: dict[str
 def _engine_error(path: Path, section: str, message: str, key: str | None) -> ScenarioError:
     match = _ENGINE_MESSAGE.match(message)
     if match:
-        return ScenarioError(path, f"{section}.{match.group(1)}", message[len(match.group(1)) + 1 :])
+        return ScenarioError(
+            path, f"{section}.{match.group(1)}", message[len(match.group(1)) + 1 :]
+        )
     return ScenarioError(path, f"{section}.{key}" if key else section, message)
 
 
