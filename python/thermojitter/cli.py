@@ -43,9 +43,18 @@ class UserError(Exception):
 def _paper(args: argparse.Namespace) -> int:
     from thermojitter.paper import PaperOptions, run_paper
 
-    options = PaperOptions(dt_out=args.dt_out, flutter_hours=args.flutter_hours)
-    if args.quick:
-        options = PaperOptions(dt_out=1.0, thermal_dt_out=5.0, flutter_hours=6.0)
+    base = (
+        PaperOptions(dt_out=1.0, thermal_dt_out=5.0, flutter_hours=6.0)
+        if args.quick
+        else (PaperOptions())
+    )
+    options = PaperOptions(
+        rtol=base.rtol,
+        atol=base.atol,
+        dt_out=args.dt_out if args.dt_out is not None else base.dt_out,
+        thermal_dt_out=base.thermal_dt_out,
+        flutter_hours=args.flutter_hours if args.flutter_hours is not None else base.flutter_hours,
+    )
     started = time.perf_counter()
     summary = run_paper(_out_dir(args.out), options, progress=not args.no_progress)
     elapsed = time.perf_counter() - started
@@ -275,7 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
     paper.add_argument(
         "--flutter-hours",
         type=_positive,
-        default=14.0,
+        default=None,
         metavar="H",
         help="length of the undamped runs of Figs. 17-18, hours from just before the first "
         "eclipse (default 14; the growth leaves the small-angle range after about 12 h)",
@@ -283,14 +292,15 @@ def build_parser() -> argparse.ArgumentParser:
     paper.add_argument(
         "--dt-out",
         type=_positive,
-        default=0.5,
+        default=None,
         metavar="S",
         help="reporting interval of the coupled runs, s (default 0.5; the jitter period is ~8 s)",
     )
     paper.add_argument(
         "--quick",
         action="store_true",
-        help="reduced horizon for a fast check: 6 h flutter runs, 1 s output",
+        help="reduced horizon for a fast check: 6 h flutter runs, 1 s output (explicit "
+        "--flutter-hours / --dt-out still win)",
     )
     paper.add_argument("--no-progress", action="store_true", help="no progress bar")
     paper.set_defaults(handler=_paper)
