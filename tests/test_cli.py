@@ -362,3 +362,19 @@ def test_ctrl_c_keeps_finished_orbits(
     assert frame["t"].iloc[-1] < period  # the first orbit only, kept on disk
     assert len(frame) == math.ceil(period / 60.0)
     assert json.loads((out / "run.json").read_text())["interrupted"] is True
+
+
+def test_paper_stops_cleanly_between_figures(tmp_path: Path) -> None:
+    from thermojitter.paper import PaperOptions, run_paper
+
+    polls = []
+
+    def stop_after_first_figure() -> bool:
+        polls.append(1)
+        return len(polls) >= 2  # polled before the first section, then after each figure
+
+    with pytest.raises(KeyboardInterrupt):
+        run_paper(tmp_path, PaperOptions(), progress=False, stop=stop_after_first_figure)
+    assert (tmp_path / "fig02_one_node_temperature.png").exists()
+    assert not (tmp_path / "fig03_case_a_temperatures.png").exists()
+    assert not (tmp_path / "report.md").exists()

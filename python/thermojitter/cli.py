@@ -12,7 +12,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import signal
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -36,6 +38,35 @@ class UserError(Exception):
     """A problem with what the user asked for: reported in one line, exit code 2."""
 
 
+class _Interrupt:
+    """Ctrl-C as a flag polled between orbits and figures, so the stop happens at a clean point
+    (never inside matplotlib or a callback); a second Ctrl-C stops at once."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self._previous: Any = None
+
+    def __call__(self) -> bool:
+        return self.requested
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+
+    def __enter__(self) -> _Interrupt:
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+
+
+_STOP = _Interrupt()
+
+
 # --------------------------------------------------------------------------------------------
 # paper
 
@@ -56,7 +87,7 @@ def _paper(args: argparse.Namespace) -> int:
         flutter_hours=args.flutter_hours if args.flutter_hours is not None else base.flutter_hours,
     )
     started = time.perf_counter()
-    summary = run_paper(_out_dir(args.out), options, progress=not args.no_progress)
+    summary = run_paper(_out_dir(args.out), options, progress=not args.no_progress, stop=_STOP)
     elapsed = time.perf_counter() - started
     print(
         f"wrote {len(summary['figures'])} figures, summary.json and report.md to {args.out} "
@@ -79,12 +110,13 @@ def _chunks(t0: float, t1: float, period: float) -> list[tuple[float, float]]:
 
 
 def simulate_scenario(
-    scenario: Scenario, *, progress: bool = True
+    scenario: Scenario, *, progress: bool = True, stop: Any = None
 ) -> tuple[dict[str, Any], dict[str, Any], bool]:
     """Runs a scenario orbit by orbit (each continuing from the last state).
 
-    Returns (columns with "t", counters, interrupted). On Ctrl-C the orbits finished so far are
-    returned with interrupted = True."""
+    Returns (columns with "t", counters, interrupted). On Ctrl-C (or when ``stop()`` turns
+    True, polled after each orbit) the orbits finished so far are returned with
+    interrupted = True."""
     from thermojitter.simulate import simulate
 
     sim = scenario.simulation
@@ -136,6 +168,8 @@ def simulate_scenario(
             y0 = [float(v) for v in sol.y_end]
             if bar is not None:
                 bar.update(1)
+            if stop is not None and stop() and not last:
+                raise KeyboardInterrupt
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -174,7 +208,9 @@ def _run(args: argparse.Namespace) -> int:
     fmt = args.format or scenario.output.format
     make_plots = scenario.output.plots and not args.no_plots
     started = time.perf_counter()
-    columns, counters, interrupted = simulate_scenario(scenario, progress=not args.no_progress)
+    columns, counters, interrupted = simulate_scenario(
+        scenario, progress=not args.no_progress, stop=_STOP
+    )
     t = columns["t"]
     written = []
     if len(t):
@@ -343,7 +379,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_USER_ERROR
     try:
-        return int(args.handler(args))
+        with _STOP:
+            _STOP.requested = False
+            return int(args.handler(args))
     except KeyboardInterrupt:
         print("thermojitter: interrupted (files already written are kept)", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -874,11 +874,13 @@ def run_paper(
     *,
     sections: list[Section] | None = None,
     progress: bool = True,
+    stop: Callable[[], bool] | None = None,
 ) -> dict[str, Any]:
     """Writes the figures, ``summary.json`` and ``report.md`` into ``out``; returns the summary.
 
     ``summary.json`` is rewritten after every section (with ``"complete": false`` until the end),
-    so an interrupted run keeps what it had finished.
+    so an interrupted run keeps what it had finished. ``stop`` is polled after every figure and
+    section; when it returns True the run ends with ``KeyboardInterrupt``.
     """
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
@@ -892,10 +894,15 @@ def run_paper(
 
         bar = tqdm(total=sum(s.figures for s in chosen), unit="fig", desc="paper", leave=False)
 
+    def check() -> None:
+        if stop is not None and stop():
+            raise KeyboardInterrupt
+
     def tick(name: str) -> None:
         if bar is not None:
             bar.set_postfix_str(name, refresh=False)
             bar.update(1)
+        check()
 
     ctx = PaperContext(folder, opts, tick=tick)
     summary: dict[str, Any] = {
@@ -919,6 +926,7 @@ def run_paper(
     results: list[tuple[Section, SectionResult]] = []
     try:
         for section in chosen:
+            check()
             res = section.build(ctx)
             results.append((section, res))
             summary.update(res.summary)
