@@ -378,3 +378,28 @@ def test_paper_stops_cleanly_between_figures(tmp_path: Path) -> None:
     assert (tmp_path / "fig02_one_node_temperature.png").exists()
     assert not (tmp_path / "fig03_case_a_temperatures.png").exists()
     assert not (tmp_path / "report.md").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["paper", "--out", "x", "--dt-out", "-1"],
+        ["paper"],
+        ["nonsense"],
+        ["run", "--out", "x"],
+    ],
+)
+def test_command_line_mistakes_are_one_line(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as stop:
+        cli.main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("thermojitter") and "--help" in err
+
+
+def test_too_long_a_run_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _scenario(tmp_path, "[simulation]\nt_end = 1e12\ndt_out = 1e8\n")
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "orbits" in capsys.readouterr().err

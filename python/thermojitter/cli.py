@@ -18,7 +18,7 @@ import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -30,6 +30,9 @@ EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
 MAX_ROWS = 20_000_000
 """Largest time series ``run`` will keep (rows); more asks for a larger dt_out."""
+
+MAX_ORBITS = 100_000
+"""Longest run ``run`` accepts, in orbits (about 270 years of GEO)."""
 
 COLUMNS = ("T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit")
 
@@ -128,6 +131,13 @@ def simulate_scenario(
             "simulation.dt_out",
             f"{sim.dt_out} s over {t1 - t0:.6g} s gives {n_rows:.3g} rows, more than "
             f"{MAX_ROWS:.0e}: choose a larger dt_out",
+        )
+    n_orbits = (t1 - t0) / scenario.orbit.period
+    if n_orbits > MAX_ORBITS:
+        raise ScenarioError(
+            scenario.source,
+            "simulation",
+            f"the span covers {n_orbits:.3g} orbits, more than {MAX_ORBITS:.0e}: shorten it",
         )
     grid = t0 + sim.dt_out * np.arange(int(math.floor((t1 - t0) / sim.dt_out)) + 1)
     if grid[-1] < t1:
@@ -293,8 +303,15 @@ def _positive(text: str) -> float:
     return value
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit code 2) pointing at --help."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="thermojitter",
         description=(
             "Thermal jitter and thermal flutter of long, thin spacecraft appendages "
