@@ -632,7 +632,7 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
         for ax in (ax1, ax2):
             plots.shade_shadow(ax, ctx.shadows(run.t[0], run.t[-1]), scale=3600.0, offset=entry)
             ax.grid(alpha=0.3)
-        ax2.legend(loc="lower right", fontsize=8)
+        ax2.legend(loc="lower right" if coupled else "upper right", fontsize=8)
         if coupled:
             ax1.set_title(
                 "Fig. 17 — thermal flutter, c_d = 0, projected area ∝ cos θ: θ grows", fontsize=10
