@@ -380,7 +380,40 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--no-plots", action="store_true", help="write no plots")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     run.set_defaults(handler=_run)
+
+    beam = sub.add_parser(
+        "beam",
+        help="compare the hinge model with a finite-element beam (paper Sec. 4.3)",
+        description=(
+            "Drive a free-free finite-element beam with the hinge run's thermal moment through "
+            "an eclipse and compare its equivalent angle with the hinge model's, for K_el by the "
+            "deflection and the frequency criteria (paper Figs. 22-24). Writes the figures, "
+            "beam_summary.json and beam_report.md into --out."
+        ),
+        epilog="Example: thermojitter beam --out out/beam",
+    )
+    beam.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    beam.add_argument(
+        "--elements",
+        type=int,
+        default=100,
+        metavar="N",
+        help="beam elements, even (default 100: 101 nodes as in the paper)",
+    )
+    beam.add_argument(
+        "--no-calibrate",
+        action="store_true",
+        help="skip fitting the hinge parameters to the beam run",
+    )
+    beam.set_defaults(handler=_beam)
     return parser
+
+
+def _beam(args: argparse.Namespace) -> int:
+    from thermojitter.beam import main_beam
+
+    argv = ["--out", str(_out_dir(args.out)), "--elements", str(args.elements)]
+    return main_beam(argv + (["--no-calibrate"] if args.no_calibrate else []))
 
 
 def _fail(message: str) -> int:
