@@ -37,6 +37,10 @@ FIGURES = [
     "fig18_flutter_frozen.png",
     "fig19_entry_linear_vs_nonlinear.png",
     "fig20_exit_linear_vs_nonlinear.png",
+    "fig22_theta_deflection.png",
+    "fig22b_theta_frequency.png",
+    "fig23_fft_deflection.png",
+    "fig24_fft_frequency.png",
 ]
 
 
@@ -51,7 +55,7 @@ def paper_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
         timeout=300,
     )
     assert done.returncode == 0, done.stderr
-    assert "wrote 13 figures" in done.stdout
+    assert f"wrote {len(FIGURES)} figures" in done.stdout
     return out
 
 
@@ -410,3 +414,18 @@ def test_too_long_a_run_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture
     path = _scenario(tmp_path, "[simulation]\nt_end = 1e12\ndt_out = 1e8\n")
     assert cli.main(["run", str(path), "--out", str(tmp_path / "o")]) == 2
     assert "orbits" in capsys.readouterr().err
+
+
+def test_summary_beam_comparison(summary: dict) -> None:
+    # Beam first free-free mode: (β₁L)² sqrt(EI/(mL⁴))/2π with β₁L = 4.7300 (paper: 0.144 Hz).
+    p = tj.Panel.paper()
+    f_n = 4.7300**2 * math.sqrt(
+        p.youngs_modulus * p.bending_inertia / (p.mass_per_length * p.length**4)
+    )
+    assert summary["beam_fe_frequency_hz"] == pytest.approx(f_n / (2 * math.pi), rel=1e-3)
+    rmse = summary["beam_rmse_deg"]
+    # Paper Sec. 4.3: 0.93° RMSE with K_el = 5.21 EI/L; the deflection criterion matches better.
+    assert 0.5 < rmse["frequency"] < 1.5
+    assert rmse["deflection"] < rmse["frequency"]
+    assert 0.10 < -summary["beam_frequency_mismatch"]["deflection"] < 0.15  # "about 12%"
+    assert abs(summary["beam_frequency_mismatch"]["frequency"]) < 0.01
