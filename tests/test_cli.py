@@ -429,3 +429,35 @@ def test_summary_beam_comparison(summary: dict) -> None:
     assert rmse["deflection"] < rmse["frequency"]
     assert 0.10 < -summary["beam_frequency_mismatch"]["deflection"] < 0.15  # "about 12%"
     assert abs(summary["beam_frequency_mismatch"]["frequency"]) < 0.01
+
+
+def test_run_keeps_per_orbit_summaries_and_resumes(tmp_path: Path) -> None:
+    scenario = tmp_path / "long.toml"
+    scenario.write_text(
+        "[orbit]\nradius = 7.0e6\nperiod = 5828.5\n\n"
+        '[simulation]\norbits = 3\nkeep = "orbits"\n\n[output]\nformat = "csv"\n'
+    )
+    out = tmp_path / "out"
+    assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 0
+    rows = (out / "orbits.csv").read_text().splitlines()
+    assert rows[0].startswith("index,t_start,t_end,theta_eq")
+    assert len(rows) == 1 + 3
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["orbits_done"] == 3 and meta["limit_crossing"] is None
+    assert (out / "orbits.png").exists()
+    # Asking for more orbits with the same settings continues from the checkpoint.
+    scenario.write_text(scenario.read_text().replace("orbits = 3", "orbits = 5"))
+    assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 0
+    assert len((out / "orbits.csv").read_text().splitlines()) == 1 + 5
+
+
+def test_run_rejects_fractional_orbits_for_summaries(tmp_path: Path) -> None:
+    scenario = tmp_path / "frac.toml"
+    scenario.write_text('[simulation]\norbits = 2.5\nkeep = "orbits"\n')
+    assert cli.main(["run", str(scenario), "--out", str(tmp_path / "o")]) == 2
+
+
+def test_scenario_refuses_two_spans(tmp_path: Path) -> None:
+    scenario = tmp_path / "two.toml"
+    scenario.write_text("[simulation]\norbits = 2\nyears = 1\n")
+    assert cli.main(["run", str(scenario), "--out", str(tmp_path / "o")]) == 2

@@ -212,9 +212,81 @@ def _write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
     return target
 
 
+def _run_orbits(args: argparse.Namespace, scenario: Scenario, out: Path) -> int:
+    """`run` with keep = "orbits": one summary row per orbit, resumable from out/checkpoint.json."""
+    from thermojitter.longrun import simulate_orbits
+
+    sim = scenario.simulation
+    n = sim.n_orbits(scenario.orbit)
+    n_orbits = max(1, int(round(n)))
+    if abs(n - n_orbits) > 1e-6 * max(n, 1.0):
+        raise ScenarioError(
+            scenario.source, "simulation", f"keep = 'orbits' needs whole orbits; the span is {n:g}"
+        )
+    fmt = args.format or scenario.output.format
+    started = time.perf_counter()
+    runs = simulate_orbits(
+        scenario.panel,
+        scenario.orbit,
+        n_orbits,
+        t_start=sim.t_start,
+        model=sim.model,  # type: ignore[arg-type]
+        coupled=sim.coupled,
+        method=sim.method,  # type: ignore[arg-type]
+        rtol=sim.rtol,
+        atol=sim.atol,
+        dt=sim.dt,
+        theta_limit=math.radians(sim.theta_limit_deg),
+        on_limit=sim.on_limit,  # type: ignore[arg-type]
+        checkpoint=out / "checkpoint.json",
+        progress=not args.no_progress,
+        stop=_STOP,
+    )
+    written = [_write_series(out / "orbits", dict(runs.columns), fmt).name]
+    if scenario.output.plots and not args.no_plots and len(runs) > 1:
+        from thermojitter.plots import orbit_summary_figure
+
+        written.append(orbit_summary_figure(out, runs.columns, Path(scenario.source).stem).name)
+    crossing = runs.limit_crossing
+    files = [*written, "run.json", "checkpoint.json"]
+    meta: dict[str, Any] = {
+        "scenario": scenario.source,
+        "keep": "orbits",
+        "orbits_requested": n_orbits,
+        "orbits_done": len(runs),
+        "interrupted": runs.interrupted,
+        "limit_crossing": None
+        if crossing is None
+        else {"t_s": crossing[0], "orbit": crossing[1], "theta_deg": math.degrees(crossing[2])},
+        "n_steps": runs.n_steps,
+        "n_rhs": runs.n_rhs,
+        "settings": runs.settings,
+        "columns": "angles in rad, times in s; see thermojitter.OrbitSummaries",
+        "files": files,
+        "wall_time_s": round(time.perf_counter() - started, 2),
+    }
+    (out / "run.json").write_text(json.dumps(meta, indent=2) + "\n")
+    if runs.interrupted:
+        print(f"interrupted after {len(runs)} orbits; run again to resume", file=sys.stderr)
+        raise KeyboardInterrupt
+    note = ""
+    if crossing is not None:
+        note = (
+            f"; |θ| passed {sim.theta_limit_deg:g}° at t = {crossing[0]:.0f} s "
+            f"(orbit {crossing[1]})"
+        )
+    print(
+        f"wrote {', '.join(meta['files'])} to {args.out} ({len(runs)} orbits, "
+        f"{runs.n_steps} steps, {meta['wall_time_s']} s{note})"
+    )
+    return 0
+
+
 def _run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     out = _out_dir(args.out)
+    if scenario.simulation.keep == "orbits":
+        return _run_orbits(args, scenario, out)
     fmt = args.format or scenario.output.format
     make_plots = scenario.output.plots and not args.no_plots
     started = time.perf_counter()

@@ -13,6 +13,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -163,6 +164,7 @@ def simulate_orbits(
     orbits_per_call: int = 1,
     progress: bool | None = None,
     max_steps: int = 500_000_000,
+    stop: Callable[[], bool] | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -172,7 +174,8 @@ def simulate_orbits(
       stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.
-    - Ctrl-C returns the finished orbits with ``interrupted=True``.
+    - Ctrl-C returns the finished orbits with ``interrupted=True``; so does ``stop()`` turning
+      True (polled between chunks, for callers that handle SIGINT themselves).
     - ``progress``: a tqdm bar (default: when stderr is a terminal and tqdm is installed).
     """
     _check_inputs(panel, orbit)
@@ -279,6 +282,8 @@ def simulate_orbits(
             if path is not None and time.monotonic() - last_save > checkpoint_every:
                 _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
                 last_save = time.monotonic()
+            if stop is not None and stop() and next_index < n_orbits and not stopped:
+                raise KeyboardInterrupt
     except KeyboardInterrupt:
         interrupted = True
     finally:

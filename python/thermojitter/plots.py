@@ -154,3 +154,27 @@ def run_figures(
         ax1.set_title(f"{title}: hinge angle and rate")
         written.append(save(fig, out / "theta.png"))
     return written
+
+
+def orbit_summary_figure(out: Path, columns: dict[str, Array], title: str) -> Path:
+    """Per-orbit summaries of a long run: amplitude, transient peaks and jitter RMS against time
+    (days), on a log scale so that growth (flutter) shows as a straight line."""
+    fig, (top, bottom) = figure(2, height=3.2)
+    days = np.asarray(columns["t_start"]) / 86400.0
+    for key, label in (
+        ("amplitude", "max |θ − θ_eq| over the orbit"),
+        ("exit_peak", "peak after shadow exit"),
+        ("entry_peak", "peak after shadow entry"),
+    ):
+        values = np.degrees(np.asarray(columns[key], dtype=float))
+        top.semilogy(days, np.where(values > 0, values, np.nan), lw=0.8, label=label)
+    top.set_ylabel("angle [deg]")
+    top.set_title(f"{title}: per-orbit summaries")
+    top.legend(loc="best", fontsize=8)
+    top.grid(alpha=0.3, which="both")
+    rms = np.degrees(np.asarray(columns["jitter_rms"], dtype=float))
+    bottom.semilogy(days, np.where(rms > 0, rms, np.nan), lw=0.8, color="C3")
+    bottom.set_ylabel("RMS of θ − M_T/K_el [deg]")
+    bottom.set_xlabel("time from the start [days]")
+    bottom.grid(alpha=0.3, which="both")
+    return save(fig, out / "orbits.png")

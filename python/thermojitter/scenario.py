@@ -8,7 +8,8 @@ A scenario has four tables, each optional::
     [orbit]        # preset = "geo_equinox" and/or any Orbit field
     preset = "geo_equinox"
 
-    [simulation]   # t_start, t_end or orbits, model, coupled, method, rtol, atol, dt, dt_out
+    [simulation]   # t_start, t_end or orbits or years, model, coupled, method, rtol, atol, dt,
+                   # dt_out, keep ("samples" | "orbits"), theta_limit_deg, on_limit
     orbits = 1
 
     [output]       # format = "csv" | "parquet", plots = true
@@ -55,6 +56,8 @@ ORBIT_PRESETS = {"geo_equinox": Orbit.geo_equinox}
 MODELS = ("nonlinear", "linear")
 METHODS = ("rk45", "rk4")
 FORMATS = ("csv", "parquet")
+KEEP = ("samples", "orbits")
+ON_LIMIT = ("stop", "flag")
 
 
 @dataclass(frozen=True)
@@ -71,13 +74,29 @@ class SimulationSettings:
     atol: float = 1e-10
     dt: float | None = None
     dt_out: float = 0.5
+    years: float | None = None
+    """Alternative to t_end and orbits: the span in Julian years (365.25 days)."""
+    keep: str = "samples"
+    """"samples": the time series every dt_out; "orbits": one summary row per orbit (for runs
+    of months and years; resumable from a checkpoint in the output folder)."""
+    theta_limit_deg: float = 20.0
+    """With keep = "orbits": |θ| beyond which the hinge model is not trusted, deg."""
+    on_limit: str = "stop"
+    """With keep = "orbits": "stop" at the first crossing of theta_limit_deg, or "flag" it."""
 
     def span(self, orbit: Orbit) -> tuple[float, float]:
         """(t0, t1) in s: t_end if given, else t_start + orbits · period (one orbit by default)."""
         if self.t_end is not None:
             return self.t_start, self.t_end
-        n = 1.0 if self.orbits is None else self.orbits
-        return self.t_start, self.t_start + n * orbit.period
+        return self.t_start, self.t_start + self.n_orbits(orbit) * orbit.period
+
+    def n_orbits(self, orbit: Orbit) -> float:
+        """The span in orbits (one by default)."""
+        if self.t_end is not None:
+            return (self.t_end - self.t_start) / orbit.period
+        if self.years is not None:
+            return self.years * 365.25 * 86400.0 / orbit.period
+        return 1.0 if self.orbits is None else self.orbits
 
 
 @dataclass(frozen=True)
@@ -209,12 +228,17 @@ def _simulation(path: Path, table: dict[str, Any]) -> SimulationSettings:
             out[key] = _choice(path, s + key, value, METHODS)
         elif key == "coupled":
             out[key] = _boolean(path, s + key, value)
+        elif key == "keep":
+            out[key] = _choice(path, s + key, value, KEEP)
+        elif key == "on_limit":
+            out[key] = _choice(path, s + key, value, ON_LIMIT)
         elif key in ("t_start", "t_end"):
             out[key] = _real(path, s + key, value)
         else:
             out[key] = _positive(path, s + key, value)
-    if "t_end" in out and "orbits" in out:
-        raise ScenarioError(path, s + "orbits", "give either t_end or orbits, not both")
+    given = [k for k in ("t_end", "orbits", "years") if k in out]
+    if len(given) > 1:
+        raise ScenarioError(path, s + given[1], "give either t_end, orbits or years, not several")
     settings = SimulationSettings(**out)
     if settings.t_end is not None and settings.t_end <= settings.t_start:
         raise ScenarioError(
