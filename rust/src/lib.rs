@@ -12,6 +12,7 @@ pub mod integrate;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
+pub mod stability;
 pub mod steady;
 pub mod system;
 pub mod thermal;

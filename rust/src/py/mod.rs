@@ -3,6 +3,7 @@
 
 mod convert;
 mod flutter;
+mod orbit;
 
 use crate::dynamics::hinge_energy;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
@@ -389,5 +390,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
     flutter::register(m)?;
+    orbit::register(m)?;
     Ok(())
 }
