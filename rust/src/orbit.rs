@@ -169,7 +169,7 @@ impl Orbit {
                 "must be smaller than the orbit radius",
             ));
         }
-        if !(self.rate() > 0.0) {
+        if self.rate().is_nan() || self.rate() <= 0.0 {
             return Err(Error::invalid(
                 "period",
                 self.period,

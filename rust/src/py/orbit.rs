@@ -7,14 +7,13 @@ use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+/// (centre, first contact, last contact, umbra entry, umbra exit), s.
+type EclipseRow = (f64, f64, f64, f64, f64);
+
 /// Each eclipse overlapping [t0, t1], unclipped: (centre, first contact, last contact, umbra
 /// entry, umbra exit), NaN where there is no umbra.
 #[pyfunction]
-fn eclipses(
-    orbit: &Bound<'_, PyDict>,
-    t0: f64,
-    t1: f64,
-) -> PyResult<Vec<(f64, f64, f64, f64, f64)>> {
+fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<EclipseRow>> {
     let o = orbit_from(orbit)?;
     crate::integrate::check_span(t0, t1).map_err(to_py)?;
     Ok(o.eclipses(t0, t1)
