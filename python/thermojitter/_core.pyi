@@ -12,17 +12,24 @@ __all__ = [
     "IntegrationError",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
+    "declination",
     "derived",
+    "eclipses",
     "energy",
     "flutter",
+    "flux_scale",
     "illumination",
     "moment",
+    "orbit_breakpoints",
     "shadow_intervals",
     "simulate",
     "simulate_hinge",
     "simulate_thermal",
+    "stability_map",
     "steady_state",
     "stiffness",
+    "synodic_period",
+    "umbra_intervals",
     "validate_orbit",
     "validate_panel",
 ]
@@ -101,4 +108,26 @@ def simulate_hinge(
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(
     panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
+) -> dict[str, Any]: ...
+
+# --- orbit options (issue 4)
+def eclipses(
+    orbit: dict[str, Any], t0: float, t1: float
+) -> list[tuple[float, float, float, float, float]]: ...
+def umbra_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[float, float]]: ...
+def orbit_breakpoints(orbit: dict[str, Any], t0: float, t1: float) -> list[float]: ...
+def flux_scale(orbit: dict[str, Any], t: _F) -> _F: ...
+def declination(orbit: dict[str, Any], t: _F) -> _F: ...
+def synodic_period(orbit: dict[str, Any]) -> float: ...
+
+# --- stability map (issue 4)
+def stability_map(
+    panel: dict[str, float],
+    x_name: str,
+    x_values: list[float],
+    y_name: str,
+    y_values: list[float],
+    model: str,
+    coupled: bool,
+    flux: float,
 ) -> dict[str, Any]: ...
