@@ -7,7 +7,14 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 """
 
 from thermojitter._core import ConvergenceError, IntegrationError
-from thermojitter.flutter import FlutterResult, flutter
+from thermojitter.flutter import (
+    FlutterResult,
+    LinearThermalResponse,
+    StabilityMap,
+    flutter,
+    linear_thermal_response,
+    stability_map,
+)
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -27,17 +34,21 @@ __all__ = [
     "FlutterResult",
     "HingeSolution",
     "IntegrationError",
+    "LinearThermalResponse",
     "Orbit",
     "Panel",
     "Solution",
+    "StabilityMap",
     "ThermalSolution",
     "beam_frequency",
     "flutter",
     "hinge_energy",
     "hinge_stiffness",
+    "linear_thermal_response",
     "natural_frequency",
     "simulate",
     "simulate_hinge",
     "simulate_thermal",
+    "stability_map",
     "steady_state",
 ]
