@@ -135,6 +135,16 @@ def test_flux_over_the_year_moves_the_critical_damping():
     assert c_peri / c_aph == pytest.approx((peri / aph) ** 2, rel=0.02)
     with pytest.raises(ValueError, match="flux"):
         tj.flutter(PAPER, flux=0.0)
+    # the flux for a date, through the orbit
+    july = tj.flutter(PAPER, orbit=tj.Orbit.geo_year("2026-07-05T12:00"))
+    assert july.flux == pytest.approx(aph, rel=1e-5)
+    assert july.critical_damping == pytest.approx(c_aph, rel=1e-4)
+    # a damping between the two: stable around aphelion, flutter around perihelion
+    mid = PAPER.replace(damping=0.5 * (c_aph + c_peri))
+    assert tj.flutter(mid, orbit=year, t=185 * 86400.0).stable
+    assert not tj.flutter(mid, orbit=year, t=3 * 86400.0).stable
+    with pytest.raises(ValueError, match="not both"):
+        tj.flutter(PAPER, flux=1.0, orbit=year)
 
 
 # ----------------------------------------------------------------------------- stability map

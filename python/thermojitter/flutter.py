@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Equilibrium
 
@@ -48,15 +49,28 @@ def flutter(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     *,
     coupled: bool = True,
-    flux: float = 1.0,
+    flux: float | None = None,
+    orbit: Orbit | None = None,
+    t: float = 0.0,
 ) -> FlutterResult:
     """Linear stability of the sunlit equilibrium of ``panel``.
 
-    ``flux`` scales the solar constant (the Sun–Earth distance changes it by about ±3.3 % over the
-    year); the equilibrium, and with it the critical damping, depend on it.
+    ``flux`` scales the solar constant (default 1, the Sun at 1 au; the Sun–Earth distance changes
+    it by about ±3.3 % over the year); the equilibrium, and with it the critical damping, depend
+    on it. Or give ``orbit`` and a time ``t`` (s) instead: the flux is then
+    ``orbit.flux_scale(t)``, e.g. ``flutter(panel, orbit=Orbit.geo_year("2026-07-05"))`` near
+    aphelion.
     """
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    if orbit is not None:
+        if flux is not None:
+            raise ValueError("give flux or orbit (with t), not both")
+        if not isinstance(orbit, Orbit):
+            raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
+        flux = float(orbit.flux_scale(float(t))[0])
+    elif flux is None:
+        flux = 1.0
     raw = _core.flutter(panel.as_dict(), model, bool(coupled), float(flux))
     tf, tb, th = raw["equilibrium"]
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])

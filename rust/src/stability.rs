@@ -134,6 +134,31 @@ mod tests {
     }
 
     #[test]
+    fn result_does_not_depend_on_the_number_of_threads() {
+        let p = Panel::paper();
+        let x = axis("damping", &[0.0, 0.7, 1.4, 2.1, 2.8, 3.5]);
+        let y = axis("thickness", &[0.02, 0.03, 0.04, 0.05, 0.06]);
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    stability_map(
+                        &p,
+                        HingeModel::Nonlinear,
+                        Coupling::ProjectedArea,
+                        1.0,
+                        &x,
+                        &y,
+                    )
+                    .unwrap()
+                })
+        };
+        assert_eq!(run(1), run(3));
+    }
+
+    #[test]
     fn bad_axes_are_refused_by_name() {
         let p = Panel::paper();
         let run = |x: &Axis, y: &Axis| {
