@@ -175,6 +175,8 @@ def test_defaults_and_validation():
     with pytest.raises(ValueError, match="eclipse"):
         PEN.eclipse_durations(0.0, 1.0, kind="eclipse")  # type: ignore[arg-type]
     assert GEO.replace(shadow="penumbra") == PEN
+    with pytest.raises(NotImplementedError):
+        ref.shadow_intervals(PEN, 0.0, 1.0)  # the oracle knows only the paper's cylinder
 
 
 def test_integrator_follows_the_penumbra():
