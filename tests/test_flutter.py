@@ -261,3 +261,25 @@ def test_lag_pumping_estimate_matches_eigen_analysis():
         tj.linear_thermal_response(PAPER, T_star=-1.0)
     with pytest.raises(ValueError, match="omega"):
         tj.linear_thermal_response(PAPER, omega=math.nan)
+
+
+def test_critical_damping_decides_the_jitter_between_eclipses_on_the_paper_orbit():
+    """On the paper's orbit the eclipse kicks the panel; between shadow exit and the next entry
+    the swing dies out just above the critical damping and grows just below it, at the rate of
+    the eigen-analysis once the panel has warmed back up (the first hour or so after exit the
+    temperatures are still recovering and the swing decays faster)."""
+    geo = tj.Orbit.geo_equinox()
+    cd = tj.flutter(PAPER).critical_damping
+    (_, exit_), (entry, _) = geo.shadow_intervals(0.0, 2 * geo.period)
+    early = np.arange(exit_ + 6000.0, exit_ + 6100.0, 0.1)
+    late = np.arange(entry - 100.0, entry, 0.1)
+    ratios = {}
+    for factor in (0.95, 1.05):
+        p = PAPER.replace(damping=factor * cd)
+        sol = tj.simulate(p, geo, (0.0, entry), t_eval=np.concatenate([early, late]))
+        # peak-to-peak swing in each window (free of any slow drift of the mean angle)
+        a, b = sol.theta[: early.size], sol.theta[early.size :]
+        ratios[factor] = float(np.ptp(b) / np.ptp(a))
+        predicted = math.exp(tj.flutter(p).growth_rate * (late[-1] - early[-1]))
+        assert ratios[factor] == pytest.approx(predicted, rel=0.02)
+    assert ratios[0.95] > 1.3 and ratios[1.05] < 0.77
