@@ -5,8 +5,10 @@ from __future__ import annotations
 import datetime as dt
 import math
 
+import hypothesis.strategies as st
 import numpy as np
 import pytest
+from hypothesis import given, settings
 from scipy.integrate import solve_ivp
 
 import thermojitter as tj
@@ -207,3 +209,40 @@ def test_integrator_follows_the_penumbra():
         y = seg.y[:, -1]
     assert np.allclose(sol.T, expected, rtol=1e-6)
     assert sol.T.min() < T0 - 100.0  # it did go through the eclipse
+
+
+@settings(max_examples=25)
+@given(
+    altitude=st.floats(300e3, 40_000e3),
+    epoch_day=st.floats(0.0, 365.0),
+    phase0=st.floats(-math.pi, math.pi),
+)
+def test_penumbra_contacts_hold_for_any_orbit_and_date(
+    altitude: float, epoch_day: float, phase0: float
+):
+    """Random circular orbits and dates: s stays in [0, 1], is 1 at the contacts and 0 at the
+    umbra boundaries, falls monotonically through ingress and rises through egress."""
+    r = 6378.137e3 + altitude
+    orbit = tj.Orbit(
+        radius=r,
+        period=2 * math.pi * math.sqrt(r**3 / 3.986004418e14),
+        phase0=phase0,
+        shadow="penumbra",
+        season=True,
+        eccentric_sun=True,
+        epoch_day=epoch_day,
+    )
+    span = 2.0 * orbit.synodic_period
+    bps = orbit.breakpoints(0.0, span)
+    assert bps == sorted(bps)
+    for centre, first, last, u_in, u_out in orbit.eclipses(0.0, span):
+        assert first < centre < last
+        assert orbit.illumination([first, last]) == pytest.approx([1.0, 1.0], abs=1e-6)
+        if not math.isnan(u_in):
+            assert first < u_in <= centre <= u_out < last
+            assert orbit.illumination([u_in, u_out]) == pytest.approx([0.0, 0.0], abs=1e-6)
+            ingress = orbit.illumination(np.linspace(first, u_in, 200))
+            egress = orbit.illumination(np.linspace(u_out, last, 200))
+            assert np.all(np.diff(ingress) <= 1e-12) and np.all(np.diff(egress) >= -1e-12)
+        s = orbit.illumination(np.linspace(first - 60.0, last + 60.0, 2000))
+        assert np.all((s >= 0.0) & (s <= 1.0))
