@@ -296,7 +296,7 @@ BAD = {
     "wrong type bool": ("[simulation]\ncoupled = 1\n", "simulation.coupled", "true or false"),
     "unknown table": ("[panels]\nlength = 3.0\n", "panels", "unknown table"),
     "bad choice": ('[simulation]\nmodel = "quadratic"\n', "simulation.model", "nonlinear"),
-    "bad preset": ('[orbit]\npreset = "leo"\n', "orbit.preset", "geo_equinox"),
+    "bad preset": ('[orbit]\npreset = "lunar"\n', "orbit.preset", "geo_equinox"),
     "cross-field": ("[orbit]\nearth_radius = 5e7\n", "orbit.earth_radius", "smaller"),
     "span": ("[simulation]\nt_start = 10.0\nt_end = 5.0\n", "simulation.t_end", "after"),
     "both ends": ("[simulation]\nt_end = 5.0\norbits = 2\n", "simulation.orbits", "either"),
@@ -461,3 +461,49 @@ def test_scenario_refuses_two_spans(tmp_path: Path) -> None:
     scenario = tmp_path / "two.toml"
     scenario.write_text("[simulation]\norbits = 2\nyears = 1\n")
     assert cli.main(["run", str(scenario), "--out", str(tmp_path / "o")]) == 2
+
+
+def test_orbit_presets_and_options_in_scenarios(tmp_path: Path) -> None:
+    from thermojitter.scenario import ScenarioError, load_scenario
+
+    good = tmp_path / "year.toml"
+    good.write_text(
+        '[orbit]\npreset = "geo_year"\nstart_date = 2026-03-20\nshadow = "cylindrical"\n'
+        '[simulation]\nyears = 0.01\nkeep = "orbits"\n'
+    )
+    s = load_scenario(good)
+    assert s.orbit.season and s.orbit.shadow == "cylindrical"
+    assert s.simulation.n_orbits(s.orbit) == pytest.approx(0.01 * 365.25 * 86400 / s.orbit.period)
+    leo = tmp_path / "leo.toml"
+    leo.write_text('[orbit]\npreset = "leo"\naltitude = 540e3\n')
+    assert 90 * 60 < load_scenario(leo).orbit.period < 100 * 60
+    for text, key in (
+        ('[orbit]\nshadow = "umbral"\n', "orbit.shadow"),
+        ('[orbit]\nseason = "yes"\n', "orbit.season"),
+        ('[orbit]\npreset = "leo"\nstart_date = 2026-01-01\n', "orbit.start_date"),
+        ('[orbit]\npreset = "leo"\naltitude = -5.0\n', "orbit.altitude"),
+    ):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(text)
+        with pytest.raises(ScenarioError, match=key):
+            load_scenario(bad)
+
+
+def test_flutter_subcommand_through_the_main_command(tmp_path: Path) -> None:
+    out = tmp_path / "fl"
+    code = cli.main(
+        [
+            "flutter",
+            "--out",
+            str(out),
+            "--no-plot",
+            "--x",
+            "damping:0:5:3",
+            "--y",
+            "conductance:10:40:3",
+        ]
+    )
+    assert code == 0
+    record = json.loads((out / "flutter.json").read_text())
+    assert "nonlinear" in json.dumps(record)
+    assert cli.main(["flutter", str(tmp_path / "missing.toml"), "--out", str(out)]) == 2

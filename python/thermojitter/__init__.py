@@ -10,7 +10,14 @@ from thermojitter import beam
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
-from thermojitter.flutter import FlutterResult, flutter
+from thermojitter.flutter import (
+    FlutterResult,
+    LinearThermalResponse,
+    StabilityMap,
+    flutter,
+    linear_thermal_response,
+    stability_map,
+)
 from thermojitter.longrun import OrbitSummaries, simulate_orbits
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
@@ -34,10 +41,12 @@ __all__ = [
     "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
+    "LinearThermalResponse",
     "Orbit",
     "OrbitSummaries",
     "Panel",
     "Solution",
+    "StabilityMap",
     "ThermalSolution",
     "beam",
     "beam_frequency",
@@ -47,10 +56,12 @@ __all__ = [
     "compare_with_beam",
     "hinge_energy",
     "hinge_stiffness",
+    "linear_thermal_response",
     "natural_frequency",
     "simulate",
     "simulate_hinge",
     "simulate_orbits",
     "simulate_thermal",
+    "stability_map",
     "steady_state",
 ]

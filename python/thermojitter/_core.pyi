@@ -15,18 +15,25 @@ __all__ = [
     "beam_modes",
     "beam_response",
     "beam_static",
+    "declination",
     "derived",
+    "eclipses",
     "energy",
     "flutter",
+    "flux_scale",
     "illumination",
     "moment",
+    "orbit_breakpoints",
     "run_orbits",
     "shadow_intervals",
     "simulate",
     "simulate_hinge",
     "simulate_thermal",
+    "stability_map",
     "steady_state",
     "stiffness",
+    "synodic_period",
+    "umbra_intervals",
     "validate_orbit",
     "validate_panel",
 ]
@@ -151,4 +158,26 @@ def beam_response(
     max_steps: int,
     t_eval: _F | None,
     dt_out: float | None,
+) -> dict[str, Any]: ...
+
+# --- orbit options (issue 4)
+def eclipses(
+    orbit: dict[str, Any], t0: float, t1: float
+) -> list[tuple[float, float, float, float, float]]: ...
+def umbra_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[float, float]]: ...
+def orbit_breakpoints(orbit: dict[str, Any], t0: float, t1: float) -> list[float]: ...
+def flux_scale(orbit: dict[str, Any], t: _F) -> _F: ...
+def declination(orbit: dict[str, Any], t: _F) -> _F: ...
+def synodic_period(orbit: dict[str, Any]) -> float: ...
+
+# --- stability map (issue 4)
+def stability_map(
+    panel: dict[str, float],
+    x_name: str,
+    x_values: list[float],
+    y_name: str,
+    y_values: list[float],
+    model: str,
+    coupled: bool,
+    flux: float,
 ) -> dict[str, Any]: ...

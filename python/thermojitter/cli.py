@@ -16,7 +16,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -219,7 +219,8 @@ def _run_orbits(args: argparse.Namespace, scenario: Scenario, out: Path) -> int:
     sim = scenario.simulation
     n = sim.n_orbits(scenario.orbit)
     n_orbits = max(1, int(round(n)))
-    if abs(n - n_orbits) > 1e-6 * max(n, 1.0):
+    # A span in years is rounded to whole orbits; an explicit one must already be whole.
+    if sim.years is None and abs(n - n_orbits) > 1e-6 * max(n, 1.0):
         raise ScenarioError(
             scenario.source, "simulation", f"keep = 'orbits' needs whole orbits; the span is {n:g}"
         )
@@ -478,7 +479,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="skip fitting the hinge parameters to the beam run",
     )
     beam.set_defaults(handler=_beam)
+
+    flutter = sub.add_parser(
+        "flutter",
+        help="flutter analysis without integration: growth rate, critical damping, stability map",
+        description="Run 'thermojitter flutter --help' for its options.",
+        add_help=False,
+    )
+    flutter.set_defaults(handler=_flutter)
     return parser
+
+
+def _flutter(argv: Sequence[str]) -> int:
+    from thermojitter.flutter_cli import flutter_command
+
+    return flutter_command(list(argv))
+
+
+# Commands with parsers of their own: main() hands them the rest of the command line.
+FORWARDED: dict[str, Callable[[Sequence[str]], int]] = {"flutter": _flutter}
 
 
 def _beam(args: argparse.Namespace) -> int:
@@ -495,6 +514,13 @@ def _fail(message: str) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``thermojitter`` command; returns the exit code."""
+    args_list = sys.argv[1:] if argv is None else list(argv)
+    if args_list and args_list[0] in FORWARDED:
+        try:
+            return FORWARDED[args_list[0]](args_list[1:])
+        except KeyboardInterrupt:
+            print("thermojitter: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
     parser = build_parser()
     args = parser.parse_args(argv)
     if getattr(args, "handler", None) is None:

@@ -28,6 +28,16 @@ StateFun = Callable[[float, FloatArray, float], FloatArray]
 # --------------------------------------------------------------------------- orbit / shadow
 
 
+def _check_orbit(orbit: Any) -> None:
+    """The oracle knows only the paper's orbit: cylindrical shadow, Sun fixed at 1 au."""
+    if (
+        getattr(orbit, "shadow", "cylindrical") != "cylindrical"
+        or getattr(orbit, "season", False)
+        or getattr(orbit, "eccentric_sun", False)
+    ):
+        raise NotImplementedError("reference: only the cylindrical shadow at equinox (1 au)")
+
+
 def _shadow_half_angle(orbit: Any) -> float:
     """Half-width of the cylindrical-shadow arc in orbit phase [rad]."""
     return math.asin(orbit.earth_radius / orbit.radius)
@@ -35,6 +45,7 @@ def _shadow_half_angle(orbit: Any) -> float:
 
 def shadow_intervals(orbit: Any, t0: float, t1: float) -> list[tuple[float, float]]:
     """Eclipses (t_enter, t_exit) [s] overlapping [t0, t1], clipped to it, in time order."""
+    _check_orbit(orbit)
     period = float(orbit.period)
     half = _shadow_half_angle(orbit) * period / (2.0 * math.pi)  # half eclipse duration [s]
     # Eclipse k is centred at (k + 1/2) * period (phase beta = pi).
@@ -51,6 +62,7 @@ def shadow_intervals(orbit: Any, t0: float, t1: float) -> list[tuple[float, floa
 
 def illumination(orbit: Any, t: float) -> float:
     """Illuminated fraction s(t): 0.0 in the cylindrical shadow, 1.0 in sunlight."""
+    _check_orbit(orbit)
     beta = (2.0 * math.pi * t / orbit.period) % (2.0 * math.pi)
     return 0.0 if abs(beta - math.pi) < _shadow_half_angle(orbit) else 1.0
 

@@ -23,7 +23,9 @@ from __future__ import annotations
 import math
 import re
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
+from datetime import date
 from pathlib import Path
 from typing import Any
 
@@ -52,7 +54,13 @@ class ScenarioError(ValueError):
         super().__init__(message)
 
 
-ORBIT_PRESETS = {"geo_equinox": Orbit.geo_equinox}
+ORBIT_PRESETS = {
+    "geo_equinox": Orbit.geo_equinox,
+    "geo_year": Orbit.geo_year,
+    "leo": Orbit.leo,
+    "sunlit": Orbit.sunlit,
+}
+SHADOWS = ("none", "cylindrical", "penumbra")
 MODELS = ("nonlinear", "linear")
 METHODS = ("rk45", "rk4")
 FORMATS = ("csv", "parquet")
@@ -112,6 +120,8 @@ class Scenario:
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     output: OutputSettings = field(default_factory=OutputSettings)
     source: str = "<built-in>"
+    extra: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """Tables a command adds to the format (e.g. [flutter]), checked by that command."""
 
 
 _ENGINE_MESSAGE = re.compile(r"^(\w+) = ")
@@ -204,15 +214,41 @@ def _panel(path: Path, table: dict[str, Any]) -> Panel:
 
 
 def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
-    known = {f.name for f in fields(Orbit)} | {"preset"}
+    """[orbit]: a preset (with its own arguments: start_date for geo_year, altitude for leo)
+    and/or any Orbit field."""
+    known = {f.name for f in fields(Orbit)} | {"preset", "start_date", "altitude"}
     _reject_unknown(path, "orbit", table, known)
-    base: dict[str, float] = {}
+    base: dict[str, Any] = {}
+    preset = None
     if "preset" in table:
         preset = _choice(path, "orbit.preset", table["preset"], tuple(ORBIT_PRESETS))
+    if "start_date" in table and preset != "geo_year":
+        raise ScenarioError(path, "orbit.start_date", "goes with preset = 'geo_year'")
+    if "altitude" in table and preset != "leo":
+        raise ScenarioError(path, "orbit.altitude", "goes with preset = 'leo'")
+    if preset == "geo_year":
+        start = table.get("start_date", "2026-01-01")
+        if not isinstance(start, (str, int, date)) or isinstance(start, bool):
+            raise ScenarioError(path, "orbit.start_date", "must be a date (2026-03-20) or a day")
+        try:
+            base = Orbit.geo_year(start).as_dict()
+        except (ValueError, TypeError) as exc:
+            raise ScenarioError(path, "orbit.start_date", str(exc)) from None
+    elif preset == "leo":
+        altitude = _positive(path, "orbit.altitude", table.get("altitude", 540e3))
+        base = Orbit.leo(altitude).as_dict()
+    elif preset is not None:
         base = ORBIT_PRESETS[preset]().as_dict()
-    values = {
-        key: _real(path, f"orbit.{key}", value) for key, value in table.items() if key != "preset"
-    }
+    values: dict[str, Any] = {}
+    for key, value in table.items():
+        if key in ("preset", "start_date", "altitude"):
+            continue
+        if key == "shadow":
+            values[key] = _choice(path, "orbit.shadow", value, SHADOWS)
+        elif key in ("season", "eccentric_sun"):
+            values[key] = _boolean(path, f"orbit.{key}", value)
+        else:
+            values[key] = _real(path, f"orbit.{key}", value)
     return _validated(path, "orbit", Orbit, base, values)  # type: ignore[no-any-return]
 
 
@@ -256,10 +292,15 @@ def _output(path: Path, table: dict[str, Any]) -> OutputSettings:
     return OutputSettings(format=fmt, plots=plots)
 
 
-def parse_scenario(data: dict[str, Any], path: str | Path = "<scenario>") -> Scenario:
-    """A scenario from parsed TOML data; ``path`` is used in error messages only."""
+def parse_scenario(
+    data: dict[str, Any], path: str | Path = "<scenario>", extra_sections: Sequence[str] = ()
+) -> Scenario:
+    """A scenario from parsed TOML data; ``path`` is used in error messages only.
+
+    ``extra_sections`` names further tables the caller accepts; they are returned unchecked in
+    ``Scenario.extra`` (absent ones as empty tables)."""
     where = Path(path)
-    sections = {"panel", "orbit", "simulation", "output"}
+    sections = {"panel", "orbit", "simulation", "output", *extra_sections}
     for key in data:
         if key not in sections:
             raise ScenarioError(
@@ -271,10 +312,11 @@ def parse_scenario(data: dict[str, Any], path: str | Path = "<scenario>") -> Sce
         simulation=_simulation(where, _table(where, data, "simulation")),
         output=_output(where, _table(where, data, "output")),
         source=str(path),
+        extra={name: _table(where, data, name) for name in extra_sections},
     )
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path, extra_sections: Sequence[str] = ()) -> Scenario:
     """Reads and checks a TOML scenario file; raises :class:`ScenarioError` on any problem."""
     where = Path(path)
     try:
@@ -291,4 +333,4 @@ def load_scenario(path: str | Path) -> Scenario:
         raise ScenarioError(where, None, "is not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(where, None, f"invalid TOML: {exc}") from None
-    return parse_scenario(data, where)
+    return parse_scenario(data, where, extra_sections)

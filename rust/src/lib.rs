@@ -13,6 +13,7 @@ pub mod integrate;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
+pub mod stability;
 pub mod steady;
 pub mod summary;
 pub mod system;

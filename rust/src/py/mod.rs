@@ -5,6 +5,7 @@ mod beam;
 mod convert;
 mod flutter;
 mod longrun;
+mod orbit;
 
 use crate::dynamics::hinge_energy;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
@@ -393,5 +394,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     longrun::register(m)?;
     beam::register(m)?;
+    orbit::register(m)?;
     Ok(())
 }
