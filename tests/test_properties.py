@@ -111,7 +111,10 @@ def test_sunlit_equilibrium_is_a_fixed_point(panel: tj.Panel, coupled: bool, mod
     growth = max(tj.flutter(panel, model, coupled=coupled).growth_rate, 0.0)
     amplification = math.exp(growth * 0.9 * ENTRY)
     assert tight[0] < 1e-8 * amplification and tight[1] < 1e-7 * amplification
-    assert tight[0] <= loose[0] / 100 + 1e-14
+    if growth == 0.0:
+        # Stable: the drift is pure truncation error, so it shrinks with the tolerance. (When
+        # unstable, round-off is amplified by e^(g t) too and the tolerance no longer rules it.)
+        assert tight[0] <= loose[0] / 100 + 1e-14
     assert abs(eq.thermal_moment - panel.hinge_stiffness * eq.theta) < 1e-8 * abs(eq.thermal_moment)
 
 
