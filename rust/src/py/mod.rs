@@ -2,6 +2,7 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod convert;
+mod ensemble;
 mod flutter;
 mod longrun;
 
@@ -391,5 +392,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
     flutter::register(m)?;
     longrun::register(m)?;
+    ensemble::register(m)?;
     Ok(())
 }
