@@ -9,6 +9,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.flutter import FlutterResult, flutter
 from thermojitter.longrun import OrbitSummaries, simulate_orbits
+from thermojitter.montecarlo import SensitivityResult, monte_carlo, sensitivity, sweep
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -31,16 +32,20 @@ __all__ = [
     "Orbit",
     "OrbitSummaries",
     "Panel",
+    "SensitivityResult",
     "Solution",
     "ThermalSolution",
     "beam_frequency",
     "flutter",
     "hinge_energy",
     "hinge_stiffness",
+    "monte_carlo",
     "natural_frequency",
+    "sensitivity",
     "simulate",
     "simulate_hinge",
     "simulate_orbits",
     "simulate_thermal",
     "steady_state",
+    "sweep",
 ]

@@ -9,9 +9,11 @@ _F = NDArray[np.float64]
 
 __all__ = [
     "ConvergenceError",
+    "EnsemblePool",
     "IntegrationError",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
+    "check_panels",
     "derived",
     "energy",
     "flutter",
@@ -125,3 +127,29 @@ def run_orbits(
     theta_limit: float,
     stop_at_limit: bool,
 ) -> dict[str, Any]: ...
+
+# --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
+def check_panels(panels: _F) -> list[tuple[int, str]]: ...
+
+class EnsemblePool:
+    def __new__(cls, threads: int | None = None) -> EnsemblePool: ...
+    @property
+    def threads(self) -> int: ...
+    def run(
+        self,
+        panels: _F,
+        orbit: dict[str, Any],
+        *,
+        model: str,
+        coupled: bool,
+        method_name: str,
+        rtol: float,
+        atol: float,
+        dt: float | None,
+        max_step: float,
+        max_steps: int,
+        n_orbits: int,
+        window: float,
+        threshold: float | None,
+        stop_at_threshold: bool,
+    ) -> dict[str, Any]: ...
