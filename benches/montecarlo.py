@@ -1,0 +1,99 @@
+"""Monte Carlo throughput: 200 panels around Table 1, one GEO orbit each (rk45, rtol 1e-8,
+atol 1e-10), on 1 and 2 rayon threads; and the cost of a sample against one ``tj.simulate`` call
+of the same orbit for the same panels (the sample adds the flutter analysis, the critical damping
+and the per-orbit summary). Run it on a quiet machine (check ``uptime``).
+
+    python benches/montecarlo.py [--n 200] [--threads 1 2] [--repeat 1] [--simulate 200]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+from typing import Any
+
+import numpy as np
+
+import thermojitter as tj
+
+RTOL, ATOL = 1e-8, 1e-10
+VARY = {
+    "damping": ("uniform", 2.0, 4.0),
+    "emissivity_back": ("normal", 0.3, 0.03),
+    "conductance": ("normal", 25.0, 2.5),
+}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--n", type=int, default=200, help="samples")
+    parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--repeat", type=int, default=1, help="runs per thread count (median)")
+    parser.add_argument("--simulate", type=int, default=200, help="panels run with tj.simulate")
+    args = parser.parse_args()
+
+    panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
+    print(
+        f"load average: {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores"
+    )
+    print(f"{args.n} samples x 1 GEO orbit, rtol={RTOL:g}, atol={ATOL:g}, vary={list(VARY)}")
+
+    def batch(threads: int) -> Any:
+        return tj.monte_carlo(
+            panel, orbit, vary=VARY, n=args.n, seed=1, threads=threads, rtol=RTOL, atol=ATOL,
+            progress=False,
+        )  # fmt: skip
+
+    walls: dict[int, float] = {}
+    frames = {}
+    for threads in args.threads:
+        times = []
+        for _ in range(args.repeat):
+            start = time.perf_counter()
+            frames[threads] = batch(threads)
+            times.append(time.perf_counter() - start)
+        walls[threads] = statistics.median(times)
+    frame = frames[args.threads[0]]
+    steps = int(frame["n_steps"].sum())
+    base = walls[args.threads[0]]
+    print(f"{'threads':>8}{'wall s':>10}{'samples/s':>12}{'speed-up':>10}{'ns/step':>10}")
+    for threads, wall in walls.items():
+        print(
+            f"{threads:>8}{wall:>10.2f}{args.n / wall:>12.1f}{base / wall:>10.2f}"
+            f"{1e9 * wall * threads / steps:>10.0f}"
+        )
+    same = all(frames[t].equals(frame) for t in frames)
+    print(f"identical frames across thread counts: {same}")
+
+    if 1 not in walls:
+        return
+    # The same panels, one tj.simulate call each (end state only), on this thread.
+    k = min(args.simulate, args.n)
+    start = time.perf_counter()
+    sim_steps = 0
+    for _, row in frame.iloc[:k].iterrows():
+        p = panel.replace(**{name: float(row[name]) for name in VARY})
+        sol = tj.simulate(
+            p, orbit, (0.0, orbit.period), rtol=RTOL, atol=ATOL, t_eval=np.array([orbit.period])
+        )
+        sim_steps += sol.n_steps
+    per_sim = (time.perf_counter() - start) / k
+    per_sample = walls[1] / args.n
+    print(
+        f"one tj.simulate call ({k} of the panels): {1e3 * per_sim:7.1f} ms, "
+        f"{1e9 * per_sim * k / sim_steps:.0f} ns/step"
+    )
+    print(
+        f"one Monte Carlo sample, 1 thread:        {1e3 * per_sample:7.1f} ms, "
+        f"{1e9 * walls[1] / steps:.0f} ns/step"
+    )
+    print(
+        f"per-sample overhead: {1e3 * (per_sample - per_sim):+.1f} ms "
+        f"({100.0 * (per_sample / per_sim - 1.0):+.1f} %)"
+    )
+
+
+if __name__ == "__main__":
+    main()
