@@ -1,6 +1,6 @@
 """Typed stub of the native engine module (built from rust/src/py by maturin)."""
 
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -131,6 +131,7 @@ def run_orbits(
 # --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
 def check_panels(panels: _F) -> list[tuple[int, str]]: ...
 
+@final
 class EnsemblePool:
     def __new__(cls, threads: int | None = None) -> EnsemblePool: ...
     @property

@@ -309,7 +309,10 @@ mod tests {
         let err = out[2].error.as_deref().unwrap();
         assert!(err.starts_with("emissivity_front"), "{err}");
         assert!(out[2].growth_rate.is_nan());
-        assert!(out.iter().enumerate().all(|(i, m)| (i == 2) == m.error.is_some()));
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(i, m)| (i == 2) == m.error.is_some()));
     }
 
     #[test]
@@ -341,6 +344,10 @@ mod tests {
         assert!(e.to_string().starts_with("horizon"), "{e}");
         let mut s = settings();
         s.threshold = Some(-1.0);
-        assert!(s.validate().unwrap_err().to_string().starts_with("threshold"));
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("threshold"));
     }
 }
