@@ -654,8 +654,9 @@ def monte_carlo(
       ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``; each worker
       runs chunks on as many rayon threads as it has threads.
     - ``checkpoint``: a directory; finished chunks (``chunk_size`` samples, default depending on n
-      only) are written there as Parquet as they complete, and a run with the same settings
-      resumes from them. Settings that differ are refused, naming them.
+      only; a resumed run keeps the size it started with) are written there as Parquet as they
+      complete, and a run with the same settings resumes from them. Settings that differ are
+      refused, naming them.
 
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
@@ -763,16 +764,29 @@ def sensitivity(
     second_order: bool = False,
     truncate: bool = False,
     horizon: int = 1,
-    **options: Any,
+    threshold: float | None = None,
+    stop_at_threshold: bool = False,
+    threads: int | None = None,
+    backend: Any = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    chunk_size: int | None = None,
+    progress: bool = True,
+    model: Literal["nonlinear", "linear"] = "nonlinear",
+    coupled: bool = True,
+    method: Literal["rk45", "rk4"] = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    window: float = 600.0,
+    max_steps: int = 500_000_000,
 ) -> SensitivityResult:
     """Sobol sensitivity indices of one metric to the parameters in ``vary`` (needs SALib:
     ``pip install 'thermojitter[sensitivity]'``).
 
-    Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design, mapped
-    through the distributions of ``vary`` like ``monte_carlo``; the other keyword arguments go to
-    the batch run (threads, backend, checkpoint, rtol, ...). Returns a DataFrame indexed by
-    parameter with ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` (first-order and total indices and
-    their 95 % confidence half-widths), with the samples that were run.
+    Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design (best with n
+    a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
+    arguments these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` per parameter
+    (first-order and total indices, 95 % confidence half-widths).
     """
     try:
         from SALib.analyze import sobol as sobol_analyze
@@ -787,8 +801,12 @@ def sensitivity(
     vary = _check_vary(vary)
     n = _check_n(n, 2)
     seed = _check_seed(seed, None)
-    if metric not in METRICS or metric in ("error", "n_steps"):
+    if metric not in _FLOAT_METRICS and metric != "stable":
         raise ValueError(f"metric = {metric!r} is invalid: choose from {', '.join(_FLOAT_METRICS)}")
+    options = _options(
+        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        stop_at_threshold, max_steps,
+    )  # fmt: skip
     names = list(vary)
     problem = {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
     with warnings.catch_warnings():
@@ -797,19 +815,6 @@ def sensitivity(
             sobol_sample.sample(problem, n, calc_second_order=second_order, seed=seed), dtype=float
         )
     names, values, matrix = _sampled(panel, vary, u, bool(truncate))
-    run_opts = {
-        k: options.pop(k)
-        for k in ("threads", "backend", "checkpoint", "chunk_size", "progress")
-        if k in options
-    }
-    batch = _options(
-        orbit, horizon, options.pop("model", "nonlinear"), options.pop("coupled", True),
-        options.pop("method", "rk45"), options.pop("rtol", 1e-8), options.pop("atol", 1e-10),
-        options.pop("dt", None), options.pop("window", 600.0), options.pop("threshold", None),
-        options.pop("stop_at_threshold", False), options.pop("max_steps", 500_000_000),
-    )  # fmt: skip
-    if options:
-        raise TypeError(f"sensitivity got unexpected keyword arguments: {', '.join(options)}")
     settings = {
         "study": "sensitivity",
         "panel": panel.as_dict(),
@@ -819,23 +824,22 @@ def sensitivity(
         "second_order": bool(second_order),
         "truncate": bool(truncate),
     }
-    run_opts.setdefault("progress", True)
     samples = _run_design(
-        names, values, matrix, batch, settings,
-        threads=run_opts.get("threads"), backend=run_opts.get("backend"),
-        checkpoint=run_opts.get("checkpoint"), chunk_size=run_opts.get("chunk_size"),
-        progress=bool(run_opts["progress"]),
+        names, values, matrix, options, settings, threads=threads, backend=backend,
+        checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
     )  # fmt: skip
     y = samples[metric].to_numpy(dtype=float)
-    failed = np.flatnonzero(~np.isfinite(y))
-    if failed.size:
+    missing = np.flatnonzero(~np.isfinite(y))
+    if missing.size:
+        k = int(missing[0])
+        why = samples["error"].iloc[k] or "no value"
         raise ValueError(
-            f"{metric} is not defined for {failed.size} of {len(y)} samples (e.g. sample "
-            f"{failed[0]}: {samples['error'].iloc[failed[0]]}); Sobol indices need every one"
+            f"{metric} is not defined for {missing.size} of {len(y)} samples (sample {k}: "
+            f"{why}); Sobol indices need a value for every sample"
         )
     res = sobol_analyze.analyze(problem, y, calc_second_order=second_order, seed=seed)
-    out = pd.DataFrame(
+    indices = pd.DataFrame(
         {k: np.asarray(res[k], dtype=float) for k in ("S1", "S1_conf", "ST", "ST_conf")},
         index=pd.Index(names, name="parameter"),
     )
-    return SensitivityResult(indices=out, metric=metric, samples=samples)
+    return SensitivityResult(indices=indices, metric=metric, samples=samples)
