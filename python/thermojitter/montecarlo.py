@@ -14,6 +14,7 @@ computes only the others.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import hashlib
 import itertools
 import json
@@ -21,7 +22,7 @@ import math
 import os
 import threading
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Generator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -342,7 +343,7 @@ def _local_chunks(
     todo: list[tuple[int, int, int]],
     options: dict[str, Any],
     threads: int | None,
-) -> Iterator[tuple[int, dict[str, Any]]]:
+) -> Generator[tuple[int, dict[str, Any]], None, None]:
     """Yields (chunk, metrics) as chunks finish. Two chunks are in flight at once on one rayon
     pool, so the pool's threads stay busy while a chunk finishes its last samples."""
     pool = _core.EnsemblePool(threads)
@@ -381,7 +382,7 @@ def _dask_chunks(
     matrix: NDArray[np.float64],
     todo: list[tuple[int, int, int]],
     options: dict[str, Any],
-) -> Iterator[tuple[int, dict[str, Any]]]:
+) -> Generator[tuple[int, dict[str, Any]], None, None]:
     from distributed import as_completed
 
     futures = {client.submit(dask_chunk, matrix[a:b], options, pure=False): k for k, a, b in todo}
@@ -529,18 +530,20 @@ def _run_design(
     client, owned = (None, False) if backend is None else _dask_client(backend)
     try:
         if todo:
-            stream = (
+            stream: Generator[tuple[int, dict[str, Any]], None, None] = (
                 _local_chunks(matrix, todo, options, threads)
                 if client is None
                 else _dask_chunks(client, matrix, todo, options)
             )
-            for k, metrics in stream:
-                done[k] = metrics
-                start, stop = bounds[k][1], bounds[k][2]
-                if directory is not None:
-                    _write_chunk(directory, k, start, metrics)
-                if bar is not None:
-                    bar.update(stop - start)
+            # closing: on any error (Ctrl-C included) the pending chunks are cancelled at once.
+            with contextlib.closing(stream):
+                for k, metrics in stream:
+                    done[k] = metrics
+                    start, stop = bounds[k][1], bounds[k][2]
+                    if directory is not None:
+                        _write_chunk(directory, k, start, metrics)
+                    if bar is not None:
+                        bar.update(stop - start)
     finally:
         if bar is not None:
             bar.close()
