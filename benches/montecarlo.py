@@ -3,7 +3,7 @@ atol 1e-10), on 1 and 2 rayon threads; and the cost of a sample against one ``tj
 of the same orbit for the same panels (the sample adds the flutter analysis, the critical damping
 and the per-orbit summary). Run it on a quiet machine (check ``uptime``).
 
-    python benches/montecarlo.py [--n 200] [--threads 1 2] [--repeat 1] [--simulate 200]
+    python benches/montecarlo.py [--n 200] [--threads 1 2] [--repeat 1] [--simulate 50]
 """
 
 from __future__ import annotations
@@ -13,8 +13,6 @@ import os
 import statistics
 import time
 from typing import Any
-
-import numpy as np
 
 import thermojitter as tj
 
@@ -31,7 +29,7 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=200, help="samples")
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeat", type=int, default=1, help="runs per thread count (median)")
-    parser.add_argument("--simulate", type=int, default=200, help="panels run with tj.simulate")
+    parser.add_argument("--simulate", type=int, default=50, help="panels run with tj.simulate")
     args = parser.parse_args()
 
     panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
@@ -69,30 +67,31 @@ def main() -> None:
 
     if 1 not in walls:
         return
-    # The same panels, one tj.simulate call each (end state only), on this thread.
+    # The same panels, one call each on this thread: tj.simulate (end state only) and
+    # tj.simulate_orbits (the per-orbit summary a sample is reduced from).
     k = min(args.simulate, args.n)
+    panels = [
+        panel.replace(**{name: float(row[name]) for name in VARY})
+        for _, row in frame.iloc[:k].iterrows()
+    ]
     start = time.perf_counter()
-    sim_steps = 0
-    for _, row in frame.iloc[:k].iterrows():
-        p = panel.replace(**{name: float(row[name]) for name in VARY})
-        sol = tj.simulate(
-            p, orbit, (0.0, orbit.period), rtol=RTOL, atol=ATOL, t_eval=np.array([orbit.period])
-        )
-        sim_steps += sol.n_steps
+    for p in panels:
+        tj.simulate(p, orbit, (0.0, orbit.period), rtol=RTOL, atol=ATOL, t_eval=[orbit.period])
     per_sim = (time.perf_counter() - start) / k
+    start = time.perf_counter()
+    for p in panels:
+        tj.simulate_orbits(p, orbit, 1, rtol=RTOL, atol=ATOL, progress=False)
+    per_orbits = (time.perf_counter() - start) / k
     per_sample = walls[1] / args.n
-    print(
-        f"one tj.simulate call ({k} of the panels): {1e3 * per_sim:7.1f} ms, "
-        f"{1e9 * per_sim * k / sim_steps:.0f} ns/step"
-    )
-    print(
-        f"one Monte Carlo sample, 1 thread:        {1e3 * per_sample:7.1f} ms, "
-        f"{1e9 * walls[1] / steps:.0f} ns/step"
-    )
-    print(
-        f"per-sample overhead: {1e3 * (per_sample - per_sim):+.1f} ms "
-        f"({100.0 * (per_sample / per_sim - 1.0):+.1f} %)"
-    )
+    mc_steps = int(frame["n_steps"].iloc[:k].sum())
+    print(f"per sample, same {k} panels ({mc_steps // k} steps each):")
+    for name, t in (
+        ("tj.simulate (end state only)", per_sim),
+        ("tj.simulate_orbits (summary)", per_orbits),
+        ("tj.monte_carlo, 1 thread", per_sample),
+    ):
+        print(f"  {name:<30}{1e3 * t:8.1f} ms {100.0 * (t / per_sim - 1.0):+8.1f} %")
+    print(f"overhead of a sample over one tj.simulate call: {1e3 * (per_sample - per_sim):+.1f} ms")
 
 
 if __name__ == "__main__":
