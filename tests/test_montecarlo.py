@@ -87,6 +87,17 @@ def test_metrics_agree_with_a_sampled_single_run() -> None:
     assert row["t_reached"] == LOW.period
 
 
+def test_stop_at_threshold_cuts_the_run_at_the_crossing() -> None:
+    flagged = run(n=4, threshold=0.12)
+    stopped = run(n=4, threshold=0.12, stop_at_threshold=True)
+    crossed = flagged["t_threshold"].notna().to_numpy()
+    assert crossed.any()
+    np.testing.assert_array_equal(stopped["t_threshold"], flagged["t_threshold"])
+    assert (stopped["t_reached"][crossed] < LOW.period).all()
+    assert (stopped["t_reached"][~crossed] == LOW.period).all()
+    assert (stopped["n_steps"][crossed] < flagged["n_steps"][crossed]).all()
+
+
 def test_stability_agrees_with_the_critical_damping() -> None:
     # Two computations: the eigenvalues at the sampled damping, and the damping that zeroes them.
     frame = run(n=24, horizon=1, sampler="lhs")
