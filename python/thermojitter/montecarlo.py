@@ -649,13 +649,14 @@ def monte_carlo(
       (e.g. an emissivity above 1) is refused before anything runs, unless ``truncate=True``:
       then each distribution is truncated to the valid range.
     - ``sampler``: ``"random"`` (NumPy generator), ``"lhs"`` (Latin hypercube) or ``"sobol"``
-      (scrambled; best with n a power of 2), all seeded by ``seed``.
+      (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
+      ``frame.attrs["seed"]``; required with ``checkpoint``).
     - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
     - ``threshold`` (rad): time the first |θ| above it (``t_threshold``); with
       ``stop_at_threshold`` a sample stops there.
-    - ``threads``: rayon threads (default: one per core). ``backend``: None (this machine),
-      ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``; each worker
-      runs chunks on as many rayon threads as it has threads.
+    - ``threads``: rayon threads on this machine (default: one per core). ``backend``: None (this
+      machine), ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``;
+      each worker then runs chunks on as many rayon threads as it has threads.
     - ``checkpoint``: a directory; finished chunks (``chunk_size`` samples, default depending on n
       only; a resumed run keeps the size it started with) are written there as Parquet as they
       complete, and a run with the same settings resumes from them. Settings that differ are
