@@ -237,6 +237,29 @@ def test_killed_run_resumes_to_the_same_frame(tmp_path: Path) -> None:
         tj.monte_carlo(PAPER, LOW, checkpoint=path, **{**common, "seed": None})
 
 
+def test_ctrl_c_stops_the_run_and_keeps_the_finished_chunks(tmp_path: Path) -> None:
+    path = tmp_path / "ckpt"
+    script = _child(path).replace("tj.monte_carlo(", "try:\n    tj.monte_carlo(", 1)
+    script = script.replace(
+        "\n                       chunk_size", "\n                           chunk_size"
+    )
+    script += "except KeyboardInterrupt:\n    print('interrupted')\n"
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while len(list(path.glob("chunk-*.parquet"))) < 2:
+        if proc.poll() is not None or time.monotonic() > deadline:
+            pytest.fail("child finished before it could be interrupted")
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=60)
+    assert proc.returncode == 0 and out.strip() == "interrupted"
+    finished = sorted(path.glob("chunk-*.parquet"))
+    assert 2 <= len(finished) < 30
+    assert not list(path.glob("*.tmp"))
+    for chunk in finished:  # each one whole
+        assert pd.read_parquet(chunk)["sample"].size == 2
+
+
 def test_sobol_indices_find_the_parameter_that_matters() -> None:
     pytest.importorskip("SALib")
     vary = {"emissivity_back": ("uniform", 0.2, 0.4), "damping": ("uniform", 1.0, 4.0)}

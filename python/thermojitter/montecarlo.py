@@ -412,10 +412,13 @@ def _write_chunk(directory: Path, k: int, start: int, metrics: dict[str, Any]) -
     columns["error"] = pa.array(metrics["error"], type=pa.string())
     path = _chunk_path(directory, k)
     tmp = path.with_name(path.name + ".tmp")
-    pq.write_table(pa.table(columns), tmp)
-    with open(tmp, "rb") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    try:
+        pq.write_table(pa.table(columns), tmp)
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def _read_chunk(directory: Path, k: int, start: int, stop: int) -> dict[str, Any] | None:
@@ -535,15 +538,24 @@ def _run_design(
                 if client is None
                 else _dask_chunks(client, matrix, todo, options)
             )
+            written = set(done)
             # closing: on any error (Ctrl-C included) the pending chunks are cancelled at once.
             with contextlib.closing(stream):
-                for k, metrics in stream:
-                    done[k] = metrics
-                    start, stop = bounds[k][1], bounds[k][2]
+                try:
+                    for k, metrics in stream:
+                        done[k] = metrics
+                        start, stop = bounds[k][1], bounds[k][2]
+                        if directory is not None:
+                            _write_chunk(directory, k, start, metrics)
+                            written.add(k)
+                        if bar is not None:
+                            bar.update(stop - start)
+                except BaseException:
+                    # A finished chunk whose write was interrupted is written before leaving.
                     if directory is not None:
-                        _write_chunk(directory, k, start, metrics)
-                    if bar is not None:
-                        bar.update(stop - start)
+                        for k in sorted(set(done) - written):
+                            _write_chunk(directory, k, bounds[k][1], done[k])
+                    raise
     finally:
         if bar is not None:
             bar.close()
