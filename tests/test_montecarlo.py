@@ -43,6 +43,8 @@ def test_same_frame_for_any_threads_and_chunking() -> None:
     assert one["error"].isna().all()
     # Another seed draws other panels; the same seed the same ones.
     assert not np.array_equal(run(seed=8)["damping"], one["damping"])
+    # With the random sampler a sample depends on (seed, index) only, not on n.
+    pd.testing.assert_frame_equal(run(n=5), one.iloc[:5], check_exact=True)
 
 
 def test_same_frame_on_a_dask_cluster() -> None:

@@ -660,7 +660,8 @@ def monte_carlo(
       ``("triangular", lo, mode, hi)``). A design with a sample outside a parameter's valid range
       (e.g. an emissivity above 1) is refused before anything runs, unless ``truncate=True``:
       then each distribution is truncated to the valid range.
-    - ``sampler``: ``"random"`` (NumPy generator), ``"lhs"`` (Latin hypercube) or ``"sobol"``
+    - ``sampler``: ``"random"`` (NumPy generator; sample i depends on the seed and i only, so a
+      larger n extends a study), ``"lhs"`` (Latin hypercube) or ``"sobol"``
       (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
       ``frame.attrs["seed"]``; required with ``checkpoint``).
     - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
