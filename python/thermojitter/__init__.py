@@ -19,6 +19,7 @@ from thermojitter.flutter import (
     stability_map,
 )
 from thermojitter.longrun import OrbitSummaries, simulate_orbits
+from thermojitter.montecarlo import SensitivityResult, monte_carlo, sensitivity, sweep
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -45,6 +46,7 @@ __all__ = [
     "Orbit",
     "OrbitSummaries",
     "Panel",
+    "SensitivityResult",
     "Solution",
     "StabilityMap",
     "ThermalSolution",
@@ -57,11 +59,14 @@ __all__ = [
     "hinge_energy",
     "hinge_stiffness",
     "linear_thermal_response",
+    "monte_carlo",
     "natural_frequency",
+    "sensitivity",
     "simulate",
     "simulate_hinge",
     "simulate_orbits",
     "simulate_thermal",
     "stability_map",
     "steady_state",
+    "sweep",
 ]

@@ -1,6 +1,6 @@
 """Typed stub of the native engine module (built from rust/src/py by maturin)."""
 
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -9,12 +9,14 @@ _F = NDArray[np.float64]
 
 __all__ = [
     "ConvergenceError",
+    "EnsemblePool",
     "IntegrationError",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
     "beam_static",
+    "check_panels",
     "declination",
     "derived",
     "eclipses",
@@ -181,3 +183,30 @@ def stability_map(
     coupled: bool,
     flux: float,
 ) -> dict[str, Any]: ...
+
+# --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
+def check_panels(panels: _F) -> list[tuple[int, str]]: ...
+
+@final
+class EnsemblePool:
+    def __new__(cls, threads: int | None = None) -> EnsemblePool: ...
+    @property
+    def threads(self) -> int: ...
+    def run(
+        self,
+        panels: _F,
+        orbit: dict[str, Any],
+        *,
+        model: str,
+        coupled: bool,
+        method_name: str,
+        rtol: float,
+        atol: float,
+        dt: float | None,
+        max_step: float,
+        max_steps: int,
+        n_orbits: int,
+        window: float,
+        threshold: float | None,
+        stop_at_threshold: bool,
+    ) -> dict[str, Any]: ...

@@ -7,6 +7,7 @@
 
 pub mod beam;
 pub mod dynamics;
+pub mod ensemble;
 pub mod error;
 pub mod flutter;
 pub mod integrate;

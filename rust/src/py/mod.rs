@@ -3,6 +3,7 @@
 
 mod beam;
 mod convert;
+mod ensemble;
 mod flutter;
 mod longrun;
 mod orbit;
@@ -395,5 +396,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     longrun::register(m)?;
     beam::register(m)?;
     orbit::register(m)?;
+    ensemble::register(m)?;
     Ok(())
 }
