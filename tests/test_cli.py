@@ -507,3 +507,18 @@ def test_flutter_subcommand_through_the_main_command(tmp_path: Path) -> None:
     record = json.loads((out / "flutter.json").read_text())
     assert "nonlinear" in json.dumps(record)
     assert cli.main(["flutter", str(tmp_path / "missing.toml"), "--out", str(out)]) == 2
+
+
+def test_mc_subcommand_through_the_main_command(tmp_path: Path) -> None:
+    scenario = tmp_path / "mc.toml"
+    scenario.write_text(
+        '[orbit]\nradius = 7.0e6\nperiod = 5828.5\n\n[vary]\ndamping = ["uniform", 1.0, 4.0]\n'
+    )
+    out = tmp_path / "mc"
+    assert cli.main(["mc", str(scenario), "--n", "6", "--out", str(out), "--no-progress"]) == 0
+    assert (out / "samples.parquet").exists() and (out / "scatter.png").exists()
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[vary]\nstiffness = ["uniform", 1.0, 2.0]\n')
+    assert cli.main(["mc", str(bad), "--n", "4", "--out", str(tmp_path / "b")]) == 2
+    bad.write_text('[panel]\nmass_per_length = -1\n[vary]\ndamping = ["uniform", 1.0, 2.0]\n')
+    assert cli.main(["mc", str(bad), "--n", "4", "--out", str(tmp_path / "c")]) == 2

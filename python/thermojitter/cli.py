@@ -487,6 +487,14 @@ def build_parser() -> argparse.ArgumentParser:
         add_help=False,
     )
     flutter.set_defaults(handler=_flutter)
+
+    mc = sub.add_parser(
+        "mc",
+        help="Monte Carlo study of a scenario with a [vary] table (Parquet, histograms)",
+        description="Run 'thermojitter mc --help' for its options.",
+        add_help=False,
+    )
+    mc.set_defaults(handler=_mc)
     return parser
 
 
@@ -496,8 +504,14 @@ def _flutter(argv: Sequence[str]) -> int:
     return flutter_command(list(argv))
 
 
+def _mc(argv: Sequence[str]) -> int:
+    from thermojitter.montecarlo_cli import mc_command
+
+    return mc_command(list(argv))
+
+
 # Commands with parsers of their own: main() hands them the rest of the command line.
-FORWARDED: dict[str, Callable[[Sequence[str]], int]] = {"flutter": _flutter}
+FORWARDED: dict[str, Callable[[Sequence[str]], int]] = {"flutter": _flutter, "mc": _mc}
 
 
 def _beam(args: argparse.Namespace) -> int:
@@ -519,8 +533,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         try:
             return FORWARDED[args_list[0]](args_list[1:])
         except KeyboardInterrupt:
-            print("thermojitter: interrupted", file=sys.stderr)
+            print("thermojitter: interrupted (files already written are kept)", file=sys.stderr)
             return EXIT_INTERRUPTED
+        except (ValueError, TypeError, IntegrationError, ConvergenceError) as exc:
+            return _fail(" ".join(str(exc).split()))
+        except ImportError as exc:
+            return _fail(f"{exc} (pip install 'thermojitter[cli]')")
     parser = build_parser()
     args = parser.parse_args(argv)
     if getattr(args, "handler", None) is None:

@@ -1,10 +1,10 @@
 """``thermojitter mc SCENARIO.toml --n 1000 --out DIR``: a Monte Carlo study from a scenario file.
 
-Interim scenario format (read here with tomllib until the shared scenario parser lands):
+The scenario format of ``thermojitter run`` with two more tables:
 
     [panel]            # Panel fields overriding Table 1 (optional)
     damping = 3.0
-    [orbit]            # Orbit fields (optional; default GEO at equinox)
+    [orbit]            # a preset and/or Orbit fields (optional; default GEO at equinox)
     radius = 7.0e6
     period = 5828.5
     [vary]             # parameter = [distribution, numbers...] (see tj.monte_carlo)
@@ -27,14 +27,9 @@ from typing import Any
 
 import numpy as np
 
+from thermojitter.flutter_cli import UNITS as _PANEL_UNITS
 from thermojitter.montecarlo import monte_carlo
-from thermojitter.orbit import Orbit
-from thermojitter.panel import Panel
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
+from thermojitter.scenario import ScenarioError, load_scenario
 
 HISTOGRAMS = (
     "theta_eq", "growth_rate", "critical_damping", "theta_abs_max", "entry_peak", "exit_peak",
@@ -45,27 +40,18 @@ _RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window
 
 
 def read_scenario(path: str | Path) -> dict[str, Any]:
-    """The panel, orbit, vary and montecarlo tables of a scenario file, checked."""
-    with open(path, "rb") as fh:
-        doc = tomllib.load(fh)
-    unknown = sorted(set(doc) - {"panel", "orbit", "vary", "montecarlo"})
-    if unknown:
-        raise ValueError(f"{path}: unknown table(s) {', '.join(unknown)}")
-    panel = Panel.from_dict(doc.get("panel", {}))
-    orbit_fields = doc.get("orbit", {})
-    bad = sorted(set(orbit_fields) - set(Orbit.geo_equinox().as_dict()))
-    if bad:
-        raise ValueError(f"{path}: unknown orbit field(s) {', '.join(bad)}")
-    orbit = Orbit(**orbit_fields)
-    vary = doc.get("vary")
+    """The panel, orbit, vary and montecarlo tables of a scenario file, checked (the panel and
+    orbit by the shared scenario parser, so every scenario file of ``run`` works here)."""
+    scenario = load_scenario(path, extra_sections=("vary", "montecarlo"))
+    vary = scenario.extra["vary"]
     if not vary:
-        raise ValueError(f"{path}: a [vary] table is required (parameter = [dist, numbers...])")
-    settings = dict(doc.get("montecarlo", {}))
+        raise ScenarioError(path, "vary", "a [vary] table is required (parameter = [dist, ...])")
+    settings = dict(scenario.extra["montecarlo"])
     allowed = {"n", "seed", "sampler", "truncate", *_RUN_KEYS}
     extra = sorted(set(settings) - allowed)
     if extra:
-        raise ValueError(f"{path}: unknown [montecarlo] key(s) {', '.join(extra)}")
-    return {"panel": panel, "orbit": orbit, "vary": vary, "settings": settings}
+        raise ScenarioError(path, f"montecarlo.{extra[0]}", "unknown key")
+    return {"panel": scenario.panel, "orbit": scenario.orbit, "vary": vary, "settings": settings}
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -93,6 +79,20 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+# Plot labels: angles are shown in degrees (the tables keep radians), other metrics in SI.
+_ANGLES = {"theta_eq", "theta_abs_max", "entry_peak", "exit_peak", "jitter_rms", "jitter_peak"}
+_UNITS = {"growth_rate": "1/s", "critical_damping": "N m s/rad", "t_threshold": "s"}
+
+
+def _shown(frame: Any, name: str) -> tuple[np.ndarray, str]:
+    """A metric or parameter column as plotted, with its axis label."""
+    values = frame[name].to_numpy(float)
+    if name in _ANGLES:
+        return np.degrees(values), f"{name} [deg]"
+    unit = _UNITS.get(name) or _PANEL_UNITS.get(name)
+    return values, f"{name} [{unit}]" if unit else name
+
+
 def plot(frame: Any, names: Sequence[str], out: Path) -> list[Path]:
     """Histograms of the metrics and scatter plots of the metrics against the parameters."""
     import matplotlib
@@ -106,9 +106,10 @@ def plot(frame: Any, names: Sequence[str], out: Path) -> list[Path]:
     rows = max(1, -(-len(metrics) // cols))
     fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3 * rows), squeeze=False)
     for ax, m in zip(axes.flat, metrics, strict=False):
-        values = frame[m].to_numpy(float)
+        values, label = _shown(frame, m)
         ax.hist(values[np.isfinite(values)], bins=40, color="tab:blue")
-        ax.set_title(m)
+        ax.set_xlabel(label)
+        ax.set_ylabel("samples")
     for ax in list(axes.flat)[len(metrics) :]:
         ax.set_visible(False)
     fig.suptitle(f"{len(frame)} samples")
@@ -128,11 +129,11 @@ def plot(frame: Any, names: Sequence[str], out: Path) -> list[Path]:
     for i, name in enumerate(names):
         for j, m in enumerate(SCATTER_METRICS):
             ax = axes[i, j]
-            x, y = frame[name].to_numpy(float), frame[m].to_numpy(float)
+            (x, xlabel), (y, ylabel) = _shown(frame, name), _shown(frame, m)
             ax.scatter(x[stable], y[stable], s=6, label="stable", color="tab:blue")
             ax.scatter(x[~stable], y[~stable], s=6, label="flutter", color="tab:red")
-            ax.set_xlabel(name)
-            ax.set_ylabel(m)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel)
     axes[0, 0].legend(fontsize="small")
     fig.tight_layout()
     path = out / "scatter.png"
