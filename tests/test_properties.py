@@ -106,8 +106,15 @@ def test_sunlit_equilibrium_is_a_fixed_point(panel: tj.Panel, coupled: bool, mod
 
     loose, tight = drift(1e-8), drift(1e-11)
     # At a true fixed point the only motion is integration error, which follows the tolerance.
-    assert tight[0] < 1e-8 and tight[1] < 1e-7
-    assert tight[0] <= loose[0] / 100 + 1e-14
+    # Below the critical damping the fixed point is unstable: that error then grows as e^(g t),
+    # with g the growth rate of the linear analysis.
+    growth = max(tj.flutter(panel, model, coupled=coupled).growth_rate, 0.0)
+    amplification = math.exp(growth * 0.9 * ENTRY)
+    assert tight[0] < 1e-8 * amplification and tight[1] < 1e-7 * amplification
+    if growth == 0.0:
+        # Stable: the drift is pure truncation error, so it shrinks with the tolerance. (When
+        # unstable, round-off is amplified by e^(g t) too and the tolerance no longer rules it.)
+        assert tight[0] <= loose[0] / 100 + 1e-14
     assert abs(eq.thermal_moment - panel.hinge_stiffness * eq.theta) < 1e-8 * abs(eq.thermal_moment)
 
 

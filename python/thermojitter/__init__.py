@@ -6,8 +6,20 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
+from thermojitter import beam
 from thermojitter._core import ConvergenceError, IntegrationError
-from thermojitter.flutter import FlutterResult, flutter
+from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
+from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
+from thermojitter.flutter import (
+    FlutterResult,
+    LinearThermalResponse,
+    StabilityMap,
+    flutter,
+    linear_thermal_response,
+    stability_map,
+)
+from thermojitter.longrun import OrbitSummaries, simulate_orbits
+from thermojitter.montecarlo import SensitivityResult, monte_carlo, sensitivity, sweep
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -22,22 +34,39 @@ from thermojitter.simulate import (
 __version__ = "0.1.0"
 
 __all__ = [
+    "BeamComparison",
+    "CalibrationResult",
     "ConvergenceError",
     "Equilibrium",
     "FlutterResult",
+    "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
+    "LinearThermalResponse",
     "Orbit",
+    "OrbitSummaries",
     "Panel",
+    "SensitivityResult",
     "Solution",
+    "StabilityMap",
     "ThermalSolution",
+    "beam",
     "beam_frequency",
     "flutter",
+    "calibrate",
+    "calibrate_from_csv",
+    "compare_with_beam",
     "hinge_energy",
     "hinge_stiffness",
+    "linear_thermal_response",
+    "monte_carlo",
     "natural_frequency",
+    "sensitivity",
     "simulate",
     "simulate_hinge",
+    "simulate_orbits",
     "simulate_thermal",
+    "stability_map",
     "steady_state",
+    "sweep",
 ]

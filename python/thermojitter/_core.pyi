@@ -1,6 +1,6 @@
 """Typed stub of the native engine module (built from rust/src/py by maturin)."""
 
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -9,20 +9,33 @@ _F = NDArray[np.float64]
 
 __all__ = [
     "ConvergenceError",
+    "EnsemblePool",
     "IntegrationError",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
+    "beam_modes",
+    "beam_response",
+    "beam_static",
+    "check_panels",
+    "declination",
     "derived",
+    "eclipses",
     "energy",
     "flutter",
+    "flux_scale",
     "illumination",
     "moment",
+    "orbit_breakpoints",
+    "run_orbits",
     "shadow_intervals",
     "simulate",
     "simulate_hinge",
     "simulate_thermal",
+    "stability_map",
     "steady_state",
     "stiffness",
+    "synodic_period",
+    "umbra_intervals",
     "validate_orbit",
     "validate_panel",
 ]
@@ -102,3 +115,98 @@ def simulate_hinge(
 def flutter(
     panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
 ) -> dict[str, Any]: ...
+
+# --- long runs ----------------------------------------------------------------------------------
+def run_orbits(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    model: str,
+    coupled: bool,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_start: float,
+    first_index: int,
+    n_orbits: int,
+    y0: list[float],
+    window: float,
+    theta_limit: float,
+    stop_at_limit: bool,
+) -> dict[str, Any]: ...
+
+# --- finite-element beam comparator (rust/src/py/beam.rs) ---
+
+def beam_modes(panel: dict[str, float], n_elements: int, n_modes: int) -> dict[str, Any]: ...
+def beam_static(panel: dict[str, float], n_elements: int, moment: float) -> float: ...
+def beam_response(
+    panel: dict[str, float],
+    n_elements: int,
+    moment_t: _F,
+    moment: _F,
+    t0: float,
+    t1: float,
+    *,
+    damping_ratio: float,
+    residual: bool,
+    method_name: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_step: float,
+    max_steps: int,
+    t_eval: _F | None,
+    dt_out: float | None,
+) -> dict[str, Any]: ...
+
+# --- orbit options (issue 4)
+def eclipses(
+    orbit: dict[str, Any], t0: float, t1: float
+) -> list[tuple[float, float, float, float, float]]: ...
+def umbra_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[float, float]]: ...
+def orbit_breakpoints(orbit: dict[str, Any], t0: float, t1: float) -> list[float]: ...
+def flux_scale(orbit: dict[str, Any], t: _F) -> _F: ...
+def declination(orbit: dict[str, Any], t: _F) -> _F: ...
+def synodic_period(orbit: dict[str, Any]) -> float: ...
+
+# --- stability map (issue 4)
+def stability_map(
+    panel: dict[str, float],
+    x_name: str,
+    x_values: list[float],
+    y_name: str,
+    y_values: list[float],
+    model: str,
+    coupled: bool,
+    flux: float,
+) -> dict[str, Any]: ...
+
+# --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
+def check_panels(panels: _F) -> list[tuple[int, str]]: ...
+
+@final
+class EnsemblePool:
+    def __new__(cls, threads: int | None = None) -> EnsemblePool: ...
+    @property
+    def threads(self) -> int: ...
+    def run(
+        self,
+        panels: _F,
+        orbit: dict[str, Any],
+        *,
+        model: str,
+        coupled: bool,
+        method_name: str,
+        rtol: float,
+        atol: float,
+        dt: float | None,
+        max_step: float,
+        max_steps: int,
+        n_orbits: int,
+        window: float,
+        threshold: float | None,
+        stop_at_threshold: bool,
+    ) -> dict[str, Any]: ...

@@ -7,9 +7,10 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Equilibrium
 
@@ -48,15 +49,28 @@ def flutter(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     *,
     coupled: bool = True,
-    flux: float = 1.0,
+    flux: float | None = None,
+    orbit: Orbit | None = None,
+    t: float = 0.0,
 ) -> FlutterResult:
     """Linear stability of the sunlit equilibrium of ``panel``.
 
-    ``flux`` scales the solar constant (the Sun–Earth distance changes it by about ±3.3 % over the
-    year); the equilibrium, and with it the critical damping, depend on it.
+    ``flux`` scales the solar constant (default 1, the Sun at 1 au; the Sun–Earth distance changes
+    it by about ±3.3 % over the year); the equilibrium, and with it the critical damping, depend
+    on it. Or give ``orbit`` and a time ``t`` (s) instead: the flux is then
+    ``orbit.flux_scale(t)``, e.g. ``flutter(panel, orbit=Orbit.geo_year("2026-07-05"))`` near
+    aphelion.
     """
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    if orbit is not None:
+        if flux is not None:
+            raise ValueError("give flux or orbit (with t), not both")
+        if not isinstance(orbit, Orbit):
+            raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
+        flux = float(orbit.flux_scale(float(t))[0])
+    elif flux is None:
+        flux = 1.0
     raw = _core.flutter(panel.as_dict(), model, bool(coupled), float(flux))
     tf, tb, th = raw["equilibrium"]
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
@@ -70,4 +84,264 @@ def flutter(
         model=model,
         coupled=bool(coupled),
         flux=float(flux),
+    )
+
+
+# ----------------------------------------------------------------------------- stability map
+
+Axis = tuple[str, ArrayLike]
+
+DEFAULT_X: tuple[str, NDArray[np.float64]] = ("damping", np.linspace(0.0, 5.0, 51))
+"""Default x axis of :func:`stability_map`: hinge damping c_d, N m s/rad."""
+DEFAULT_Y: tuple[str, NDArray[np.float64]] = ("conductance", np.linspace(5.0, 60.0, 56))
+"""Default y axis of :func:`stability_map`: through-thickness conductance K, W/(m² K)."""
+
+
+@dataclass(frozen=True)
+class StabilityMap:
+    """Flutter growth rate over a grid of two panel parameters.
+
+    ``growth_rate[i, j]`` and ``frequency_hz[i, j]`` belong to ``y[i]`` and ``x[j]`` (rows follow
+    y, as for ``matplotlib.pyplot.contourf(x, y, growth_rate)``).
+    """
+
+    x_name: str
+    x: NDArray[np.float64]
+    y_name: str
+    y: NDArray[np.float64]
+    growth_rate: NDArray[np.float64]
+    frequency_hz: NDArray[np.float64]
+    model: str
+    coupled: bool
+    flux: float
+
+    @property
+    def stable(self) -> NDArray[np.bool_]:
+        """True where the sunlit equilibrium is stable (growth rate < 0)."""
+        return np.asarray(self.growth_rate < 0.0)
+
+
+def _axis(which: str, axis: object) -> tuple[str, NDArray[np.float64]]:
+    if not (isinstance(axis, tuple) and len(axis) == 2 and isinstance(axis[0], str)):
+        raise TypeError(f"{which} must be a (parameter name, values) tuple")
+    name, raw = axis
+    if name not in _core.PANEL_FIELDS:
+        raise ValueError(
+            f"{which} = {name!r} is invalid: not a panel parameter; one of "
+            + ", ".join(_core.PANEL_FIELDS)
+        )
+    values = np.asarray(raw, dtype=float)
+    if values.ndim != 1 or values.size == 0:
+        raise ValueError(f"{which} values for {name!r} must be a non-empty 1-D sequence")
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"{which} values for {name!r} must be finite")
+    return name, values
+
+
+def stability_map(
+    panel: Panel,
+    x: Axis = DEFAULT_X,
+    y: Axis = DEFAULT_Y,
+    model: Literal["nonlinear", "linear"] = "nonlinear",
+    *,
+    coupled: bool = True,
+    flux: float = 1.0,
+) -> StabilityMap:
+    """Growth rate of the sunlit equilibrium with two panel parameters swept over a grid.
+
+    ``x`` and ``y`` are ``(name, values)`` with ``name`` any :class:`Panel` field; the other
+    fields keep the values of ``panel``. The grid is analysed in parallel by the engine (one
+    eigen-analysis per point, the same as :func:`flutter`); the result does not depend on the
+    number of threads.
+    """
+    if not isinstance(panel, Panel):
+        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    x_name, xs = _axis("x", x)
+    y_name, ys = _axis("y", y)
+    if x_name == y_name:
+        raise ValueError(f"y = {y_name!r} is invalid: must differ from the x parameter")
+    raw = _core.stability_map(
+        panel.as_dict(),
+        x_name,
+        xs.tolist(),
+        y_name,
+        ys.tolist(),
+        model,
+        bool(coupled),
+        float(flux),
+    )
+    return StabilityMap(
+        x_name=x_name,
+        x=xs,
+        y_name=y_name,
+        y=ys,
+        growth_rate=np.asarray(raw["growth_rate"], dtype=float).reshape(ys.size, xs.size),
+        frequency_hz=np.asarray(raw["frequency_hz"], dtype=float).reshape(ys.size, xs.size),
+        model=model,
+        coupled=bool(coupled),
+        flux=float(flux),
+    )
+
+
+# ------------------------------------------------------------ closed-form linear analysis (4.2)
+
+
+@dataclass(frozen=True)
+class LinearThermalResponse:
+    """The linear analysis of paper Sec. 4.2.
+
+    With ε_f = ε_b = ε and T⁴ linearised about a common T*, the gradient ΔT = T_f − T_b obeys
+
+        dΔT/dt + q ΔT = p cos θ,     p = 2 α C flux/(m c),   q = (4 K + 8 σ ε T*³)/(m c)
+
+    and the linear hinge θ̈ + r θ̇ + ω_n² θ = s ΔT, r = c_d/I_B, s = χ a E I/(I_B d). Under a
+    forcing p cos(ω t + φ) the steady response is
+
+        ΔT(t) = p/√(q² + ω²) · cos(ω t + φ − lag),   lag = atan2(ω, q),
+
+    (the paper's p q²/(q² + ω²) [cos/q + ω sin/q²], rewritten). The projected area varies at the
+    hinge frequency, so the forcing of the hinge by s ΔT has the hinge's own frequency: the system
+    is resonant, and the lag puts part of the moment in phase with θ̇. For a swing θ = θ* + A cos
+    ω_n t that part acts as a negative damping
+    ``thermal_damping = s p sin θ* /(q² + ω_n²)`` (1/s); the oscillation grows when it exceeds r,
+    at about (thermal_damping − r)/2, so the critical damping is about
+    ``I_B · thermal_damping`` — which the eigen-analysis of :func:`flutter` gives exactly.
+    """
+
+    p: float
+    """Forcing of the gradient, K/s."""
+    q: float
+    """Relaxation rate of the gradient, 1/s."""
+    r: float
+    """Hinge damping rate c_d/I_B, 1/s."""
+    s: float
+    """Hinge acceleration per kelvin of gradient, rad/(K s²)."""
+    omega: float
+    """Forcing angular frequency, rad/s."""
+    omega_n: float
+    """Natural angular frequency of the linear hinge, rad/s."""
+    T_star: float
+    """Linearisation temperature, K."""
+    emissivity: float
+    """Common emissivity ε used in q, the mean of ε_f and ε_b."""
+    theta_star: float
+    """Sunlit equilibrium hinge angle, rad."""
+    hinge_inertia: float
+    """I_B, kg m²."""
+
+    @property
+    def amplitude(self) -> float:
+        """Steady amplitude of ΔT under p cos(ω t + φ), K: p/√(q² + ω²)."""
+        return self.p / math.hypot(self.q, self.omega)
+
+    @property
+    def phase_lag(self) -> float:
+        """Lag of ΔT behind the forcing, rad: atan2(ω, q), in [0, π/2)."""
+        return math.atan2(self.omega, self.q)
+
+    @property
+    def time_constant(self) -> float:
+        """1/q, s: how fast the gradient forgets its initial value."""
+        return 1.0 / self.q
+
+    @property
+    def resonant(self) -> bool:
+        """True when the forcing is at the hinge's natural frequency (within 1 %)."""
+        return abs(self.omega - self.omega_n) <= 0.01 * self.omega_n
+
+    @property
+    def thermal_damping(self) -> float:
+        """Negative damping rate from the lag, 1/s: s p sin θ* /(q² + ω_n²)."""
+        return self.s * self.p * math.sin(self.theta_star) / (self.q**2 + self.omega_n**2)
+
+    @property
+    def critical_damping_estimate(self) -> float:
+        """c_d at which the lag's pumping is balanced, N m s/rad: I_B · thermal_damping."""
+        return self.hinge_inertia * self.thermal_damping
+
+    @property
+    def growth_rate_estimate(self) -> float:
+        """Growth rate of the swing, 1/s: (thermal_damping − r)/2."""
+        return 0.5 * (self.thermal_damping - self.r)
+
+    def delta_T(
+        self, t: ArrayLike, *, phi: float = 0.0, delta_T0: float | None = None
+    ) -> NDArray[np.float64]:
+        """Closed-form ΔT(t) − ΔT(0)-response for dΔT/dt + q ΔT = p cos(ω t + φ), K.
+
+        ``delta_T0``: the gradient at t = 0 (its transient decays as e^(−q t)); ``None`` gives the
+        steady (long-period) solution alone."""
+        times = np.asarray(t, dtype=float)
+        w, q = self.omega, self.q
+        steady = self.amplitude * np.cos(w * times + phi - self.phase_lag)
+        if delta_T0 is None:
+            return np.asarray(steady)
+        steady0 = self.amplitude * math.cos(phi - self.phase_lag)
+        return np.asarray(steady + (delta_T0 - steady0) * np.exp(-q * times))
+
+    def describe(self) -> str:
+        """A short statement of the analysis, with numbers."""
+        return (
+            f"p = {self.p:.4g} K/s, q = {self.q:.4g} 1/s (1/q = {self.time_constant:.1f} s), "
+            f"omega = {self.omega:.4g} rad/s: dT amplitude {self.amplitude:.4g} K per unit "
+            f"cos forcing, lag {math.degrees(self.phase_lag):.1f} deg. "
+            + (
+                "The forcing is at the hinge's natural frequency: the system is resonant. "
+                if self.resonant
+                else ""
+            )
+            + f"Thermal pumping {self.thermal_damping:.4g} 1/s vs damping r = {self.r:.4g} 1/s: "
+            f"critical c_d ~ {self.critical_damping_estimate:.4g} N m s/rad."
+        )
+
+
+def linear_thermal_response(
+    panel: Panel,
+    omega: float | None = None,
+    T_star: float | None = None,
+    *,
+    flux: float = 1.0,
+) -> LinearThermalResponse:
+    """The closed-form linear analysis of paper Sec. 4.2 for ``panel``.
+
+    ``omega``: forcing angular frequency, rad/s (default ω_n, the hinge's natural frequency, as in
+    the paper). ``T_star``: linearisation temperature, K (default the mean of the two layers at the
+    sunlit equilibrium under ``flux``). The paper assumes ε_f = ε_b; for other panels ε is taken
+    as their mean, an approximation.
+    """
+    from thermojitter.simulate import steady_state
+
+    if not isinstance(panel, Panel):
+        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    flux = float(flux)
+    if not (math.isfinite(flux) and flux > 0.0):
+        raise ValueError(f"flux = {flux} is invalid: must be finite and > 0")
+    eq = steady_state(panel, flux=flux)
+    derived = _core.derived(panel.as_dict())
+    inertia = float(derived["hinge_inertia"])
+    omega_n = math.sqrt(panel.hinge_stiffness / inertia)
+    if omega is None:
+        omega = omega_n
+    omega = float(omega)
+    if not (math.isfinite(omega) and omega >= 0.0):
+        raise ValueError(f"omega = {omega} is invalid: must be finite and >= 0")
+    if T_star is None:
+        T_star = 0.5 * (eq.T_front + eq.T_back)
+    T_star = float(T_star)
+    if not (math.isfinite(T_star) and T_star > 0.0):
+        raise ValueError(f"T_star = {T_star} is invalid: must be finite and > 0")
+    mc = panel.mass_per_length * panel.specific_heat
+    eps = 0.5 * (panel.emissivity_front + panel.emissivity_back)
+    sigma = float(_core.STEFAN_BOLTZMANN)
+    return LinearThermalResponse(
+        p=2.0 * panel.absorptivity * panel.solar_constant * flux / mc,
+        q=(4.0 * panel.conductance + 8.0 * sigma * eps * T_star**3) / mc,
+        r=panel.damping / inertia,
+        s=float(derived["moment_per_kelvin"]) / inertia,
+        omega=omega,
+        omega_n=omega_n,
+        T_star=T_star,
+        emissivity=eps,
+        theta_star=eq.theta,
+        hinge_inertia=inertia,
     )

@@ -1,9 +1,35 @@
-"""Orbits: phase, Earth shadow, illumination."""
+"""Orbits: phase, Earth shadow (none, cylindrical, penumbra), illumination, the Sun over the year.
+
+The orbit is circular, in the Earth's equatorial plane, and the plate points at the Sun. The
+phase β is measured from the Sun's meridian: β = 0 at the subsolar point (t = 0 by default) and
+the shadow is centred on β = π.
+
+Shadow models (``shadow``):
+
+- ``"none"``: permanent sunlight, s = 1 (for flutter growth measurements).
+- ``"cylindrical"``: the paper's model, a cylinder of radius R_E behind the Earth; s jumps
+  between 1 and 0.
+- ``"penumbra"``: the Sun is a disk (angular radius asin(R_sun / distance), about 0.267° at 1 au)
+  partly hidden by the Earth's disk (angular radius asin(R_E / r)); s is the visible fraction of
+  the solar disk, continuous in [0, 1], from the overlap area of the two disks (planar geometry
+  in angles; the atmosphere is ignored). At GEO sunrise and sunset take about two minutes.
+
+The year (``season=True``): the Sun's declination is δ = asin(sin 23.44° · sin(2π (d − 78.5) /
+365.2422)), d the day of the year (days since 1 January 00:00 UTC; 78.5 is a mean March
+equinox, about 20 March 12:00), and the Sun moves eastwards by 360°/365.2422 per day, so
+eclipses recur once per synodic period (86400 s at GEO). At GEO eclipses happen only within about
+±23 days of the equinoxes, growing from 0 to about 72 min (first to last contact) and back.
+``eccentric_sun=True``: the Sun–Earth distance is r = 1 − 0.0167 cos(2π (d − 3) / 365.2422) au
+(perihelion about 4 January) and the flux scales as 1/r², ±3.3 %. Dates are mean values, good to
+about a day; the equation of time is ignored.
+"""
 
 from __future__ import annotations
 
+import datetime as _dt
 import math
 from dataclasses import dataclass, fields
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -16,14 +42,64 @@ EARTH_RADIUS = 6_378.137e3
 """Equatorial Earth radius, m."""
 SIDEREAL_DAY = 86_164.0905
 """One sidereal day, s."""
+MU_EARTH = 3.986004418e14
+"""Earth's gravitational parameter, m³/s²."""
+EQUINOX_DAY = 78.5
+"""Mean March equinox, days since 1 January 00:00 UTC."""
+PERIHELION_DAY = 3.0
+"""Mean perihelion, days since 1 January 00:00 UTC."""
+
+ShadowModel = Literal["none", "cylindrical", "penumbra"]
+_SHADOWS = ("none", "cylindrical", "penumbra")
+_FLOATS = ("radius", "earth_radius", "period", "phase0", "epoch_day")
+_BOOLS = ("season", "eccentric_sun")
+
+DateLike = str | _dt.date | float | int
+
+
+def day_of_year(date: DateLike) -> float:
+    """Days since 1 January 00:00 UTC of the date's year, fractional.
+
+    ``date``: an ISO date or date-time string ("2026-03-20", "2026-03-20T14:46"), a
+    ``datetime.date``/``datetime.datetime`` (aware ones are converted to UTC), or a number taken
+    as the day of the year already.
+    """
+    if isinstance(date, bool):
+        raise TypeError("start_date must be a date, an ISO date string or a day of the year")
+    if isinstance(date, (int, float)):
+        value = float(date)
+        if not math.isfinite(value):
+            raise ValueError(f"start_date = {date} is invalid: must be finite")
+        return value
+    if isinstance(date, str):
+        try:
+            parsed: _dt.date = _dt.datetime.fromisoformat(date)
+        except ValueError:
+            raise ValueError(
+                f"start_date = {date!r} is invalid: not an ISO date (YYYY-MM-DD[THH:MM[:SS]])"
+            ) from None
+        date = parsed
+    if isinstance(date, _dt.datetime):
+        if date.tzinfo is not None:
+            date = date.astimezone(_dt.timezone.utc).replace(tzinfo=None)
+        start = _dt.datetime(date.year, 1, 1)
+        return (date - start).total_seconds() / 86400.0
+    if isinstance(date, _dt.date):
+        return float((date - _dt.date(date.year, 1, 1)).days)
+    raise TypeError(
+        f"start_date must be a date, an ISO date string or a day of the year, "
+        f"not {type(date).__name__}"
+    )
 
 
 @dataclass(frozen=True)
 class Orbit:
-    """A circular orbit with a cylindrical Earth shadow and the Sun in the orbit plane.
+    """A circular equatorial orbit, its Earth shadow and the Sun over the year.
 
-    Phase β = 2π t/period + phase0, with β = 0 at the subsolar point; the shadow is centred on
-    β = π. Immutable and validated on construction.
+    Phase β = 2π t/period + phase0 relative to a fixed Sun (``season=False``), or advancing at
+    2π/period − 2π/year when the Sun moves over the year; β = 0 at the subsolar point, the shadow
+    centred on β = π. Immutable and validated on construction. The defaults are the paper's
+    scenario (GEO at equinox, cylindrical shadow, Sun at 1 au).
     """
 
     radius: float = GEO_RADIUS
@@ -31,16 +107,33 @@ class Orbit:
     earth_radius: float = EARTH_RADIUS
     """Radius of the shadowing body, m."""
     period: float = SIDEREAL_DAY
-    """Orbit period, s."""
+    """Orbit period (inertial), s."""
     phase0: float = 0.0
     """Phase at t = 0, rad."""
+    shadow: ShadowModel = "cylindrical"
+    """Shadow model: "none", "cylindrical" or "penumbra"."""
+    season: bool = False
+    """The Sun's declination and right ascension follow the year from ``epoch_day``."""
+    eccentric_sun: bool = False
+    """The flux (∝ 1/r²) and the Sun's size follow the Sun–Earth distance r."""
+    epoch_day: float = EQUINOX_DAY
+    """Day of the year at t = 0 (days since 1 January 00:00 UTC)."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise TypeError(f"{f.name} must be a real number, not {type(value).__name__}")
-            object.__setattr__(self, f.name, float(value))
+            if f.name in _FLOATS:
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    raise TypeError(f"{f.name} must be a real number, not {type(value).__name__}")
+                object.__setattr__(self, f.name, float(value))
+            elif f.name in _BOOLS:
+                if not isinstance(value, (bool, np.bool_)):
+                    raise TypeError(f"{f.name} must be a bool, not {type(value).__name__}")
+                object.__setattr__(self, f.name, bool(value))
+            elif f.name == "shadow" and value not in _SHADOWS:
+                raise ValueError(
+                    f"shadow = {value!r} is invalid: must be 'none', 'cylindrical' or 'penumbra'"
+                )
         _core.validate_orbit(self.as_dict())
 
     @classmethod
@@ -48,19 +141,111 @@ class Orbit:
         """The paper's scenario: GEO at equinox, cylindrical shadow, t = 0 at the subsolar point."""
         return cls()
 
-    def as_dict(self) -> dict[str, float]:
+    @classmethod
+    def geo_year(
+        cls,
+        start_date: DateLike = "2026-01-01",
+        *,
+        shadow: ShadowModel = "penumbra",
+        eccentric_sun: bool = True,
+    ) -> Orbit:
+        """GEO over a realistic year from ``start_date`` (t = 0 at the subsolar point that day):
+        the Sun's declination (eclipse seasons around the equinoxes), its distance (flux ±3.3 %)
+        and a penumbra."""
+        return cls(
+            shadow=shadow,
+            season=True,
+            eccentric_sun=eccentric_sun,
+            epoch_day=day_of_year(start_date),
+        )
+
+    @classmethod
+    def leo(cls, altitude: float = 540e3, *, shadow: ShadowModel = "cylindrical") -> Orbit:
+        """A Hubble-like circular low orbit at ``altitude`` (m): Keplerian period (about 95 min at
+        540 km), the Sun in the orbit plane (the longest eclipses, about 36 min)."""
+        if isinstance(altitude, bool) or not isinstance(altitude, (int, float)):
+            raise TypeError(f"altitude must be a real number, not {type(altitude).__name__}")
+        if not (math.isfinite(altitude) and altitude > 0.0):
+            raise ValueError(f"altitude = {altitude} is invalid: must be finite and > 0")
+        radius = EARTH_RADIUS + float(altitude)
+        period = 2.0 * math.pi * math.sqrt(radius**3 / MU_EARTH)
+        return cls(radius=radius, period=period, shadow=shadow)
+
+    @classmethod
+    def sunlit(cls) -> Orbit:
+        """GEO in permanent sunlight (``shadow="none"``)."""
+        return cls(shadow="none")
+
+    def replace(self, **changes: Any) -> Orbit:
+        """A validated copy with some fields changed."""
+        return type(self)(**{**self.as_dict(), **changes})
+
+    def as_dict(self) -> dict[str, Any]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
     @property
     def eclipse_duration(self) -> float:
-        """Time in shadow per orbit, s: period · asin(R_E/r)/π."""
+        """Time in the cylindrical shadow per orbit with the Sun in the orbit plane, s:
+        period · asin(R_E/r)/π. For the other models see :meth:`eclipse_durations`."""
         return self.period * math.asin(self.earth_radius / self.radius) / math.pi
 
+    @property
+    def synodic_period(self) -> float:
+        """Time between two eclipses, s (the period relative to the Sun)."""
+        return float(_core.synodic_period(self.as_dict()))
+
     def shadow_intervals(self, t0: float, t1: float) -> list[tuple[float, float]]:
-        """Every eclipse (t_enter, t_exit), s, overlapping [t0, t1], clipped to it, in order."""
+        """Every eclipse (t_enter, t_exit), s, overlapping [t0, t1], clipped to it, in order.
+
+        Cylinder: shadow entry and exit. Penumbra: first and last contact, where s starts to fall
+        below 1 and where it is back to 1 (see :meth:`umbra_intervals` for s = 0)."""
         return list(_core.shadow_intervals(self.as_dict(), float(t0), float(t1)))
 
+    def umbra_intervals(self, t0: float, t1: float) -> list[tuple[float, float]]:
+        """Intervals where s = 0, s, clipped to [t0, t1] (the shadow intervals for the cylinder)."""
+        return list(_core.umbra_intervals(self.as_dict(), float(t0), float(t1)))
+
+    def breakpoints(self, t0: float, t1: float) -> list[float]:
+        """Times in (t0, t1) where s jumps (cylinder) or has a kink (penumbra contacts and umbra
+        boundaries); the integrators stop on each."""
+        return list(_core.orbit_breakpoints(self.as_dict(), float(t0), float(t1)))
+
+    def eclipses(self, t0: float, t1: float) -> NDArray[np.float64]:
+        """Eclipses overlapping [t0, t1], unclipped, one row each: (deepest point, first contact,
+        last contact, umbra entry, umbra exit), s; NaN where there is no umbra."""
+        rows = _core.eclipses(self.as_dict(), float(t0), float(t1))
+        return np.asarray(rows, dtype=float).reshape(-1, 5)
+
+    def eclipse_durations(
+        self, t0: float, t1: float, *, kind: Literal["total", "umbra"] = "total"
+    ) -> NDArray[np.float64]:
+        """Duration, s, of each eclipse whose deepest point is in [t0, t1): ``kind="total"`` from
+        first to last contact (s < 1), ``"umbra"`` with s = 0."""
+        if kind not in ("total", "umbra"):
+            raise ValueError(f"kind = {kind!r} is invalid: must be 'total' or 'umbra'")
+        e = self.eclipses(t0, t1)
+        e = e[(e[:, 0] >= t0) & (e[:, 0] < t1)]
+        if kind == "total":
+            return e[:, 2] - e[:, 1]
+        umbra = e[:, 4] - e[:, 3]
+        return np.where(np.isnan(umbra), 0.0, umbra)
+
     def illumination(self, t: ArrayLike) -> NDArray[np.float64]:
-        """Illuminated fraction of the Sun s(t): 1 in sunlight, 0 in shadow."""
+        """Illuminated fraction of the Sun s(t): 1 in sunlight, 0 in umbra, between in penumbra."""
         times = np.atleast_1d(np.asarray(t, dtype=float))
         return np.asarray(_core.illumination(self.as_dict(), np.ascontiguousarray(times)))
+
+    def flux_scale(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Solar flux at time t relative to the solar constant at 1 au: 1/r², r in au (1 unless
+        ``eccentric_sun``). Pass it to :func:`thermojitter.flutter` as ``flux``."""
+        times = np.atleast_1d(np.asarray(t, dtype=float))
+        return np.asarray(_core.flux_scale(self.as_dict(), np.ascontiguousarray(times)))
+
+    def declination(self, t: ArrayLike) -> NDArray[np.float64]:
+        """The Sun's declination at time t, rad (0 unless ``season``)."""
+        times = np.atleast_1d(np.asarray(t, dtype=float))
+        return np.asarray(_core.declination(self.as_dict(), np.ascontiguousarray(times)))
+
+    def time_of(self, date: DateLike) -> float:
+        """Seconds from t = 0 (``epoch_day``) to ``date`` within the same year's day count."""
+        return (day_of_year(date) - self.epoch_day) * 86400.0

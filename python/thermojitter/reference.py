@@ -28,6 +28,16 @@ StateFun = Callable[[float, FloatArray, float], FloatArray]
 # --------------------------------------------------------------------------- orbit / shadow
 
 
+def _check_orbit(orbit: Any) -> None:
+    """The oracle knows only the paper's orbit: cylindrical shadow, Sun fixed at 1 au."""
+    if (
+        getattr(orbit, "shadow", "cylindrical") != "cylindrical"
+        or getattr(orbit, "season", False)
+        or getattr(orbit, "eccentric_sun", False)
+    ):
+        raise NotImplementedError("reference: only the cylindrical shadow at equinox (1 au)")
+
+
 def _shadow_half_angle(orbit: Any) -> float:
     """Half-width of the cylindrical-shadow arc in orbit phase [rad]."""
     return math.asin(orbit.earth_radius / orbit.radius)
@@ -35,6 +45,7 @@ def _shadow_half_angle(orbit: Any) -> float:
 
 def shadow_intervals(orbit: Any, t0: float, t1: float) -> list[tuple[float, float]]:
     """Eclipses (t_enter, t_exit) [s] overlapping [t0, t1], clipped to it, in time order."""
+    _check_orbit(orbit)
     period = float(orbit.period)
     half = _shadow_half_angle(orbit) * period / (2.0 * math.pi)  # half eclipse duration [s]
     # Eclipse k is centred at (k + 1/2) * period (phase beta = pi).
@@ -51,6 +62,7 @@ def shadow_intervals(orbit: Any, t0: float, t1: float) -> list[tuple[float, floa
 
 def illumination(orbit: Any, t: float) -> float:
     """Illuminated fraction s(t): 0.0 in the cylindrical shadow, 1.0 in sunlight."""
+    _check_orbit(orbit)
     beta = (2.0 * math.pi * t / orbit.period) % (2.0 * math.pi)
     return 0.0 if abs(beta - math.pi) < _shadow_half_angle(orbit) else 1.0
 
@@ -226,6 +238,7 @@ def _integrate_segments(
     t_eval: ArrayLike | None,
     method: str,
     names: tuple[str, ...],
+    max_step: float = np.inf,
 ) -> ReferenceSolution:
     """Integrate fun(t, y, s) with one solve_ivp call per shadow-free segment."""
     t0, t1 = float(t_span[0]), float(t_span[1])
@@ -260,7 +273,15 @@ def _integrate_segments(
             # state starts the next segment.
             seg_eval = np.union1d(mine, [b])
         sol = solve_ivp(
-            fun, (a, b), y, method=method, t_eval=seg_eval, args=(s,), rtol=rtol, atol=atol
+            fun,
+            (a, b),
+            y,
+            method=method,
+            t_eval=seg_eval,
+            args=(s,),
+            rtol=rtol,
+            atol=atol,
+            max_step=max_step,
         )
         if not sol.success:
             raise RuntimeError(f"solve_ivp failed on [{a}, {b}]: {sol.message}")
@@ -296,8 +317,13 @@ def simulate(
     t_eval: ArrayLike | None = None,
     y0: ArrayLike | None = None,
     method: str = "RK45",
+    max_step: float = np.inf,
 ) -> ReferenceSolution:
-    """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses."""
+    """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses.
+
+    ``max_step`` (s) caps solve_ivp's step; near an equilibrium its steps can otherwise span
+    several hinge periods, and its interpolant between them does not resolve the oscillation.
+    """
     if y0 is None:
         y0 = (*steady_state(panel, coupled), 0.0)
 
@@ -305,7 +331,7 @@ def simulate(
         return rhs_coupled(t, y, panel, s, model, coupled)
 
     names = ("T_front", "T_back", "theta", "theta_dot")
-    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names)
+    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names, max_step)
 
 
 def simulate_thermal(

@@ -45,8 +45,7 @@ pub fn jacobian(
     let h = 0.5 * panel.heat_capacity();
     let k = panel.conductance;
     let absorbed = panel.absorptivity * panel.solar_constant * flux;
-    let (s, c) = eq.theta.sin_cos();
-    let _ = c;
+    let s = eq.theta.sin();
     // d(absorbed · cos θ)/dθ; zero when the projected area is frozen.
     let d_heating = match coupling {
         Coupling::ProjectedArea => -absorbed * s,

@@ -5,14 +5,18 @@
 //!
 //! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
 
+pub mod beam;
 pub mod dynamics;
+pub mod ensemble;
 pub mod error;
 pub mod flutter;
 pub mod integrate;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
+pub mod stability;
 pub mod steady;
+pub mod summary;
 pub mod system;
 pub mod thermal;
 

@@ -3,7 +3,7 @@
 
 use crate::dynamics::{hinge_acceleration, sin_cos, HingeModel};
 use crate::integrate::OdeSystem;
-use crate::orbit::Orbit;
+use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
 use crate::thermal::{one_node_rate, two_layer_rates};
 use crate::STEFAN_BOLTZMANN;
@@ -24,6 +24,10 @@ pub enum Coupling {
 struct Sunlight {
     orbit: Orbit,
     segment: (f64, f64),
+    /// s over the current segment when it cannot change there: every segment of a cylindrical
+    /// shadow, and the full-Sun and umbra segments of a penumbral one (the breakpoints include
+    /// every contact). None inside a penumbra, where s(t) is evaluated at each call.
+    constant_s: Option<f64>,
 }
 
 impl Sunlight {
@@ -31,12 +35,31 @@ impl Sunlight {
         Sunlight {
             orbit,
             segment: (0.0, 0.0),
+            constant_s: None,
         }
     }
+
+    fn enter(&mut self, a: f64, b: f64) {
+        self.segment = (a, b);
+        let mid = self.orbit.illumination_on(0.5 * (a + b), a, b);
+        let varies = matches!(self.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
+        self.constant_s = if varies { None } else { Some(mid) };
+    }
+
     #[inline]
     fn flux(&self, t: f64) -> f64 {
-        let (a, b) = self.segment;
-        self.orbit.illumination_on(t, a, b) * self.orbit.flux_scale(t)
+        let s = match self.constant_s {
+            Some(s) => s,
+            None => {
+                let (a, b) = self.segment;
+                self.orbit.illumination_on(t, a, b)
+            }
+        };
+        if self.orbit.eccentric_sun {
+            s * self.orbit.flux_scale(t)
+        } else {
+            s
+        }
     }
 }
 
@@ -65,7 +88,7 @@ impl OdeSystem<1> for OneNode {
         self.sun.orbit.breakpoints(t0, t1)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
-        self.sun.segment = (a, b);
+        self.sun.enter(a, b);
     }
 }
 
@@ -95,7 +118,7 @@ impl OdeSystem<2> for TwoLayer {
         self.sun.orbit.breakpoints(t0, t1)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
-        self.sun.segment = (a, b);
+        self.sun.enter(a, b);
     }
 }
 
@@ -215,7 +238,7 @@ impl OdeSystem<4> for Coupled {
         self.sun.orbit.breakpoints(t0, t1)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
-        self.sun.segment = (a, b);
+        self.sun.enter(a, b);
     }
 }
 

@@ -3,6 +3,7 @@
 use super::to_py;
 use crate::dynamics::HingeModel;
 use crate::integrate::{Method, Tolerances};
+use crate::orbit::Shadow;
 use crate::simulate::Output;
 use crate::{Orbit, Panel};
 use nalgebra::SVector;
@@ -51,12 +52,42 @@ pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
     Ok(p)
 }
 
+/// An optional entry of a mapping of type T, named in any error.
+fn optional_item<'py, T: FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    kind: &str,
+) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) => v
+            .extract::<T>()
+            .map(Some)
+            .map_err(|_| PyTypeError::new_err(format!("{key} must be {kind}"))),
+    }
+}
+
+/// An orbit from a mapping: radius, earth_radius, period and phase0 are required; shadow
+/// ('none' | 'cylindrical' | 'penumbra'), season, eccentric_sun and epoch_day are optional and
+/// default to the paper's equinox.
 pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
+    let base = Orbit::geo_equinox();
+    let shadow = match optional_item::<String>(d, "shadow", "a string")? {
+        Some(name) => Shadow::from_name(&name).map_err(to_py)?,
+        None => base.shadow,
+    };
     let o = Orbit {
         radius: float_item(d, "radius")?,
         earth_radius: float_item(d, "earth_radius")?,
         period: float_item(d, "period")?,
         phase0: float_item(d, "phase0")?,
+        shadow,
+        season: optional_item(d, "season", "a bool")?.unwrap_or(base.season),
+        eccentric_sun: optional_item(d, "eccentric_sun", "a bool")?.unwrap_or(base.eccentric_sun),
+        epoch_day: match d.get_item("epoch_day")? {
+            Some(_) => float_item(d, "epoch_day")?,
+            None => base.epoch_day,
+        },
     };
     o.validate().map_err(to_py)?;
     Ok(o)

@@ -3,6 +3,7 @@
 use super::convert::{hinge_model, panel_from};
 use super::to_py;
 use crate::flutter::{analyse, check_flux, critical_damping};
+use crate::stability::Axis;
 use crate::system::Coupling;
 use numpy::PyArray2;
 use pyo3::prelude::*;
@@ -52,7 +53,50 @@ fn flutter<'py>(
     Ok(d)
 }
 
+/// Growth rate and frequency over a grid of two panel parameters (rows: y, columns: x).
+#[pyfunction]
+#[pyo3(signature = (panel, x_name, x_values, y_name, y_values, model, coupled, flux))]
+#[allow(clippy::too_many_arguments)]
+fn stability_map<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    x_name: String,
+    x_values: Vec<f64>,
+    y_name: String,
+    y_values: Vec<f64>,
+    model: &str,
+    coupled: bool,
+    flux: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = panel_from(panel)?;
+    let m = hinge_model(model)?;
+    let c = coupling(coupled);
+    let x = Axis {
+        name: x_name,
+        values: x_values,
+    };
+    let y = Axis {
+        name: y_name,
+        values: y_values,
+    };
+    let map = py
+        .detach(|| crate::stability::stability_map(&p, m, c, flux, &x, &y))
+        .map_err(to_py)?;
+    let grid = |v: &[f64]| -> Vec<Vec<f64>> { v.chunks(map.nx).map(|r| r.to_vec()).collect() };
+    let d = PyDict::new(py);
+    d.set_item(
+        "growth_rate",
+        PyArray2::from_vec2(py, &grid(&map.growth_rate))?,
+    )?;
+    d.set_item(
+        "frequency_hz",
+        PyArray2::from_vec2(py, &grid(&map.frequency_hz))?,
+    )?;
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(flutter, m)?)?;
+    m.add_function(wrap_pyfunction!(stability_map, m)?)?;
     Ok(())
 }

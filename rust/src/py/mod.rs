@@ -1,8 +1,12 @@
 //! The pyo3 layer: converts Python values to engine types, maps engine errors to exceptions and
 //! releases the GIL around every integration. It holds no physics.
 
+mod beam;
 mod convert;
+mod ensemble;
 mod flutter;
+mod longrun;
+mod orbit;
 
 use crate::dynamics::hinge_energy;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
@@ -393,5 +397,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
     flutter::register(m)?;
+    longrun::register(m)?;
+    beam::register(m)?;
+    orbit::register(m)?;
+    ensemble::register(m)?;
     Ok(())
 }

@@ -1,0 +1,210 @@
+"""Calibration of the hinge model against a measured or simulated angle series θ(t).
+
+The hinge parameters K_el (``hinge_stiffness``), c_d (``damping``) and optionally χ
+(``moment_scale``) are fitted by non-linear least squares (``scipy.optimize.least_squares``)
+with the engine doing every forward run: the coupled model (:func:`thermojitter.simulate`) over
+the series' time span, from the sunlit equilibrium of the trial panel (or a given ``y0``),
+sampled at the series' times. Standard errors come from the Jacobian at the solution,
+cov = s² (JᵀJ)⁻¹ with s² = Σr²/(n − p).
+
+    fit = tj.calibrate(t, theta, panel=tj.Panel.paper(), orbit=tj.Orbit.geo_equinox())
+    fit.parameters["hinge_stiffness"], fit.standard_errors["hinge_stiffness"], fit.residual_rms
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
+
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+from thermojitter.simulate import Model, _check_inputs, simulate
+
+Array = NDArray[np.float64]
+
+FITTABLE = ("hinge_stiffness", "damping", "moment_scale")
+"""Panel parameters calibrate() can fit."""
+MIN_POINTS = 20
+"""Fewest samples a series may hold."""
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """Fitted hinge parameters with standard errors (same units as the panel fields), the RMS of
+    the residual θ_model − θ_data (rad), and the model's θ at the series' times."""
+
+    parameters: dict[str, float]
+    standard_errors: dict[str, float]
+    residual_rms: float
+    covariance: Array
+    panel: Panel
+    t: Array
+    theta_model: Array
+    n_points: int
+    success: bool
+    message: str
+    nfev: int
+    settings: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def residual_rms_deg(self) -> float:
+        return math.degrees(self.residual_rms)
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready numbers."""
+        return {
+            "parameters": dict(self.parameters),
+            "standard_errors": dict(self.standard_errors),
+            "residual_rms_deg": self.residual_rms_deg,
+            "n_points": self.n_points,
+            "success": self.success,
+            "nfev": self.nfev,
+        }
+
+
+def _series(t: ArrayLike, theta: ArrayLike) -> tuple[Array, Array]:
+    ts = np.asarray(t, dtype=float)
+    th = np.asarray(theta, dtype=float)
+    if ts.ndim != 1:
+        raise ValueError(f"t must be one-dimensional, not of shape {ts.shape}")
+    if th.shape != ts.shape:
+        raise ValueError(f"theta has shape {th.shape}; must match t's {ts.shape}")
+    if ts.size < MIN_POINTS:
+        raise ValueError(f"t holds {ts.size} samples: the series is too short (need {MIN_POINTS})")
+    if not np.all(np.isfinite(ts)):
+        raise ValueError("t holds NaN or infinite values")
+    if not np.all(np.isfinite(th)):
+        raise ValueError("theta holds NaN or infinite values")
+    if np.any(np.diff(ts) <= 0):
+        i = int(np.argmax(np.diff(ts) <= 0)) + 1
+        raise ValueError(f"t must be strictly increasing (t[{i}] = {ts[i]} does not increase)")
+    return ts, th
+
+
+def calibrate(
+    t: ArrayLike,
+    theta: ArrayLike,
+    *,
+    panel: Panel | None = None,
+    orbit: Orbit | None = None,
+    fit: Sequence[str] = ("hinge_stiffness", "damping"),
+    initial: Mapping[str, float] | None = None,
+    y0: Sequence[float] | None = None,
+    model: Model = "nonlinear",
+    coupled: bool = True,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    diff_step: float = 1e-6,
+) -> CalibrationResult:
+    """Fits the hinge parameters named in ``fit`` to the angle series ``theta`` (rad) at times
+    ``t`` (s, strictly increasing, at least :data:`MIN_POINTS` samples, no NaN).
+
+    ``panel`` holds every other parameter and the starting values (default Table 1); ``initial``
+    overrides starting values. ``orbit`` defaults to GEO at equinox, and the times are on its
+    clock (t = 0 at the subsolar point). ``y0`` = (T_f, T_b, θ, θ̇) at ``t[0]``; default the
+    sunlit equilibrium of each trial panel. The forward runs use ``rtol``/``atol``, tight enough
+    for the finite-difference Jacobian (relative step ``diff_step``).
+    """
+    ts, th = _series(t, theta)
+    base = Panel.paper() if panel is None else panel
+    orb = Orbit.geo_equinox() if orbit is None else orbit
+    _check_inputs(base, orb)
+    names = list(fit)
+    if not names or len(set(names)) != len(names) or any(n not in FITTABLE for n in names):
+        raise ValueError(f"fit = {fit!r} is invalid: a non-empty set of {', '.join(FITTABLE)}")
+    if ts.size <= len(names):
+        raise ValueError(f"t holds {ts.size} samples: too short to fit {len(names)} parameters")
+    start = {n: float(getattr(base, n)) for n in names}
+    for key, value in (initial or {}).items():
+        if key not in names:
+            raise ValueError(f"initial names {key!r}, which is not fitted (fit = {names})")
+        start[key] = float(value)
+    trial0 = base.replace(**start)  # validates the starting values
+    x0 = np.array([start[n] for n in names])
+    scale = np.array([max(abs(v), 1e-3) for v in x0])
+    lower = np.array(
+        [0.0 if n == "damping" else 1e-9 * s for n, s in zip(names, scale, strict=True)]
+    )
+
+    def forward(x: Array) -> Array:
+        trial = trial0.replace(**dict(zip(names, (float(v) for v in x), strict=True)))
+        sol = simulate(
+            trial,
+            orb,
+            (ts[0], ts[-1]),
+            model=model,
+            coupled=coupled,
+            t_eval=ts,
+            y0=y0,
+            rtol=rtol,
+            atol=atol,
+        )
+        return np.asarray(sol.theta)
+
+    def residual(x: Array) -> Array:
+        return forward(x) - th
+
+    res = least_squares(
+        residual,
+        x0,
+        x_scale="jac",
+        bounds=(lower, np.full_like(x0, np.inf)),
+        diff_step=diff_step,
+        method="trf",
+    )
+    n, p = ts.size, len(names)
+    s2 = float(np.sum(res.fun**2)) / (n - p)
+    # cov = s² (JᵀJ)⁻¹ through the SVD of J (column-scaled for conditioning)
+    jac = np.asarray(res.jac) * scale
+    _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    if sv[-1] <= sv[0] * 1e-12:
+        cov_scaled = np.full((p, p), np.inf)
+    else:
+        cov_scaled = (vt.T / sv**2) @ vt * s2
+    cov = cov_scaled * np.outer(scale, scale)
+    params = {nm: float(v) for nm, v in zip(names, res.x, strict=True)}
+    return CalibrationResult(
+        parameters=params,
+        standard_errors={nm: float(math.sqrt(cov[i, i])) for i, nm in enumerate(names)},
+        residual_rms=float(np.sqrt(np.mean(res.fun**2))),
+        covariance=cov,
+        panel=trial0.replace(**params),
+        t=ts,
+        theta_model=res.fun + th,
+        n_points=n,
+        success=bool(res.success),
+        message=str(res.message),
+        nfev=int(res.nfev),
+        settings={"model": model, "coupled": coupled, "fit": names, "rtol": rtol, "atol": atol},
+    )
+
+
+def calibrate_from_csv(
+    path: str | Path,
+    *,
+    time_column: str = "t",
+    angle_column: str = "theta",
+    degrees: bool = False,
+    **kwargs: Any,
+) -> CalibrationResult:
+    """:func:`calibrate` on telemetry from a CSV file with a header row: ``time_column`` (s) and
+    ``angle_column`` (rad, or degrees with ``degrees=True``). Other keywords go to calibrate."""
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"path = {str(p)!r} is invalid: no such file")
+    data = np.genfromtxt(p, delimiter=",", names=True, dtype=float, encoding="utf-8")
+    columns = data.dtype.names or ()
+    for name, col in (("time_column", time_column), ("angle_column", angle_column)):
+        if col not in columns:
+            raise ValueError(f"{name} = {col!r} is invalid: the file's columns are {columns}")
+    theta = np.atleast_1d(data[angle_column]).astype(float)
+    if degrees:
+        theta = np.radians(theta)
+    return calibrate(np.atleast_1d(data[time_column]).astype(float), theta, **kwargs)

@@ -1,0 +1,291 @@
+"""``thermojitter flutter [SCENARIO.toml] --out DIR``: the flutter analysis of a scenario.
+
+Prints the sunlit equilibrium, the growth rate, frequency and critical damping for the
+non-linear and the linear hinge, the closed-form estimate of paper Sec. 4.2, and the critical
+damping at perihelion and aphelion flux; writes ``stability_map.png`` (growth rate over two panel
+parameters with its zero contour) and ``flutter.json`` into DIR.
+
+The scenario is a TOML file. Its ``[panel]`` table sets any :class:`~thermojitter.Panel` field
+(Table 1 for the rest); an optional ``[orbit]`` table (``preset`` = "geo_equinox" | "geo_year" |
+"leo" | "sunlit", ``start_date``, ``altitude``, or :class:`~thermojitter.Orbit` fields) gives the
+flux at t = 0; an optional ``[flutter]`` table sets ``model``, ``coupled``, ``flux``, ``x`` and
+``y`` (as on the command line). Other tables are ignored, so the scenario files of
+``thermojitter run`` work here too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, Literal, cast
+
+import numpy as np
+
+from thermojitter import _core
+from thermojitter.flutter import (
+    FlutterResult,
+    StabilityMap,
+    flutter,
+    linear_thermal_response,
+    stability_map,
+)
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+from thermojitter.scenario import ScenarioError, load_scenario
+
+DEFAULT_X = "damping:0:5:51"
+DEFAULT_Y = "conductance:5:60:56"
+ModelName = Literal["nonlinear", "linear"]
+MODELS: tuple[ModelName, ...] = ("nonlinear", "linear")
+
+
+UNITS = {
+    "emissivity_front": "-",
+    "emissivity_back": "-",
+    "absorptivity": "-",
+    "specific_heat": "J/(kg K)",
+    "mass_per_length": "kg/m",
+    "expansion_coeff": "1/K",
+    "length": "m",
+    "youngs_modulus": "Pa",
+    "thickness": "m",
+    "width": "m",
+    "conductance": "W/(m² K)",
+    "hinge_stiffness": "N m/rad",
+    "bending_inertia": "m⁴",
+    "damping": "N m s/rad",
+    "solar_constant": "W/m²",
+    "moment_scale": "-",
+}
+
+
+class FlutterInputError(ValueError):
+    """A bad scenario file or option (one line, exit code 2)."""
+
+
+def parse_axis(text: str, which: str) -> tuple[str, np.ndarray]:
+    """``NAME:START:STOP:N`` → (name, N values from START to STOP)."""
+    parts = str(text).split(":")
+    if len(parts) != 4:
+        raise FlutterInputError(f"{which} = {text!r}: expected NAME:START:STOP:N")
+    name = parts[0]
+    if name not in _core.PANEL_FIELDS:
+        raise FlutterInputError(
+            f"{which} = {text!r}: {name!r} is not a panel parameter; one of "
+            + ", ".join(_core.PANEL_FIELDS)
+        )
+    try:
+        start, stop, n = float(parts[1]), float(parts[2]), int(parts[3])
+    except ValueError:
+        raise FlutterInputError(
+            f"{which} = {text!r}: START, STOP must be numbers, N an integer"
+        ) from None
+    if not (math.isfinite(start) and math.isfinite(stop)) or n < 1 or n > 2000:
+        raise FlutterInputError(f"{which} = {text!r}: need finite bounds and 1 <= N <= 2000")
+    return name, np.linspace(start, stop, n)
+
+
+def _number(path: Path, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise FlutterInputError(f"{path}: {key} must be a number, not {type(value).__name__}")
+    return float(value)
+
+
+def _analysis_record(r: FlutterResult) -> dict[str, Any]:
+    return {
+        "growth_rate_per_s": r.growth_rate,
+        "e_folding_time_s": r.e_folding_time,
+        "frequency_hz": r.frequency_hz,
+        "critical_damping_N_m_s_per_rad": r.critical_damping,
+        "stable": r.stable,
+        "eigenvalues": [[z.real, z.imag] for z in r.eigenvalues],
+    }
+
+
+def plot_map(m: StabilityMap, panel: Panel, path: Path) -> None:
+    """Growth-rate colour map with the zero contour (the flutter boundary)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import TwoSlopeNorm
+
+    g = m.growth_rate * 1e4
+    lo, hi = float(g.min()), float(g.max())
+    fig, ax = plt.subplots(figsize=(7.0, 5.2), layout="constrained")
+    if lo < 0.0 < hi:
+        norm: Any = TwoSlopeNorm(vcenter=0.0, vmin=lo, vmax=hi)
+    else:
+        norm = None
+    if m.x.size > 1 and m.y.size > 1:
+        filled: Any = ax.contourf(m.x, m.y, g, levels=40, cmap="RdBu_r", norm=norm)
+        if lo < 0.0 < hi:
+            zero = ax.contour(m.x, m.y, g, levels=[0.0], colors="k", linewidths=1.5)
+            ax.clabel(zero, fmt={0.0: "growth rate = 0"}, fontsize=8)
+    else:
+        filled = ax.scatter(
+            np.repeat(m.x[None, :], m.y.size, 0), np.repeat(m.y[:, None], m.x.size, 1), c=g
+        )
+    fig.colorbar(filled, ax=ax, label="growth rate (1e-4 1/s); > 0: flutter")
+    ax.plot(
+        getattr(panel, m.x_name), getattr(panel, m.y_name), "k*", markersize=12, label="scenario"
+    )
+    ax.set_xlabel(f"{m.x_name} ({UNITS.get(m.x_name, '-')})")
+    ax.set_ylabel(f"{m.y_name} ({UNITS.get(m.y_name, '-')})")
+    ax.set_title(f"Thermal flutter of the sunlit equilibrium ({m.model} hinge, flux x{m.flux:.3f})")
+    ax.legend(loc="upper right")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def flutter_command(argv: Sequence[str] | None = None) -> int:
+    """Runs ``thermojitter flutter``; returns the exit code (0, or 2 for bad input)."""
+    parser = argparse.ArgumentParser(
+        prog="thermojitter flutter",
+        description="Flutter analysis of a scenario without integration: growth rate, "
+        "frequency and critical damping at the sunlit equilibrium, and a stability map.",
+    )
+    parser.add_argument("scenario", nargs="?", help="TOML scenario (default: Table 1 at GEO)")
+    parser.add_argument("--out", default="out/flutter", help="output directory")
+    parser.add_argument("--x", default=None, help=f"map x axis NAME:START:STOP:N ({DEFAULT_X})")
+    parser.add_argument("--y", default=None, help=f"map y axis NAME:START:STOP:N ({DEFAULT_Y})")
+    parser.add_argument("--model", choices=MODELS, default=None, help="hinge model of the map")
+    parser.add_argument("--flux", type=float, default=None, help="solar flux factor (1 = 1 au)")
+    parser.add_argument(
+        "--uncoupled", action="store_true", help="freeze the projected area (no pumping)"
+    )
+    parser.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    args = parser.parse_args(argv)
+    try:
+        return _run(args)
+    except FlutterInputError as e:
+        print(f"thermojitter flutter: error: {e}", file=sys.stderr)
+        return 2
+
+
+def _run(args: argparse.Namespace) -> int:
+    panel, orbit, options = Panel.paper(), Orbit.geo_equinox(), {}
+    source = "Table 1 (paper), GEO equinox"
+    if args.scenario is not None:
+        path = Path(args.scenario)
+        try:
+            scenario = load_scenario(path, extra_sections=("flutter",))
+        except ScenarioError as e:
+            raise FlutterInputError(str(e)) from None
+        panel, orbit, options = scenario.panel, scenario.orbit, scenario.extra["flutter"]
+        unknown = set(options) - {"model", "coupled", "flux", "x", "y"}
+        if unknown:
+            raise FlutterInputError(f"{path}: flutter.{sorted(unknown)[0]}: unknown key")
+        source = str(path)
+    raw_model = args.model or options.get("model", "nonlinear")
+    if raw_model not in MODELS:
+        raise FlutterInputError(f"model = {raw_model!r}: must be 'nonlinear' or 'linear'")
+    model = cast(ModelName, raw_model)
+    coupled = not args.uncoupled and options.get("coupled", True) is not False
+    if args.flux is not None:
+        flux = float(args.flux)
+    elif "flux" in options:
+        flux = _number(Path(source), "flutter.flux", options["flux"])
+    else:
+        flux = float(orbit.flux_scale(0.0)[0])
+    if not (math.isfinite(flux) and flux > 0.0):
+        raise FlutterInputError(f"flux = {flux}: must be finite and > 0")
+    x = parse_axis(args.x or options.get("x", DEFAULT_X), "x")
+    y = parse_axis(args.y or options.get("y", DEFAULT_Y), "y")
+    if x[0] == y[0]:
+        raise FlutterInputError(f"x and y are both {x[0]!r}: choose two different parameters")
+
+    try:
+        results = {m: flutter(panel, m, coupled=coupled, flux=flux) for m in MODELS}
+        closed = linear_thermal_response(panel, flux=flux)
+        year = Orbit.geo_year("2026-01-01").flux_scale(np.arange(0.0, 366.0) * 86400.0)
+        peri, aph = float(year.max()), float(year.min())
+        seasonal = {
+            m: {
+                "perihelion": flutter(panel, m, coupled=coupled, flux=peri).critical_damping,
+                "aphelion": flutter(panel, m, coupled=coupled, flux=aph).critical_damping,
+            }
+            for m in MODELS
+        }
+        smap = stability_map(panel, x=x, y=y, model=model, coupled=coupled, flux=flux)
+    except ValueError as e:
+        raise FlutterInputError(str(e)) from None
+
+    eq = results["nonlinear"].equilibrium
+    lines = [
+        f"thermal flutter analysis: {source}",
+        f"  flux factor {flux:.4f}, projected area {'coupled' if coupled else 'frozen'}, "
+        f"c_d = {panel.damping:g} N m s/rad",
+        f"  sunlit equilibrium: T_front {eq.T_front:.2f} K, T_back {eq.T_back:.2f} K, "
+        f"theta {math.degrees(eq.theta):.3f} deg",
+    ]
+    for m, r in results.items():
+        lines.append(
+            f"  {m:9s}: growth rate {r.growth_rate:+.4e} 1/s ("
+            + ("stable" if r.stable else f"flutter, e-folding {r.e_folding_time / 3600:.2f} h")
+            + f"), frequency {r.frequency_hz:.5f} Hz, critical damping "
+            f"{r.critical_damping:.4f} N m s/rad"
+        )
+    lines.append(
+        f"  Sec. 4.2 closed form: q = {closed.q:.4g} 1/s, lag {math.degrees(closed.phase_lag):.1f}"
+        f" deg at omega_n; critical damping ~ {closed.critical_damping_estimate:.4f} N m s/rad"
+    )
+    for m in MODELS:
+        lines.append(
+            f"  over the year ({m}): critical damping {seasonal[m]['perihelion']:.4f} at "
+            f"perihelion (flux {peri:.4f}), {seasonal[m]['aphelion']:.4f} at aphelion "
+            f"(flux {aph:.4f})"
+        )
+    print("\n".join(lines))
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    png = out / "stability_map.png"
+    if not args.no_plot:
+        plot_map(smap, panel, png)
+    record = {
+        "scenario": source,
+        "panel": panel.as_dict(),
+        "flux": flux,
+        "coupled": coupled,
+        "equilibrium": {
+            "T_front_K": eq.T_front,
+            "T_back_K": eq.T_back,
+            "theta_deg": math.degrees(eq.theta),
+        },
+        "models": {m: _analysis_record(r) for m, r in results.items()},
+        "closed_form": {
+            "p_K_per_s": closed.p,
+            "q_per_s": closed.q,
+            "phase_lag_rad": closed.phase_lag,
+            "amplitude_K": closed.amplitude,
+            "thermal_damping_per_s": closed.thermal_damping,
+            "critical_damping_estimate": closed.critical_damping_estimate,
+        },
+        "year": {
+            "perihelion_flux": peri,
+            "aphelion_flux": aph,
+            "critical_damping": seasonal,
+        },
+        "map": {
+            "model": smap.model,
+            "x_name": smap.x_name,
+            "x": smap.x.tolist(),
+            "y_name": smap.y_name,
+            "y": smap.y.tolist(),
+            "growth_rate": smap.growth_rate.tolist(),
+            "frequency_hz": smap.frequency_hz.tolist(),
+            "png": None if args.no_plot else png.name,
+        },
+    }
+    (out / "flutter.json").write_text(json.dumps(record, indent=2))
+    print(f"  wrote {out / 'flutter.json'}" + ("" if args.no_plot else f" and {png}"))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(flutter_command())

@@ -1,0 +1,318 @@
+"""Long runs over months and years: one summary per orbit, resumable from a checkpoint.
+
+The run is integrated in chunks of whole orbits. Between chunks, Python shows progress, notices
+Ctrl-C and writes the checkpoint. Each chunk restarts the integrator at an orbit boundary, so a
+run resumed from a checkpoint gives the very same summaries as one that was never interrupted.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from thermojitter import _core
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+from thermojitter.simulate import _check_inputs, steady_state
+
+SUMMARY_FIELDS = (
+    "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
+    "jitter_peak", "t_entry", "t_exit", "entry_theta_min", "exit_theta_max", "entry_peak",
+    "exit_peak",
+)  # fmt: skip
+"""Columns of the per-orbit summaries (angles rad, times s; NaN where an orbit has no eclipse)."""
+
+DEFAULT_THETA_LIMIT = math.radians(20.0)
+"""|θ| beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
+meant for modest angles)."""
+
+
+@dataclass
+class OrbitSummaries:
+    """Per-orbit summaries of a long run, with how it ended.
+
+    Columns (one value per orbit): ``index``, ``t_start``, ``t_end``, ``theta_eq`` (sunlit
+    equilibrium at that orbit's flux), ``theta_max``, ``theta_min``, ``amplitude``
+    (max |θ − θ_eq|), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
+    the quasi-static deflection), ``t_entry``/``t_exit`` (umbra), ``entry_theta_min`` and
+    ``exit_theta_max`` (in the window after entry and exit), ``entry_peak``/``exit_peak``
+    (max |θ − θ_eq| in those windows).
+    """
+
+    columns: dict[str, NDArray[Any]]
+    y_end: NDArray[np.float64]
+    t_end: float
+    n_steps: int = 0
+    n_rhs: int = 0
+    limit_crossing: tuple[float, int, float] | None = None
+    """(t s, orbit index, θ rad) where |θ| first passed theta_limit, or None."""
+    interrupted: bool = False
+    """True when Ctrl-C ended the run early; the columns hold the finished orbits."""
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def __getattr__(self, name: str) -> NDArray[Any]:
+        columns = self.__dict__.get("columns", {})
+        if name in columns:
+            return columns[name]
+        raise AttributeError(name)
+
+    def __len__(self) -> int:
+        return len(self.columns["index"])
+
+    @property
+    def completed_orbits(self) -> int:
+        return len(self)
+
+    def to_pandas(self) -> Any:
+        import pandas as pd
+
+        return pd.DataFrame(self.columns).set_index("index")
+
+
+def _fingerprint(settings: dict[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
+
+
+def _empty_columns() -> dict[str, list[Any]]:
+    return {name: [] for name in SUMMARY_FIELDS}
+
+
+def _save_checkpoint(
+    path: Path,
+    settings: dict[str, Any],
+    columns: dict[str, list[Any]],
+    y: list[float],
+    next_index: int,
+    counters: dict[str, int],
+    crossing: tuple[float, int, float] | None,
+) -> None:
+    """Writes atomically: a killed writer leaves the previous checkpoint intact."""
+    payload = {
+        "fingerprint": _fingerprint(settings),
+        "settings": settings,
+        "next_index": next_index,
+        "y": y,
+        "counters": counters,
+        "crossing": crossing,
+        "columns": {
+            k: [float(v) if k != "index" else int(v) for v in vals] for k, vals in columns.items()
+        },
+    }
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w") as fh:
+        # repr-exact floats: json writes the shortest round-tripping form, NaN as NaN.
+        json.dump(payload, fh)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def _flatten(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    flat: dict[str, Any] = {}
+    for key, value in settings.items():
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            flat[prefix + key] = value
+    return flat
+
+
+def _load_checkpoint(path: Path, settings: dict[str, Any]) -> dict[str, Any] | None:
+    if not path.exists():
+        return None
+    with open(path) as fh:
+        payload: dict[str, Any] = json.load(fh)
+    if payload.get("fingerprint") != _fingerprint(settings):
+        old, new = _flatten(payload.get("settings", {})), _flatten(settings)
+        changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+        raise ValueError(
+            f"checkpoint {path} was written for other settings (differs in: "
+            f"{', '.join(changed) or 'unknown'}); remove it or use another path"
+        )
+    return payload
+
+
+def simulate_orbits(
+    panel: Panel,
+    orbit: Orbit,
+    n_orbits: int,
+    *,
+    t_start: float = 0.0,
+    model: Literal["nonlinear", "linear"] = "nonlinear",
+    coupled: bool = True,
+    method: Literal["rk45", "rk4"] = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    y0: tuple[float, float, float, float] | None = None,
+    window: float = 600.0,
+    theta_limit: float = DEFAULT_THETA_LIMIT,
+    on_limit: Literal["stop", "flag"] = "stop",
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: float = 10.0,
+    orbits_per_call: int = 1,
+    progress: bool | None = None,
+    max_steps: int = 500_000_000,
+    stop: Callable[[], bool] | None = None,
+) -> OrbitSummaries:
+    """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
+
+    Memory grows with the number of orbits, not of steps (a 10-year GEO run keeps ~3650 rows).
+
+    - ``theta_limit`` (rad): the hinge model's range of validity; when |θ| passes it the run
+      stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
+    - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
+      the end; if it exists (same settings) the run resumes from it and gives identical results.
+    - Ctrl-C returns the finished orbits with ``interrupted=True``; so does ``stop()`` turning
+      True (polled between chunks, for callers that handle SIGINT themselves).
+    - ``progress``: a tqdm bar (default: when stderr is a terminal and tqdm is installed).
+    """
+    _check_inputs(panel, orbit)
+    if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
+        raise ValueError(f"n_orbits = {n_orbits!r} is invalid: must be an integer >= 1")
+    if (
+        isinstance(orbits_per_call, bool)
+        or not isinstance(orbits_per_call, int)
+        or orbits_per_call < 1
+    ):
+        raise ValueError(
+            f"orbits_per_call = {orbits_per_call!r} is invalid: must be an integer >= 1"
+        )
+    if on_limit not in ("stop", "flag"):
+        raise ValueError(f"on_limit = {on_limit!r} is invalid: must be 'stop' or 'flag'")
+    for name, value in (
+        ("t_start", t_start),
+        ("window", window),
+        ("theta_limit", theta_limit),
+        ("checkpoint_every", checkpoint_every),
+    ):
+        if not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"{name} = {value!r} is invalid: must be a finite number")
+    if y0 is None:
+        flux = 1.0
+        eq = steady_state(panel, coupled=coupled, flux=flux)
+        y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
+    settings: dict[str, Any] = {
+        "panel": panel.as_dict(),
+        "orbit": orbit.as_dict(),
+        "t_start": float(t_start),
+        "model": model,
+        "coupled": bool(coupled),
+        "method": method,
+        "rtol": float(rtol),
+        "atol": float(atol),
+        "dt": dt,
+        "y0": [float(v) for v in y0],
+        "window": float(window),
+        "theta_limit": float(theta_limit),
+        "on_limit": on_limit,
+        "orbits_per_call": orbits_per_call,
+    }
+    core_args: dict[str, Any] = {
+        "model": model,
+        "coupled": bool(coupled),
+        "method_name": method,
+        "rtol": float(rtol),
+        "atol": float(atol),
+        "dt": None if dt is None else float(dt),
+        "max_step": math.inf,
+        "max_steps": int(max_steps),
+        "window": float(window),
+        "theta_limit": float(theta_limit),
+        "stop_at_limit": on_limit == "stop",
+    }
+
+    columns = _empty_columns()
+    y = [float(v) for v in y0]
+    next_index = 0
+    counters = {"n_steps": 0, "n_rhs": 0}
+    crossing: tuple[float, int, float] | None = None
+    path = Path(checkpoint) if checkpoint is not None else None
+    if path is not None:
+        saved = _load_checkpoint(path, settings)
+        if saved is not None:
+            columns = {k: list(v) for k, v in saved["columns"].items()}
+            y, next_index = saved["y"], int(saved["next_index"])
+            counters = saved["counters"]
+            crossing = tuple(saved["crossing"]) if saved["crossing"] else None  # type: ignore[assignment]
+
+    bar = _progress_bar(progress, n_orbits, next_index)
+    interrupted = False
+    stopped = crossing is not None and on_limit == "stop"
+    last_save = time.monotonic()
+    try:
+        while next_index < n_orbits and not stopped:
+            # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same places.
+            count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
+            t0 = float(t_start) + next_index * orbit.period
+            raw = _core.run_orbits(
+                panel.as_dict(),
+                orbit.as_dict(),
+                t_start=t0,
+                first_index=next_index,
+                n_orbits=count,
+                y0=y,
+                **core_args,
+            )
+            for name in SUMMARY_FIELDS:
+                columns[name].extend(np.asarray(raw[name]).tolist())
+            y = list(raw["y_end"])
+            counters["n_steps"] += int(raw["n_steps"])
+            counters["n_rhs"] += int(raw["n_rhs"])
+            if crossing is None and raw["crossing"] is not None:
+                crossing = tuple(raw["crossing"])  # type: ignore[assignment]
+            if raw["stopped"]:
+                stopped = True
+                next_index = int(columns["index"][-1]) + 1
+            else:
+                next_index += count
+            if bar is not None:
+                bar.update(count)
+            if path is not None and time.monotonic() - last_save > checkpoint_every:
+                _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
+                last_save = time.monotonic()
+            if stop is not None and stop() and next_index < n_orbits and not stopped:
+                raise KeyboardInterrupt
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        if bar is not None:
+            bar.close()
+        if path is not None:
+            _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
+
+    return OrbitSummaries(
+        columns={
+            k: np.asarray(v, dtype=np.int64 if k == "index" else float) for k, v in columns.items()
+        },
+        y_end=np.asarray(y, dtype=float),
+        t_end=float(columns["t_end"][-1]) if columns["t_end"] else float(t_start),
+        n_steps=counters["n_steps"],
+        n_rhs=counters["n_rhs"],
+        limit_crossing=crossing,
+        interrupted=interrupted,
+        settings=settings,
+    )
+
+
+def _progress_bar(progress: bool | None, total: int, done: int) -> Any:
+    if progress is None:
+        progress = sys.stderr.isatty()
+    if not progress:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=total, initial=done, unit="orbit", desc="thermojitter", leave=False)

@@ -1,0 +1,862 @@
+"""Monte Carlo studies, full-factorial sweeps and Sobol sensitivity over panel parameters.
+
+A study is a design — one row of panel parameters per sample, drawn in Python from the seed up
+front — and a batch run of it in the Rust engine on a rayon pool with the GIL released. Each
+sample depends only on its own row, so the results are the same, bit for bit, whatever the
+number of threads, the chunking or the backend (local threads or Dask workers).
+
+The design is cut into chunks of rows. With ``checkpoint=DIR`` every finished chunk is written to
+``DIR/chunk-NNNNN.parquet`` as soon as it completes, beside ``DIR/manifest.json`` (the settings and
+their fingerprint); a run started again with the same settings reads the finished chunks and
+computes only the others.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import hashlib
+import itertools
+import json
+import math
+import os
+import threading
+import warnings
+from collections.abc import Generator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+from scipy.stats import qmc
+
+from thermojitter import _core
+from thermojitter.longrun import _fingerprint, _flatten
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+from thermojitter.simulate import _check_inputs
+
+Sampler = Literal["random", "lhs", "sobol"]
+
+METRICS = (
+    "theta_eq", "growth_rate", "frequency_hz", "stable", "critical_damping", "theta_abs_max",
+    "amplitude", "entry_peak", "exit_peak", "jitter_rms", "jitter_peak", "t_threshold",
+    "t_reached", "n_steps", "error",
+)  # fmt: skip
+"""Columns of the metrics, after the sampled parameters (angles rad, times s, rates 1/s):
+
+- ``theta_eq``: sunlit equilibrium angle at full Sun;
+- ``growth_rate``, ``frequency_hz``, ``stable``: linear stability of that equilibrium
+  (``tj.flutter``); ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
+- ``theta_abs_max``: max |θ| over the horizon; ``amplitude``: max |θ − θ_eq|;
+- ``entry_peak``/``exit_peak``: max |θ − θ_eq| within ``window`` s after a shadow entry / exit;
+- ``jitter_rms``/``jitter_peak``: of θ − M_T/K_el (the oscillation about the quasi-static
+  deflection) over the horizon;
+- ``t_threshold``: first time |θ| passed ``threshold`` (NaN: never, or no threshold);
+- ``t_reached``: where the integration ended (the horizon, unless stopped at the threshold);
+- ``n_steps``: accepted integrator steps; ``error``: why a sample failed (None when it did not;
+  its numbers are then NaN).
+"""
+
+_FLOAT_METRICS = tuple(m for m in METRICS if m not in ("stable", "n_steps", "error"))
+
+_UNIT_INTERVAL = ("emissivity_front", "emissivity_back", "absorptivity")
+
+FORMAT_VERSION = 1
+
+
+# --- distributions --------------------------------------------------------------------------
+
+
+def _valid_range(name: str) -> tuple[float, float, bool, bool]:
+    """(lo, hi, lo open, hi open) of a panel parameter, as Panel validation checks it."""
+    if name in _UNIT_INTERVAL:
+        return 0.0, 1.0, True, False
+    if name == "damping":
+        return 0.0, math.inf, False, True
+    return 0.0, math.inf, True, True
+
+
+def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[float]:
+    args = list(spec[1:])
+    if len(args) != count:
+        raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: expected {usage}")
+    out = []
+    for a in args:
+        if isinstance(a, bool) or not isinstance(a, (int, float, np.floating, np.integer)):
+            raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not a number")
+        if not math.isfinite(float(a)):
+            raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not finite")
+        out.append(float(a))
+    return out
+
+
+def _shorthand(name: str, spec: Sequence[Any]) -> Any:
+    kind = spec[0]
+
+    def bad(reason: str) -> ValueError:
+        return ValueError(f"vary[{name!r}] = {tuple(spec)!r} is invalid: {reason}")
+
+    if kind == "uniform":
+        lo, hi = _numbers(name, spec, 2, "('uniform', lo, hi)")
+        if not hi > lo:
+            raise bad("needs lo < hi")
+        return stats.uniform(loc=lo, scale=hi - lo)
+    if kind == "normal":
+        mean, sd = _numbers(name, spec, 2, "('normal', mean, sd)")
+        if not sd > 0:
+            raise bad("needs sd > 0")
+        return stats.norm(loc=mean, scale=sd)
+    if kind == "lognormal":
+        median, sigma = _numbers(name, spec, 2, "('lognormal', median, sigma of the log)")
+        if not (median > 0 and sigma > 0):
+            raise bad("needs median > 0 and sigma > 0")
+        return stats.lognorm(s=sigma, scale=median)
+    if kind == "loguniform":
+        lo, hi = _numbers(name, spec, 2, "('loguniform', lo, hi)")
+        if not 0 < lo < hi:
+            raise bad("needs 0 < lo < hi")
+        return stats.loguniform(lo, hi)
+    if kind == "truncnorm":
+        mean, sd, lo, hi = _numbers(name, spec, 4, "('truncnorm', mean, sd, lo, hi)")
+        if not sd > 0:
+            raise bad("needs sd > 0")
+        if not hi > lo:
+            raise bad("needs lo < hi")
+        return stats.truncnorm((lo - mean) / sd, (hi - mean) / sd, loc=mean, scale=sd)
+    if kind == "triangular":
+        lo, mode, hi = _numbers(name, spec, 3, "('triangular', lo, mode, hi)")
+        if not (hi > lo and lo <= mode <= hi):
+            raise bad("needs lo <= mode <= hi and lo < hi")
+        return stats.triang(c=(mode - lo) / (hi - lo), loc=lo, scale=hi - lo)
+    raise bad(
+        f"unknown distribution {kind!r}: use 'uniform', 'normal', 'lognormal', 'loguniform', "
+        "'truncnorm', 'triangular' or a frozen scipy.stats distribution"
+    )
+
+
+def distribution(name: str, spec: Any) -> Any:
+    """A frozen scipy.stats distribution from ``spec``: a frozen distribution itself, or a
+    shorthand ``("uniform", lo, hi)``, ``("normal", mean, sd)``, ``("lognormal", median, sigma)``
+    (sigma of the natural log), ``("loguniform", lo, hi)``, ``("truncnorm", mean, sd, lo, hi)``
+    or ``("triangular", lo, mode, hi)``."""
+    if isinstance(spec, (tuple, list)) and spec and isinstance(spec[0], str):
+        return _shorthand(name, spec)
+    if callable(getattr(spec, "ppf", None)) and callable(getattr(spec, "cdf", None)):
+        with np.errstate(all="ignore"):
+            mid = np.asarray(spec.ppf(0.5), dtype=float)
+        if mid.shape != () or not np.isfinite(mid):
+            raise ValueError(
+                f"vary[{name!r}] = {spec!r} is invalid: not a proper univariate distribution "
+                "(its median is not a finite number; check its parameters)"
+            )
+        return spec
+    raise ValueError(
+        f"vary[{name!r}] = {spec!r} is invalid: give a frozen scipy.stats distribution or a "
+        "shorthand such as ('uniform', lo, hi) or ('normal', mean, sd)"
+    )
+
+
+def _describe(spec: Any) -> Any:
+    """A JSON form of a distribution spec, for the settings fingerprint."""
+    if isinstance(spec, (tuple, list)):
+        return [v if isinstance(v, str) else float(v) for v in spec]
+    dist = getattr(spec, "dist", None)
+    return {
+        "dist": getattr(dist, "name", type(spec).__name__),
+        "args": [float(a) for a in getattr(spec, "args", ())],
+        "kwds": {k: float(v) for k, v in sorted(getattr(spec, "kwds", {}).items())},
+    }
+
+
+def _check_names(names: Sequence[Any], what: str) -> None:
+    fields = Panel.field_names()
+    for name in names:
+        if not isinstance(name, str) or name not in fields:
+            raise ValueError(
+                f"{what}: {name!r} is not a panel parameter; choose from {', '.join(fields)}"
+            )
+
+
+# --- designs --------------------------------------------------------------------------------
+
+
+def _unit_design(sampler: str, n: int, d: int, seed: int) -> NDArray[np.float64]:
+    """n points of the unit cube [0, 1)^d, deterministic in (sampler, n, d, seed)."""
+    rng = np.random.default_rng(seed)
+    if sampler == "random":
+        return rng.random((n, d))
+    if sampler == "lhs":
+        engine: qmc.QMCEngine = _qmc(qmc.LatinHypercube, d, rng)
+    elif sampler == "sobol":
+        engine = _qmc(qmc.Sobol, d, rng, scramble=True)
+    else:
+        raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
+    with warnings.catch_warnings():
+        # Sobol prefers powers of 2; other sizes are still valid designs.
+        warnings.simplefilter("ignore", UserWarning)
+        return np.asarray(engine.random(n), dtype=float)
+
+
+def _qmc(cls: Any, d: int, rng: np.random.Generator, **kwargs: Any) -> qmc.QMCEngine:
+    try:
+        return cls(d, rng=rng, **kwargs)  # type: ignore[no-any-return]
+    except TypeError:  # scipy < 1.15 names it seed
+        return cls(d, seed=rng, **kwargs)  # type: ignore[no-any-return]
+
+
+def _open_unit(u: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Keeps points off 0 and 1, where unbounded distributions have infinite quantiles."""
+    return np.clip(u, np.finfo(float).tiny, np.nextafter(1.0, 0.0))
+
+
+def _quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> NDArray[np.float64]:
+    """Maps unit points through the distribution's ppf; with ``truncate``, through the ppf
+    restricted to the parameter's valid range."""
+    u = _open_unit(u)
+    if not truncate:
+        with np.errstate(all="ignore"):
+            return np.asarray(dist.ppf(u), dtype=float)
+    lo, hi, lo_open, hi_open = _valid_range(name)
+    with np.errstate(all="ignore"):
+        a, b = float(dist.cdf(lo)), float(dist.cdf(hi))
+    if not b - a > 0:
+        raise ValueError(
+            f"vary[{name!r}]: the distribution has no probability inside the valid range of "
+            f"{name} ({lo:g}, {hi:g}); truncation is impossible"
+        )
+    with np.errstate(all="ignore"):
+        x = np.asarray(dist.ppf(a + u * (b - a)), dtype=float)
+    # Rounding at the ends of the interval must not step outside the range.
+    low = np.nextafter(lo, math.inf) if lo_open else lo
+    high = np.nextafter(hi, -math.inf) if hi_open else hi
+    return np.clip(x, low, high)
+
+
+def _panel_matrix(panel: Panel, names: Sequence[str], values: NDArray[np.float64]) -> Any:
+    """Rows of every panel field (PANEL_FIELDS order): the base panel with ``names`` replaced."""
+    fields = list(_core.PANEL_FIELDS)
+    base = panel.as_dict()
+    rows = np.tile(np.array([base[f] for f in fields], dtype=float), (len(values), 1))
+    for j, name in enumerate(names):
+        rows[:, fields.index(name)] = values[:, j]
+    return np.ascontiguousarray(rows)
+
+
+def _refuse_invalid(matrix: NDArray[np.float64], hint: str) -> None:
+    """Runs the panel validation on every row; refuses the design naming the parameter."""
+    bad = _core.check_panels(matrix)
+    if not bad:
+        return
+    by_name: dict[str, list[tuple[int, str]]] = {}
+    for row, message in bad:
+        by_name.setdefault(message.split(" ", 1)[0], []).append((row, message))
+    name, rows = next(iter(by_name.items()))
+    row, message = rows[0]
+    raise ValueError(
+        f"{name}: {len(rows)} of {len(matrix)} samples are outside its valid range "
+        f"(sample {row}: {message}){hint}"
+    )
+
+
+# --- running chunks ---------------------------------------------------------------------------
+
+
+def _options(
+    orbit: Orbit,
+    horizon: int,
+    model: str,
+    coupled: bool,
+    method: str,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    window: float,
+    threshold: float | None,
+    stop_at_threshold: bool,
+    max_steps: int,
+) -> dict[str, Any]:
+    """The keyword arguments of EnsemblePool.run shared by every chunk (plain data)."""
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ValueError(f"horizon = {horizon!r} is invalid: must be a whole number of orbits >= 1")
+    if threshold is not None and not (math.isfinite(threshold) and threshold > 0):
+        raise ValueError(f"threshold = {threshold!r} is invalid: must be a finite angle > 0 (rad)")
+    if not (isinstance(window, (int, float)) and math.isfinite(window) and window > 0):
+        raise ValueError(f"window = {window!r} is invalid: must be finite and > 0 (s)")
+    return {
+        "orbit": orbit.as_dict(),
+        "model": str(model),
+        "coupled": bool(coupled),
+        "method_name": str(method),
+        "rtol": float(rtol),
+        "atol": float(atol),
+        "dt": None if dt is None else float(dt),
+        "max_step": math.inf,
+        "max_steps": int(max_steps),
+        "n_orbits": int(horizon),
+        "window": float(window),
+        "threshold": None if threshold is None else float(threshold),
+        "stop_at_threshold": bool(stop_at_threshold),
+    }
+
+
+def _run_chunk(pool: Any, panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str, Any]:
+    opts = dict(options)
+    orbit = opts.pop("orbit")
+    raw = pool.run(panels, orbit, **opts)
+    out: dict[str, Any] = {m: np.asarray(raw[m], dtype=float) for m in _FLOAT_METRICS}
+    out["stable"] = np.asarray(raw["stable"], dtype=bool)
+    out["n_steps"] = np.asarray(raw["n_steps"], dtype=np.int64)
+    out["error"] = list(raw["error"])
+    return out
+
+
+_WORKER_POOLS: dict[tuple[str, int], Any] = {}
+_WORKER_POOLS_LOCK = threading.Lock()
+
+
+def dask_chunk(panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str, Any]:
+    """Runs one chunk on a Dask worker, on a rayon pool of as many threads as the worker has.
+
+    Tasks that run at once on one worker share its pool, so the worker's cores are not
+    oversubscribed. Takes and returns plain data (a NumPy array, dicts, lists).
+    """
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+        key = (str(worker.address), int(worker.state.nthreads))
+    except (ImportError, ValueError):  # called outside a worker
+        key = ("local", 0)
+    with _WORKER_POOLS_LOCK:
+        pool = _WORKER_POOLS.get(key)
+        if pool is None:
+            pool = _core.EnsemblePool(key[1] or None)
+            _WORKER_POOLS[key] = pool
+    return _run_chunk(pool, panels, options)
+
+
+def _local_chunks(
+    matrix: NDArray[np.float64],
+    todo: list[tuple[int, int, int]],
+    options: dict[str, Any],
+    threads: int | None,
+) -> Generator[tuple[int, dict[str, Any]], None, None]:
+    """Yields (chunk, metrics) as chunks finish. Two chunks are in flight at once on one rayon
+    pool, so the pool's threads stay busy while a chunk finishes its last samples."""
+    pool = _core.EnsemblePool(threads)
+    with cf.ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermojitter") as ex:
+        futures = {ex.submit(_run_chunk, pool, matrix[a:b], options): k for k, a, b in todo}
+        try:
+            for fut in cf.as_completed(futures):
+                yield futures[fut], fut.result()
+        finally:
+            for fut in futures:
+                fut.cancel()
+
+
+def _dask_client(backend: Any) -> tuple[Any, bool]:
+    """(client, owned): a Client given, one connected to an address, or a new LocalCluster."""
+    if callable(getattr(backend, "submit", None)) and hasattr(backend, "scheduler_info"):
+        return backend, False
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as exc:
+        raise ImportError(
+            "backend='dask' needs dask.distributed: pip install 'thermojitter[dask]'"
+        ) from exc
+    if backend == "dask":
+        return Client(LocalCluster()), True
+    if isinstance(backend, str):
+        return Client(backend), True
+    raise ValueError(
+        f"backend = {backend!r} is invalid: must be None, 'dask', a scheduler address "
+        "('tcp://host:8786') or a dask.distributed Client"
+    )
+
+
+def _dask_chunks(
+    client: Any,
+    matrix: NDArray[np.float64],
+    todo: list[tuple[int, int, int]],
+    options: dict[str, Any],
+) -> Generator[tuple[int, dict[str, Any]], None, None]:
+    from distributed import as_completed
+
+    futures = {client.submit(dask_chunk, matrix[a:b], options, pure=False): k for k, a, b in todo}
+    try:
+        for fut in as_completed(list(futures)):
+            yield futures[fut], fut.result()
+    finally:
+        client.cancel([f for f in futures if not f.done()])
+
+
+# --- checkpoints ----------------------------------------------------------------------------
+
+
+def _chunk_path(directory: Path, k: int) -> Path:
+    return directory / f"chunk-{k:05d}.parquet"
+
+
+def _write_chunk(directory: Path, k: int, start: int, metrics: dict[str, Any]) -> None:
+    """Writes atomically: a killed writer leaves no partial chunk behind."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    n = len(metrics["error"])
+    columns: dict[str, Any] = {"sample": np.arange(start, start + n, dtype=np.int64)}
+    for m in METRICS:
+        columns[m] = metrics[m]
+    columns["error"] = pa.array(metrics["error"], type=pa.string())
+    path = _chunk_path(directory, k)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        pq.write_table(pa.table(columns), tmp)
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _read_chunk(directory: Path, k: int, start: int, stop: int) -> dict[str, Any] | None:
+    import pyarrow.parquet as pq
+
+    path = _chunk_path(directory, k)
+    if not path.exists():
+        return None
+    table = pq.read_table(path)
+    sample = table.column("sample").to_numpy()
+    if not np.array_equal(sample, np.arange(start, stop)):
+        raise ValueError(f"checkpoint chunk {path} does not hold samples {start}..{stop - 1}")
+    out: dict[str, Any] = {m: table.column(m).to_numpy() for m in METRICS if m != "error"}
+    out["error"] = table.column("error").to_pylist()
+    return out
+
+
+def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_size: int) -> int:
+    """Creates or checks the manifest; returns the chunk size the directory was started with."""
+    directory.mkdir(parents=True, exist_ok=True)
+    manifest = directory / "manifest.json"
+    fingerprint = _fingerprint(settings)
+    if manifest.exists():
+        saved = json.loads(manifest.read_text())
+        if saved.get("fingerprint") != fingerprint:
+            old, new = _flatten(saved.get("settings", {})), _flatten(settings)
+            changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+            raise ValueError(
+                f"checkpoint {directory} was written for other settings (differs in: "
+                f"{', '.join(changed) or 'unknown'}); remove it or use another directory"
+            )
+        return int(saved["chunk_size"])
+    payload = {
+        "format": FORMAT_VERSION,
+        "fingerprint": fingerprint,
+        "settings": settings,
+        "n": n,
+        "chunk_size": chunk_size,
+    }
+    tmp = manifest.with_name("manifest.json.tmp")
+    tmp.write_text(json.dumps(payload, indent=1))
+    os.replace(tmp, manifest)
+    return chunk_size
+
+
+# --- the driver -------------------------------------------------------------------------------
+
+
+def _default_chunk_size(n: int) -> int:
+    """Depends on n only, so that a default run cuts the same chunks on any machine."""
+    return max(1, min(64, math.ceil(n / 16)))
+
+
+def _frame(names: Sequence[str], values: NDArray[np.float64], chunks: list[dict[str, Any]]) -> Any:
+    import pandas as pd
+
+    data: dict[str, Any] = {name: values[:, j].copy() for j, name in enumerate(names)}
+    for m in METRICS:
+        if m == "error":
+            errors = [e for c in chunks for e in c["error"]]
+            data[m] = pd.Series(errors, dtype=object)
+        else:
+            data[m] = np.concatenate([np.asarray(c[m]) for c in chunks])
+    data["stable"] = data["stable"].astype(bool)
+    data["n_steps"] = data["n_steps"].astype(np.int64)
+    frame = pd.DataFrame(data)
+    frame.index = pd.RangeIndex(len(values), name="sample")
+    return frame
+
+
+def _run_design(
+    names: Sequence[str],
+    values: NDArray[np.float64],
+    matrix: NDArray[np.float64],
+    options: dict[str, Any],
+    settings: dict[str, Any],
+    *,
+    threads: int | None,
+    backend: Any,
+    checkpoint: str | os.PathLike[str] | None,
+    chunk_size: int | None,
+    progress: bool,
+) -> Any:
+    n = len(matrix)
+    if threads is not None and (
+        isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1
+    ):
+        raise ValueError(f"threads = {threads!r} is invalid: must be an integer >= 1 or None")
+    if chunk_size is None:
+        chunk_size = _default_chunk_size(n)
+    elif isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
+        raise ValueError(f"chunk_size = {chunk_size!r} is invalid: must be an integer >= 1")
+    settings = {
+        **settings,
+        "format": FORMAT_VERSION,
+        "run": {k: v for k, v in options.items() if k != "max_step"},
+        "design_sha256": hashlib.sha256(np.ascontiguousarray(matrix).tobytes()).hexdigest(),
+    }
+    directory = Path(checkpoint) if checkpoint is not None else None
+    if directory is not None:
+        chunk_size = _open_checkpoint(directory, settings, n, chunk_size)
+    bounds = [(k, a, min(n, a + chunk_size)) for k, a in enumerate(range(0, n, chunk_size))]
+    done: dict[int, dict[str, Any]] = {}
+    if directory is not None:
+        for k, a, b in bounds:
+            chunk = _read_chunk(directory, k, a, b)
+            if chunk is not None:
+                done[k] = chunk
+    todo = [c for c in bounds if c[0] not in done]
+
+    bar = _progress_bar(progress, n, sum(b - a for k, a, b in bounds if k in done))
+    client, owned = (None, False) if backend is None else _dask_client(backend)
+    try:
+        if todo:
+            stream: Generator[tuple[int, dict[str, Any]], None, None] = (
+                _local_chunks(matrix, todo, options, threads)
+                if client is None
+                else _dask_chunks(client, matrix, todo, options)
+            )
+            written = set(done)
+            # closing: on any error (Ctrl-C included) the pending chunks are cancelled at once.
+            with contextlib.closing(stream):
+                try:
+                    for k, metrics in stream:
+                        done[k] = metrics
+                        start, stop = bounds[k][1], bounds[k][2]
+                        if directory is not None:
+                            _write_chunk(directory, k, start, metrics)
+                            written.add(k)
+                        if bar is not None:
+                            bar.update(stop - start)
+                except BaseException:
+                    # A finished chunk whose write was interrupted is written before leaving.
+                    if directory is not None:
+                        for k in sorted(set(done) - written):
+                            _write_chunk(directory, k, bounds[k][1], done[k])
+                    raise
+    finally:
+        if bar is not None:
+            bar.close()
+        if owned and client is not None:
+            cluster = getattr(client, "cluster", None)
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    frame = _frame(names, values, [done[k] for k, _, _ in bounds])
+    frame.attrs["settings"] = settings
+    return frame
+
+
+def _progress_bar(progress: bool, total: int, done: int) -> Any:
+    if not progress:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=total, initial=done, unit="sample", desc="thermojitter", leave=False)
+
+
+def _check_seed(seed: Any, checkpoint: Any) -> int:
+    if seed is None:
+        if checkpoint is not None:
+            raise ValueError("seed is required with checkpoint (a resumed run must redraw it)")
+        return int(np.random.SeedSequence().entropy % (2**63))  # type: ignore[operator]
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed = {seed!r} is invalid: must be an integer >= 0")
+    return int(seed)
+
+
+def _check_n(n: Any, least: int = 1) -> int:
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < least:
+        raise ValueError(f"n = {n!r} is invalid: must be an integer >= {least}")
+    return int(n)
+
+
+def _sampled(
+    panel: Panel,
+    vary: Mapping[str, Any],
+    u: NDArray[np.float64],
+    truncate: bool,
+) -> tuple[list[str], NDArray[np.float64], NDArray[np.float64]]:
+    """(names, sampled values, full panel rows) of unit points ``u`` mapped through ``vary``."""
+    names = list(vary)
+    dists = [distribution(name, vary[name]) for name in names]
+    values = np.column_stack(
+        [
+            _quantiles(name, dist, u[:, j], truncate)
+            for j, (name, dist) in enumerate(zip(names, dists, strict=True))
+        ]
+    )
+    matrix = _panel_matrix(panel, names, values)
+    hint = "" if truncate else "; narrow the distribution or pass truncate=True"
+    _refuse_invalid(matrix, hint)
+    return names, values, matrix
+
+
+def _check_vary(vary: Any) -> Mapping[str, Any]:
+    if not isinstance(vary, Mapping) or not vary:
+        raise ValueError(
+            "vary must be a non-empty mapping of panel parameter names to distributions"
+        )
+    _check_names(list(vary), "vary")
+    return vary
+
+
+def monte_carlo(
+    panel: Panel,
+    orbit: Orbit,
+    *,
+    vary: Mapping[str, Any],
+    n: int,
+    horizon: int = 1,
+    seed: int | None = None,
+    sampler: Sampler = "random",
+    truncate: bool = False,
+    threshold: float | None = None,
+    stop_at_threshold: bool = False,
+    threads: int | None = None,
+    backend: Any = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    chunk_size: int | None = None,
+    progress: bool = True,
+    model: Literal["nonlinear", "linear"] = "nonlinear",
+    coupled: bool = True,
+    method: Literal["rk45", "rk4"] = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    window: float = 600.0,
+    max_steps: int = 500_000_000,
+) -> Any:
+    """Runs ``n`` panels drawn around ``panel`` and returns a pandas DataFrame, one row a sample:
+    the sampled parameters, then the metrics (see ``METRICS``).
+
+    - ``vary``: panel parameter name → frozen scipy.stats distribution or shorthand
+      (``("uniform", lo, hi)``, ``("normal", mean, sd)``, ``("lognormal", median, sigma)``,
+      ``("loguniform", lo, hi)``, ``("truncnorm", mean, sd, lo, hi)``,
+      ``("triangular", lo, mode, hi)``). A design with a sample outside a parameter's valid range
+      (e.g. an emissivity above 1) is refused before anything runs, unless ``truncate=True``:
+      then each distribution is truncated to the valid range.
+    - ``sampler``: ``"random"`` (NumPy generator; sample i depends on the seed and i only, so a
+      larger n extends a study), ``"lhs"`` (Latin hypercube) or ``"sobol"``
+      (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
+      ``frame.attrs["seed"]``; required with ``checkpoint``).
+    - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
+    - ``threshold`` (rad): time the first |θ| above it (``t_threshold``); with
+      ``stop_at_threshold`` a sample stops there.
+    - ``threads``: rayon threads on this machine (default: one per core). ``backend``: None (this
+      machine), ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``;
+      each worker then runs chunks on as many rayon threads as it has threads.
+    - ``checkpoint``: a directory; finished chunks (``chunk_size`` samples, default depending on n
+      only; a resumed run keeps the size it started with) are written there as Parquet as they
+      complete, and a run with the same settings resumes from them. Settings that differ are
+      refused, naming them.
+
+    The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
+    """
+    _check_inputs(panel, orbit)
+    vary = _check_vary(vary)
+    n = _check_n(n)
+    seed = _check_seed(seed, checkpoint)
+    if sampler not in ("random", "lhs", "sobol"):
+        raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
+    options = _options(
+        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        stop_at_threshold, max_steps,
+    )  # fmt: skip
+    u = _unit_design(sampler, n, len(vary), seed)
+    names, values, matrix = _sampled(panel, vary, u, bool(truncate))
+    settings = {
+        "study": "monte_carlo",
+        "panel": panel.as_dict(),
+        "vary": {name: _describe(vary[name]) for name in names},
+        "n": n,
+        "seed": seed,
+        "sampler": sampler,
+        "truncate": bool(truncate),
+    }
+    frame = _run_design(
+        names, values, matrix, options, settings, threads=threads, backend=backend,
+        checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
+    )  # fmt: skip
+    frame.attrs["seed"] = seed
+    return frame
+
+
+def sweep(
+    panel: Panel,
+    orbit: Orbit,
+    grid: Mapping[str, Sequence[float]],
+    *,
+    horizon: int = 1,
+    threshold: float | None = None,
+    stop_at_threshold: bool = False,
+    threads: int | None = None,
+    backend: Any = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    chunk_size: int | None = None,
+    progress: bool = True,
+    model: Literal["nonlinear", "linear"] = "nonlinear",
+    coupled: bool = True,
+    method: Literal["rk45", "rk4"] = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    window: float = 600.0,
+    max_steps: int = 500_000_000,
+) -> Any:
+    """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
+    the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
+    arguments are the same."""
+    _check_inputs(panel, orbit)
+    if not isinstance(grid, Mapping) or not grid:
+        raise ValueError("grid must be a non-empty mapping of panel parameter names to values")
+    _check_names(list(grid), "grid")
+    axes: list[list[float]] = []
+    for name, vals in grid.items():
+        arr = np.atleast_1d(np.asarray(vals, dtype=float))
+        if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
+            raise ValueError(f"grid[{name!r}] = {vals!r} is invalid: must be finite numbers")
+        axes.append(arr.tolist())
+    options = _options(
+        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        stop_at_threshold, max_steps,
+    )  # fmt: skip
+    names = list(grid)
+    values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
+    matrix = _panel_matrix(panel, names, values)
+    _refuse_invalid(matrix, "")
+    settings = {
+        "study": "sweep",
+        "panel": panel.as_dict(),
+        "grid": dict(zip(names, axes, strict=True)),
+    }
+    return _run_design(
+        names, values, matrix, options, settings, threads=threads, backend=backend,
+        checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class SensitivityResult:
+    """Sobol indices of ``metric``: ``indices`` is a DataFrame indexed by parameter with columns
+    ``S1``, ``S1_conf``, ``ST``, ``ST_conf``; ``samples`` is the frame of every sample run."""
+
+    indices: Any
+    metric: str
+    samples: Any
+
+
+def sensitivity(
+    panel: Panel,
+    orbit: Orbit,
+    vary: Mapping[str, Any],
+    *,
+    metric: str = "exit_peak",
+    n: int = 256,
+    seed: int = 0,
+    second_order: bool = False,
+    truncate: bool = False,
+    horizon: int = 1,
+    threshold: float | None = None,
+    stop_at_threshold: bool = False,
+    threads: int | None = None,
+    backend: Any = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    chunk_size: int | None = None,
+    progress: bool = True,
+    model: Literal["nonlinear", "linear"] = "nonlinear",
+    coupled: bool = True,
+    method: Literal["rk45", "rk4"] = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    window: float = 600.0,
+    max_steps: int = 500_000_000,
+) -> SensitivityResult:
+    """Sobol sensitivity indices of one metric to the parameters in ``vary`` (needs SALib:
+    ``pip install 'thermojitter[sensitivity]'``).
+
+    Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design (best with n
+    a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
+    arguments these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` per parameter
+    (first-order and total indices, 95 % confidence half-widths).
+    """
+    try:
+        from SALib.analyze import sobol as sobol_analyze
+        from SALib.sample import sobol as sobol_sample
+    except ImportError as exc:
+        raise ImportError(
+            "sensitivity needs SALib: pip install 'thermojitter[sensitivity]'"
+        ) from exc
+    import pandas as pd
+
+    _check_inputs(panel, orbit)
+    vary = _check_vary(vary)
+    n = _check_n(n, 2)
+    seed = _check_seed(seed, None)
+    if metric not in _FLOAT_METRICS and metric != "stable":
+        raise ValueError(f"metric = {metric!r} is invalid: choose from {', '.join(_FLOAT_METRICS)}")
+    options = _options(
+        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        stop_at_threshold, max_steps,
+    )  # fmt: skip
+    names = list(vary)
+    problem = {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # n not a power of 2
+        u = np.asarray(
+            sobol_sample.sample(problem, n, calc_second_order=second_order, seed=seed), dtype=float
+        )
+    names, values, matrix = _sampled(panel, vary, u, bool(truncate))
+    settings = {
+        "study": "sensitivity",
+        "panel": panel.as_dict(),
+        "vary": {name: _describe(vary[name]) for name in names},
+        "n": n,
+        "seed": seed,
+        "second_order": bool(second_order),
+        "truncate": bool(truncate),
+    }
+    samples = _run_design(
+        names, values, matrix, options, settings, threads=threads, backend=backend,
+        checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
+    )  # fmt: skip
+    y = samples[metric].to_numpy(dtype=float)
+    missing = np.flatnonzero(~np.isfinite(y))
+    if missing.size:
+        k = int(missing[0])
+        why = samples["error"].iloc[k] or "no value"
+        raise ValueError(
+            f"{metric} is not defined for {missing.size} of {len(y)} samples (sample {k}: "
+            f"{why}); Sobol indices need a value for every sample"
+        )
+    res = sobol_analyze.analyze(problem, y, calc_second_order=second_order, seed=seed)
+    indices = pd.DataFrame(
+        {k: np.asarray(res[k], dtype=float) for k in ("S1", "S1_conf", "ST", "ST_conf")},
+        index=pd.Index(names, name="parameter"),
+    )
+    return SensitivityResult(indices=indices, metric=metric, samples=samples)

@@ -1,0 +1,997 @@
+"""``thermojitter paper``: the paper's figures, numbers and a one-page comparison with it.
+
+The work is a list of :class:`Section` objects. Each runs what it needs (runs are shared through
+the :class:`PaperContext` cache), draws its figures, and returns its numbers for ``summary.json``,
+rows for the comparison table and a paragraph for ``report.md``. Later work (the finite-element
+beam comparison, flutter margins) adds a section with :func:`register_section`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from thermojitter import plots
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.results import Solution, ThermalSolution
+from thermojitter.simulate import simulate, simulate_thermal, steady_state
+
+Array = NDArray[np.float64]
+
+# What the paper states (Parisse & Angeletti 2024), for the comparison table.
+PAPER_THETA_DEG = 5.0
+PAPER_ECLIPSE_MIN = 70.0
+PAPER_BEAM_FREQUENCY_HZ = 0.144
+PAPER_FREQUENCY_MISMATCH = 0.12
+PAPER_K_EL = 4438.0
+
+WINDOW_S = 600.0
+"""The window after shadow entry / exit in which the extreme angles are taken, s."""
+
+
+@dataclass(frozen=True)
+class PaperOptions:
+    """Settings of ``thermojitter paper`` (SI)."""
+
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    dt_out: float = 0.5
+    """Reporting interval of the coupled runs, s (the jitter period is about 8 s)."""
+    thermal_dt_out: float = 2.0
+    """Reporting interval of the thermal-only runs, s."""
+    flutter_hours: float = 14.0
+    """Length of the undamped runs of Figs. 17–18, h, counted from 10 min before shadow entry."""
+
+
+@dataclass
+class SectionResult:
+    """What a section gives back: numbers, comparison rows and a report paragraph."""
+
+    summary: dict[str, Any] = field(default_factory=dict)
+    rows: list[tuple[str, str, str, str]] = field(default_factory=list)
+    """(quantity, paper, this model, difference) for the comparison table."""
+    text: str = ""
+    figures: list[str] = field(default_factory=list)
+    differences: list[str] = field(default_factory=list)
+    """Where the result differs from the paper, and why (listed at the end of report.md)."""
+
+
+@dataclass(frozen=True)
+class Section:
+    key: str
+    title: str
+    figures: int
+    """How many figures it draws (for the progress bar)."""
+    build: Callable[[PaperContext], SectionResult]
+
+
+class PaperContext:
+    """The scenario, the output folder, shared runs and the progress bar of one ``paper`` call."""
+
+    def __init__(
+        self,
+        out: Path,
+        options: PaperOptions,
+        *,
+        panel: Panel | None = None,
+        orbit: Orbit | None = None,
+        tick: Callable[[str], None] | None = None,
+    ) -> None:
+        self.out = out
+        self.options = options
+        self.panel = panel or Panel.paper()
+        self.orbit = orbit or Orbit.geo_equinox()
+        self.entry, self.exit = self.orbit.shadow_intervals(0.0, self.orbit.period)[0]
+        self.equilibrium = steady_state(self.panel)
+        self._tick = tick
+        self._runs: dict[str, Any] = {}
+        self.run_log: dict[str, dict[str, Any]] = {}
+
+    def cached(self, key: str, make: Callable[[], Any]) -> Any:
+        if key not in self._runs:
+            started = time.perf_counter()
+            result = make()
+            self._runs[key] = result
+            self.run_log[key] = {
+                "t_span_s": [float(result.t[0]), float(result.t[-1])],
+                "n_samples": int(len(result.t)),
+                "n_steps": int(result.n_steps),
+                "n_rejected": int(result.n_rejected),
+                "n_rhs": int(result.n_rhs),
+                "wall_s": round(time.perf_counter() - started, 3),
+            }
+        return self._runs[key]
+
+    def orbit_run(self, *, model: str = "nonlinear") -> Solution:
+        """The coupled system over one orbit from the subsolar point, started at equilibrium."""
+        o = self.options
+        return self.cached(  # type: ignore[no-any-return]
+            f"orbit_{model}",
+            lambda: simulate(
+                self.panel,
+                self.orbit,
+                (0.0, self.orbit.period),
+                model=model,  # type: ignore[arg-type]
+                rtol=o.rtol,
+                atol=o.atol,
+                dt_out=o.dt_out,
+            ),
+        )
+
+    def thermal_run(self, panel: Panel, layers: int, key: str) -> ThermalSolution:
+        o = self.options
+        return self.cached(  # type: ignore[no-any-return]
+            key,
+            lambda: simulate_thermal(
+                panel,
+                self.orbit,
+                (0.0, self.orbit.period),
+                layers=layers,  # type: ignore[arg-type]
+                rtol=o.rtol,
+                atol=o.atol,
+                dt_out=o.thermal_dt_out,
+            ),
+        )
+
+    def flutter_run(self, *, coupled: bool) -> Solution:
+        """c_d = 0 from 10 min before the first shadow entry, over ``flutter_hours``."""
+        o = self.options
+        t0 = self.entry - 600.0
+        undamped = self.panel.replace(damping=0.0)
+        y0 = steady_state(undamped, coupled=coupled)
+        return self.cached(  # type: ignore[no-any-return]
+            f"flutter_{'coupled' if coupled else 'frozen'}",
+            lambda: simulate(
+                undamped,
+                self.orbit,
+                (t0, t0 + o.flutter_hours * 3600.0),
+                coupled=coupled,
+                rtol=o.rtol,
+                atol=o.atol,
+                dt_out=o.dt_out,
+                y0=(y0.T_front, y0.T_back, y0.theta, 0.0),
+            ),
+        )
+
+    def save(self, fig: Any, name: str) -> str:
+        plots.save(fig, self.out / name)
+        if self._tick is not None:
+            self._tick(name)
+        return name
+
+    def shadows(self, t0: float, t1: float) -> list[tuple[float, float]]:
+        return self.orbit.shadow_intervals(t0, t1)
+
+
+# --------------------------------------------------------------------------------------------
+# Measurements on records
+
+
+def window(t: Array, y: Array, t0: float, t1: float) -> tuple[Array, Array]:
+    mask = (t >= t0) & (t <= t1)
+    return t[mask], y[mask]
+
+
+def detrend(t: Array, y: Array, span: float = 60.0) -> Array:
+    """y minus its moving average over ``span`` s (removes the slow thermal drift)."""
+    dt = float(np.median(np.diff(t)))
+    n = max(3, int(round(span / dt)) | 1)
+    kernel = np.ones(n) / n
+    padded = np.pad(y, n // 2, mode="edge")
+    return y - np.convolve(padded, kernel, mode="valid")
+
+
+def fft_peak_frequency(t: Array, y: Array, f_min: float = 0.02) -> float:
+    """Frequency (Hz) of the largest spectral peak above f_min of a uniformly sampled record:
+    Hann window, zero padding, parabolic interpolation on the log magnitude."""
+    dt = float(np.median(np.diff(t)))
+    n = len(y)
+    size = 1 << int(math.ceil(math.log2(16 * n)))
+    spectrum = np.abs(np.fft.rfft((y - y.mean()) * np.hanning(n), size))
+    freqs = np.fft.rfftfreq(size, dt)
+    spectrum[freqs < f_min] = 0.0
+    k = int(np.argmax(spectrum))
+    if 0 < k < len(spectrum) - 1:
+        a, b, c = np.log(spectrum[k - 1 : k + 2] + 1e-300)
+        shift = 0.5 * (a - c) / (a - 2.0 * b + c)
+        return float((k + shift) * (freqs[1] - freqs[0]))
+    return float(freqs[k])
+
+
+def zero_crossing_frequency(t: Array, y: Array) -> float:
+    """Frequency (Hz) from the mean spacing of the (interpolated) upward zero crossings."""
+    up = np.nonzero((y[:-1] < 0.0) & (y[1:] >= 0.0))[0]
+    if len(up) < 2:
+        return float("nan")
+    crossings = t[up] - y[up] * (t[up + 1] - t[up]) / (y[up + 1] - y[up])
+    return float((len(crossings) - 1) / (crossings[-1] - crossings[0]))
+
+
+def oscillation_amplitude(t: Array, y: Array, bin_s: float) -> tuple[Array, Array]:
+    """Half the peak-to-peak of y in consecutive bins of ``bin_s`` s: (bin centres, amplitudes)."""
+    edges = np.arange(t[0], t[-1], bin_s)
+    centres, amps = [], []
+    for a in edges:
+        seg = y[(t >= a) & (t < a + bin_s)]
+        if len(seg) > 1:
+            centres.append(a + 0.5 * bin_s)
+            amps.append(0.5 * float(np.ptp(seg)))
+    return np.array(centres), np.array(amps)
+
+
+def flutter_growth_estimate(panel: Panel) -> float:
+    """Linear estimate of the undamped growth rate of the jitter by thermal pumping, 1/s.
+
+    At the sunlit tilt θ0 the absorbed flux αC cos θ changes by −αC sin θ0 δθ. At the jitter
+    frequency ω the front layer (heat capacity m c/2) responds almost purely through its capacity,
+    δT_f ≈ −αC sin θ0 δθ /(iω m c/2), a quarter period behind δθ; the moment χ a E I δT_f/d then
+    acts as a negative damping c_eq = αC sin θ0 χ a E I /(d ω² m c/2), and the envelope grows as
+    exp((c_eq − c_d) t /(2 I_B)).
+    """
+    eq = steady_state(panel)
+    omega = 2.0 * math.pi * natural_frequency(panel)
+    gain = (
+        panel.absorptivity
+        * panel.solar_constant
+        * math.sin(eq.theta)
+        * panel.moment_scale
+        * panel.expansion_coeff
+        * panel.youngs_modulus
+        * panel.bending_inertia
+        / (panel.thickness * 0.5 * panel.mass_per_length * panel.specific_heat)
+    )
+    c_eq = gain / omega**2
+    return (c_eq - panel.damping) / (2.0 * panel.hinge_inertia)
+
+
+def _pct(ours: float, ref: float) -> str:
+    return f"{100.0 * (ours - ref) / ref:+.1f}%"
+
+
+# --------------------------------------------------------------------------------------------
+# Sections
+
+
+def thermal_section(ctx: PaperContext) -> SectionResult:
+    """Figs. 2–6: the thermal models alone over one orbit (no hinge, θ = 0)."""
+    res = SectionResult()
+    period, entry, exit_ = ctx.orbit.period, ctx.entry, ctx.exit
+    shadows = ctx.shadows(0.0, period)
+    hours = 3600.0
+
+    one = ctx.thermal_run(ctx.panel, 1, "thermal_one_node")
+    assert one.T is not None
+    fig, (ax,) = plots.figure(1, height=3.8)
+    plots.line(ax, one.t / hours, one.T, lw=1.2, color="C3")
+    plots.shade_shadow(ax, shadows, scale=hours)
+    ax.set_xlabel("time from the subsolar point [h]")
+    ax.set_ylabel("plate temperature $T$ [K]")
+    ax.set_title("Fig. 2 — one-node (isothermal) plate temperature over one GEO orbit (Case B)")
+    ax.legend(loc="lower left", fontsize=8)
+    ax.grid(alpha=0.3)
+    res.figures.append(ctx.save(fig, "fig02_one_node_temperature.png"))
+    res.summary["one_node_T_max_K"] = float(one.T.max())
+    res.summary["one_node_T_min_K"] = float(one.T.min())
+
+    cases = {
+        "A": (
+            ctx.panel.replace(
+                emissivity_front=ctx.panel.emissivity_back,
+                emissivity_back=ctx.panel.emissivity_front,
+            ),
+            3,
+            5,
+        ),
+        "B": (ctx.panel, 4, 6),
+    }
+    lines = []
+    for name, (panel, fig_t, fig_dt) in cases.items():
+        run = ctx.thermal_run(panel, 2, f"thermal_case_{name.lower()}")
+        assert run.T_front is not None and run.T_back is not None
+        eps = f"ε_f = {panel.emissivity_front:g}, ε_b = {panel.emissivity_back:g}"
+        fig, (ax,) = plots.figure(1, height=3.8)
+        plots.line(ax, run.t / hours, run.T_front, lw=1.2, label="front (Sun side) $T_f$")
+        plots.line(ax, run.t / hours, run.T_back, lw=1.2, ls="--", label="back $T_b$")
+        plots.shade_shadow(ax, shadows, scale=hours)
+        ax.set_xlabel("time from the subsolar point [h]")
+        ax.set_ylabel("layer temperature [K]")
+        ax.set_title(f"Fig. {fig_t} — Case {name} ({eps}): two-layer temperatures, one orbit")
+        ax.legend(loc="lower left", fontsize=8)
+        ax.grid(alpha=0.3)
+        res.figures.append(ctx.save(fig, f"fig{fig_t:02d}_case_{name.lower()}_temperatures.png"))
+
+        dT = run.T_front - run.T_back
+        t0, t1 = entry - 20 * 60.0, exit_ + 60 * 60.0
+        tw, dw = window(run.t, dT, t0, t1)
+        fig, (ax,) = plots.figure(1, height=3.8)
+        ax.plot((tw - entry) / 60.0, dw, lw=1.2, color="C2")
+        ax.axhline(0.0, color="k", lw=0.6)
+        plots.shade_shadow(ax, ctx.shadows(t0, t1), scale=60.0, offset=entry)
+        ax.set_xlabel("time from shadow entry [min]")
+        ax.set_ylabel(r"$\Delta T = T_f - T_b$ [K]")
+        ax.set_title(f"Fig. {fig_dt} — Case {name} ({eps}): ΔT around the eclipse (zoom)")
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(alpha=0.3)
+        res.figures.append(ctx.save(fig, f"fig{fig_dt:02d}_case_{name.lower()}_delta_T.png"))
+
+        _, eclipse_dT = window(run.t, dT, entry, exit_)
+        sunlit_dT = float(dT[0])
+        res.summary[f"case_{name.lower()}"] = {
+            "emissivity_front": panel.emissivity_front,
+            "emissivity_back": panel.emissivity_back,
+            "delta_T_sunlit_K": sunlit_dT,
+            "delta_T_eclipse_min_K": float(eclipse_dT.min()),
+            "delta_T_eclipse_max_K": float(eclipse_dT.max()),
+            "delta_T_max_after_exit_K": float(window(run.t, dT, exit_, exit_ + 3600)[1].max()),
+            "T_front_min_K": float(run.T_front.min()),
+            "T_back_min_K": float(run.T_back.min()),
+        }
+        lines.append(
+            f"Case {name}: ΔT = {sunlit_dT:.1f} K in sunlight, "
+            f"{eclipse_dT.min():+.2f} … {eclipse_dT.max():+.2f} K in the eclipse"
+        )
+    a, b = res.summary["case_a"], res.summary["case_b"]
+    res.rows.append(
+        (
+            "Case A: ΔT in the eclipse",
+            "stays > 0, falls towards 0",
+            f"min {a['delta_T_eclipse_min_K']:+.2f} K",
+            "as stated" if a["delta_T_eclipse_min_K"] > 0 else "differs: goes negative",
+        )
+    )
+    res.rows.append(
+        (
+            "Case B: ΔT in the eclipse",
+            "much smaller than A, negative while cooling, overshoots",
+            f"{b['delta_T_sunlit_K']:.1f} K in Sun, min {b['delta_T_eclipse_min_K']:+.2f} K, "
+            f"peak after exit {b['delta_T_max_after_exit_K']:.1f} K",
+            "as stated"
+            if b["delta_T_eclipse_min_K"] < 0 < a["delta_T_eclipse_min_K"]
+            else "differs",
+        )
+    )
+    res.text = (
+        f"One node: T swings between {one.T.min():.0f} K and {one.T.max():.0f} K (Fig. 2), cooling "
+        "fast in the shadow as the paper describes. " + "; ".join(lines) + ". "
+        "The paper gives no temperature scale, so only the shapes are compared: Case A keeps "
+        "T_f > T_b throughout; Case B's ΔT dips below zero when the front layer (higher "
+        "emissivity) cools faster, and overshoots at both transitions (Figs. 5–6)."
+    )
+    res.differences.append(
+        "Figs. 2–6: the paper prints no temperature values, so only the shapes can be compared; "
+        "they match its description. The levels depend on the solar constant, which the paper "
+        "does not give (1361 W/m² is used here)."
+    )
+    return res
+
+
+def kinematics_section(ctx: PaperContext) -> SectionResult:
+    """Fig. 12: the paths of the points of the two-bar hinge model (paper Sec. 3.1), and the
+    phase-plane path of the simulated orbit."""
+    res = SectionResult()
+    plt = plots.pyplot()
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10.0, 5.0))
+    arm = ctx.panel.half_arm
+    theta = np.radians(np.linspace(-90.0, 90.0, 721))
+    for zeta in np.arange(0.0, 2.0 * arm + 1e-9, 2.5):
+        x = (arm - zeta) * np.sin(theta)
+        for sign in (1.0, -1.0):
+            ax1.plot(x, sign * zeta * np.cos(theta), lw=0.8, color="C0")
+    zeta = np.linspace(0.0, 2.0 * arm, 2)
+    th = ctx.equilibrium.theta
+    for sign in (1.0, -1.0):
+        ax1.plot(
+            (arm - zeta) * np.sin(th),
+            sign * zeta * np.cos(th),
+            lw=2.5,
+            color="k",
+            label=f"panel at θ = {math.degrees(th):.1f}° (sunlit)" if sign > 0 else None,
+        )
+    ax1.set_aspect("equal")
+    ax1.set_xlabel("x, normal to the panel [m]")
+    ax1.set_ylabel("y, along the panel [m]")
+    ax1.set_title(
+        "Fig. 12 — paths of points Q, −90° ≤ θ ≤ 90°,\nζ = 0 … 2l every 2.5 m", fontsize=10
+    )
+    ax1.legend(loc="lower left", fontsize=8)
+    ax1.grid(alpha=0.3)
+
+    run = ctx.orbit_run()
+    tw, thw = window(run.t, run.theta, ctx.entry - 60.0, ctx.exit + 3600.0)
+    _, omw = window(run.t, run.theta_dot, ctx.entry - 60.0, ctx.exit + 3600.0)
+    ax2.plot(np.degrees(thw), np.degrees(omw), lw=0.3, color="C1")
+    ax2.plot([ctx.equilibrium.theta_deg], [0.0], "ko", ms=4, label="sunlit equilibrium")
+    ax2.legend(loc="lower right", fontsize=8)
+    ax2.set_xlabel(r"$\theta$ [deg]")
+    ax2.set_ylabel(r"$\dot\theta$ [deg/s]")
+    ax2.set_title(
+        "(added) phase plane θ–θ̇, shadow entry to 1 h after exit\n(Table 1, non-linear, coupled)",
+        fontsize=10,
+    )
+    ax2.grid(alpha=0.3)
+    res.figures.append(ctx.save(fig, "fig12_kinematics.png"))
+    res.text = (
+        "Fig. 12 is, as in the paper, the family of elliptic arcs x = (l − ζ) sin θ, y = ζ cos θ "
+        "of the points of each half (semi-axes |l − ζ| and ζ; a circle at ζ = l/2), for "
+        "|θ| ≤ 90°. Beside it (not in the paper) the θ–θ̇ phase-plane trajectory of the "
+        "simulated orbit shows how small the actual excursion is."
+    )
+    res.differences.append(
+        "Fig. 12 follows the paper's text (the paths of the points of the hinge model), not a "
+        "θ–θ̇ phase portrait; the phase portrait is added beside it, labelled as an addition."
+    )
+    return res
+
+
+def jitter_section(ctx: PaperContext) -> SectionResult:
+    """Figs. 14–16: θ over one orbit and the transients at shadow entry and exit."""
+    res = SectionResult()
+    run = ctx.orbit_run()
+    entry, exit_ = ctx.entry, ctx.exit
+    theta = np.degrees(run.theta)
+    eq = ctx.equilibrium
+    p = ctx.panel
+
+    fig, (ax,) = plots.figure(1, height=3.8)
+    plots.line(ax, run.t / 3600.0, theta, lw=0.7)
+    plots.shade_shadow(ax, ctx.shadows(0.0, ctx.orbit.period), scale=3600.0)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("time from the subsolar point [h]")
+    ax.set_ylabel(r"hinge angle $\theta$ [deg]")
+    ax.set_title("Fig. 14 — thermal shock: hinge angle θ over one orbit (non-linear, coupled)")
+    ax.legend(loc="lower left", fontsize=8)
+    ax.grid(alpha=0.3)
+    res.figures.append(ctx.save(fig, "fig14_theta_orbit.png"))
+
+    for number, (t_event, name) in ((15, (entry, "entry")), (16, (exit_, "exit"))):
+        t0, t1 = t_event - 60.0, t_event + 15 * 60.0
+        tw, thw = window(run.t, theta, t0, t1)
+        _, mw = window(run.t, run.thermal_moment, t0, t1)
+        fig, (ax1, ax2) = plots.figure(2, height=5.5)
+        ax1.plot((tw - t_event) / 60.0, thw, lw=0.8)
+        ax1.set_ylabel(r"$\theta$ [deg]")
+        ax2.plot((tw - t_event) / 60.0, mw, lw=1.0, color="C3")
+        ax2.set_ylabel("thermal moment $M_T$ [N m]")
+        for ax in (ax1, ax2):
+            plots.shade_shadow(ax, ctx.shadows(t0, t1), scale=60.0, offset=t_event)
+            ax.axhline(0.0, color="k", lw=0.5)
+            ax.grid(alpha=0.3)
+        ax1.legend(loc="best", fontsize=8)
+        ax2.set_xlabel(f"time from shadow {name} [min]")
+        where = "entering" if name == "entry" else "leaving"
+        ax1.set_title(f"Fig. {number} — zoom: {where} the shadow, hinge angle and thermal moment")
+        res.figures.append(ctx.save(fig, f"fig{number}_{name}.png"))
+
+    _, after_entry = window(run.t, theta, entry, entry + WINDOW_S)
+    _, after_exit = window(run.t, theta, exit_, exit_ + WINDOW_S)
+    te, the = window(run.t, run.theta, entry + 30.0, exit_)
+    osc = detrend(te, the)
+    f_fft = fft_peak_frequency(te, osc)
+    f_zero = zero_crossing_frequency(te, osc)
+    f_hinge = natural_frequency(p)
+    f_beam = beam_frequency(p)
+    stiffness = {
+        c: hinge_stiffness(p, c) for c in ("deflection", "deflection_small_angle", "frequency")
+    }
+    mismatch = (f_fft - f_beam) / f_beam
+    ei = p.youngs_modulus * p.bending_inertia
+    # the residual jitter in sunlight at the end of the orbit (1 h before the end)
+    _, late = window(run.t, theta, ctx.orbit.period - 3600.0, ctx.orbit.period)
+    res.summary.update(
+        {
+            "theta_steady_deg": eq.theta_deg,
+            "delta_T_steady_K": eq.delta_T,
+            "T_front_steady_K": eq.T_front,
+            "T_back_steady_K": eq.T_back,
+            "thermal_moment_steady_Nm": eq.thermal_moment,
+            "entry_theta_min_deg": float(after_entry.min()),
+            "exit_theta_max_deg": float(after_exit.max()),
+            "orbit_theta_min_deg": float(theta.min()),
+            "orbit_theta_max_deg": float(theta.max()),
+            "residual_jitter_last_hour_deg": 0.5 * float(np.ptp(late)),
+            "jitter_frequency_hz": f_fft,
+            "jitter_frequency_zero_crossings_hz": f_zero,
+            "jitter_frequency_window_s": [float(te[0]), float(te[-1])],
+            "natural_frequency_hz": f_hinge,
+            "beam_frequency_hz": f_beam,
+            "frequency_mismatch": mismatch,
+            "hinge_stiffness": stiffness,
+            "hinge_stiffness_used": p.hinge_stiffness,
+        }
+    )
+    res.rows += [
+        (
+            "steady sunlit angle θ",
+            "about 5°",
+            f"{eq.theta_deg:.2f}°",
+            f"{eq.theta_deg - PAPER_THETA_DEG:+.2f}°",
+        ),
+        (
+            "θ in 10 min after entry / exit",
+            "reverses sign, then back",
+            f"min {after_entry.min():+.2f}° / max {after_exit.max():+.2f}°",
+            "as stated" if after_entry.min() < 0 < after_exit.max() else "differs",
+        ),
+        (
+            "beam first free–free frequency f_n",
+            f"{PAPER_BEAM_FREQUENCY_HZ} Hz",
+            f"{f_beam:.4f} Hz",
+            _pct(f_beam, PAPER_BEAM_FREQUENCY_HZ),
+        ),
+        (
+            "jitter frequency (measured, FFT of θ in eclipse)",
+            f"≈ {PAPER_FREQUENCY_MISMATCH:.0%} off f_n",
+            f"{f_fft:.4f} Hz ({100 * mismatch:+.1f}% vs f_n)",
+            f"{100 * abs(mismatch):.1f}% vs ≈ 12%",
+        ),
+        (
+            "hinge model natural frequency",
+            "–",
+            f"{f_hinge:.4f} Hz",
+            _pct(f_fft, f_hinge) + " measured vs model",
+        ),
+        (
+            "K_el, deflection criterion",
+            f"{PAPER_K_EL:g} N m/rad (Table 1)",
+            f"{stiffness['deflection']:.0f} (exact), {stiffness['deflection_small_angle']:.0f} "
+            "(4EI/L)",
+            _pct(stiffness["deflection"], PAPER_K_EL),
+        ),
+        (
+            "K_el, frequency criterion",
+            "≈ 5.21 EI/L",
+            f"{stiffness['frequency']:.0f} N m/rad "
+            f"= {stiffness['frequency'] * p.length / ei:.2f} EI/L",
+            "–",
+        ),
+    ]
+    res.text = (
+        f"With Table 1 (K_el = {p.hinge_stiffness:g} N m/rad) the sunlit equilibrium is "
+        f"θ = {eq.theta_deg:.2f}° (ΔT = {eq.delta_T:.2f} K, M_T = {eq.thermal_moment:.0f} N m). "
+        f"At shadow entry M_T changes sign within a minute and θ swings to "
+        f"{after_entry.min():+.2f}° (Fig. 15); at exit it overshoots to {after_exit.max():+.2f}° "
+        f"(Fig. 16) before settling back to {eq.theta_deg:.1f}°, as the paper describes. "
+        f"The jitter measured from θ in the eclipse oscillates at {f_fft:.4f} Hz (zero "
+        f"crossings: {f_zero:.4f} Hz), the hinge model's {f_hinge:.4f} Hz, "
+        f"{100 * mismatch:+.1f}% from the beam's f_n = {f_beam:.4f} Hz (paper: ≈ 12%). "
+    )
+    res.differences += [
+        f"Steady angle {eq.theta_deg:.2f}° against 'about 5°': the level scales with the solar "
+        "constant, which the paper does not state (1361 W/m² here).",
+        f"Frequency mismatch {100 * abs(mismatch):.1f}% against 'about 12%': the hinge "
+        f"frequency with Table 1's K_el is {f_hinge:.4f} Hz and the beam's {f_beam:.4f} Hz "
+        "(β₁L = 4.7300); the paper rounds (its 1.506π gives the same f_n).",
+        f"K_el: the deflection criterion gives {stiffness['deflection']:.0f} N m/rad here "
+        f"(exact) and {stiffness['deflection_small_angle']:.0f} (4EI/L = 4·70e9·8e-7/50), while "
+        "Table 1 lists 4438; 4EI/L with the Table 1 values is exactly 4480, so the table value "
+        "comes from data not given in the paper.",
+    ]
+    return res
+
+
+def flutter_section(ctx: PaperContext) -> SectionResult:
+    """Figs. 17–18: no damping, with and without the projected-area coupling."""
+    res = SectionResult()
+    opts = ctx.options
+    entry = ctx.entry
+    t_first_exit = ctx.exit
+    out: dict[str, Any] = {}
+    estimate = flutter_growth_estimate(ctx.panel.replace(damping=0.0))
+    swapped = ctx.panel.replace(
+        emissivity_front=ctx.panel.emissivity_back, emissivity_back=ctx.panel.emissivity_front
+    )
+    case_a = steady_state(swapped)
+    case_a_c = flutter_growth_estimate(swapped) * 2.0 * swapped.hinge_inertia + swapped.damping
+    for number, coupled in ((17, True), (18, False)):
+        run = ctx.flutter_run(coupled=coupled)
+        theta = np.degrees(run.theta)
+        eq = steady_state(ctx.panel.replace(damping=0.0), coupled=coupled)
+        centres, amps = oscillation_amplitude(run.t, theta, 600.0)
+        # growth measured from 1 h after the first exit (thermal transient over) while the
+        # amplitude stays below 10° (modest angles, where the hinge model holds)
+        fit = (centres > t_first_exit + 3600.0) & (amps < 10.0) & (amps > 0.0)
+        rate = float("nan")
+        if fit.sum() >= 3:
+            rate = float(np.polyfit(centres[fit], np.log(amps[fit]), 1)[0])
+        fig, (ax1, ax2) = plots.figure(2, height=6.0)
+        hours = (run.t - entry) / 3600.0
+        plots.line(ax1, hours, theta, lw=0.5)
+        ax1.set_ylabel(r"$\theta$ [deg]")
+        ax2.semilogy(
+            (centres - entry) / 3600.0,
+            np.maximum(amps, 1e-6),
+            "o-",
+            ms=2.5,
+            lw=0.8,
+            color="C1",
+            label="half peak-to-peak of θ per 10 min (with the thermal drift)",
+        )
+        if math.isfinite(rate) and coupled:
+            c = centres[fit]
+            ax2.semilogy(
+                (c - entry) / 3600.0,
+                np.exp(np.polyval(np.polyfit(c, np.log(amps[fit]), 1), c)),
+                "k--",
+                lw=1.0,
+                label=f"fit: e-folding {1 / rate / 3600:.2f} h",
+            )
+        ax2.axhline(20.0, color="C3", lw=0.8, ls=":", label="20°: beyond modest angles")
+        ax2.set_ylim(bottom=0.01)
+        ax2.set_ylabel("oscillation amplitude [deg]")
+        ax2.set_xlabel("time from the first shadow entry [h]")
+        for ax in (ax1, ax2):
+            plots.shade_shadow(ax, ctx.shadows(run.t[0], run.t[-1]), scale=3600.0, offset=entry)
+            ax.grid(alpha=0.3)
+        ax2.legend(loc="lower right" if coupled else "upper right", fontsize=8)
+        if coupled:
+            ax1.set_title(
+                "Fig. 17 — thermal flutter, c_d = 0, projected area ∝ cos θ: θ grows", fontsize=10
+            )
+        else:
+            ax1.set_title(
+                "Fig. 18 — c_d = 0, projected area frozen (cos θ → 1): no growth", fontsize=10
+            )
+        res.figures.append(
+            ctx.save(fig, f"fig{number}_flutter_{'coupled' if coupled else 'frozen'}.png")
+        )
+        late = amps[centres > t_first_exit + 3600.0]
+        out["coupled" if coupled else "frozen"] = {
+            "theta_equilibrium_deg": eq.theta_deg,
+            "amplitude_1h_after_exit_deg": float(late[0]) if len(late) else float("nan"),
+            "amplitude_end_deg": float(amps[-1]),
+            "theta_abs_max_deg": float(np.abs(theta).max()),
+            "growth_rate_per_s": rate,
+            "e_folding_time_h": 1.0 / rate / 3600.0 if rate > 0 else float("inf"),
+        }
+    out["horizon_h"] = opts.flutter_hours
+    out["growth_rate_estimate_per_s"] = estimate
+    out["e_folding_time_estimate_h"] = 1.0 / estimate / 3600.0 if estimate > 0 else float("inf")
+    out["negative_damping_estimate_Nms"] = estimate * 2.0 * ctx.panel.hinge_inertia
+    out["case_a_negative_damping_estimate_Nms"] = case_a_c
+    res.summary["flutter"] = out
+    co, fr = out["coupled"], out["frozen"]
+    res.rows += [
+        (
+            "c_d = 0, coupled (Fig. 17)",
+            "amplitude grows progressively",
+            f"{co['amplitude_1h_after_exit_deg']:.3f}° → {co['amplitude_end_deg']:.1f}° in "
+            f"{opts.flutter_hours:g} h (e-folding {co['e_folding_time_h']:.2f} h)",
+            "grows; e-folding in hours, not orbits",
+        ),
+        (
+            "c_d = 0, frozen area (Fig. 18)",
+            "keeps the residual amplitude",
+            f"{fr['amplitude_1h_after_exit_deg']:.3f}° → {fr['amplitude_end_deg']:.3f}°",
+            "as stated"
+            if fr["amplitude_end_deg"] < 1.5 * fr["amplitude_1h_after_exit_deg"]
+            else "differs",
+        ),
+    ]
+    res.text = (
+        f"With c_d = 0 and the projected area following cos θ, the jitter left by the eclipse "
+        f"grows exponentially in sunlight with an e-folding time of {co['e_folding_time_h']:.2f} h "
+        f"(linear estimate from the quarter-period lag of the front layer: "
+        f"{out['e_folding_time_estimate_h']:.2f} h; the equivalent negative damping is "
+        f"{estimate * 2 * ctx.panel.hinge_inertia:.2f} N m s/rad, less than Table 1's "
+        f"c_d = {ctx.panel.damping:g}, which is why the damped case is stable). It passes 10° "
+        f"within about half an orbit, so Fig. 17 shows {opts.flutter_hours:g} h rather than "
+        "several orbits: beyond a few tens of degrees the one-hinge model (small-angle "
+        "stiffness, cos θ flux with no self-shadowing) no longer describes a real panel, and "
+        "the run saturates near ±131°. With the area frozen (Fig. 18) the residual amplitude "
+        f"stays at {fr['amplitude_end_deg']:.3f}°: no pumping, as in the paper."
+        f" Case A (emissivities swapped) tilts to {case_a.theta_deg:.1f}° in sunlight, which "
+        f"raises the negative damping to {case_a_c:.2f} N m s/rad, above c_d = "
+        f"{ctx.panel.damping:g}: by the same estimate the coupled Case A panel flutters even "
+        "with Table 1's damping (try `thermojitter run examples/case_a.toml`)."
+    )
+    res.differences.append(
+        "Fig. 17: the paper describes 'a periodic progressive increment of the amplitude'; "
+        "here the growth is exponential with an e-folding time of "
+        f"{co['e_folding_time_h']:.1f} h, so it leaves the small-angle range within half an "
+        "orbit. The run is cut at "
+        f"{opts.flutter_hours:g} h; the paper does not give its time axis, so the rate cannot "
+        "be compared."
+    )
+    return res
+
+
+def linearity_section(ctx: PaperContext) -> SectionResult:
+    """Figs. 19–20: the linear and non-linear hinge at shadow entry and exit."""
+    res = SectionResult()
+    nl = ctx.orbit_run(model="nonlinear")
+    li = ctx.orbit_run(model="linear")
+    diff = np.degrees(nl.theta - li.theta)
+    for number, (t_event, name) in ((19, (ctx.entry, "entry")), (20, (ctx.exit, "exit"))):
+        t0, t1 = t_event - 30.0, t_event + 120.0
+        mask = (nl.t >= t0) & (nl.t <= t1)
+        x = nl.t[mask] - t_event
+        fig, (ax1, ax2) = plots.figure(2, height=5.5)
+        ax1.plot(x, np.degrees(nl.theta[mask]), lw=1.6, label="non-linear (eq. 20)")
+        ax1.plot(
+            x, np.degrees(li.theta[mask]), lw=1.0, ls="--", color="C3", label="linearised (eq. 28)"
+        )
+        ax1.set_ylabel(r"$\theta$ [deg]")
+        ax1.legend(loc="best", fontsize=8)
+        ax2.plot(x, diff[mask], lw=0.8, color="k")
+        ax2.set_ylabel(r"$\theta_{nl} - \theta_{lin}$ [deg]")
+        ax2.set_xlabel(f"time from shadow {name} [s]")
+        for ax in (ax1, ax2):
+            plots.shade_shadow(ax, ctx.shadows(t0, t1), offset=t_event, label=None)
+            ax.grid(alpha=0.3)
+        where = "entering" if name == "entry" else "leaving"
+        ax1.set_title(f"Fig. {number} — {where} the shadow: linearised vs non-linear hinge")
+        res.figures.append(ctx.save(fig, f"fig{number}_{name}_linear_vs_nonlinear.png"))
+
+    w0, w1 = ctx.entry, ctx.exit + WINDOW_S
+    _, dwin = window(nl.t, diff, w0, w1)
+    _, zoom_e = window(nl.t, diff, ctx.entry, ctx.entry + 120.0)
+    _, zoom_x = window(nl.t, diff, ctx.exit, ctx.exit + 120.0)
+    _, before_exit = window(nl.t, diff, ctx.exit - 120.0, ctx.exit)
+    swing = float(np.ptp(window(nl.t, np.degrees(nl.theta), w0, w1)[1]))
+    te, th_lin = window(li.t, li.theta, ctx.entry + 30.0, ctx.exit)
+    f_lin = fft_peak_frequency(te, detrend(te, th_lin))
+    te, th_nl = window(nl.t, nl.theta, ctx.entry + 30.0, ctx.exit)
+    f_nl = fft_peak_frequency(te, detrend(te, th_nl))
+    drift_cycles = abs(f_lin - f_nl) * (ctx.exit - ctx.entry)
+    _, ring = window(nl.t, np.degrees(nl.theta), ctx.exit - 120.0, ctx.exit)
+    res.summary.update(
+        {
+            "max_abs_theta_nonlinear_minus_linear_deg": float(np.abs(dwin).max()),
+            "theta_nonlinear_minus_linear_window_s": [w0, w1],
+            "max_abs_theta_nonlinear_minus_linear_first_2min_deg": {
+                "entry": float(np.abs(zoom_e).max()),
+                "exit": float(np.abs(zoom_x).max()),
+            },
+            "jitter_frequency_linear_hz": f_lin,
+        }
+    )
+    e, x, w = np.abs(zoom_e).max(), np.abs(zoom_x).max(), np.abs(dwin).max()
+    res.rows.append(
+        (
+            "linear vs non-linear θ (Figs. 19–20)",
+            "almost indistinguishable",
+            f"max \\|Δθ\\| {e:.2f}° (entry) / {x:.2f}° (exit) in the first 2 min; "
+            f"{w:.2f}° over the eclipse + 10 min",
+            f"entry: as stated; exit: visibly out of phase ({100 * w / swing:.1f}% of the "
+            f"{swing:.1f}° swing)",
+        )
+    )
+    res.text = (
+        "The linearised hinge differs from the non-linear one only through 1 + 3 sin²θ and the "
+        "θ̇² term, both of order θ² (< 1% at 5°). At shadow entry the curves overlie each other "
+        f"(largest gap {e:.2f}° in two minutes, Fig. 19). At exit they are visibly out of "
+        f"phase (Fig. 20, up to {x:.2f}°): the ringing left by the entry transient "
+        f"(±{0.5 * np.ptp(ring):.2f}° just before exit) runs at {f_nl:.5f} Hz non-linear and "
+        f"{f_lin:.5f} Hz linear, a drift of {drift_cycles:.2f} cycles over the "
+        f"{(ctx.exit - ctx.entry) / 60:.0f}-min eclipse, so the two records already differ by "
+        f"{np.abs(before_exit).max():.2f}° when the exit transient starts. The paper's "
+        "'almost indistinguishable' holds for the transients themselves, not for the phase of "
+        "the residual ringing."
+    )
+    res.differences.append(
+        f"Fig. 20: the linear and non-linear ringing drift {drift_cycles:.2f} cycles apart in "
+        f"the eclipse, so at exit they differ by up to {x:.2f}° where the paper sees no "
+        "difference (its figure may not resolve the ~8 s ringing)."
+    )
+    return res
+
+
+def beam_section(ctx: PaperContext) -> SectionResult:
+    """Paper Sec. 4.3: the hinge model against a finite-element free–free beam."""
+    from thermojitter.beam import FIGURES, PAPER_NUMBERS, beam_comparison_figures
+
+    result = beam_comparison_figures(ctx.panel, ctx.orbit, ctx.out, calibrate=True)
+    for key in FIGURES:
+        if ctx._tick is not None:
+            ctx._tick(FIGURES[key])
+    cases = result["cases"]
+    d, f, s = cases["deflection"], cases["frequency"], cases["frequency_scaled"]
+    f_beam = result["beam"]["natural_frequencies_hz"][0]
+    res = SectionResult(figures=[Path(v).name for v in result["figures"].values()])
+    res.summary = {
+        "beam_fe_frequency_hz": f_beam,
+        "beam_rmse_deg": {name: c["rmse_deg"] for name, c in cases.items()},
+        "beam_frequency_mismatch": {name: c["frequency_mismatch"] for name, c in cases.items()},
+        "beam_damping_ratio": d["damping_ratio"],
+        "beam_calibration": result.get("calibration"),
+    }
+    res.rows = [
+        (
+            "beam first free–free frequency (FE, 100 elements)",
+            f"{PAPER_NUMBERS['natural_frequency_hz']} Hz",
+            f"{f_beam:.4f} Hz",
+            _pct(f_beam, PAPER_NUMBERS["natural_frequency_hz"]),
+        ),
+        (
+            "RMSE θ − θ_f, K_el = 5.21 EI/L",
+            f"{PAPER_NUMBERS['rmse_deg']}°",
+            f"{f['rmse_deg']:.2f}°",
+            f"{f['rmse_deg'] - PAPER_NUMBERS['rmse_deg']:+.2f}°",
+        ),
+        ("RMSE θ − θ_f, Table 1 K_el (deflection)", "good agreement", f"{d['rmse_deg']:.2f}°", "–"),
+        (
+            "jitter frequency mismatch, deflection K_el",
+            "about 12%",
+            f"{100 * d['frequency_mismatch']:+.1f}%",
+            "–",
+        ),
+    ]
+    res.text = (
+        f"The free–free beam (Hermite elements, modal transient, rigid modes removed as inertia "
+        f"relief does) has its first mode at {f_beam:.4f} Hz. Driven by the hinge run's thermal "
+        f"moment, its equivalent angle θ_f follows the hinge model with K_el from the deflection "
+        f"criterion to an RMSE of {d['rmse_deg']:.2f}°, at a jitter frequency "
+        f"{100 * abs(d['frequency_mismatch']):.1f}% below f_n; with K_el = 5.21 EI/L the "
+        f"frequencies agree ({100 * f['frequency_mismatch']:+.2f}%) but the RMSE grows to "
+        f"{f['rmse_deg']:.2f}°; scaling M_T by χ = {s['moment_scale']:.3f} as in the paper's "
+        f"closing remark meets both (RMSE {s['rmse_deg']:.2f}°)."
+    )
+    return res
+
+
+SECTIONS: list[Section] = [
+    Section("thermal", "Thermal models (Figs. 2–6)", 5, thermal_section),
+    Section("kinematics", "Hinge kinematics (Fig. 12)", 1, kinematics_section),
+    Section("jitter", "Thermal jitter over one orbit (Figs. 14–16)", 3, jitter_section),
+    Section("flutter", "Thermal flutter without damping (Figs. 17–18)", 2, flutter_section),
+    Section("linearity", "Linear vs non-linear hinge (Figs. 19–20)", 2, linearity_section),
+    Section("beam", "Hinge model against a finite-element beam (Figs. 22–24)", 4, beam_section),
+]
+"""The sections of ``thermojitter paper``, in report order."""
+
+
+def register_section(section: Section) -> None:
+    """Adds (or replaces, by key) a section of the paper reproduction."""
+    for i, existing in enumerate(SECTIONS):
+        if existing.key == section.key:
+            SECTIONS[i] = section
+            return
+    SECTIONS.append(section)
+
+
+# --------------------------------------------------------------------------------------------
+# Driver
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> None:
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(_jsonable(data), indent=2, ensure_ascii=False) + "\n")
+    tmp.replace(path)
+
+
+def _report(
+    ctx: PaperContext, results: list[tuple[Section, SectionResult]], summary: dict[str, Any]
+) -> str:
+    p = ctx.panel
+    lines = [
+        "# thermojitter — reproduction of Parisse & Angeletti 2024 (Table 1 panel, GEO equinox)",
+        "",
+        f"Panel: Table 1 (ε_f = {p.emissivity_front:g}, ε_b = {p.emissivity_back:g}, "
+        f"K_el = {p.hinge_stiffness:g} N m/rad, c_d = {p.damping:g} N m s/rad, "
+        f"C = {p.solar_constant:g} W/m²). Orbit: GEO, period {ctx.orbit.period:.1f} s, "
+        f"cylindrical shadow of {summary['eclipse_duration_min']:.2f} min "
+        f"(paper: about {PAPER_ECLIPSE_MIN:g} min). Solver: Dormand–Prince 5(4), "
+        f"rtol = {ctx.options.rtol:g}, atol = {ctx.options.atol:g}, steps stopped at shadow "
+        f"entry and exit; output every {ctx.options.dt_out:g} s. All numbers: `summary.json`.",
+        "",
+        "| quantity | paper | this model | difference |",
+        "|---|---|---|---|",
+        f"| eclipse duration | about {PAPER_ECLIPSE_MIN:g} min | "
+        f"{summary['eclipse_duration_min']:.2f} min | "
+        f"{summary['eclipse_duration_min'] - PAPER_ECLIPSE_MIN:+.2f} min |",
+    ]
+    for _, res in results:
+        for row in res.rows:
+            lines.append("| " + " | ".join(row) + " |")
+    lines.append("")
+    for section, res in results:
+        lines.append(f"**{section.title}.** {res.text}")
+        if res.figures:
+            lines.append("Figures: " + ", ".join(f"[{f}]({f})" for f in res.figures) + ".")
+        lines.append("")
+    lines.append("**Differences from the paper, and why.**")
+    lines.append("")
+    lines.append(
+        f"- Eclipse {summary['eclipse_duration_min']:.2f} min against 'about 70 min': a "
+        "cylindrical Earth shadow at equinox, no penumbra; the paper rounds."
+    )
+    lines += [f"- {d}" for _, res in results for d in res.differences]
+    return "\n".join(lines) + "\n"
+
+
+def run_paper(
+    out: str | Path,
+    options: PaperOptions | None = None,
+    *,
+    sections: list[Section] | None = None,
+    progress: bool = True,
+    stop: Callable[[], bool] | None = None,
+) -> dict[str, Any]:
+    """Writes the figures, ``summary.json`` and ``report.md`` into ``out``; returns the summary.
+
+    ``summary.json`` is rewritten after every section (with ``"complete": false`` until the end),
+    so an interrupted run keeps what it had finished. ``stop`` is polled after every figure and
+    section; when it returns True the run ends with ``KeyboardInterrupt``.
+    """
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    opts = options or PaperOptions()
+    chosen = list(SECTIONS if sections is None else sections)
+    started = time.perf_counter()
+
+    bar: Any = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=sum(s.figures for s in chosen), unit="fig", desc="paper", leave=False)
+
+    def check() -> None:
+        if stop is not None and stop():
+            raise KeyboardInterrupt
+
+    def tick(name: str) -> None:
+        if bar is not None:
+            bar.set_postfix_str(name, refresh=False)
+            bar.update(1)
+        check()
+
+    ctx = PaperContext(folder, opts, tick=tick)
+    summary: dict[str, Any] = {
+        "complete": False,
+        "eclipse_duration_min": ctx.orbit.eclipse_duration / 60.0,
+        "orbit_period_s": ctx.orbit.period,
+        "shadow_entry_s": ctx.entry,
+        "shadow_exit_s": ctx.exit,
+        "solver": {
+            "method": "rk45",
+            "rtol": opts.rtol,
+            "atol": opts.atol,
+            "dt_out_s": opts.dt_out,
+            "thermal_dt_out_s": opts.thermal_dt_out,
+            "flutter_hours": opts.flutter_hours,
+            "runs": ctx.run_log,
+        },
+        "panel": ctx.panel.as_dict(),
+        "orbit": ctx.orbit.as_dict(),
+    }
+    results: list[tuple[Section, SectionResult]] = []
+    try:
+        for section in chosen:
+            check()
+            res = section.build(ctx)
+            results.append((section, res))
+            summary.update(res.summary)
+            summary["figures"] = [f for _, r in results for f in r.figures]
+            _write_json(folder / "summary.json", summary)
+    finally:
+        if bar is not None:
+            bar.close()
+    summary["complete"] = True
+    summary["wall_time_s"] = round(time.perf_counter() - started, 2)
+    summary["python"] = platform.python_version()
+    _write_json(folder / "summary.json", summary)
+    (folder / "report.md").write_text(_report(ctx, results, summary))
+    return summary

@@ -1,0 +1,336 @@
+"""Scenario files: one simulation described in TOML, checked key by key.
+
+A scenario has four tables, each optional::
+
+    [panel]        # any Panel field (SI); missing ones take the Table 1 values
+    mass_per_length = 5.51
+
+    [orbit]        # preset = "geo_equinox" and/or any Orbit field
+    preset = "geo_equinox"
+
+    [simulation]   # t_start, t_end or orbits or years, model, coupled, method, rtol, atol, dt,
+                   # dt_out, keep ("samples" | "orbits"), theta_limit_deg, on_limit
+    orbits = 1
+
+    [output]       # format = "csv" | "parquet", plots = true
+    format = "csv"
+
+Every problem is a :class:`ScenarioError` naming the file, the key and the reason.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field, fields
+from datetime import date
+from pathlib import Path
+from typing import Any
+
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+
+class ScenarioError(ValueError):
+    """A scenario file that cannot be used: names the file, the key (dotted) and the reason."""
+
+    def __init__(self, path: str | Path, key: str | None, reason: str) -> None:
+        self.path = str(path)
+        self.key = key
+        self.reason = reason
+        if key is None:
+            message = f"{self.path}: {reason}"
+        elif reason.startswith("= "):  # the engine's "name = value is invalid: ..." form
+            message = f"{self.path}: {key} {reason}"
+        else:
+            message = f"{self.path}: {key}: {reason}"
+        super().__init__(message)
+
+
+ORBIT_PRESETS = {
+    "geo_equinox": Orbit.geo_equinox,
+    "geo_year": Orbit.geo_year,
+    "leo": Orbit.leo,
+    "sunlit": Orbit.sunlit,
+}
+SHADOWS = ("none", "cylindrical", "penumbra")
+MODELS = ("nonlinear", "linear")
+METHODS = ("rk45", "rk4")
+FORMATS = ("csv", "parquet")
+KEEP = ("samples", "orbits")
+ON_LIMIT = ("stop", "flag")
+
+
+@dataclass(frozen=True)
+class SimulationSettings:
+    """Time span (s) and solver options of one run."""
+
+    t_start: float = 0.0
+    t_end: float | None = None
+    orbits: float | None = None
+    model: str = "nonlinear"
+    coupled: bool = True
+    method: str = "rk45"
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    dt: float | None = None
+    dt_out: float = 0.5
+    years: float | None = None
+    """Alternative to t_end and orbits: the span in Julian years (365.25 days)."""
+    keep: str = "samples"
+    """"samples": the time series every dt_out; "orbits": one summary row per orbit (for runs
+    of months and years; resumable from a checkpoint in the output folder)."""
+    theta_limit_deg: float = 20.0
+    """With keep = "orbits": |θ| beyond which the hinge model is not trusted, deg."""
+    on_limit: str = "stop"
+    """With keep = "orbits": "stop" at the first crossing of theta_limit_deg, or "flag" it."""
+
+    def span(self, orbit: Orbit) -> tuple[float, float]:
+        """(t0, t1) in s: t_end if given, else t_start + orbits · period (one orbit by default)."""
+        if self.t_end is not None:
+            return self.t_start, self.t_end
+        return self.t_start, self.t_start + self.n_orbits(orbit) * orbit.period
+
+    def n_orbits(self, orbit: Orbit) -> float:
+        """The span in orbits (one by default)."""
+        if self.t_end is not None:
+            return (self.t_end - self.t_start) / orbit.period
+        if self.years is not None:
+            return self.years * 365.25 * 86400.0 / orbit.period
+        return 1.0 if self.orbits is None else self.orbits
+
+
+@dataclass(frozen=True)
+class OutputSettings:
+    format: str = "csv"
+    plots: bool = True
+
+
+@dataclass(frozen=True)
+class Scenario:
+    panel: Panel = field(default_factory=Panel.paper)
+    orbit: Orbit = field(default_factory=Orbit.geo_equinox)
+    simulation: SimulationSettings = field(default_factory=SimulationSettings)
+    output: OutputSettings = field(default_factory=OutputSettings)
+    source: str = "<built-in>"
+    extra: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """Tables a command adds to the format (e.g. [flutter]), checked by that command."""
+
+
+_ENGINE_MESSAGE = re.compile(r"^(\w+) = ")
+
+
+def _real(path: Path, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ScenarioError(path, key, f"must be a number, not {_toml_type(value)} {value!r}")
+    number = float(value)
+    if not math.isfinite(number):
+        raise ScenarioError(path, key, f"must be finite, not {value!r}")
+    return number
+
+
+def _positive(path: Path, key: str, value: Any) -> float:
+    number = _real(path, key, value)
+    if number <= 0.0:
+        raise ScenarioError(path, key, f"must be > 0, not {value!r}")
+    return number
+
+
+def _choice(path: Path, key: str, value: Any, allowed: tuple[str, ...]) -> str:
+    if not isinstance(value, str):
+        raise ScenarioError(path, key, f"must be a string, not {_toml_type(value)} {value!r}")
+    if value not in allowed:
+        options = ", ".join(repr(a) for a in allowed)
+        raise ScenarioError(path, key, f"must be one of {options}, not {value!r}")
+    return value
+
+
+def _boolean(path: Path, key: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise ScenarioError(path, key, f"must be true or false, not {_toml_type(value)} {value!r}")
+    return value
+
+
+def _toml_type(value: Any) -> str:
+    names = {bool: "a boolean", int: "an integer", float: "a float", str: "a string"}
+    for kind, name in names.items():
+        if type(value) is kind:
+            return name
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "an array"
+    return "a " + type(value).__name__
+
+
+def _reject_unknown(path: Path, section: str, table: dict[str, Any], known: set[str]) -> None:
+    for key in table:
+        if key not in known:
+            hint = ", ".join(sorted(known))
+            raise ScenarioError(path, f"{section}.{key}", f"unknown key (allowed: {hint})")
+
+
+def _table(path: Path, data: dict[str, Any], name: str) -> dict[str, Any]:
+    value = data.get(name, {})
+    if not isinstance(value, dict):
+        raise ScenarioError(path, name, f"must be a table [{name}], not {_toml_type(value)}")
+    return value
+
+
+def _validated(path: Path, section: str, build: Any, base: Any, values: dict[str, float]) -> Any:
+    """Builds the object one key at a time (so a bad value is named), then all together."""
+    for key, value in values.items():
+        try:
+            build(**{**base, key: value})
+        except (ValueError, TypeError) as exc:
+            raise _engine_error(path, section, str(exc), key) from None
+    try:
+        return build(**{**base, **values})
+    except (ValueError, TypeError) as exc:
+        raise _engine_error(path, section, str(exc), None) from None
+
+
+def _engine_error(path: Path, section: str, message: str, key: str | None) -> ScenarioError:
+    match = _ENGINE_MESSAGE.match(message)
+    if match:
+        return ScenarioError(
+            path, f"{section}.{match.group(1)}", message[len(match.group(1)) + 1 :]
+        )
+    return ScenarioError(path, f"{section}.{key}" if key else section, message)
+
+
+def _panel(path: Path, table: dict[str, Any]) -> Panel:
+    known = set(Panel.field_names())
+    _reject_unknown(path, "panel", table, known)
+    values = {key: _real(path, f"panel.{key}", value) for key, value in table.items()}
+    return _validated(path, "panel", Panel, {}, values)  # type: ignore[no-any-return]
+
+
+def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
+    """[orbit]: a preset (with its own arguments: start_date for geo_year, altitude for leo)
+    and/or any Orbit field."""
+    known = {f.name for f in fields(Orbit)} | {"preset", "start_date", "altitude"}
+    _reject_unknown(path, "orbit", table, known)
+    base: dict[str, Any] = {}
+    preset = None
+    if "preset" in table:
+        preset = _choice(path, "orbit.preset", table["preset"], tuple(ORBIT_PRESETS))
+    if "start_date" in table and preset != "geo_year":
+        raise ScenarioError(path, "orbit.start_date", "goes with preset = 'geo_year'")
+    if "altitude" in table and preset != "leo":
+        raise ScenarioError(path, "orbit.altitude", "goes with preset = 'leo'")
+    if preset == "geo_year":
+        start = table.get("start_date", "2026-01-01")
+        if not isinstance(start, (str, int, date)) or isinstance(start, bool):
+            raise ScenarioError(path, "orbit.start_date", "must be a date (2026-03-20) or a day")
+        try:
+            base = Orbit.geo_year(start).as_dict()
+        except (ValueError, TypeError) as exc:
+            raise ScenarioError(path, "orbit.start_date", str(exc)) from None
+    elif preset == "leo":
+        altitude = _positive(path, "orbit.altitude", table.get("altitude", 540e3))
+        base = Orbit.leo(altitude).as_dict()
+    elif preset is not None:
+        base = ORBIT_PRESETS[preset]().as_dict()
+    values: dict[str, Any] = {}
+    for key, value in table.items():
+        if key in ("preset", "start_date", "altitude"):
+            continue
+        if key == "shadow":
+            values[key] = _choice(path, "orbit.shadow", value, SHADOWS)
+        elif key in ("season", "eccentric_sun"):
+            values[key] = _boolean(path, f"orbit.{key}", value)
+        else:
+            values[key] = _real(path, f"orbit.{key}", value)
+    return _validated(path, "orbit", Orbit, base, values)  # type: ignore[no-any-return]
+
+
+def _simulation(path: Path, table: dict[str, Any]) -> SimulationSettings:
+    known = {f.name for f in fields(SimulationSettings)}
+    _reject_unknown(path, "simulation", table, known)
+    s = "simulation."
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        if key in ("model",):
+            out[key] = _choice(path, s + key, value, MODELS)
+        elif key == "method":
+            out[key] = _choice(path, s + key, value, METHODS)
+        elif key == "coupled":
+            out[key] = _boolean(path, s + key, value)
+        elif key == "keep":
+            out[key] = _choice(path, s + key, value, KEEP)
+        elif key == "on_limit":
+            out[key] = _choice(path, s + key, value, ON_LIMIT)
+        elif key in ("t_start", "t_end"):
+            out[key] = _real(path, s + key, value)
+        else:
+            out[key] = _positive(path, s + key, value)
+    given = [k for k in ("t_end", "orbits", "years") if k in out]
+    if len(given) > 1:
+        raise ScenarioError(path, s + given[1], "give either t_end, orbits or years, not several")
+    settings = SimulationSettings(**out)
+    if settings.t_end is not None and settings.t_end <= settings.t_start:
+        raise ScenarioError(
+            path, s + "t_end", f"must be after t_start = {settings.t_start}, not {settings.t_end}"
+        )
+    if settings.method == "rk4" and settings.dt is None:
+        raise ScenarioError(path, s + "dt", "is required with method = 'rk4' (the fixed step, s)")
+    return settings
+
+
+def _output(path: Path, table: dict[str, Any]) -> OutputSettings:
+    _reject_unknown(path, "output", table, {"format", "plots"})
+    fmt = _choice(path, "output.format", table.get("format", "csv"), FORMATS)
+    plots = _boolean(path, "output.plots", table.get("plots", True))
+    return OutputSettings(format=fmt, plots=plots)
+
+
+def parse_scenario(
+    data: dict[str, Any], path: str | Path = "<scenario>", extra_sections: Sequence[str] = ()
+) -> Scenario:
+    """A scenario from parsed TOML data; ``path`` is used in error messages only.
+
+    ``extra_sections`` names further tables the caller accepts; they are returned unchecked in
+    ``Scenario.extra`` (absent ones as empty tables)."""
+    where = Path(path)
+    sections = {"panel", "orbit", "simulation", "output", *extra_sections}
+    for key in data:
+        if key not in sections:
+            raise ScenarioError(
+                where, key, f"unknown table (allowed: {', '.join(sorted(sections))})"
+            )
+    return Scenario(
+        panel=_panel(where, _table(where, data, "panel")),
+        orbit=_orbit(where, _table(where, data, "orbit")),
+        simulation=_simulation(where, _table(where, data, "simulation")),
+        output=_output(where, _table(where, data, "output")),
+        source=str(path),
+        extra={name: _table(where, data, name) for name in extra_sections},
+    )
+
+
+def load_scenario(path: str | Path, extra_sections: Sequence[str] = ()) -> Scenario:
+    """Reads and checks a TOML scenario file; raises :class:`ScenarioError` on any problem."""
+    where = Path(path)
+    try:
+        raw = where.read_bytes()
+    except FileNotFoundError:
+        raise ScenarioError(where, None, "no such file") from None
+    except IsADirectoryError:
+        raise ScenarioError(where, None, "is a directory, not a scenario file") from None
+    except OSError as exc:
+        raise ScenarioError(where, None, f"cannot be read ({exc.strerror})") from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise ScenarioError(where, None, "is not UTF-8 text") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(where, None, f"invalid TOML: {exc}") from None
+    return parse_scenario(data, where, extra_sections)

@@ -1,0 +1,353 @@
+//! Batches of independent panels (Monte Carlo samples, sweep points) run in parallel on rayon.
+//!
+//! Each sample is one panel integrated over a whole number of orbits from its sunlit equilibrium,
+//! plus the flutter analysis of that equilibrium, reduced to a few numbers. A sample is computed
+//! by one thread from its own inputs only, so the results do not depend on the number of threads
+//! or on how a batch is cut into chunks.
+
+use crate::dynamics::HingeModel;
+use crate::error::{require_positive, Error, Result};
+use crate::flutter::{analyse, critical_damping};
+use crate::integrate::Method;
+use crate::orbit::Orbit;
+use crate::params::Panel;
+use crate::steady::equilibrium;
+use crate::summary::{run_orbits, OrbitRun, SummaryOptions};
+use crate::system::Coupling;
+use nalgebra::Vector4;
+use rayon::prelude::*;
+use rayon::ThreadPool;
+
+/// What every sample of a batch shares.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnsembleSettings {
+    pub orbit: Orbit,
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    pub method: Method,
+    /// Whole orbits integrated from t = 0, the first starting at the sunlit equilibrium.
+    pub n_orbits: u64,
+    /// Window after shadow entry and exit in which the transient peaks are taken, s.
+    pub window: f64,
+    /// |θ| whose first crossing is timed, rad.
+    pub threshold: Option<f64>,
+    /// Stop a sample at the first crossing of the threshold (its metrics then cover the run so
+    /// far).
+    pub stop_at_threshold: bool,
+}
+
+impl EnsembleSettings {
+    pub fn validate(&self) -> Result<()> {
+        self.orbit.validate()?;
+        self.method.validate()?;
+        require_positive("window", self.window)?;
+        if self.n_orbits == 0 {
+            return Err(Error::invalid("horizon", 0, "must be >= 1 orbit"));
+        }
+        if let Some(th) = self.threshold {
+            require_positive("threshold", th)?;
+        }
+        Ok(())
+    }
+}
+
+/// The numbers kept from one sample. Angles rad, times s; NaN where not defined.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleMetrics {
+    /// Sunlit equilibrium angle at full Sun.
+    pub theta_eq: f64,
+    /// Largest real part of the Jacobian's eigenvalues at that equilibrium, 1/s.
+    pub growth_rate: f64,
+    pub frequency_hz: f64,
+    /// Damping at which the growth rate crosses zero, N m s/rad.
+    pub critical_damping: f64,
+    /// max |θ| over the horizon.
+    pub theta_abs_max: f64,
+    /// max |θ − θ_eq| over the horizon.
+    pub amplitude: f64,
+    /// max |θ − θ_eq| within the window after any shadow entry, and after any exit.
+    pub entry_peak: f64,
+    pub exit_peak: f64,
+    /// RMS and peak of θ − M_T/K_el over the horizon.
+    pub jitter_rms: f64,
+    pub jitter_peak: f64,
+    /// First time |θ| passed the threshold (NaN: never, or no threshold).
+    pub t_threshold: f64,
+    /// Time the integration reached (the horizon unless stopped at the threshold).
+    pub t_reached: f64,
+    pub n_steps: u64,
+    /// Why the sample could not be computed; every number is then NaN.
+    pub error: Option<String>,
+}
+
+impl SampleMetrics {
+    fn failed(err: Error) -> Self {
+        SampleMetrics {
+            theta_eq: f64::NAN,
+            growth_rate: f64::NAN,
+            frequency_hz: f64::NAN,
+            critical_damping: f64::NAN,
+            theta_abs_max: f64::NAN,
+            amplitude: f64::NAN,
+            entry_peak: f64::NAN,
+            exit_peak: f64::NAN,
+            jitter_rms: f64::NAN,
+            jitter_peak: f64::NAN,
+            t_threshold: f64::NAN,
+            t_reached: f64::NAN,
+            n_steps: 0,
+            error: Some(err.to_string()),
+        }
+    }
+
+    pub fn stable(&self) -> bool {
+        self.growth_rate < 0.0
+    }
+}
+
+/// Largest value, ignoring NaN (the windows of an orbit without an eclipse); NaN if all are.
+fn max_defined(values: impl Iterator<Item = f64>) -> f64 {
+    values.fold(f64::NAN, |acc, v| if v.is_nan() { acc } else { acc.max(v) })
+}
+
+fn reduce(run: &OrbitRun) -> (f64, f64, f64, f64, f64, f64) {
+    let s = &run.summaries;
+    let theta_abs_max = max_defined(s.iter().map(|o| o.theta_max.abs().max(o.theta_min.abs())));
+    let amplitude = max_defined(s.iter().map(|o| o.amplitude));
+    let entry = max_defined(s.iter().map(|o| o.entry_peak));
+    let exit = max_defined(s.iter().map(|o| o.exit_peak));
+    let jitter_peak = max_defined(s.iter().map(|o| o.jitter_peak));
+    // Each orbit's RMS weighted by the time integrated in it (the last may be cut short).
+    let (mut sq, mut total) = (0.0, 0.0);
+    for o in s {
+        let span = (o.t_end.min(run.stats.t_end) - o.t_start).max(0.0);
+        sq += o.jitter_rms * o.jitter_rms * span;
+        total += span;
+    }
+    let rms = if total > 0.0 {
+        (sq / total).sqrt()
+    } else {
+        f64::NAN
+    };
+    (theta_abs_max, amplitude, entry, exit, rms, jitter_peak)
+}
+
+/// One sample: the flutter analysis and the summarised run of `panel`.
+pub fn run_sample(panel: &Panel, settings: &EnsembleSettings) -> Result<SampleMetrics> {
+    panel.validate()?;
+    let s = settings;
+    let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
+    let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
+    let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
+    let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+    let options = SummaryOptions {
+        window: s.window,
+        // Without a threshold nothing is timed: a limit no angle reaches.
+        theta_limit: s.threshold.unwrap_or(f64::MAX),
+        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
+    };
+    let run = run_orbits(
+        panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
+    )?;
+    let (theta_abs_max, amplitude, entry_peak, exit_peak, jitter_rms, jitter_peak) = reduce(&run);
+    Ok(SampleMetrics {
+        theta_eq: flutter.equilibrium.theta,
+        growth_rate: flutter.growth_rate,
+        frequency_hz: flutter.frequency_hz,
+        critical_damping: critical,
+        theta_abs_max,
+        amplitude,
+        entry_peak,
+        exit_peak,
+        jitter_rms,
+        jitter_peak,
+        t_threshold: run.crossing.map_or(f64::NAN, |c| c.t),
+        t_reached: run.stats.t_end,
+        n_steps: run.stats.n_steps,
+        error: None,
+    })
+}
+
+/// A rayon pool of its own with `threads` workers (0: rayon's default, one per core).
+pub fn pool(threads: usize) -> Result<ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::invalid("threads", threads, &e.to_string()))
+}
+
+/// Runs every panel on `pool`, results in input order. A sample that fails (an invalid panel,
+/// an integration that cannot finish) keeps its error in its metrics; the batch goes on.
+pub fn run_batch(
+    pool: &ThreadPool,
+    panels: &[Panel],
+    settings: &EnsembleSettings,
+) -> Result<Vec<SampleMetrics>> {
+    settings.validate()?;
+    Ok(pool.install(|| {
+        panels
+            .par_iter()
+            .with_max_len(1)
+            .map(|p| run_sample(p, settings).unwrap_or_else(SampleMetrics::failed))
+            .collect()
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::Tolerances;
+
+    fn settings() -> EnsembleSettings {
+        EnsembleSettings {
+            orbit: Orbit {
+                radius: 7.0e6,
+                period: 5828.5,
+                ..Orbit::geo_equinox()
+            },
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances {
+                rtol: 1e-6,
+                atol: 1e-8,
+                ..Tolerances::default()
+            }),
+            n_orbits: 1,
+            window: 600.0,
+            threshold: Some(0.2),
+            stop_at_threshold: false,
+        }
+    }
+
+    fn panels() -> Vec<Panel> {
+        (0..6)
+            .map(|k| Panel {
+                damping: 0.5 * k as f64,
+                conductance: 20.0 + k as f64,
+                ..Panel::paper()
+            })
+            .collect()
+    }
+
+    /// Every number of a batch by its bits (NaN equals NaN), with the errors.
+    fn bits(batch: &[SampleMetrics]) -> Vec<(Vec<u64>, Option<String>)> {
+        batch
+            .iter()
+            .map(|m| {
+                let v = [
+                    m.theta_eq,
+                    m.growth_rate,
+                    m.frequency_hz,
+                    m.critical_damping,
+                    m.theta_abs_max,
+                    m.amplitude,
+                    m.entry_peak,
+                    m.exit_peak,
+                    m.jitter_rms,
+                    m.jitter_peak,
+                    m.t_threshold,
+                    m.t_reached,
+                ];
+                let mut b: Vec<u64> = v.iter().map(|x| x.to_bits()).collect();
+                b.push(m.n_steps);
+                (b, m.error.clone())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn results_do_not_depend_on_threads_or_order() {
+        let s = settings();
+        let one = run_batch(&pool(1).unwrap(), &panels(), &s).unwrap();
+        let two = run_batch(&pool(2).unwrap(), &panels(), &s).unwrap();
+        assert_eq!(bits(&one), bits(&two));
+        let mut reversed = panels();
+        reversed.reverse();
+        let mut back = run_batch(&pool(2).unwrap(), &reversed, &s).unwrap();
+        back.reverse();
+        assert_eq!(bits(&one), bits(&back));
+    }
+
+    #[test]
+    fn a_sample_equals_its_single_run_and_flutter_analysis() {
+        let s = settings();
+        let p = panels()[3];
+        let m = run_sample(&p, &s).unwrap();
+        let a = analyse(&p, s.model, s.coupling, 1.0).unwrap();
+        assert_eq!(m.growth_rate, a.growth_rate);
+        assert_eq!(m.stable(), a.stable());
+        let eq = equilibrium(&p, s.coupling, 1.0).unwrap();
+        let run = run_orbits(
+            &p,
+            &s.orbit,
+            s.model,
+            s.coupling,
+            &s.method,
+            0.0,
+            0,
+            1,
+            Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+            SummaryOptions {
+                window: 600.0,
+                theta_limit: 0.2,
+                stop_at_limit: false,
+            },
+        )
+        .unwrap();
+        let o = run.summaries[0];
+        assert_eq!(m.exit_peak, o.exit_peak);
+        assert_eq!(m.theta_abs_max, o.theta_max.abs().max(o.theta_min.abs()));
+        assert!((m.jitter_rms - o.jitter_rms).abs() <= 1e-15 * o.jitter_rms);
+        assert_eq!(m.theta_eq, eq.theta);
+    }
+
+    #[test]
+    fn a_bad_panel_fails_alone() {
+        let mut ps = panels();
+        ps[2].emissivity_front = 1.5;
+        let out = run_batch(&pool(2).unwrap(), &ps, &settings()).unwrap();
+        let err = out[2].error.as_deref().unwrap();
+        assert!(err.starts_with("emissivity_front"), "{err}");
+        assert!(out[2].growth_rate.is_nan());
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(i, m)| (i == 2) == m.error.is_some()));
+    }
+
+    #[test]
+    fn threshold_timing_and_stopping() {
+        let mut s = settings();
+        let p = Panel {
+            damping: 0.0,
+            ..Panel::paper()
+        };
+        let base = run_sample(&p, &s).unwrap();
+        let limit = 0.5 * (base.theta_abs_max + base.theta_eq.abs());
+        s.threshold = Some(limit);
+        let flagged = run_sample(&p, &s).unwrap();
+        assert!(flagged.t_threshold > 0.0 && flagged.t_threshold < s.orbit.period);
+        assert_eq!(flagged.t_reached, s.orbit.period);
+        s.stop_at_threshold = true;
+        let stopped = run_sample(&p, &s).unwrap();
+        assert_eq!(stopped.t_threshold, flagged.t_threshold);
+        assert!(stopped.t_reached < s.orbit.period);
+        s.threshold = None;
+        assert!(run_sample(&p, &s).unwrap().t_threshold.is_nan());
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        let mut s = settings();
+        s.n_orbits = 0;
+        let e = run_batch(&pool(1).unwrap(), &panels(), &s).unwrap_err();
+        assert!(e.to_string().starts_with("horizon"), "{e}");
+        let mut s = settings();
+        s.threshold = Some(-1.0);
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("threshold"));
+    }
+}

@@ -1,0 +1,89 @@
+//! Bindings of the orbit options: eclipses, umbra, the Sun over the year.
+
+use super::convert::orbit_from;
+use super::to_py;
+use crate::orbit::Orbit;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// (centre, first contact, last contact, umbra entry, umbra exit), s.
+type EclipseRow = (f64, f64, f64, f64, f64);
+
+/// Each eclipse overlapping [t0, t1], unclipped: (centre, first contact, last contact, umbra
+/// entry, umbra exit), NaN where there is no umbra.
+#[pyfunction]
+fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<EclipseRow>> {
+    let o = orbit_from(orbit)?;
+    crate::integrate::check_span(t0, t1).map_err(to_py)?;
+    Ok(o.eclipses(t0, t1)
+        .iter()
+        .map(|e| {
+            let (c, d) = e.umbra.unwrap_or((f64::NAN, f64::NAN));
+            (e.centre, e.outer.0, e.outer.1, c, d)
+        })
+        .collect())
+}
+
+/// Umbra intervals of an orbit within [t0, t1], clipped.
+#[pyfunction]
+fn umbra_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
+    let o = orbit_from(orbit)?;
+    crate::integrate::check_span(t0, t1).map_err(to_py)?;
+    Ok(o.umbra_intervals(t0, t1))
+}
+
+/// Times in (t0, t1) where s(t) jumps or has a kink.
+#[pyfunction]
+fn orbit_breakpoints(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<f64>> {
+    let o = orbit_from(orbit)?;
+    crate::integrate::check_span(t0, t1).map_err(to_py)?;
+    Ok(o.breakpoints(t0, t1))
+}
+
+fn map_times<'py>(
+    py: Python<'py>,
+    orbit: &Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+    f: impl Fn(&Orbit, f64) -> f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let o = orbit_from(orbit)?;
+    let v: Vec<f64> = t.as_array().iter().map(|&x| f(&o, x)).collect();
+    Ok(PyArray1::from_vec(py, v))
+}
+
+/// Solar flux relative to 1 au at each time.
+#[pyfunction]
+fn flux_scale<'py>(
+    py: Python<'py>,
+    orbit: &Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    map_times(py, orbit, t, Orbit::flux_scale)
+}
+
+/// The Sun's declination at each time, rad.
+#[pyfunction]
+fn declination<'py>(
+    py: Python<'py>,
+    orbit: &Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    map_times(py, orbit, t, Orbit::declination)
+}
+
+/// Orbit period relative to the Sun (time between eclipses), s.
+#[pyfunction]
+fn synodic_period(orbit: &Bound<'_, PyDict>) -> PyResult<f64> {
+    Ok(orbit_from(orbit)?.synodic_period())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(eclipses, m)?)?;
+    m.add_function(wrap_pyfunction!(umbra_intervals, m)?)?;
+    m.add_function(wrap_pyfunction!(orbit_breakpoints, m)?)?;
+    m.add_function(wrap_pyfunction!(flux_scale, m)?)?;
+    m.add_function(wrap_pyfunction!(declination, m)?)?;
+    m.add_function(wrap_pyfunction!(synodic_period, m)?)?;
+    Ok(())
+}

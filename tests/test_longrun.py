@@ -1,0 +1,137 @@
+"""Long runs: per-orbit summaries, the validity limit, checkpoint/resume, Ctrl-C."""
+
+from __future__ import annotations
+
+import json
+import math
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import thermojitter as tj
+from conftest import EXIT, GEO, PAPER
+
+# A low orbit keeps these tests fast: ~1.6 h period, ~35 min eclipse.
+LOW = tj.Orbit(radius=7.0e6, period=5828.5)
+
+
+def test_summaries_agree_with_the_sampled_solution() -> None:
+    runs = tj.simulate_orbits(PAPER, GEO, 1)
+    sol = tj.simulate(PAPER, GEO, (0.0, GEO.period), dt_out=0.05)
+    window = (sol.t >= EXIT) & (sol.t <= EXIT + 600.0)
+    assert runs.exit_theta_max[0] == pytest.approx(sol.theta[window].max(), abs=1e-6)
+    assert runs.theta_min[0] == pytest.approx(sol.theta.min(), abs=1e-6)
+    assert runs.t_exit[0] == pytest.approx(EXIT)
+    dynamic = sol.theta - sol.thermal_moment / PAPER.hinge_stiffness
+    assert runs.jitter_rms[0] == pytest.approx(np.sqrt(np.mean(dynamic**2)), rel=1e-2)
+
+
+def test_undamped_panel_is_stopped_at_the_validity_limit() -> None:
+    limit = math.radians(15.0)
+    runs = tj.simulate_orbits(PAPER.replace(damping=0.0), GEO, 5, theta_limit=limit)
+    assert runs.limit_crossing is not None
+    t, orbit, theta = runs.limit_crossing
+    assert abs(theta) > limit and orbit == runs.index[-1]
+    assert len(runs) < 5  # stopped, not integrated on to nonsense
+    flagged = tj.simulate_orbits(
+        PAPER.replace(damping=0.0), LOW, 3, theta_limit=limit, on_limit="flag"
+    )
+    assert len(flagged) == 3
+
+
+def test_damping_above_and_below_critical() -> None:
+    crit = tj.flutter(PAPER).critical_damping
+    kick = tj.steady_state(PAPER)
+    y0 = (kick.T_front, kick.T_back, kick.theta + 0.02, 0.0)
+    above = tj.simulate_orbits(PAPER.replace(damping=1.3 * crit), LOW, 8, y0=y0)
+    below = tj.simulate_orbits(PAPER.replace(damping=0.7 * crit), LOW, 8, y0=y0)
+    # Compare the jitter left at the end of each orbit's sunlit arc: it decays or grows.
+    assert above.jitter_peak[-1] < above.jitter_peak[1]
+    assert below.jitter_peak[-1] > below.jitter_peak[1]
+
+
+def _child_script(path: Path, n: int) -> str:
+    return textwrap.dedent(f"""
+        import json, sys, thermojitter as tj
+        orbit = tj.Orbit(radius=7.0e6, period=5828.5)
+        r = tj.simulate_orbits(tj.Panel.paper(), orbit, {n}, checkpoint={str(path)!r},
+                               checkpoint_every=0.0, progress=False)
+        print(json.dumps({{"interrupted": r.interrupted, "done": len(r)}}))
+    """)
+
+
+def _wait_for_progress(path: Path, proc: subprocess.Popen[str], at_least: int) -> None:
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        if path.exists():
+            try:
+                if json.loads(path.read_text())["next_index"] >= at_least:
+                    return
+            except (json.JSONDecodeError, KeyError):
+                pass  # caught mid-replace; try again
+        if proc.poll() is not None:
+            pytest.fail("child finished before it could be interrupted")
+        time.sleep(0.02)
+    pytest.fail("no checkpoint progress")
+
+
+def test_killed_run_resumes_to_identical_summaries(tmp_path: Path) -> None:
+    n = 30
+    path = tmp_path / "run.ckpt"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _child_script(path, n)], text=True, stdout=subprocess.PIPE
+    )
+    _wait_for_progress(path, proc, 3)
+    proc.kill()  # SIGKILL: no chance to clean up
+    proc.wait()
+    done_before = json.loads(path.read_text())["next_index"]
+    assert 0 < done_before < n
+    resumed = tj.simulate_orbits(PAPER, LOW, n, checkpoint=path, progress=False)
+    straight = tj.simulate_orbits(PAPER, LOW, n, progress=False)
+    assert len(resumed) == len(straight) == n
+    for name, column in straight.columns.items():
+        np.testing.assert_array_equal(resumed.columns[name], column, err_msg=name)
+    np.testing.assert_array_equal(resumed.y_end, straight.y_end)
+
+
+def test_ctrl_c_returns_the_finished_orbits(tmp_path: Path) -> None:
+    path = tmp_path / "run.ckpt"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _child_script(path, 100_000)], text=True, stdout=subprocess.PIPE
+    )
+    _wait_for_progress(path, proc, 2)
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=60)
+    result = json.loads(out.strip().splitlines()[-1])
+    assert proc.returncode == 0
+    assert result["interrupted"] is True and result["done"] >= 2
+    assert json.loads(path.read_text())["next_index"] == result["done"]
+
+
+def test_checkpoint_with_other_settings_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "run.ckpt"
+    tj.simulate_orbits(PAPER, LOW, 2, checkpoint=path)
+    with pytest.raises(ValueError, match="damping"):
+        tj.simulate_orbits(PAPER.replace(damping=1.0), LOW, 2, checkpoint=path)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"n_orbits": 0}, "n_orbits"),
+        ({"theta_limit": -1.0}, "theta_limit"),
+        ({"window": math.nan}, "window"),
+        ({"on_limit": "warn"}, "on_limit"),
+        ({"orbits_per_call": 0}, "orbits_per_call"),
+    ],
+)
+def test_bad_long_run_settings(kwargs: dict[str, object], name: str) -> None:
+    args: dict[str, object] = {"n_orbits": 1, **kwargs}
+    with pytest.raises(ValueError, match=name):
+        tj.simulate_orbits(PAPER, LOW, **args)  # type: ignore[arg-type]

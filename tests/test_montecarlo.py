@@ -1,0 +1,311 @@
+"""Monte Carlo, sweeps and sensitivity: determinism across threads, chunks and backends,
+kill-and-resume, refusal of bad inputs, and metrics checked against single runs."""
+
+from __future__ import annotations
+
+import math
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+import thermojitter as tj
+from conftest import PAPER
+from thermojitter import montecarlo
+from thermojitter.montecarlo_cli import mc_command
+
+# A low orbit and loose tolerances keep these tests fast: ~1.6 h period, ~35 min eclipse.
+LOW = tj.Orbit(radius=7.0e6, period=5828.5)
+FAST: dict[str, Any] = {"rtol": 1e-6, "atol": 1e-8, "progress": False}
+VARY = {"damping": ("uniform", 1.0, 4.0), "emissivity_back": ("normal", 0.3, 0.03)}
+
+
+def run(**kwargs: Any) -> pd.DataFrame:
+    args: dict[str, Any] = {"vary": VARY, "n": 12, "seed": 7, **FAST, **kwargs}
+    return tj.monte_carlo(PAPER, LOW, **args)
+
+
+def test_same_frame_for_any_threads_and_chunking() -> None:
+    one = run(threads=1)
+    two = run(threads=2, chunk_size=5)
+    single = run(threads=2, chunk_size=1)
+    pd.testing.assert_frame_equal(one, two, check_exact=True)
+    pd.testing.assert_frame_equal(one, single, check_exact=True)
+    assert list(one.columns[:2]) == ["damping", "emissivity_back"]
+    assert one["error"].isna().all()
+    # Another seed draws other panels; the same seed the same ones.
+    assert not np.array_equal(run(seed=8)["damping"], one["damping"])
+    # With the random sampler a sample depends on (seed, index) only, not on n.
+    pd.testing.assert_frame_equal(run(n=5), one.iloc[:5], check_exact=True)
+
+
+def test_same_frame_on_a_dask_cluster() -> None:
+    distributed = pytest.importorskip("distributed")
+    local = run(threads=2, chunk_size=3)
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+    )
+    try:
+        with distributed.Client(cluster) as client:
+            on_dask = run(backend=client, chunk_size=3)
+            workers = client.scheduler_info()["workers"]
+        by_address = run(backend=cluster.scheduler_address, chunk_size=4)
+    finally:
+        cluster.close()
+    assert {w["nthreads"] for w in workers.values()} == {1}
+    # The chunks ran on the workers, each on a rayon pool of the worker's one thread.
+    used = [key for key in montecarlo._WORKER_POOLS if key[0] in workers]
+    assert used and all(montecarlo._WORKER_POOLS[key].threads == 1 for key in used)
+    pd.testing.assert_frame_equal(local, on_dask, check_exact=True)
+    pd.testing.assert_frame_equal(local, by_address, check_exact=True)
+
+
+def test_metrics_agree_with_a_sampled_single_run() -> None:
+    frame = run(n=3, threshold=0.12, rtol=1e-8, atol=1e-10)
+    row = frame.iloc[1]
+    panel = PAPER.replace(damping=row["damping"], emissivity_back=row["emissivity_back"])
+    sol = tj.simulate(panel, LOW, (0.0, LOW.period), dt_out=0.05)
+    assert row["theta_abs_max"] == pytest.approx(np.abs(sol.theta).max(), abs=1e-6)
+    dynamic = sol.theta - sol.thermal_moment / panel.hinge_stiffness
+    assert row["jitter_rms"] == pytest.approx(np.sqrt(np.mean(dynamic**2)), rel=1e-2)
+    above = sol.t[np.abs(sol.theta) > 0.12]
+    assert above.size and row["t_threshold"] == pytest.approx(above[0], abs=0.05)
+    entry, exit_ = LOW.shadow_intervals(0.0, LOW.period)[0]
+    eq = tj.steady_state(panel).theta
+    # The window opens at the exit itself, where θ is still at its lowest: sample it from there.
+    window = tj.simulate(
+        panel, LOW, (0.0, LOW.period), t_eval=np.linspace(exit_, exit_ + 600, 30001)
+    )
+    assert row["exit_peak"] == pytest.approx(np.abs(window.theta - eq).max(), abs=1e-6)
+    assert row["theta_eq"] == pytest.approx(eq, rel=1e-9)
+    assert row["t_reached"] == LOW.period
+
+
+def test_stop_at_threshold_cuts_the_run_at_the_crossing() -> None:
+    flagged = run(n=4, threshold=0.12)
+    stopped = run(n=4, threshold=0.12, stop_at_threshold=True)
+    crossed = flagged["t_threshold"].notna().to_numpy()
+    assert crossed.any()
+    np.testing.assert_array_equal(stopped["t_threshold"], flagged["t_threshold"])
+    assert (stopped["t_reached"][crossed] < LOW.period).all()
+    assert (stopped["t_reached"][~crossed] == LOW.period).all()
+    assert (stopped["n_steps"][crossed] < flagged["n_steps"][crossed]).all()
+
+
+def test_stability_agrees_with_the_critical_damping() -> None:
+    # Two computations: the eigenvalues at the sampled damping, and the damping that zeroes them.
+    frame = run(n=24, horizon=1, sampler="lhs")
+    margin = frame["damping"] - frame["critical_damping"]
+    assert (frame["stable"] == (margin > 0)).all()
+    assert frame["stable"].any() and (~frame["stable"]).any()
+    panel = PAPER.replace(
+        damping=frame["damping"].iloc[0], emissivity_back=frame["emissivity_back"].iloc[0]
+    )
+    assert frame["growth_rate"].iloc[0] == pytest.approx(tj.flutter(panel).growth_rate, rel=1e-12)
+
+
+def test_latin_hypercube_fills_every_stratum() -> None:
+    n = 16
+    frame = run(n=n, sampler="lhs", vary={"damping": ("uniform", 1.0, 5.0)}, horizon=1)
+    strata = np.floor((frame["damping"].to_numpy() - 1.0) / 4.0 * n).astype(int)
+    assert sorted(strata) == list(range(n))
+    sobol = run(n=n, sampler="sobol", vary={"damping": ("uniform", 1.0, 5.0)})
+    strata = np.floor((sobol["damping"].to_numpy() - 1.0) / 4.0 * n).astype(int)
+    assert sorted(strata) == list(range(n))  # a scrambled Sobol' set of 2^k points does too
+
+
+def test_truncation_draws_from_the_truncated_distribution() -> None:
+    vary = {"emissivity_front": ("normal", 0.9, 0.1)}
+    with pytest.raises(ValueError, match=r"emissivity_front.*truncate=True"):
+        run(vary=vary, n=200)
+    frame = run(vary=vary, n=200, truncate=True, rtol=1e-4, atol=1e-6)
+    x = frame["emissivity_front"].to_numpy()
+    assert x.max() <= 1.0 and x.min() > 0.0
+    truth = stats.truncnorm(-9.0, 1.0, loc=0.9, scale=0.1)
+    assert stats.kstest(x, truth.cdf).pvalue > 1e-3
+
+
+def test_sweep_is_full_factorial_in_order() -> None:
+    grid = {"damping": [1.0, 3.0], "conductance": [20.0, 25.0, 30.0]}
+    frame = tj.sweep(PAPER, LOW, grid, **FAST)
+    assert len(frame) == 6
+    assert frame["damping"].tolist() == [1.0, 1.0, 1.0, 3.0, 3.0, 3.0]
+    assert frame["conductance"].tolist() == [20.0, 25.0, 30.0] * 2
+    for _, row in frame.iterrows():
+        panel = PAPER.replace(damping=row["damping"], conductance=row["conductance"])
+        assert row["theta_eq"] == pytest.approx(tj.steady_state(panel).theta, rel=1e-9)
+    # Damping leaves the equilibrium alone; conductance changes it.
+    eq = frame["theta_eq"].to_numpy().reshape(2, 3)
+    np.testing.assert_allclose(eq[0], eq[1], rtol=1e-12)
+    assert np.all(np.diff(eq[0]) < 0)
+    with pytest.raises(ValueError, match="damping"):
+        tj.sweep(PAPER, LOW, {"damping": [1.0, -1.0]}, **FAST)
+
+
+def test_failed_samples_are_kept_with_their_error() -> None:
+    frame = run(n=3, max_steps=10)
+    assert frame["error"].str.contains("integration failed").all()
+    assert frame["theta_abs_max"].isna().all()
+    assert len(frame) == 3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"vary": {"colour": ("uniform", 0, 1)}}, "'colour' is not a panel parameter"),
+        ({"vary": {"damping": ("uniform", 2.0, 1.0)}}, r"damping.*lo < hi"),
+        ({"vary": {"damping": ("uniform", 1.0)}}, r"damping.*expected \('uniform', lo, hi\)"),
+        ({"vary": {"conductance": ("normal", 25.0, 0.0)}}, r"conductance.*sd > 0"),
+        ({"vary": {"conductance": ("normal", 25.0, math.nan)}}, r"conductance.*not finite"),
+        ({"vary": {"conductance": ("gamma", 2.0, 1.0)}}, "unknown distribution 'gamma'"),
+        ({"vary": {"conductance": stats.norm(25.0, -1.0)}}, r"conductance.*not a proper"),
+        ({"vary": {"conductance": 25.0}}, r"conductance.*frozen scipy.stats"),
+        ({"vary": {}}, "non-empty"),
+        ({"vary": {"damping": ("normal", 0.5, 2.0)}, "n": 50}, r"damping: \d+ of 50 samples"),
+        ({"vary": {"absorptivity": ("uniform", 0.9, 1.2)}}, r"absorptivity.*must be in \(0, 1\]"),
+        ({"n": 0}, "n = 0"),
+        ({"horizon": 0}, "horizon"),
+        ({"horizon": 1.5}, "horizon"),
+        ({"threads": 0}, "threads"),
+        ({"seed": -1}, "seed"),
+        ({"sampler": "halton"}, "sampler"),
+        ({"threshold": -0.1}, "threshold"),
+        ({"chunk_size": 0}, "chunk_size"),
+        ({"backend": 42}, "backend"),
+        ({"rtol": -1.0}, "rtol"),
+    ],
+)
+def test_bad_inputs_are_refused_by_name(kwargs: dict[str, Any], match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        run(**kwargs)
+
+
+def test_truncation_needs_probability_in_the_valid_range() -> None:
+    with pytest.raises(ValueError, match=r"emissivity_back.*no probability"):
+        run(vary={"emissivity_back": ("uniform", 1.5, 2.0)}, truncate=True)
+
+
+def _child(path: Path) -> str:
+    return textwrap.dedent(f"""
+        import thermojitter as tj
+        low = tj.Orbit(radius=7.0e6, period=5828.5)
+        vary = {{"damping": ("uniform", 1.0, 4.0), "emissivity_back": ("normal", 0.3, 0.03)}}
+        tj.monte_carlo(tj.Panel.paper(), low, vary=vary, n=60, seed=3, horizon=3, threads=1,
+                       chunk_size=2, checkpoint={str(path)!r}, progress=False)
+    """)
+
+
+def test_killed_run_resumes_to_the_same_frame(tmp_path: Path) -> None:
+    path = tmp_path / "ckpt"
+    proc = subprocess.Popen([sys.executable, "-c", _child(path)])
+    deadline = time.monotonic() + 120
+    while len(list(path.glob("chunk-*.parquet"))) < 3:
+        if proc.poll() is not None:
+            pytest.fail("child finished before it could be killed")
+        if time.monotonic() > deadline:
+            pytest.fail("no chunk written")
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGKILL)  # no chance to clean up
+    proc.wait()
+    written = {p: p.stat().st_mtime_ns for p in path.glob("chunk-*.parquet")}
+    assert 3 <= len(written) < 30
+    vary = {"damping": ("uniform", 1.0, 4.0), "emissivity_back": ("normal", 0.3, 0.03)}
+    common: dict[str, Any] = {"vary": vary, "n": 60, "seed": 3, "horizon": 3, "progress": False}
+    resumed = tj.monte_carlo(PAPER, LOW, checkpoint=path, threads=2, **common)
+    assert len(list(path.glob("chunk-*.parquet"))) == 30
+    for p, mtime in written.items():
+        assert p.stat().st_mtime_ns == mtime, f"{p.name} was computed again"
+    straight = tj.monte_carlo(PAPER, LOW, threads=2, chunk_size=7, **common)
+    pd.testing.assert_frame_equal(resumed, straight, check_exact=True)
+    # A run with other settings is refused, naming what differs.
+    with pytest.raises(ValueError, match=r"differs in: .*seed"):
+        tj.monte_carlo(PAPER, LOW, checkpoint=path, **{**common, "seed": 4})
+    with pytest.raises(ValueError, match=r"differs in: .*vary\.damping"):
+        tj.monte_carlo(
+            PAPER,
+            LOW,
+            checkpoint=path,
+            **{**common, "vary": {**vary, "damping": ("uniform", 1, 5)}},
+        )
+    with pytest.raises(ValueError, match="seed is required"):
+        tj.monte_carlo(PAPER, LOW, checkpoint=path, **{**common, "seed": None})
+
+
+def test_ctrl_c_stops_the_run_and_keeps_the_finished_chunks(tmp_path: Path) -> None:
+    path = tmp_path / "ckpt"
+    script = _child(path).replace("tj.monte_carlo(", "try:\n    tj.monte_carlo(", 1)
+    script = script.replace(
+        "\n                       chunk_size", "\n                           chunk_size"
+    )
+    script += "except KeyboardInterrupt:\n    print('interrupted')\n"
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while len(list(path.glob("chunk-*.parquet"))) < 2:
+        if proc.poll() is not None or time.monotonic() > deadline:
+            pytest.fail("child finished before it could be interrupted")
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=60)
+    assert proc.returncode == 0 and out.strip() == "interrupted"
+    finished = sorted(path.glob("chunk-*.parquet"))
+    assert 2 <= len(finished) < 30
+    assert not list(path.glob("*.tmp"))
+    for chunk in finished:  # each one whole
+        assert pd.read_parquet(chunk)["sample"].size == 2
+
+
+def test_sobol_indices_find_the_parameter_that_matters() -> None:
+    pytest.importorskip("SALib")
+    vary = {"emissivity_back": ("uniform", 0.2, 0.4), "damping": ("uniform", 1.0, 4.0)}
+    res = tj.sensitivity(PAPER, LOW, vary, metric="theta_eq", n=32, **FAST)
+    s = res.indices
+    # The sunlit equilibrium does not depend on damping at all: its indices vanish exactly.
+    assert s.loc["damping", "ST"] == 0.0 and s.loc["damping", "S1"] == 0.0
+    assert s.loc["emissivity_back", "ST"] == pytest.approx(1.0, abs=0.05)
+    assert len(res.samples) == 32 * 4
+    with pytest.raises(ValueError, match="metric"):
+        tj.sensitivity(PAPER, LOW, vary, metric="error", n=4, **FAST)
+
+
+def test_mc_command_writes_samples_and_plots(tmp_path: Path) -> None:
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        textwrap.dedent("""
+            [panel]
+            conductance = 24.0
+            [orbit]
+            radius = 7.0e6
+            period = 5828.5
+            [vary]
+            damping = ["uniform", 1.0, 4.0]
+            [montecarlo]
+            rtol = 1e-6
+            atol = 1e-8
+        """)
+    )
+    out = tmp_path / "out"
+    argv = [str(scenario), "--n", "6", "--out", str(out), "--no-progress", "--seed", "2"]
+    assert mc_command(argv) == 0
+    frame = pd.read_parquet(out / "samples.parquet")
+    assert len(frame) == 6 and frame["damping"].between(1.0, 4.0).all()
+    assert (out / "histograms.png").stat().st_size > 0 and (out / "scatter.png").exists()
+    expected = tj.monte_carlo(
+        PAPER.replace(conductance=24.0),
+        LOW,
+        vary={"damping": ("uniform", 1.0, 4.0)},
+        n=6,
+        seed=2,
+        **FAST,
+    )
+    np.testing.assert_array_equal(frame["exit_peak"], expected["exit_peak"])
+    scenario.write_text("[vary]\ncolour = ['uniform', 0, 1]\n")
+    with pytest.raises(ValueError, match="colour"):
+        mc_command([str(scenario), "--n", "2", "--out", str(out / "x"), "--no-progress"])
