@@ -359,6 +359,70 @@ def bench(orbits: int, repeat: int, repeat_slow: int, reference_rhs: bool) -> di
     return out
 
 
+def per_call_us(fn: Callable[[], object], calls: int = 2000, batches: int = 5) -> float:
+    """Best over batches of the mean time per call, µs."""
+    fn()
+    best = math.inf
+    for _ in range(batches):
+        start = time.perf_counter()
+        for _ in range(calls):
+            fn()
+        best = min(best, (time.perf_counter() - start) / calls)
+    return best * 1e6
+
+
+def call_overhead() -> None:
+    """Cost of one short call (1 s of the coupled model, a handful of steps): what a sweep of many
+    short runs pays per call on top of the integration."""
+    p = problem(1)
+    span, t_eval = (0.0, 1.0), [1.0]
+    rows = [
+        (
+            "thermojitter simulate",
+            lambda: tj.simulate(p.panel, p.orbit, span, rtol=RTOL, atol=ATOL, t_eval=t_eval),
+        ),
+        (
+            "thermojitter simulate, y0 given",
+            lambda: tj.simulate(
+                p.panel, p.orbit, span, rtol=RTOL, atol=ATOL, t_eval=t_eval, y0=p.y0
+            ),
+        ),
+        (
+            "scipy solve_ivp RK45",
+            lambda: solve_ivp(
+                rhs_python,
+                span,
+                p.y0,
+                rtol=RTOL,
+                atol=ATOL,
+                t_eval=t_eval,
+                args=(p.segments[0][2], *p.coef),
+            ),
+        ),
+    ]
+    if CyRK is not None:
+        rows.append(
+            (
+                "CyRK nbsolve_ivp RK45",
+                lambda: CyRK.nbsolve_ivp(
+                    rhs_numba,
+                    span,
+                    p.y0,
+                    args=(p.segments[0][2], *p.coef),
+                    rtol=RTOL,
+                    atol=ATOL,
+                    t_eval=np.asarray(t_eval),
+                    warnings=False,
+                ),
+            )
+        )
+    print("\nper-call cost of a 1 s run (coupled model, a few steps), best of 5 x 2000 calls")
+    print(f"| {'call':<34} | {'us/call':>8} |")
+    print(f"|{'-' * 36}|{'-' * 10}|")
+    for name, fn in rows:
+        print(f"| {name:<34} | {per_call_us(fn):>8.1f} |")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--orbits", type=int, nargs="+", default=[1, 10])
@@ -378,6 +442,7 @@ def main() -> None:
     )
     if CyRK is None:
         print("CyRK is not installed (pip install -e '.[bench]'): its rows are left out")
+    call_overhead()
     for orbits in args.orbits:
         slow = args.repeat_slow if orbits == 1 else 1
         r = bench(orbits, args.repeat, slow, reference_rhs=orbits == 1)
