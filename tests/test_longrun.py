@@ -135,3 +135,19 @@ def test_bad_long_run_settings(kwargs: dict[str, object], name: str) -> None:
     args: dict[str, object] = {"n_orbits": 1, **kwargs}
     with pytest.raises(ValueError, match=name):
         tj.simulate_orbits(PAPER, LOW, **args)  # type: ignore[arg-type]
+
+
+def test_weak_flutter_grows_at_the_predicted_rate() -> None:
+    """Just below the critical damping the growth is slow (e-folding over a day or more); the
+    long run must neither hide it in numerical dissipation nor invent it."""
+    base = PAPER.replace(solar_constant=1361.0 * 1.034)  # perihelion flux
+    crit = tj.flutter(base).critical_damping
+    sunlit = tj.Orbit.sunlit()
+    eq = tj.steady_state(base)
+    y0 = (eq.T_front, eq.T_back, eq.theta + 1e-6, 0.0)  # a kick far below atol-relevant sizes
+    for damping in (crit - 0.1, crit + 0.1):
+        panel = base.replace(damping=damping)
+        predicted = tj.flutter(panel).growth_rate
+        runs = tj.simulate_orbits(panel, sunlit, 4, y0=y0)
+        measured = math.log(runs.amplitude[3] / runs.amplitude[1]) / (2 * sunlit.period)
+        assert measured == pytest.approx(predicted, rel=0.03), damping

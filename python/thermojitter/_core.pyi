@@ -136,6 +136,7 @@ def run_orbits(
     window: float,
     theta_limit: float,
     stop_at_limit: bool,
+    steps_per_period: float,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---

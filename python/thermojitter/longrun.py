@@ -165,6 +165,7 @@ def simulate_orbits(
     progress: bool | None = None,
     max_steps: int = 500_000_000,
     stop: Callable[[], bool] | None = None,
+    steps_per_period: float = 40.0,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -177,6 +178,11 @@ def simulate_orbits(
     - Ctrl-C returns the finished orbits with ``interrupted=True``; so does ``stop()`` turning
       True (polled between chunks, for callers that handle SIGINT themselves).
     - ``progress``: a tqdm bar (default: when stderr is a terminal and tqdm is installed).
+    - ``steps_per_period``: rk45's step is capped at T_n/steps_per_period, T_n the hinge's natural
+      period (0: error control alone). Without the cap the step grows, once the oscillation is
+      small against ``atol``, to where the method's own dissipation exceeds a weak flutter's
+      growth rate, and flutter near the critical damping goes unseen. With 40 the measured growth
+      is within 1 % of the eigen-analysis; it costs about twice the steps of error control alone.
     """
     _check_inputs(panel, orbit)
     if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
@@ -199,8 +205,15 @@ def simulate_orbits(
     ):
         if not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ValueError(f"{name} = {value!r} is invalid: must be a finite number")
+    if not isinstance(steps_per_period, (int, float)) or not (
+        math.isfinite(steps_per_period) and steps_per_period >= 0
+    ):
+        raise ValueError(
+            f"steps_per_period = {steps_per_period!r} is invalid: must be a finite number >= 0"
+        )
     if y0 is None:
-        flux = 1.0
+        # The sunlit equilibrium at the solar flux of the start date.
+        flux = float(orbit.flux_scale(float(t_start))[0])
         eq = steady_state(panel, coupled=coupled, flux=flux)
         y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
     settings: dict[str, Any] = {
@@ -218,6 +231,7 @@ def simulate_orbits(
         "theta_limit": float(theta_limit),
         "on_limit": on_limit,
         "orbits_per_call": orbits_per_call,
+        "steps_per_period": float(steps_per_period),
     }
     core_args: dict[str, Any] = {
         "model": model,
@@ -231,6 +245,7 @@ def simulate_orbits(
         "window": float(window),
         "theta_limit": float(theta_limit),
         "stop_at_limit": on_limit == "stop",
+        "steps_per_period": float(steps_per_period),
     }
 
     columns = _empty_columns()

@@ -145,6 +145,7 @@ pub fn run_sample(panel: &Panel, settings: &EnsembleSettings) -> Result<SampleMe
         // Without a threshold nothing is timed: a limit no angle reaches.
         theta_limit: s.threshold.unwrap_or(f64::MAX),
         stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
+        steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
     };
     let run = run_orbits(
         panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
@@ -291,6 +292,7 @@ mod tests {
                 window: 600.0,
                 theta_limit: 0.2,
                 stop_at_limit: false,
+                steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
             },
         )
         .unwrap();

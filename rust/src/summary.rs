@@ -88,6 +88,28 @@ pub struct SummaryOptions {
     pub theta_limit: f64,
     /// Stop at the first crossing of the limit (else only record it).
     pub stop_at_limit: bool,
+    /// Cap the adaptive step at T_n / steps_per_period, T_n the hinge's natural period (0: no
+    /// cap). Error control alone lets the step grow to the stability limit of the hinge mode
+    /// once the oscillation is small against atol, and the method's own dissipation there can
+    /// exceed a weak flutter's growth rate: it would hide flutter near the critical damping.
+    pub steps_per_period: f64,
+}
+
+/// Default of [`SummaryOptions::steps_per_period`]: Dormand–Prince's dissipation then stays
+/// below 1 % of a growth rate of 1e-6 1/s (it falls as the fifth power of the step).
+pub const STEPS_PER_HINGE_PERIOD: f64 = 40.0;
+
+/// `method` with its step capped at T_n / steps_per_period (adaptive methods only).
+pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> Method {
+    match method {
+        Method::Dopri5(tol) if steps_per_period > 0.0 => {
+            let period = 2.0 * std::f64::consts::PI / panel.natural_angular_frequency();
+            let mut tol = *tol;
+            tol.max_step = tol.max_step.min(period / steps_per_period);
+            Method::Dopri5(tol)
+        }
+        other => *other,
+    }
 }
 
 struct Collector {
@@ -239,6 +261,8 @@ pub fn run_orbits(
 ) -> Result<OrbitRun> {
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
+    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    let method = &resolve_hinge(method, panel, options.steps_per_period);
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
@@ -293,6 +317,7 @@ mod tests {
             window: 600.0,
             theta_limit: 0.5,
             stop_at_limit: true,
+            steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
         run_orbits(
             &p,
@@ -341,6 +366,7 @@ mod tests {
             window: 600.0,
             theta_limit: 0.5,
             stop_at_limit: true,
+            steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
         let second = run_orbits(
             &p,
@@ -373,6 +399,7 @@ mod tests {
             window: 600.0,
             theta_limit: 0.35,
             stop_at_limit: true,
+            steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
         let run = run_orbits(
             &p,

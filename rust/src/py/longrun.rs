@@ -10,7 +10,7 @@ use pyo3::types::PyDict;
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, method_name, rtol, atol, dt, max_step, max_steps, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, method_name, rtol, atol, dt, max_step, max_steps, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -31,6 +31,7 @@ fn run_orbits<'py>(
     window: f64,
     theta_limit: f64,
     stop_at_limit: bool,
+    steps_per_period: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = panel_from(panel)?;
     let o = orbit_from(orbit)?;
@@ -46,6 +47,7 @@ fn run_orbits<'py>(
         window,
         theta_limit,
         stop_at_limit,
+        steps_per_period,
     };
     let out = py
         .detach(|| {
