@@ -119,7 +119,11 @@ def simulate(
       ``dt_out`` s (default 0.5 s). Every step is never kept.
     - ``y0``: (T_front K, T_back K, θ rad, θ̇ rad/s); default the sunlit equilibrium.
 
-    Steps stop exactly at every shadow entry and exit. Raises ``ValueError`` naming a bad input,
+    Steps stop exactly at every shadow entry and exit. Error control alone (as here by default,
+    like scipy's RK45) lets the step grow once the oscillation is small against ``atol``, and
+    the method's own dissipation can then hide a weak flutter near the critical damping: for
+    growth studies pass ``max_step`` ≈ T_n/40 (T_n = 1/natural_frequency), or use
+    :func:`thermojitter.simulate_orbits`, which does so by default. Raises ``ValueError`` naming a bad input,
     ``IntegrationError`` if the integrator cannot finish.
     """
     _check_inputs(panel, orbit)
