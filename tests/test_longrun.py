@@ -151,3 +151,17 @@ def test_weak_flutter_grows_at_the_predicted_rate() -> None:
         runs = tj.simulate_orbits(panel, sunlit, 4, y0=y0)
         measured = math.log(runs.amplitude[3] / runs.amplitude[1]) / (2 * sunlit.period)
         assert measured == pytest.approx(predicted, rel=0.03), damping
+
+
+def test_one_panel_is_stable_in_one_season_and_flutters_in_another() -> None:
+    """c_d between the aphelion and perihelion critical dampings (about 2.03 and 2.31)."""
+    panel = PAPER.replace(damping=2.20)
+    for start, grows in (("2026-07-01", False), ("2026-11-20", True)):  # no eclipses in either
+        orbit = tj.Orbit.geo_year(start)
+        flux = float(orbit.flux_scale(0.0)[0])
+        assert (tj.flutter(panel, flux=flux).growth_rate > 0) == grows
+        eq = tj.steady_state(panel, flux=flux)
+        runs = tj.simulate_orbits(panel, orbit, 12, y0=(eq.T_front, eq.T_back, eq.theta + 1e-4, 0))
+        assert not np.isfinite(runs.t_entry).any()
+        ratio = runs.jitter_peak[-1] / runs.jitter_peak[1]
+        assert ratio > 5.0 if grows else ratio < 0.2, (start, ratio)
