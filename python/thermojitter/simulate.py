@@ -123,8 +123,10 @@ def simulate(
     like scipy's RK45) lets the step grow once the oscillation is small against ``atol``, and
     the method's own dissipation can then hide a weak flutter near the critical damping: for
     growth studies pass ``max_step`` ≈ T_n/40 (T_n = 1/natural_frequency), or use
-    :func:`thermojitter.simulate_orbits`, which does so by default. Raises ``ValueError`` naming a bad input,
-    ``IntegrationError`` if the integrator cannot finish.
+    :func:`thermojitter.simulate_orbits`, which does so by default.
+
+    Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
+    finish.
     """
     _check_inputs(panel, orbit)
     t0, t1 = _span(t_span)
