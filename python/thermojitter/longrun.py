@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from thermojitter import _core
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.simulate import _check_inputs, steady_state
+from thermojitter.simulate import _check_inputs, solver_settings, steady_state
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -236,12 +236,7 @@ def simulate_orbits(
     core_args: dict[str, Any] = {
         "model": model,
         "coupled": bool(coupled),
-        "method_name": method,
-        "rtol": float(rtol),
-        "atol": float(atol),
-        "dt": None if dt is None else float(dt),
-        "max_step": math.inf,
-        "max_steps": int(max_steps),
+        "solver": solver_settings(method, rtol, atol, dt, math.inf, max_steps),
         "window": float(window),
         "theta_limit": float(theta_limit),
         "stop_at_limit": on_limit == "stop",

@@ -36,7 +36,7 @@ from thermojitter import _core
 from thermojitter.longrun import _fingerprint, _flatten
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.simulate import _check_inputs
+from thermojitter.simulate import _check_inputs, solver_settings
 
 Sampler = Literal["random", "lhs", "sobol"]
 
@@ -289,12 +289,7 @@ def _options(
         "orbit": orbit.as_dict(),
         "model": str(model),
         "coupled": bool(coupled),
-        "method_name": str(method),
-        "rtol": float(rtol),
-        "atol": float(atol),
-        "dt": None if dt is None else float(dt),
-        "max_step": math.inf,
-        "max_steps": int(max_steps),
+        "solver": solver_settings(str(method), rtol, atol, dt, math.inf, max_steps),
         "n_orbits": int(horizon),
         "window": float(window),
         "threshold": None if threshold is None else float(threshold),
@@ -514,7 +509,7 @@ def _run_design(
     settings = {
         **settings,
         "format": FORMAT_VERSION,
-        "run": {k: v for k, v in options.items() if k != "max_step"},
+        "run": options,
         "design_sha256": hashlib.sha256(np.ascontiguousarray(matrix).tobytes()).hexdigest(),
     }
     directory = Path(checkpoint) if checkpoint is not None else None

@@ -57,17 +57,28 @@ def _solver_args(
     _check_type("method", method, str)
     if t_eval is None and dt_out is None:
         dt_out = DEFAULT_DT_OUT
+    return {
+        "solver": solver_settings(method, rtol, atol, dt, max_step, max_steps),
+        "t_eval": _times(t_eval),
+        "dt_out": None if dt_out is None else float(dt_out),
+    }
+
+
+def solver_settings(
+    method: str, rtol: float, atol: float, dt: float | None, max_step: float, max_steps: int
+) -> dict[str, Any]:
+    """The integrator settings as the engine takes them (it checks the values and names any bad
+    one); ``dt`` is the fixed step of rk4, ``max_step`` caps rk45's step (s)."""
+    _check_type("method", method, str)
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
         raise ValueError(f"max_steps = {max_steps!r} is invalid: must be an integer >= 1")
     return {
-        "method_name": method,
+        "method": method,
         "rtol": float(rtol),
         "atol": float(atol),
         "dt": None if dt is None else float(dt),
         "max_step": float(max_step),
         "max_steps": int(max_steps),
-        "t_eval": _times(t_eval),
-        "dt_out": None if dt_out is None else float(dt_out),
     }
 
 

@@ -1,6 +1,6 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
-use super::convert::{method, output, panel_from};
+use super::convert::{output, panel_from, solver_from};
 use super::to_py;
 use crate::beam::{respond, FreeFreeBeam, BEAM_MODES};
 use crate::system::MomentHistory;
@@ -100,7 +100,7 @@ fn beam_static(
 
 /// Modal transient response to end moments ±M(t) given as samples (`moment_t`, `moment`).
 #[pyfunction]
-#[pyo3(signature = (panel, n_elements, moment_t, moment, t0, t1, *, damping_ratio, residual, method_name, rtol, atol, dt, max_step, max_steps, t_eval, dt_out))]
+#[pyo3(signature = (panel, n_elements, moment_t, moment, t0, t1, *, damping_ratio, residual, solver, t_eval, dt_out))]
 #[allow(clippy::too_many_arguments)]
 fn beam_response<'py>(
     py: Python<'py>,
@@ -112,17 +112,12 @@ fn beam_response<'py>(
     t1: f64,
     damping_ratio: f64,
     residual: bool,
-    method_name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    max_step: f64,
-    max_steps: u64,
+    solver: &Bound<'py, PyDict>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let beam = beam_from(panel, n_elements)?;
-    let m = method(method_name, rtol, atol, dt, max_step, max_steps)?;
+    let m = solver_from(solver)?;
     let out = output(t_eval, dt_out, t0, t1)?;
     let history = MomentHistory::Samples {
         t: moment_t.as_array().to_vec(),

@@ -136,6 +136,33 @@ pub fn method(
     Ok(m)
 }
 
+/// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
+/// run function receives it.
+pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
+    let name: String = d
+        .get_item("method")?
+        .ok_or_else(|| PyValueError::new_err("method is missing"))?
+        .extract()
+        .map_err(|_| PyTypeError::new_err("method must be a string"))?;
+    let dt = match d.get_item("dt")? {
+        Some(v) if !v.is_none() => Some(float_item(d, "dt")?),
+        _ => None,
+    };
+    let max_steps: u64 = d
+        .get_item("max_steps")?
+        .ok_or_else(|| PyValueError::new_err("max_steps is missing"))?
+        .extract()
+        .map_err(|_| PyValueError::new_err("max_steps must be an integer >= 1"))?;
+    method(
+        &name,
+        float_item(d, "rtol")?,
+        float_item(d, "atol")?,
+        dt,
+        float_item(d, "max_step")?,
+        max_steps,
+    )
+}
+
 pub fn output(
     t_eval: Option<PyReadonlyArray1<'_, f64>>,
     dt_out: Option<f64>,

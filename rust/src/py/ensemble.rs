@@ -1,6 +1,6 @@
 //! Bindings of batched runs: a rayon pool of its own, and the check of a design up front.
 
-use super::convert::{hinge_model, method, orbit_from};
+use super::convert::{hinge_model, orbit_from, solver_from};
 use super::to_py;
 use crate::ensemble::{pool, run_batch, EnsembleSettings, SampleMetrics};
 use crate::system::Coupling;
@@ -71,7 +71,7 @@ impl EnsemblePool {
     }
 
     /// Runs one sample per row of `panels`; returns the metrics as columns.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, method_name, rtol, atol, dt, max_step, max_steps, n_orbits, window, threshold, stop_at_threshold))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -80,12 +80,7 @@ impl EnsemblePool {
         orbit: &Bound<'py, PyDict>,
         model: &str,
         coupled: bool,
-        method_name: &str,
-        rtol: f64,
-        atol: f64,
-        dt: Option<f64>,
-        max_step: f64,
-        max_steps: u64,
+        solver: &Bound<'py, PyDict>,
         n_orbits: u64,
         window: f64,
         threshold: Option<f64>,
@@ -100,7 +95,7 @@ impl EnsemblePool {
             } else {
                 Coupling::Frozen
             },
-            method: method(method_name, rtol, atol, dt, max_step, max_steps)?,
+            method: solver_from(solver)?,
             n_orbits,
             window,
             threshold,

@@ -1,6 +1,6 @@
 //! Bindings of summarised long runs.
 
-use super::convert::{hinge_model, method, orbit_from, panel_from, state};
+use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
 use super::to_py;
 use crate::summary::{run_orbits as run, SummaryOptions};
 use crate::system::Coupling;
@@ -10,7 +10,7 @@ use pyo3::types::PyDict;
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, method_name, rtol, atol, dt, max_step, max_steps, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -18,12 +18,7 @@ fn run_orbits<'py>(
     orbit: &Bound<'py, PyDict>,
     model: &str,
     coupled: bool,
-    method_name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    max_step: f64,
-    max_steps: u64,
+    solver: &Bound<'py, PyDict>,
     t_start: f64,
     first_index: u64,
     n_orbits: u64,
@@ -41,7 +36,7 @@ fn run_orbits<'py>(
     } else {
         Coupling::Frozen
     };
-    let m = method(method_name, rtol, atol, dt, max_step, max_steps)?;
+    let m = solver_from(solver)?;
     let y = state::<4>(&y0)?;
     let options = SummaryOptions {
         window,

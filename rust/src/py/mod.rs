@@ -14,7 +14,7 @@ use crate::simulate::{run, Trajectory};
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling, DrivenHinge, MomentHistory, OneNode, TwoLayer};
 use crate::{dynamics::thermal_moment, Error};
-use convert::{hinge_model, method, orbit_from, output, panel_from, state};
+use convert::{hinge_model, orbit_from, output, panel_from, solver_from, state};
 use nalgebra::SVector;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
@@ -197,7 +197,7 @@ fn energy<'py>(
 
 /// Integrates the coupled thermo-structural system.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, method_name, rtol, atol, dt, max_step, max_steps, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -207,12 +207,7 @@ fn simulate<'py>(
     t1: f64,
     model: &str,
     coupled: bool,
-    method_name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    max_step: f64,
-    max_steps: u64,
+    solver: &Bound<'py, PyDict>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
@@ -225,7 +220,7 @@ fn simulate<'py>(
     } else {
         Coupling::Frozen
     };
-    let m = method(method_name, rtol, atol, dt, max_step, max_steps)?;
+    let m = solver_from(solver)?;
     let out = output(t_eval, dt_out, t0, t1)?;
     let y_start: SVector<f64, 4> = match y0 {
         Some(v) => state::<4>(&v)?,
@@ -259,7 +254,7 @@ fn simulate<'py>(
 
 /// Integrates a thermal model alone: one node (eq. 1) or two layers (eq. 2, θ = 0).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, layers, method_name, rtol, atol, dt, max_step, max_steps, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, orbit, t0, t1, *, layers, solver, t_eval, dt_out, y0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_thermal<'py>(
     py: Python<'py>,
@@ -268,19 +263,14 @@ fn simulate_thermal<'py>(
     t0: f64,
     t1: f64,
     layers: u32,
-    method_name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    max_step: f64,
-    max_steps: u64,
+    solver: &Bound<'py, PyDict>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = panel_from(panel)?;
     let o = orbit_from(orbit)?;
-    let m = method(method_name, rtol, atol, dt, max_step, max_steps)?;
+    let m = solver_from(solver)?;
     let out = output(t_eval, dt_out, t0, t1)?;
     match layers {
         1 => {
@@ -322,7 +312,7 @@ fn simulate_thermal<'py>(
 
 /// Integrates the hinge alone under a prescribed moment: a constant, or samples (t, M).
 #[pyfunction]
-#[pyo3(signature = (panel, t0, t1, *, model, moment, moment_t, method_name, rtol, atol, dt, max_step, max_steps, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, t0, t1, *, model, moment, moment_t, solver, t_eval, dt_out, y0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_hinge<'py>(
     py: Python<'py>,
@@ -332,19 +322,14 @@ fn simulate_hinge<'py>(
     model: &str,
     moment: PyReadonlyArray1<'py, f64>,
     moment_t: Option<PyReadonlyArray1<'py, f64>>,
-    method_name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    max_step: f64,
-    max_steps: u64,
+    solver: &Bound<'py, PyDict>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Vec<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = panel_from(panel)?;
     let hinge = hinge_model(model)?;
-    let m = method(method_name, rtol, atol, dt, max_step, max_steps)?;
+    let m = solver_from(solver)?;
     let out = output(t_eval, dt_out, t0, t1)?;
     let values = moment.as_array().to_vec();
     let history = match moment_t {
