@@ -159,7 +159,7 @@ def run_figures(
 def orbit_summary_figure(out: Path, columns: dict[str, Array], title: str) -> Path:
     """Per-orbit summaries of a long run: amplitude, transient peaks and jitter RMS against time
     (days), on a log scale so that growth (flutter) shows as a straight line."""
-    fig, (top, bottom) = figure(2, height=3.2)
+    fig, (top, bottom) = figure(2, height=4.2)
     days = np.asarray(columns["t_start"]) / 86400.0
     for key, label in (
         ("amplitude", "max |θ − θ_eq| over the orbit"),
@@ -174,7 +174,10 @@ def orbit_summary_figure(out: Path, columns: dict[str, Array], title: str) -> Pa
     top.grid(alpha=0.3, which="both")
     rms = np.degrees(np.asarray(columns["jitter_rms"], dtype=float))
     bottom.semilogy(days, np.where(rms > 0, rms, np.nan), lw=0.8, color="C3")
-    bottom.set_ylabel("RMS of θ − M_T/K_el [deg]")
+    bottom.set_ylabel("RMS jitter [deg]")
+    bottom.set_title(
+        "RMS over each orbit of θ − M_T/K_el (the oscillation about the static angle)", fontsize=9
+    )
     bottom.set_xlabel("time from the start [days]")
     bottom.grid(alpha=0.3, which="both")
     return save(fig, out / "orbits.png")
