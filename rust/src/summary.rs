@@ -308,30 +308,37 @@ mod tests {
     use super::*;
     use crate::integrate::Tolerances;
 
-    fn paper_run(n: u64) -> OrbitRun {
-        let p = Panel::paper();
+    /// GEO equinox orbits `first .. first + n` of `panel` from `y0` (default: its sunlit
+    /// equilibrium at t_start = 0), stopping where |θ| passes `theta_limit`.
+    fn run(
+        panel: &Panel,
+        theta_limit: f64,
+        first: u64,
+        n: u64,
+        y0: Option<Vector4<f64>>,
+    ) -> OrbitRun {
         let o = Orbit::geo_equinox();
-        let eq = equilibrium(&p, Coupling::ProjectedArea, 1.0).unwrap();
-        let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+        let y0 = y0.unwrap_or_else(|| {
+            let eq = equilibrium(panel, Coupling::ProjectedArea, 1.0).unwrap();
+            Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0)
+        });
         let opts = SummaryOptions {
             window: 600.0,
-            theta_limit: 0.5,
+            theta_limit,
             stop_at_limit: true,
             steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
+        let method = Method::Dopri5(Tolerances::default());
+        let t_start = first as f64 * o.period;
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
         run_orbits(
-            &p,
-            &o,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            0.0,
-            0,
-            n,
-            y0,
-            opts,
+            panel, &o, model, coupling, &method, t_start, first, n, y0, opts,
         )
         .unwrap()
+    }
+
+    fn paper_run(n: u64) -> OrbitRun {
+        run(&Panel::paper(), 0.5, 0, n, None)
     }
 
     #[test]
@@ -359,28 +366,8 @@ mod tests {
     fn chunked_runs_equal_one_run_orbit_for_orbit() {
         // Resuming from the end state of orbit k must give the same summaries as running on.
         let whole = paper_run(2);
-        let p = Panel::paper();
-        let o = Orbit::geo_equinox();
         let first = paper_run(1);
-        let opts = SummaryOptions {
-            window: 600.0,
-            theta_limit: 0.5,
-            stop_at_limit: true,
-            steps_per_period: STEPS_PER_HINGE_PERIOD,
-        };
-        let second = run_orbits(
-            &p,
-            &o,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            o.period,
-            1,
-            1,
-            first.y_end,
-            opts,
-        )
-        .unwrap();
+        let second = run(&Panel::paper(), 0.5, 1, 1, Some(first.y_end));
         let d = (whole.summaries[1].exit_theta_max - second.summaries[0].exit_theta_max).abs();
         assert!(d < 1e-8, "{d}");
         assert_eq!(second.summaries[0].index, 1);
@@ -392,33 +379,13 @@ mod tests {
             damping: 0.0,
             ..Panel::paper()
         };
-        let o = Orbit::geo_equinox();
-        let eq = equilibrium(&p, Coupling::ProjectedArea, 1.0).unwrap();
-        let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-        let opts = SummaryOptions {
-            window: 600.0,
-            theta_limit: 0.35,
-            stop_at_limit: true,
-            steps_per_period: STEPS_PER_HINGE_PERIOD,
-        };
-        let run = run_orbits(
-            &p,
-            &o,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            0.0,
-            0,
-            20,
-            y0,
-            opts,
-        )
-        .unwrap();
+        let run = run(&p, 0.35, 0, 20, None);
         let c = run
             .crossing
             .expect("an undamped panel below c_d* must leave the limit");
         assert!(c.theta.abs() > 0.35);
-        assert!(run.stats.stopped && run.stats.t_end < 20.0 * o.period);
+        let period = Orbit::geo_equinox().period;
+        assert!(run.stats.stopped && run.stats.t_end < 20.0 * period);
         assert_eq!(run.summaries.last().unwrap().index, c.orbit);
     }
 }
