@@ -576,23 +576,13 @@ def beam_report_markdown(result: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main_beam(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``thermojitter beam``: the paper's beam comparison (Figs. 22–24) for
-    Table 1, written to ``--out`` with ``beam_summary.json`` and ``beam_report.md``."""
-    parser = argparse.ArgumentParser(
-        prog="thermojitter beam",
-        description="Compare the hinge model with a finite-element free-free beam (paper 4.3).",
-    )
-    parser.add_argument("--out", default="beam-out", help="output directory (default: beam-out)")
-    parser.add_argument("--elements", type=int, default=100, help="beam elements (even)")
-    parser.add_argument("--no-calibrate", action="store_true", help="skip the hinge fits")
-    args = parser.parse_args(None if argv is None else list(argv))
-    result = beam_comparison_figures(
-        out_dir=args.out, n_elements=args.elements, calibrate=not args.no_calibrate
-    )
-    path = Path(args.out) / "beam_summary.json"
+def write_beam_comparison(out: str | Path, n_elements: int = 100, calibrate: bool = True) -> int:
+    """The paper's beam comparison (Figs. 22–24) for Table 1, written to ``out`` with
+    ``beam_summary.json`` and ``beam_report.md``; prints one line per case."""
+    result = beam_comparison_figures(out_dir=out, n_elements=n_elements, calibrate=calibrate)
+    path = Path(out) / "beam_summary.json"
     path.write_text(json.dumps(result, indent=2))
-    (Path(args.out) / "beam_report.md").write_text(beam_report_markdown(result))
+    (Path(out) / "beam_report.md").write_text(beam_report_markdown(result))
     for name, case in result["cases"].items():
         print(
             f"{name:17s} K_el = {case['hinge_stiffness']:8.1f} N m/rad  chi = "
@@ -602,3 +592,17 @@ def main_beam(argv: Sequence[str] | None = None) -> int:
         )
     print(f"beam f_n = {result['beam']['natural_frequencies_hz'][0]:.4f} Hz; wrote {path}")
     return 0
+
+
+def main_beam(argv: Sequence[str] | None = None) -> int:
+    """The beam comparison from a command line of its own (``--out``, ``--elements``,
+    ``--no-calibrate``); ``thermojitter beam`` calls :func:`write_beam_comparison` directly."""
+    parser = argparse.ArgumentParser(
+        prog="thermojitter beam",
+        description="Compare the hinge model with a finite-element free-free beam (paper 4.3).",
+    )
+    parser.add_argument("--out", default="beam-out", help="output directory (default: beam-out)")
+    parser.add_argument("--elements", type=int, default=100, help="beam elements (even)")
+    parser.add_argument("--no-calibrate", action="store_true", help="skip the hinge fits")
+    args = parser.parse_args(None if argv is None else list(argv))
+    return write_beam_comparison(args.out, args.elements, not args.no_calibrate)

@@ -401,7 +401,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="reproduce the paper on its Table 1 panel",
         description=(
             "Reproduce the paper on its Table 1 panel in GEO at equinox: writes the figures "
-            "(fig02 … fig20 PNG), summary.json (the key numbers, solver settings and step "
+            "(fig02 … fig24 PNG), summary.json (the key numbers, solver settings and step "
             "counts) and report.md (the numbers set beside what the paper states) into --out."
         ),
         epilog="Example: thermojitter paper --out out/",
@@ -515,10 +515,9 @@ FORWARDED: dict[str, Callable[[Sequence[str]], int]] = {"flutter": _flutter, "mc
 
 
 def _beam(args: argparse.Namespace) -> int:
-    from thermojitter.beam import main_beam
+    from thermojitter.beam import write_beam_comparison
 
-    argv = ["--out", str(_out_dir(args.out)), "--elements", str(args.elements)]
-    return main_beam(argv + (["--no-calibrate"] if args.no_calibrate else []))
+    return write_beam_comparison(_out_dir(args.out), args.elements, not args.no_calibrate)
 
 
 def _fail(message: str) -> int:
