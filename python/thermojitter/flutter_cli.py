@@ -34,33 +34,13 @@ from thermojitter.flutter import (
     stability_map,
 )
 from thermojitter.orbit import Orbit
-from thermojitter.panel import Panel
+from thermojitter.panel import PANEL_UNITS, Panel
 from thermojitter.scenario import ScenarioError, load_scenario
 
 DEFAULT_X = "damping:0:5:51"
 DEFAULT_Y = "conductance:5:60:56"
 ModelName = Literal["nonlinear", "linear"]
 MODELS: tuple[ModelName, ...] = ("nonlinear", "linear")
-
-
-UNITS = {
-    "emissivity_front": "-",
-    "emissivity_back": "-",
-    "absorptivity": "-",
-    "specific_heat": "J/(kg K)",
-    "mass_per_length": "kg/m",
-    "expansion_coeff": "1/K",
-    "length": "m",
-    "youngs_modulus": "Pa",
-    "thickness": "m",
-    "width": "m",
-    "conductance": "W/(m² K)",
-    "hinge_stiffness": "N m/rad",
-    "bending_inertia": "m⁴",
-    "damping": "N m s/rad",
-    "solar_constant": "W/m²",
-    "moment_scale": "-",
-}
 
 
 class FlutterInputError(ValueError):
@@ -134,8 +114,8 @@ def plot_map(m: StabilityMap, panel: Panel, path: Path) -> None:
     ax.plot(
         getattr(panel, m.x_name), getattr(panel, m.y_name), "k*", markersize=12, label="scenario"
     )
-    ax.set_xlabel(f"{m.x_name} ({UNITS.get(m.x_name, '-')})")
-    ax.set_ylabel(f"{m.y_name} ({UNITS.get(m.y_name, '-')})")
+    ax.set_xlabel(f"{m.x_name} ({PANEL_UNITS.get(m.x_name, '-')})")
+    ax.set_ylabel(f"{m.y_name} ({PANEL_UNITS.get(m.y_name, '-')})")
     ax.set_title(f"Thermal flutter of the sunlit equilibrium ({m.model} hinge, flux x{m.flux:.3f})")
     ax.legend(loc="upper right")
     fig.savefig(path, dpi=120)

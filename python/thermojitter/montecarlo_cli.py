@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from thermojitter.flutter_cli import UNITS as _PANEL_UNITS
 from thermojitter.montecarlo import monte_carlo
+from thermojitter.panel import PANEL_UNITS
 from thermojitter.scenario import ScenarioError, load_scenario
 
 HISTOGRAMS = (
@@ -89,7 +89,7 @@ def _shown(frame: Any, name: str) -> tuple[np.ndarray, str]:
     values = frame[name].to_numpy(float)
     if name in _ANGLES:
         return np.degrees(values), f"{name} [deg]"
-    unit = _UNITS.get(name) or _PANEL_UNITS.get(name)
+    unit = _UNITS.get(name) or PANEL_UNITS.get(name)
     return values, f"{name} [{unit}]" if unit else name
 
 

@@ -9,6 +9,26 @@ from typing import Any, Literal
 
 from thermojitter import _core
 
+PANEL_UNITS = {
+    "emissivity_front": "-",
+    "emissivity_back": "-",
+    "absorptivity": "-",
+    "specific_heat": "J/(kg K)",
+    "mass_per_length": "kg/m",
+    "expansion_coeff": "1/K",
+    "length": "m",
+    "youngs_modulus": "Pa",
+    "thickness": "m",
+    "width": "m",
+    "conductance": "W/(m² K)",
+    "hinge_stiffness": "N m/rad",
+    "bending_inertia": "m⁴",
+    "damping": "N m s/rad",
+    "solar_constant": "W/m²",
+    "moment_scale": "-",
+}
+"""SI unit of each Panel field, for axis labels and tables."""
+
 StiffnessCriterion = Literal["deflection", "deflection_small_angle", "frequency"]
 
 

@@ -165,9 +165,13 @@ class PaperContext:
 
     def save(self, fig: Any, name: str) -> str:
         plots.save(fig, self.out / name)
+        self.tick(name)
+        return name
+
+    def tick(self, name: str) -> None:
+        """One figure done (progress bar, Ctrl-C check)."""
         if self._tick is not None:
             self._tick(name)
-        return name
 
     def shadows(self, t0: float, t1: float) -> list[tuple[float, float]]:
         return self.orbit.shadow_intervals(t0, t1)
@@ -791,9 +795,8 @@ def beam_section(ctx: PaperContext) -> SectionResult:
     from thermojitter.beam import FIGURES, PAPER_NUMBERS, beam_comparison_figures
 
     result = beam_comparison_figures(ctx.panel, ctx.orbit, ctx.out, calibrate=True)
-    for key in FIGURES:
-        if ctx._tick is not None:
-            ctx._tick(FIGURES[key])
+    for name in FIGURES.values():
+        ctx.tick(name)
     cases = result["cases"]
     d, f, s = cases["deflection"], cases["frequency"], cases["frequency_scaled"]
     f_beam = result["beam"]["natural_frequencies_hz"][0]

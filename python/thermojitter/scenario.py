@@ -29,6 +29,7 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
+from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 
@@ -87,7 +88,7 @@ class SimulationSettings:
     keep: str = "samples"
     """"samples": the time series every dt_out; "orbits": one summary row per orbit (for runs
     of months and years; resumable from a checkpoint in the output folder)."""
-    theta_limit_deg: float = 20.0
+    theta_limit_deg: float = math.degrees(DEFAULT_THETA_LIMIT)
     """With keep = "orbits": |θ| beyond which the hinge model is not trusted, deg."""
     on_limit: str = "stop"
     """With keep = "orbits": "stop" at the first crossing of theta_limit_deg, or "flag" it."""
