@@ -55,11 +55,7 @@ impl Sunlight {
                 self.orbit.illumination_on(t, a, b)
             }
         };
-        if self.orbit.eccentric_sun {
-            s * self.orbit.flux_scale(t)
-        } else {
-            s
-        }
+        s * self.orbit.flux_scale(t)
     }
 }
 
