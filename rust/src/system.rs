@@ -120,13 +120,12 @@ impl OdeSystem<2> for TwoLayer {
 
 /// The coupled thermo-structural system, state (T_f, T_b, θ, θ̇) (paper eqs. 20 and 28).
 ///
-/// The panel's coefficients are folded into per-second rates once, in [`Coupled::new`]; build a
-/// new system rather than changing `panel` afterwards.
+/// The panel's coefficients are folded into per-second rates once, in [`Coupled::new`]; the
+/// system keeps only those.
 #[derive(Debug, Clone, Copy)]
 pub struct Coupled {
-    pub panel: Panel,
-    pub model: HingeModel,
-    pub coupling: Coupling,
+    model: HingeModel,
+    coupling: Coupling,
     sun: Sunlight,
     rates: Rates,
 }
@@ -169,7 +168,6 @@ impl Rates {
 impl Coupled {
     pub fn new(panel: Panel, orbit: Orbit, model: HingeModel, coupling: Coupling) -> Self {
         Coupled {
-            panel,
             model,
             coupling,
             sun: Sunlight::new(orbit),
