@@ -6,11 +6,13 @@
 //! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
 
 pub mod beam;
+pub mod conduction;
 pub mod dynamics;
 pub mod ensemble;
 pub mod error;
 pub mod flutter;
 pub mod integrate;
+pub mod laminate;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
