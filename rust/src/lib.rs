@@ -13,6 +13,7 @@ pub mod error;
 pub mod flutter;
 pub mod integrate;
 pub mod laminate;
+pub mod layered;
 pub mod orbit;
 pub mod params;
 pub mod simulate;

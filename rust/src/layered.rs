@@ -1,0 +1,693 @@
+//! The N-node laminate coupled to the hinge: state (thermal coordinates…, θ, θ̇).
+//!
+//! The thermal coordinates are either the node temperatures (when every conduction mode is slow
+//! enough for explicit steps the size of the hinge's) or the amplitudes of the slow conduction
+//! modes, with the fast modes quasi-static.
+//!
+//! Why modes: the conduction operator is linear and constant, so its modes decouple; only the
+//! face nodes see the non-linear radiation and the cos θ heating. A mode k with rate λ_k driven
+//! at the hinge's angular frequency ω lags it by atan(ω/λ_k); when λ_k ≫ ω the lag is small and
+//! the mode follows its forcing, q_k = φ_kᵀ b / (C_tot λ_k) (b: the heat entering at the faces),
+//! so it can leave the state. That removes exactly the fast modes that would force explicit steps
+//! of microseconds, keeps the slow ones (where the physics of the lag is) exact, and is exact in
+//! every steady state. The fast modes change the face temperatures, which change the radiation,
+//! so the two face temperatures are found by Newton's method at every evaluation (two unknowns;
+//! it converges in two or three iterations because the fast modes' face compliance is tiny
+//! against radiation). Measured against the full nodal model in docs/laminates.md.
+
+use crate::conduction::{Conduction, Modes};
+use crate::dynamics::{sin_cos, HingeModel};
+use crate::error::{Error, Result};
+use crate::params::Panel;
+use crate::system::Coupling;
+use nalgebra::{DMatrix, DVector};
+
+/// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
+/// the hinge's angular frequency), and quasi-static above. See docs/laminates.md for the
+/// measurement behind the value.
+pub const FAST_MODE_FACTOR: f64 = 20.0;
+
+/// The thermal coordinates of the state.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Thermal {
+    /// Node temperatures, front to back.
+    Nodal,
+    /// Amplitudes of the slow modes, the fast ones quasi-static.
+    Modal(Reduced),
+}
+
+/// The slow-mode model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reduced {
+    /// λ_k of the kept modes, 1/s.
+    pub rates: Vec<f64>,
+    /// φ_k at the front and back nodes, divided by C_tot (the forcing of each kept mode).
+    front: Vec<f64>,
+    back: Vec<f64>,
+    /// φ_k at the front and back nodes (the face temperatures of each kept mode).
+    front_shape: Vec<f64>,
+    back_shape: Vec<f64>,
+    /// μᵀ φ_k: the moment of each kept mode, N m/K.
+    moment: Vec<f64>,
+    /// Face temperatures of the quasi-static fast modes per unit face input,
+    /// F = Σ_fast φ_face φ_faceᵀ / (C_tot λ_k), K m²/W.
+    compliance: [[f64; 2]; 2],
+    /// Moment of the fast modes per unit face input, Σ_fast (μᵀφ_k) φ_face / (C_tot λ_k).
+    fast_moment: [f64; 2],
+    /// Indices of the kept modes in `modes`.
+    kept: Vec<usize>,
+    /// The full modal basis (for initial states and node temperatures).
+    pub modes: Modes,
+}
+
+/// The coupled N-node system's coefficients (no orbit: the flux factor is an argument).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layered {
+    pub conduction: Conduction,
+    pub thermal: Thermal,
+    model: HingeModel,
+    coupling: Coupling,
+    /// 1/I_B, c_d/I_B, K_el/I_B.
+    inverse_inertia: f64,
+    damping: f64,
+    stiffness: f64,
+}
+
+impl Layered {
+    /// The system of `conduction` on `panel`'s hinge. `fast_factor` sets which conduction modes
+    /// are quasi-static (λ_k > fast_factor ω_n); `f64::INFINITY` keeps every node.
+    pub fn new(
+        panel: &Panel,
+        conduction: Conduction,
+        model: HingeModel,
+        coupling: Coupling,
+        fast_factor: f64,
+    ) -> Result<Self> {
+        panel.validate()?;
+        if fast_factor.is_nan() || fast_factor <= 0.0 {
+            return Err(Error::invalid("fast_factor", fast_factor, "must be > 0"));
+        }
+        let inertia = panel.hinge_inertia();
+        let cut = fast_factor * panel.natural_angular_frequency();
+        let modes = conduction.modes();
+        let thermal = if modes.rates.iter().all(|&l| l <= cut) {
+            Thermal::Nodal
+        } else {
+            Thermal::Modal(Reduced::new(&conduction, modes, cut))
+        };
+        Ok(Layered {
+            conduction,
+            thermal,
+            model,
+            coupling,
+            inverse_inertia: 1.0 / inertia,
+            damping: panel.damping / inertia,
+            stiffness: panel.hinge_stiffness / inertia,
+        })
+    }
+
+    /// Number of thermal coordinates in the state.
+    pub fn thermal_size(&self) -> usize {
+        match &self.thermal {
+            Thermal::Nodal => self.conduction.nodes(),
+            Thermal::Modal(r) => r.rates.len(),
+        }
+    }
+
+    /// State size: thermal coordinates + θ + θ̇.
+    pub fn size(&self) -> usize {
+        self.thermal_size() + 2
+    }
+
+    #[inline]
+    fn sin_cos(&self, theta: f64) -> (f64, f64) {
+        match (self.coupling, self.model) {
+            (Coupling::Frozen, HingeModel::Linear) => (0.0, 1.0),
+            _ => sin_cos(theta),
+        }
+    }
+
+    /// dy/dt at illumination factor `flux` (written into `dy`); returns the thermal moment.
+    pub fn rhs_at_flux(&self, flux: f64, y: &[f64], dy: &mut [f64]) -> f64 {
+        let m = self.thermal_size();
+        let (th, om) = (y[m], y[m + 1]);
+        let (sin, cos) = self.sin_cos(th);
+        let area = match self.coupling {
+            Coupling::ProjectedArea => cos,
+            Coupling::Frozen => 1.0,
+        };
+        let moment = match &self.thermal {
+            Thermal::Nodal => {
+                self.conduction.rates(flux * area, &y[..m], &mut dy[..m]);
+                self.conduction.moment(&y[..m])
+            }
+            Thermal::Modal(r) => r.rates_and_moment(&self.conduction, flux * area, &y[..m], dy),
+        };
+        let forced = moment * self.inverse_inertia - self.damping * om - self.stiffness * th;
+        dy[m] = om;
+        dy[m + 1] = match self.model {
+            HingeModel::Linear => forced,
+            HingeModel::Nonlinear => (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin),
+        };
+        moment
+    }
+
+    /// Node temperatures of a state at illumination factor `flux` (front first).
+    pub fn node_temperatures(&self, flux: f64, y: &[f64]) -> Vec<f64> {
+        let m = self.thermal_size();
+        match &self.thermal {
+            Thermal::Nodal => y[..m].to_vec(),
+            Thermal::Modal(r) => {
+                let area = match self.coupling {
+                    Coupling::ProjectedArea => y[m].cos(),
+                    Coupling::Frozen => 1.0,
+                };
+                r.node_temperatures(&self.conduction, flux * area, &y[..m])
+            }
+        }
+    }
+
+    /// The state of node temperatures `t` and hinge (θ, θ̇) in this system's coordinates (the
+    /// fast modes of `t` are dropped: they follow from the rest).
+    pub fn state_from_nodes(&self, t: &[f64], theta: f64, theta_dot: f64) -> Vec<f64> {
+        let mut y = match &self.thermal {
+            Thermal::Nodal => t.to_vec(),
+            Thermal::Modal(r) => r.project(&self.conduction, t),
+        };
+        y.push(theta);
+        y.push(theta_dot);
+        y
+    }
+}
+
+impl Reduced {
+    fn new(conduction: &Conduction, modes: Modes, cut: f64) -> Self {
+        let n = conduction.nodes();
+        let total = modes.total_capacity;
+        let mu = &conduction.moment_weight;
+        let mut r = Reduced {
+            rates: Vec::new(),
+            front: Vec::new(),
+            back: Vec::new(),
+            front_shape: Vec::new(),
+            back_shape: Vec::new(),
+            moment: Vec::new(),
+            compliance: [[0.0; 2]; 2],
+            fast_moment: [0.0; 2],
+            kept: Vec::new(),
+            modes: modes.clone(),
+        };
+        for (k, &lambda) in modes.rates.iter().enumerate() {
+            let phi = modes.shapes.column(k);
+            let face = [phi[0], phi[n - 1]];
+            let mode_moment: f64 = (0..n).map(|i| mu[i] * phi[i]).sum();
+            // The uniform mode (λ = 0) is always slow.
+            if k == 0 || lambda <= cut {
+                r.kept.push(k);
+                r.rates.push(lambda);
+                r.front.push(face[0] / total);
+                r.back.push(face[1] / total);
+                r.front_shape.push(face[0]);
+                r.back_shape.push(face[1]);
+                r.moment.push(mode_moment);
+            } else {
+                let w = 1.0 / (total * lambda);
+                for i in 0..2 {
+                    for j in 0..2 {
+                        r.compliance[i][j] += face[i] * face[j] * w;
+                    }
+                    r.fast_moment[i] += mode_moment * face[i] * w;
+                }
+            }
+        }
+        r
+    }
+
+    /// Face temperatures u = u_slow + F b(u) and face inputs b, by Newton's method.
+    #[inline]
+    fn faces(&self, c: &Conduction, flux: f64, amp: &[f64]) -> ([f64; 2], (f64, f64)) {
+        let mut slow = [0.0, 0.0];
+        for k in 0..amp.len() {
+            slow[0] += self.front_shape[k] * amp[k];
+            slow[1] += self.back_shape[k] * amp[k];
+        }
+        let f = &self.compliance;
+        let mut b = c.face_inputs(flux, slow[0], slow[1]);
+        let mut u = [
+            slow[0] + f[0][0] * b.0 + f[0][1] * b.1,
+            slow[1] + f[1][0] * b.0 + f[1][1] * b.1,
+        ];
+        for _ in 0..20 {
+            b = c.face_inputs(flux, u[0], u[1]);
+            // g(u) = u − slow − F b(u); ∂b/∂u = −diag(d).
+            let g = [
+                u[0] - slow[0] - (f[0][0] * b.0 + f[0][1] * b.1),
+                u[1] - slow[1] - (f[1][0] * b.0 + f[1][1] * b.1),
+            ];
+            let d = [
+                4.0 * c.radiation_front * u[0] * u[0] * u[0],
+                4.0 * c.radiation_back * u[1] * u[1] * u[1],
+            ];
+            let j = [
+                [1.0 + f[0][0] * d[0], f[0][1] * d[1]],
+                [f[1][0] * d[0], 1.0 + f[1][1] * d[1]],
+            ];
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            let du = [
+                (j[1][1] * g[0] - j[0][1] * g[1]) / det,
+                (j[0][0] * g[1] - j[1][0] * g[0]) / det,
+            ];
+            u[0] -= du[0];
+            u[1] -= du[1];
+            if du[0].abs() <= 1e-14 * u[0].abs() && du[1].abs() <= 1e-14 * u[1].abs() {
+                break;
+            }
+        }
+        (u, c.face_inputs(flux, u[0], u[1]))
+    }
+
+    /// Rates of the kept modes (into dy[..m]) and the thermal moment.
+    #[inline]
+    fn rates_and_moment(&self, c: &Conduction, flux: f64, amp: &[f64], dy: &mut [f64]) -> f64 {
+        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let mut moment = self.fast_moment[0] * b0 + self.fast_moment[1] * b1 - c.moment_offset;
+        for k in 0..amp.len() {
+            dy[k] = -self.rates[k] * amp[k] + self.front[k] * b0 + self.back[k] * b1;
+            moment += self.moment[k] * amp[k];
+        }
+        moment
+    }
+
+    fn node_temperatures(&self, c: &Conduction, flux: f64, amp: &[f64]) -> Vec<f64> {
+        let n = c.nodes();
+        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let total = self.modes.total_capacity;
+        let mut t = vec![0.0; n];
+        for (k, &lambda) in self.modes.rates.iter().enumerate() {
+            let phi = self.modes.shapes.column(k);
+            let q = match self.kept.iter().position(|&j| j == k) {
+                Some(p) => amp[p],
+                None => (phi[0] * b0 + phi[n - 1] * b1) / (total * lambda),
+            };
+            for i in 0..n {
+                t[i] += phi[i] * q;
+            }
+        }
+        t
+    }
+
+    /// Amplitudes of the kept modes of a nodal profile: q_k = φ_kᵀ C T / C_tot.
+    fn project(&self, c: &Conduction, t: &[f64]) -> Vec<f64> {
+        let total = self.modes.total_capacity;
+        self.kept
+            .iter()
+            .map(|&k| {
+                let phi = self.modes.shapes.column(k);
+                (0..c.nodes())
+                    .map(|i| phi[i] * c.capacity[i] * t[i])
+                    .sum::<f64>()
+                    / total
+            })
+            .collect()
+    }
+}
+
+/// The steady state of the coupled N-node system under a constant illumination factor: node
+/// temperatures (front first) and θ, with θ̇ = 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayeredEquilibrium {
+    pub temperatures: Vec<f64>,
+    pub theta: f64,
+    pub moment: f64,
+}
+
+/// Newton's method on the N heat balances and the static hinge (M_T = K_el θ), with the
+/// analytic Jacobian, from the uncoupled steady profile.
+pub fn equilibrium(
+    panel: &Panel,
+    c: &Conduction,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<LayeredEquilibrium> {
+    let n = c.nodes();
+    let profile = c.steady_profile(flux)?;
+    let k_el = panel.hinge_stiffness;
+    let mut x = DVector::zeros(n + 1);
+    for i in 0..n {
+        x[i] = profile[i];
+    }
+    x[n] = c.moment(&profile) / k_el;
+    let k = c.conduction_matrix();
+    for _ in 0..100 {
+        let th = x[n];
+        let (area, d_area) = match coupling {
+            Coupling::ProjectedArea => (th.cos(), -th.sin()),
+            Coupling::Frozen => (1.0, 0.0),
+        };
+        let t: Vec<f64> = x.rows(0, n).iter().copied().collect();
+        let (qf, qb) = c.face_inputs(flux * area, t[0], t[n - 1]);
+        let mut f = DVector::zeros(n + 1);
+        let kt = &k * x.rows(0, n);
+        for i in 0..n {
+            f[i] = -kt[i];
+        }
+        f[0] += qf;
+        f[n - 1] += qb;
+        f[n] = (c.moment(&t) - k_el * th) / k_el;
+        let mut jac = DMatrix::zeros(n + 1, n + 1);
+        jac.view_mut((0, 0), (n, n)).copy_from(&(-&k));
+        jac[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3);
+        jac[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3);
+        jac[(0, n)] = c.absorbed * flux * d_area;
+        for i in 0..n {
+            jac[(n, i)] = c.moment_weight[i] / k_el;
+        }
+        jac[(n, n)] = -1.0;
+        let dx = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
+            what: "steady state".into(),
+            reason: "singular Jacobian".into(),
+        })?;
+        let mut lambda = 1.0;
+        while (0..n).any(|i| x[i] + lambda * dx[i] <= 0.0) {
+            lambda *= 0.5;
+        }
+        x += &dx * lambda;
+        let small_t = (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]);
+        if small_t && dx[n].abs() < 1e-14 {
+            if x[n].abs() >= std::f64::consts::FRAC_PI_2 {
+                return Err(Error::NoConvergence {
+                    what: "steady state".into(),
+                    reason: format!(
+                        "hinge angle {} rad is beyond 90°: the panel is far too soft",
+                        x[n]
+                    ),
+                });
+            }
+            let temperatures: Vec<f64> = x.rows(0, n).iter().copied().collect();
+            let moment = c.moment(&temperatures);
+            return Ok(LayeredEquilibrium {
+                temperatures,
+                theta: x[n],
+                moment,
+            });
+        }
+    }
+    Err(Error::NoConvergence {
+        what: "steady state".into(),
+        reason: "Newton did not converge in 100 iterations".into(),
+    })
+}
+
+/// The analytic Jacobian of the nodal system (N node temperatures, θ, θ̇) at a steady state.
+pub fn jacobian(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+    eq: &LayeredEquilibrium,
+) -> DMatrix<f64> {
+    let n = c.nodes();
+    let t = &eq.temperatures;
+    let mut j = DMatrix::zeros(n + 2, n + 2);
+    let k = c.conduction_matrix();
+    for r in 0..n {
+        for col in 0..n {
+            j[(r, col)] = -k[(r, col)] / c.capacity[r];
+        }
+    }
+    j[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3) / c.capacity[0];
+    j[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3) / c.capacity[n - 1];
+    let s = eq.theta.sin();
+    if coupling == Coupling::ProjectedArea {
+        j[(0, n)] = -c.absorbed * flux * s / c.capacity[0];
+    }
+    j[(n, n + 1)] = 1.0;
+    // The static residual is zero at the equilibrium, so the derivative of the non-linear
+    // inertia factor drops out (as in the two-layer Jacobian).
+    let inertia = panel.hinge_inertia()
+        * match model {
+            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
+            HingeModel::Linear => 1.0,
+        };
+    for col in 0..n {
+        j[(n + 1, col)] = c.moment_weight[col] / inertia;
+    }
+    j[(n + 1, n)] = -panel.hinge_stiffness / inertia;
+    j[(n + 1, n + 1)] = -panel.damping / inertia;
+    j
+}
+
+/// Linear stability of the N-node system's sunlit equilibrium (the full nodal Jacobian: an
+/// eigen-analysis has no step to protect from fast modes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayeredFlutter {
+    pub equilibrium: LayeredEquilibrium,
+    /// Largest real part of the eigenvalues, 1/s.
+    pub growth_rate: f64,
+    /// Frequency of the fastest oscillatory pair, Hz.
+    pub frequency_hz: f64,
+}
+
+pub fn analyse(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<LayeredFlutter> {
+    let eq = equilibrium(panel, c, coupling, flux)?;
+    let (growth_rate, frequency_hz) = growth(panel, c, model, coupling, flux, &eq)?;
+    Ok(LayeredFlutter {
+        equilibrium: eq,
+        growth_rate,
+        frequency_hz,
+    })
+}
+
+/// (growth rate, frequency) of the Jacobian at `eq`.
+fn growth(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+    eq: &LayeredEquilibrium,
+) -> Result<(f64, f64)> {
+    let n = c.nodes();
+    let jac = jacobian(panel, c, model, coupling, flux, eq);
+    // Balance kelvin rows against radian rows (a diagonal similarity keeps the eigenvalues).
+    let tmax = eq.temperatures.iter().fold(1.0_f64, |a, &b| a.max(b));
+    let mut scale = vec![1.0; n + 2];
+    scale[n] = 1.0 / tmax;
+    scale[n + 1] = panel.natural_angular_frequency() / tmax;
+    let balanced = DMatrix::from_fn(n + 2, n + 2, |i, j| jac[(i, j)] * scale[j] / scale[i]);
+    let ev = balanced.complex_eigenvalues();
+    if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+        return Err(Error::NoConvergence {
+            what: "eigenvalues".into(),
+            reason: "non-finite result".into(),
+        });
+    }
+    let growth = ev.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    let omega = ev.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
+    Ok((growth, omega / (2.0 * std::f64::consts::PI)))
+}
+
+/// The damping c_d (N m s/rad) at which the growth rate crosses zero (bisection); 0 when the
+/// panel is stable without damping.
+pub fn critical_damping(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<f64> {
+    // The equilibrium does not depend on c_d.
+    let eq = equilibrium(panel, c, coupling, flux)?;
+    let rate = |cd: f64| -> Result<f64> {
+        let p = Panel {
+            damping: cd,
+            ..*panel
+        };
+        Ok(growth(&p, c, model, coupling, flux, &eq)?.0)
+    };
+    if rate(0.0)? < 0.0 {
+        return Ok(0.0);
+    }
+    let mut hi = panel
+        .damping
+        .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
+    let mut tries = 0;
+    while rate(hi)? >= 0.0 {
+        hi *= 2.0;
+        tries += 1;
+        if tries > 200 {
+            return Err(Error::NoConvergence {
+                what: "critical damping".into(),
+                reason: "no stabilising damping found".into(),
+            });
+        }
+    }
+    let mut lo = 0.0;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if rate(mid)? >= 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-12 * hi {
+            break;
+        }
+    }
+    Ok(0.5 * (lo + hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::laminate::{Laminate, MATERIALS};
+    use crate::system::Coupled;
+    use crate::Orbit;
+
+    /// A CFRP/honeycomb solar-array substrate with Kapton on the Sun side.
+    pub(crate) fn wing_layup() -> Laminate {
+        Laminate {
+            layers: vec![
+                MATERIALS[4].layer(50e-6),
+                MATERIALS[2].layer(0.3e-3),
+                MATERIALS[3].layer(20e-3),
+                MATERIALS[2].layer(0.3e-3),
+            ],
+            emissivity_front: 0.8,
+            emissivity_back: 0.8,
+            absorptivity: 0.9,
+            reference_temperature: 293.15,
+        }
+    }
+
+    #[test]
+    fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
+        let p = Panel {
+            damping: 2.0,
+            ..Panel::paper()
+        };
+        for model in [HingeModel::Nonlinear, HingeModel::Linear] {
+            for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+                let c = Conduction::homogeneous(&p, 2).unwrap();
+                let sys = Layered::new(&p, c, model, coupling, FAST_MODE_FACTOR).unwrap();
+                assert_eq!(sys.thermal, Thermal::Nodal);
+                let two = Coupled::new(p, Orbit::geo_equinox(), model, coupling);
+                for y in [[380.0, 368.0, 0.085, 0.0], [250.0, 262.0, -0.3, 0.02]] {
+                    let mut dy = [0.0; 4];
+                    sys.rhs_at_flux(0.97, &y, &mut dy);
+                    let want = two.rhs_at_flux(0.97, &nalgebra::Vector4::from(y));
+                    for i in 0..4 {
+                        assert!((dy[i] - want[i]).abs() <= 1e-13 * want[i].abs().max(1e-3));
+                    }
+                }
+                let eq = equilibrium(&p, &sys.conduction, coupling, 1.0).unwrap();
+                let two_eq = crate::steady::equilibrium(&p, coupling, 1.0).unwrap();
+                assert!((eq.theta / two_eq.theta - 1.0).abs() < 1e-10);
+                assert!((eq.temperatures[0] / two_eq.t_front - 1.0).abs() < 1e-12);
+                let a = analyse(&p, &sys.conduction, model, coupling, 1.0).unwrap();
+                let b = crate::flutter::analyse(&p, model, coupling, 1.0).unwrap();
+                assert!(
+                    (a.growth_rate - b.growth_rate).abs() < 1e-9 * b.growth_rate.abs().max(1e-6)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let p = Panel {
+            damping: 0.5,
+            ..Panel::paper()
+        };
+        let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
+        let sys = Layered::new(
+            &p,
+            c.clone(),
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            f64::INFINITY,
+        )
+        .unwrap();
+        let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+        let jac = jacobian(
+            &p,
+            &c,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            1.0,
+            &eq,
+        );
+        let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+        let n = y.len();
+        let mut f0 = vec![0.0; n];
+        sys.rhs_at_flux(1.0, &y, &mut f0);
+        assert!(f0.iter().all(|v| v.abs() < 1e-9), "equilibrium: {f0:?}");
+        for j in 0..n {
+            let h = if j < n - 2 { 1e-6 * y[j] } else { 1e-5 };
+            let (mut yp, mut ym) = (y.clone(), y.clone());
+            yp[j] += h;
+            ym[j] -= h;
+            let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+            sys.rhs_at_flux(1.0, &yp, &mut fp);
+            sys.rhs_at_flux(1.0, &ym, &mut fm);
+            let scale = (0..n).map(|i| jac[(i, j)].abs()).fold(1e-12, f64::max);
+            for i in 0..n {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                assert!(
+                    (fd - jac[(i, j)]).abs() < 1e-6 * scale,
+                    "({i},{j}) {fd} vs {}",
+                    jac[(i, j)]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn quasi_static_fast_modes_are_exact_in_steady_state() {
+        // An aluminium boom wall: every non-uniform conduction mode is fast.
+        let lam = Laminate {
+            layers: vec![MATERIALS[0].layer(1e-3)],
+            ..wing_layup()
+        };
+        let p = lam.equivalent_panel(&Panel::paper()).unwrap();
+        for layup in [lam, wing_layup()] {
+            let c = Conduction::new(&p, &layup, 20).unwrap();
+            let sys = Layered::new(
+                &p,
+                c.clone(),
+                HingeModel::Nonlinear,
+                Coupling::ProjectedArea,
+                FAST_MODE_FACTOR,
+            )
+            .unwrap();
+            assert!(matches!(sys.thermal, Thermal::Modal(_)));
+            let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+            let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+            let mut dy = vec![0.0; y.len()];
+            let m = sys.rhs_at_flux(1.0, &y, &mut dy);
+            // The moment is a sum of large terms that nearly cancel (M_T = Σ μ_i T_i − Σ μ_i T_ref):
+            // compare against their size.
+            let size: f64 = c
+                .moment_weight
+                .iter()
+                .zip(&eq.temperatures)
+                .map(|(m, t)| (m * t).abs())
+                .sum();
+            assert!((m - eq.moment).abs() < 1e-13 * size, "{m} vs {}", eq.moment);
+            let t = sys.node_temperatures(1.0, &y);
+            for i in 0..20 {
+                assert!((t[i] / eq.temperatures[i] - 1.0).abs() < 1e-12);
+            }
+            for (i, v) in dy.iter().enumerate() {
+                assert!(v.abs() < 1e-9 * (1.0 + y[i].abs()), "{i}: {v}");
+            }
+        }
+    }
+}
