@@ -33,7 +33,7 @@ pub enum Thermal {
     /// Node temperatures, front to back.
     Nodal,
     /// Amplitudes of the slow modes, the fast ones quasi-static.
-    Modal(Reduced),
+    Modal(Box<Reduced>),
 }
 
 /// The slow-mode model.
@@ -93,7 +93,7 @@ impl Layered {
         let thermal = if modes.rates.iter().all(|&l| l <= cut) {
             Thermal::Nodal
         } else {
-            Thermal::Modal(Reduced::new(&conduction, modes, cut))
+            Thermal::Modal(Box::new(Reduced::new(&conduction, modes, cut)))
         };
         Ok(Layered {
             conduction,
@@ -227,9 +227,9 @@ impl Reduced {
     #[inline]
     fn faces(&self, c: &Conduction, flux: f64, amp: &[f64]) -> ([f64; 2], (f64, f64)) {
         let mut slow = [0.0, 0.0];
-        for k in 0..amp.len() {
-            slow[0] += self.front_shape[k] * amp[k];
-            slow[1] += self.back_shape[k] * amp[k];
+        for ((a, f), b) in amp.iter().zip(&self.front_shape).zip(&self.back_shape) {
+            slow[0] += f * a;
+            slow[1] += b * a;
         }
         let f = &self.compliance;
         let mut b = c.face_inputs(flux, slow[0], slow[1]);
@@ -682,8 +682,8 @@ mod tests {
                 .sum();
             assert!((m - eq.moment).abs() < 1e-13 * size, "{m} vs {}", eq.moment);
             let t = sys.node_temperatures(1.0, &y);
-            for i in 0..20 {
-                assert!((t[i] / eq.temperatures[i] - 1.0).abs() < 1e-12);
+            for (a, b) in t.iter().zip(&eq.temperatures) {
+                assert!((a / b - 1.0).abs() < 1e-12);
             }
             for (i, v) in dy.iter().enumerate() {
                 assert!(v.abs() < 1e-9 * (1.0 + y[i].abs()), "{i}: {v}");

@@ -6,6 +6,7 @@ mod convert;
 mod ensemble;
 mod error;
 mod flutter;
+mod laminate;
 mod longrun;
 mod orbit;
 
@@ -380,5 +381,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     beam::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
+    laminate::register(m)?;
     Ok(())
 }
