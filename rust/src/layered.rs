@@ -18,8 +18,10 @@
 use crate::conduction::{Conduction, Modes};
 use crate::dynamics::{sin_cos, HingeModel};
 use crate::error::{Error, Result};
+use crate::integrate::{Dyn, OdeSystem, State};
+use crate::orbit::Orbit;
 use crate::params::Panel;
-use crate::system::Coupling;
+use crate::system::{Coupling, Sunlight};
 use nalgebra::{DMatrix, DVector};
 
 /// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
@@ -309,6 +311,38 @@ impl Reduced {
                     / total
             })
             .collect()
+    }
+}
+
+/// The N-node system in orbit: the illumination of the current segment drives it.
+#[derive(Debug, Clone)]
+pub struct LayeredOrbit {
+    pub system: Layered,
+    sun: Sunlight,
+}
+
+impl LayeredOrbit {
+    pub fn new(system: Layered, orbit: Orbit) -> Self {
+        LayeredOrbit {
+            system,
+            sun: Sunlight::new(orbit),
+        }
+    }
+}
+
+impl OdeSystem<Dyn> for LayeredOrbit {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State<Dyn>) -> State<Dyn> {
+        let mut dy = DVector::zeros(y.len());
+        self.system
+            .rhs_at_flux(self.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        dy
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.sun.orbit.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.sun.enter(a, b);
     }
 }
 
@@ -687,6 +721,95 @@ mod tests {
             }
             for (i, v) in dy.iter().enumerate() {
                 assert!(v.abs() < 1e-9 * (1.0 + y[i].abs()), "{i}: {v}");
+            }
+        }
+    }
+
+    /// The example wing (CFRP/honeycomb, 20 m) and boom (1 mm aluminium, 2 m) as panels.
+    pub(crate) fn examples() -> Vec<(&'static str, Panel, Laminate)> {
+        let boom = Laminate {
+            layers: vec![MATERIALS[0].layer(1e-3)],
+            emissivity_front: 0.8,
+            emissivity_back: 0.8,
+            absorptivity: 0.4,
+            reference_temperature: 293.15,
+        };
+        let mut out = Vec::new();
+        for (name, lam, length) in [("wing", wing_layup(), 20.0), ("boom", boom, 2.0)] {
+            let base = Panel {
+                length,
+                damping: 0.0,
+                ..Panel::paper()
+            };
+            let mut p = lam.equivalent_panel(&base).unwrap();
+            p.hinge_stiffness = crate::params::hinge_stiffness(
+                &p,
+                crate::params::StiffnessCriterion::DeflectionSmallAngle,
+                0.0,
+            )
+            .unwrap();
+            out.push((name, p, lam));
+        }
+        out
+    }
+
+    /// Measurement behind FAST_MODE_FACTOR: one eclipse exit of the example wing and boom with
+    /// 20 nodes, for several cuts; prints the jitter after exit, the steps and the critical
+    /// damping of the reduced model. `cargo test --release -- --ignored fast_mode --nocapture`
+    #[test]
+    #[ignore]
+    fn fast_mode_factor_measurement() {
+        use crate::integrate::{Method, Tolerances};
+        use crate::simulate::{run, Output};
+        let orbit = Orbit::geo_equinox();
+        let (entry, exit) = orbit.shadow_intervals(0.0, orbit.period)[0];
+        for (name, p, lam) in examples() {
+            let p = Panel { damping: 0.0, ..p };
+            let c = Conduction::new(&p, &lam, 20).unwrap();
+            let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+            let full =
+                analyse(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0).unwrap();
+            let cd = critical_damping(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0)
+                .unwrap();
+            let wn = p.natural_angular_frequency();
+            let rates = c.modes().rates;
+            println!(
+                "{name}: omega_n {wn:.3} rad/s, theta_eq {:.3e} rad, conduction rates {:.3e}..{:.3e} 1/s, full-model growth(c_d=0) {:.4e} 1/s, c_d* {cd:.5e}",
+                eq.theta, rates[1], rates[19], full.growth_rate
+            );
+            let t0 = entry - 600.0;
+            let t1 = exit + 1200.0;
+            let tn = 2.0 * std::f64::consts::PI / wn;
+            for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 200.0, 1000.0] {
+                let sys = Layered::new(
+                    &p,
+                    c.clone(),
+                    HingeModel::Nonlinear,
+                    Coupling::ProjectedArea,
+                    factor,
+                )
+                .unwrap();
+                let kept = sys.thermal_size();
+                let y0 = DVector::from_vec(sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0));
+                let mut orb = LayeredOrbit::new(sys, orbit);
+                let method = Method::Dopri5(Tolerances {
+                    rtol: 1e-8,
+                    atol: 1e-10,
+                    max_step: tn / 40.0,
+                    max_steps: 50_000_000,
+                });
+                let start = std::time::Instant::now();
+                let traj = run(&mut orb, &method, (t0, t1), y0, &Output::Every(0.05)).unwrap();
+                let secs = start.elapsed().as_secs_f64();
+                let m = kept;
+                let peak = traj
+                    .t
+                    .iter()
+                    .zip(&traj.y)
+                    .filter(|(t, _)| **t > exit)
+                    .map(|(_, y)| (y[m] - eq.theta).abs())
+                    .fold(0.0, f64::max);
+                println!("  factor {factor:>6}: kept {kept:>2} modes, steps {:>9}, {secs:.2} s, exit peak |theta - theta_eq| {peak:.6e}", traj.stats.n_steps);
             }
         }
     }

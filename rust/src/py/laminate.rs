@@ -73,7 +73,10 @@ pub fn laminate_from(d: &Bound<'_, PyDict>) -> PyResult<Laminate> {
 }
 
 /// The layup of a panel: its own, or one homogeneous layer for a plain panel.
-pub fn layup_or_homogeneous(panel: &Panel, layup: Option<&Bound<'_, PyDict>>) -> PyResult<Laminate> {
+pub fn layup_or_homogeneous(
+    panel: &Panel,
+    layup: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Laminate> {
     match layup {
         Some(d) => laminate_from(d),
         None => Ok(Laminate::homogeneous(panel)),
