@@ -39,6 +39,10 @@ pub struct Conduction {
     pub moment_weight: Vec<f64>,
     /// Σ μ_i T_ref, N m.
     pub moment_offset: f64,
+    /// Σ μ_i, N m/K (zero for a layup symmetric in E a about its neutral axis).
+    pub moment_total: f64,
+    /// T_ref, K.
+    pub reference_temperature: f64,
     /// α C, W/m² absorbed at the front per unit flux factor.
     pub absorbed: f64,
     /// σ ε_f and σ ε_b, W/(m² K⁴).
@@ -121,13 +125,16 @@ impl Conduction {
                 element_layer.push(li);
             }
         }
-        let moment_offset = moment_weight.iter().sum::<f64>() * laminate.reference_temperature;
+        let moment_total: f64 = moment_weight.iter().sum();
+        let moment_offset = moment_total * laminate.reference_temperature;
         Ok(Conduction {
             depth,
             capacity,
             conductance,
             moment_weight,
             moment_offset,
+            moment_total,
+            reference_temperature: laminate.reference_temperature,
             absorbed: panel.absorptivity * panel.solar_constant,
             radiation_front: STEFAN_BOLTZMANN * panel.emissivity_front,
             radiation_back: STEFAN_BOLTZMANN * panel.emissivity_back,
@@ -135,9 +142,42 @@ impl Conduction {
         })
     }
 
-    /// The model of a plain panel: one homogeneous layer ([`Laminate::homogeneous`]).
+    /// The model of a plain panel: one homogeneous layer ([`Laminate::homogeneous`]) on equal
+    /// elements, with its coefficients taken straight from the panel so that two nodes give
+    /// eq. 2's coefficients to the bit: capacities m c/(N−1) (half at the faces), conductances
+    /// K (N−1), and moment weights χ a E I/d × ν_i, with ν_i = 12 ∫ φ_i (1/2 − ξ) dξ in the
+    /// thickness coordinate ξ = s/d (ν = ±(3δ − 2δ²) at the faces, 6δ − 12 i δ² inside,
+    /// δ = 1/(N−1)).
     pub fn homogeneous(panel: &Panel, nodes: usize) -> Result<Self> {
-        Self::new(panel, &Laminate::homogeneous(panel), nodes)
+        // Validation (and the node count's range) as for any laminate.
+        let mut c = Self::new(panel, &Laminate::homogeneous(panel), nodes)?;
+        let elements = (nodes - 1) as f64;
+        let delta = 1.0 / elements;
+        let d = panel.thickness;
+        let interior = panel.heat_capacity() / elements;
+        let face = 0.5 * panel.heat_capacity() / elements;
+        let per_kelvin = panel.moment_per_kelvin();
+        let face_weight = 3.0 * delta - 2.0 * delta * delta;
+        for i in 0..nodes {
+            let last = i + 1 == nodes;
+            c.depth[i] = if last { d } else { i as f64 * d / elements };
+            c.capacity[i] = if i == 0 || last { face } else { interior };
+            let nu = if i == 0 {
+                face_weight
+            } else if last {
+                -face_weight
+            } else {
+                6.0 * delta - 12.0 * i as f64 * delta * delta
+            };
+            c.moment_weight[i] = per_kelvin * nu;
+        }
+        for g in c.conductance.iter_mut() {
+            *g = panel.conductance * elements;
+        }
+        // A homogeneous plate bends with the gradient only: no reference temperature.
+        c.moment_offset = 0.0;
+        c.moment_total = 0.0;
+        Ok(c)
     }
 
     pub fn nodes(&self) -> usize {
@@ -180,14 +220,15 @@ impl Conduction {
         }
     }
 
-    /// M_T of a nodal temperature profile, N m.
+    /// M_T of a nodal temperature profile, N m: Σ μ_i (T_i − T_0) + Σ μ_i (T_0 − T_ref), the
+    /// form that keeps the large Σ μ_i T_i from cancelling.
     pub fn moment(&self, t: &[f64]) -> f64 {
-        self.moment_weight
-            .iter()
-            .zip(t)
-            .map(|(m, x)| m * x)
-            .sum::<f64>()
-            - self.moment_offset
+        let t0 = t[0];
+        let mut m = 0.0;
+        for (mu, x) in self.moment_weight.iter().zip(t) {
+            m += mu * (x - t0);
+        }
+        m + self.moment_total * (t0 - self.reference_temperature)
     }
 
     /// The conduction matrix K (symmetric, tridiagonal): C dT/dt = −K T + face inputs.
