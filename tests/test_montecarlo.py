@@ -241,11 +241,11 @@ def test_killed_run_resumes_to_the_same_frame(tmp_path: Path) -> None:
 
 def test_ctrl_c_stops_the_run_and_keeps_the_finished_chunks(tmp_path: Path) -> None:
     path = tmp_path / "ckpt"
-    script = _child(path).replace("tj.monte_carlo(", "try:\n    tj.monte_carlo(", 1)
+    script = _child(path).replace("tj.monte_carlo(", "df = tj.monte_carlo(", 1)
     script = script.replace(
-        "\n                       chunk_size", "\n                           chunk_size"
+        "\n                       chunk_size", "\n                            chunk_size"
     )
-    script += "except KeyboardInterrupt:\n    print('interrupted')\n"
+    script += "print('interrupted' if df.attrs['interrupted'] else 'finished', len(df))\n"
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while len(list(path.glob("chunk-*.parquet"))) < 2:
@@ -254,9 +254,11 @@ def test_ctrl_c_stops_the_run_and_keeps_the_finished_chunks(tmp_path: Path) -> N
         time.sleep(0.01)
     proc.send_signal(signal.SIGINT)
     out, _ = proc.communicate(timeout=60)
-    assert proc.returncode == 0 and out.strip() == "interrupted"
+    word, kept = out.split()
+    assert proc.returncode == 0 and word == "interrupted"
     finished = sorted(path.glob("chunk-*.parquet"))
     assert 2 <= len(finished) < 30
+    assert int(kept) == 2 * len(finished)  # the frame returned holds the finished chunks
     assert not list(path.glob("*.tmp"))
     for chunk in finished:  # each one whole
         assert pd.read_parquet(chunk)["sample"].size == 2

@@ -1,5 +1,6 @@
 //! Bindings of batched runs: a rayon pool of its own, and the check of a design up front.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, solver_from};
 use super::to_py;
 use crate::ensemble::{pool, run_batch, EnsembleSettings, SampleMetrics};
@@ -71,7 +72,7 @@ impl EnsemblePool {
     }
 
     /// Runs one sample per row of `panels`; returns the metrics as columns.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, cancel=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -85,7 +86,9 @@ impl EnsemblePool {
         window: f64,
         threshold: Option<f64>,
         stop_at_threshold: bool,
+        cancel: Option<&Bound<'py, CancelToken>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let cancel = token(cancel);
         let ps = panels_from(&panels)?;
         let settings = EnsembleSettings {
             orbit: orbit_from(orbit)?,
@@ -103,7 +106,7 @@ impl EnsemblePool {
         };
         let pool = &self.pool;
         let out = py
-            .detach(|| run_batch(pool, &ps, &settings))
+            .detach(|| run_batch(pool, &ps, &settings, &cancel))
             .map_err(to_py)?;
         let d = PyDict::new(py);
         let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };

@@ -2,6 +2,7 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod beam;
+mod cancel;
 mod convert;
 mod ensemble;
 mod flutter;
@@ -18,7 +19,7 @@ use convert::{hinge_model, orbit_from, output, panel_from, solver_from, state};
 use nalgebra::SVector;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -43,6 +44,7 @@ pub(crate) fn to_py(err: Error) -> PyErr {
         Error::InvalidParameter { .. } => PyValueError::new_err(err.to_string()),
         Error::Integration { .. } => IntegrationError::new_err(err.to_string()),
         Error::NoConvergence { .. } => ConvergenceError::new_err(err.to_string()),
+        Error::Cancelled => PyKeyboardInterrupt::new_err(err.to_string()),
     }
 }
 
@@ -386,5 +388,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     beam::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
+    cancel::register(m)?;
     Ok(())
 }
