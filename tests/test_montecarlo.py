@@ -277,7 +277,9 @@ def test_sobol_indices_find_the_parameter_that_matters() -> None:
         tj.sensitivity(PAPER, LOW, vary, metric="error", n=4, **FAST)
 
 
-def test_mc_command_writes_samples_and_plots(tmp_path: Path) -> None:
+def test_mc_command_writes_samples_and_plots(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     scenario = tmp_path / "s.toml"
     scenario.write_text(
         textwrap.dedent("""
@@ -309,5 +311,7 @@ def test_mc_command_writes_samples_and_plots(tmp_path: Path) -> None:
     )
     np.testing.assert_array_equal(frame["exit_peak"], expected["exit_peak"])
     scenario.write_text("[vary]\ncolour = ['uniform', 0, 1]\n")
-    with pytest.raises(ValueError, match="colour"):
-        mc_command([str(scenario), "--n", "2", "--out", str(out / "x"), "--no-progress"])
+    # Bad input: one line naming the key, exit code 2 (the command's one error path).
+    code = mc_command([str(scenario), "--n", "2", "--out", str(out / "x"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2 and "colour" in err and err.count("\n") == 1

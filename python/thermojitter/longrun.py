@@ -176,8 +176,8 @@ def simulate_orbits(
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.
     - Ctrl-C stops within one integration step and returns the finished orbits with
-      ``interrupted=True``, saying so in one line on stderr; so does ``stop()`` turning True
-      (polled between chunks, for callers that handle SIGINT themselves).
+      ``interrupted=True``, saying so in one line on stderr. So does ``stop()`` turning True
+      (polled between chunks, for callers that handle SIGINT and report it themselves), silently.
     - ``progress``: a tqdm bar on stderr with the remaining time (in Jupyter a widget; also when
       stderr is not a terminal); ``None``: only when stderr is a terminal; ``False``: none.
     - ``steps_per_period``: rk45's step is capped at T_n/steps_per_period, T_n the hinge's natural
@@ -260,7 +260,7 @@ def simulate_orbits(
             crossing = tuple(saved["crossing"]) if saved["crossing"] else None  # type: ignore[assignment]
 
     bar = progress_bar(n_orbits, initial=next_index, unit="orbit", enabled=progress)
-    interrupted = False
+    interrupted = report = False
     stopped = crossing is not None and on_limit == "stop"
     last_save = time.monotonic()
     engine = Interruptible()
@@ -297,16 +297,17 @@ def simulate_orbits(
                 _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
                 last_save = time.monotonic()
             if stop is not None and stop() and next_index < n_orbits and not stopped:
-                raise KeyboardInterrupt
+                interrupted = True  # the caller asked, and reports it
+                break
     except KeyboardInterrupt:
-        interrupted = True
+        interrupted = report = True
     finally:
         engine.__exit__()
         if bar is not None:
             bar.close()
         if path is not None:
             _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
-    if interrupted:
+    if report:
         kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
         if path is not None:
             report_interrupted(
