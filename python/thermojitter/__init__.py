@@ -10,6 +10,7 @@ from thermojitter import beam
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
+from thermojitter.errors import InternalError, ParameterError
 from thermojitter.flutter import (
     FlutterResult,
     LinearThermalResponse,
@@ -42,10 +43,12 @@ __all__ = [
     "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
+    "InternalError",
     "LinearThermalResponse",
     "Orbit",
     "OrbitSummaries",
     "Panel",
+    "ParameterError",
     "SensitivityResult",
     "Solution",
     "StabilityMap",

@@ -11,7 +11,7 @@ use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
-use nalgebra::Vector4;
+use nalgebra::{Vector4, U4};
 use std::ops::ControlFlow;
 
 /// Points read per step (the step end and three interior points).
@@ -211,8 +211,8 @@ struct SummaryObserver<'c> {
     cancel: &'c Cancel,
 }
 
-impl Observer<4> for SummaryObserver<'_> {
-    fn on_step(&mut self, step: &DenseStep<4>) -> ControlFlow<()> {
+impl Observer<U4> for SummaryObserver<'_> {
+    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
         if let Err(e) = self.cancel.check() {
             self.error = Some(e);
             return ControlFlow::Break(());
