@@ -2,6 +2,7 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod beam;
+mod cancel;
 mod convert;
 mod ensemble;
 mod error;
@@ -385,6 +386,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     beam::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
+    cancel::register(m)?;
     laminate::register(m)?;
     Ok(())
 }
