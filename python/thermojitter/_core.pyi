@@ -192,3 +192,46 @@ class EnsemblePool:
         stop_at_threshold: bool,
         cancel: CancelToken | None = None,
     ) -> dict[str, Any]: ...
+
+# --- laminates and the N-node model -------------------------------------------------------------
+LAYER_FIELDS: list[str]
+
+def validate_layer(layer: dict[str, Any]) -> None: ...
+def validate_laminate(laminate: dict[str, Any]) -> None: ...
+def laminate_properties(laminate: dict[str, Any]) -> dict[str, float]: ...
+def equivalent_panel(laminate: dict[str, Any], panel: dict[str, float]) -> dict[str, float]: ...
+def materials() -> list[dict[str, Any]]: ...
+def conduction_grid(
+    panel: dict[str, float], layup: dict[str, Any] | None, nodes: int
+) -> dict[str, Any]: ...
+def layered_steady_state(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    coupled: bool = True,
+    flux: float = 1.0,
+) -> dict[str, Any]: ...
+def layered_flutter(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    model: str,
+    coupled: bool,
+    flux: float,
+    with_critical: bool = True,
+) -> dict[str, Any]: ...
+def simulate_layers(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    orbit: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    model: str,
+    coupled: bool,
+    solver: dict[str, Any],
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: list[float] | None,
+) -> dict[str, Any]: ...

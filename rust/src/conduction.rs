@@ -50,6 +50,9 @@ pub struct Conduction {
     pub radiation_back: f64,
     /// Index of the layer of each element.
     pub element_layer: Vec<usize>,
+    /// Built by [`Conduction::homogeneous`] with two nodes: eq. 2 itself, whose steady state is
+    /// [`crate::steady::equilibrium`]'s.
+    pub two_layer: bool,
 }
 
 /// How many elements each layer gets out of `elements` (at least one each): each further element
@@ -139,6 +142,7 @@ impl Conduction {
             radiation_front: STEFAN_BOLTZMANN * panel.emissivity_front,
             radiation_back: STEFAN_BOLTZMANN * panel.emissivity_back,
             element_layer,
+            two_layer: false,
         })
     }
 
@@ -177,6 +181,7 @@ impl Conduction {
         // A homogeneous plate bends with the gradient only: no reference temperature.
         c.moment_offset = 0.0;
         c.moment_total = 0.0;
+        c.two_layer = nodes == 2;
         Ok(c)
     }
 

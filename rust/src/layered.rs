@@ -507,6 +507,17 @@ pub fn equilibrium(
     flux: f64,
 ) -> Result<LayeredEquilibrium> {
     let n = c.nodes();
+    if c.two_layer {
+        // Two nodes on a plain panel are eq. 2: the same steady state to the bit, so that a run
+        // from it is the two-layer run.
+        let eq = crate::steady::equilibrium(panel, coupling, flux)?;
+        let temperatures = vec![eq.t_front, eq.t_back];
+        return Ok(LayeredEquilibrium {
+            moment: c.moment(&temperatures),
+            temperatures,
+            theta: eq.theta,
+        });
+    }
     let profile = c.steady_profile(flux)?;
     let k_el = panel.hinge_stiffness;
     let mut x = DVector::zeros(n + 1);
@@ -620,6 +631,10 @@ pub fn jacobian(
 #[derive(Debug, Clone, PartialEq)]
 pub struct LayeredFlutter {
     pub equilibrium: LayeredEquilibrium,
+    /// ∂f/∂y at the equilibrium, state (node temperatures, θ, θ̇).
+    pub jacobian: DMatrix<f64>,
+    /// Its eigenvalues, 1/s, by decreasing real part.
+    pub eigenvalues: Vec<nalgebra::Complex<f64>>,
     /// Largest real part of the eigenvalues, 1/s.
     pub growth_rate: f64,
     /// Frequency of the fastest oscillatory pair, Hz.
@@ -634,15 +649,17 @@ pub fn analyse(
     flux: f64,
 ) -> Result<LayeredFlutter> {
     let eq = equilibrium(panel, c, coupling, flux)?;
-    let (growth_rate, frequency_hz) = growth(panel, c, model, coupling, flux, &eq)?;
+    let (growth_rate, frequency_hz, eigenvalues) = growth(panel, c, model, coupling, flux, &eq)?;
     Ok(LayeredFlutter {
+        jacobian: jacobian(panel, c, model, coupling, flux, &eq),
         equilibrium: eq,
+        eigenvalues,
         growth_rate,
         frequency_hz,
     })
 }
 
-/// (growth rate, frequency) of the Jacobian at `eq`.
+/// (growth rate, frequency, eigenvalues by decreasing real part) of the Jacobian at `eq`.
 fn growth(
     panel: &Panel,
     c: &Conduction,
@@ -650,7 +667,7 @@ fn growth(
     coupling: Coupling,
     flux: f64,
     eq: &LayeredEquilibrium,
-) -> Result<(f64, f64)> {
+) -> Result<(f64, f64, Vec<nalgebra::Complex<f64>>)> {
     let n = c.nodes();
     let jac = jacobian(panel, c, model, coupling, flux, eq);
     // Balance kelvin rows against radian rows (a diagonal similarity keeps the eigenvalues).
@@ -666,9 +683,10 @@ fn growth(
             reason: "non-finite result".into(),
         });
     }
-    let growth = ev.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    let mut ev: Vec<_> = ev.iter().copied().collect();
+    ev.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
     let omega = ev.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
-    Ok((growth, omega / (2.0 * std::f64::consts::PI)))
+    Ok((ev[0].re, omega / (2.0 * std::f64::consts::PI), ev))
 }
 
 /// The damping c_d (N m s/rad) at which the growth rate crosses zero (bisection); 0 when the

@@ -1,6 +1,8 @@
 //! Bindings of the laminate layups and the N-node through-thickness model.
 
-use super::convert::{float_item, hinge_model, panel_from, type_error};
+use super::convert::{
+    float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
+};
 use super::error::{invalid, shield};
 use crate::conduction::Conduction;
 use crate::flutter::check_flux;
@@ -8,6 +10,7 @@ use crate::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::layered;
 use crate::params::Panel;
 use crate::system::Coupling;
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -72,25 +75,17 @@ pub fn laminate_from(d: &Bound<'_, PyDict>) -> PyResult<Laminate> {
     Ok(lam)
 }
 
-/// The layup of a panel: its own, or one homogeneous layer for a plain panel.
-pub fn layup_or_homogeneous(
-    panel: &Panel,
-    layup: Option<&Bound<'_, PyDict>>,
-) -> PyResult<Laminate> {
-    match layup {
-        Some(d) => laminate_from(d),
-        None => Ok(Laminate::homogeneous(panel)),
-    }
-}
-
-/// The conduction model of `panel` with `nodes` nodes through its layup.
+/// The conduction model of `panel` with `nodes` nodes through its layup, or through one
+/// homogeneous layer for a plain panel.
 pub fn conduction_from(
     panel: &Panel,
     layup: Option<&Bound<'_, PyDict>>,
     nodes: usize,
 ) -> PyResult<Conduction> {
-    let lam = layup_or_homogeneous(panel, layup)?;
-    Ok(Conduction::new(panel, &lam, nodes)?)
+    Ok(match layup {
+        Some(d) => Conduction::new(panel, &laminate_from(d)?, nodes)?,
+        None => Conduction::homogeneous(panel, nodes)?,
+    })
 }
 
 fn coupling(coupled: bool) -> Coupling {
@@ -99,6 +94,12 @@ fn coupling(coupled: bool) -> Coupling {
     } else {
         Coupling::Frozen
     }
+}
+
+/// Checks one layer mapping (errors name the layer and field).
+#[pyfunction]
+fn validate_layer(layer: &Bound<'_, PyAny>) -> PyResult<()> {
+    shield(|| Ok(layer_from(layer, 0)?.validate()?))
 }
 
 /// Checks a laminate mapping.
@@ -241,6 +242,13 @@ fn layered_flutter<'py>(
         d.set_item("thermal_moment", a.equilibrium.moment)?;
         d.set_item("growth_rate", a.growth_rate)?;
         d.set_item("frequency_hz", a.frequency_hz)?;
+        let size = a.jacobian.nrows();
+        let rows: Vec<Vec<f64>> = (0..size)
+            .map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect())
+            .collect();
+        d.set_item("jacobian", numpy::PyArray2::from_vec2(py, &rows)?)?;
+        let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
+        d.set_item("eigenvalues", ev)?;
         if with_critical {
             let cd = py.detach(|| layered::critical_damping(&p, &c, m, k, flux))?;
             d.set_item("critical_damping", cd)?;
@@ -249,8 +257,60 @@ fn layered_flutter<'py>(
     })
 }
 
+/// Integrates the N-node laminate coupled to the hinge; node temperatures as a (time × node)
+/// array.
+#[pyfunction]
+#[pyo3(signature = (panel, layup, nodes, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_layers<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    layup: Option<&Bound<'py, PyDict>>,
+    nodes: usize,
+    orbit: &Bound<'py, PyDict>,
+    t0: f64,
+    t1: f64,
+    model: &str,
+    coupled: bool,
+    solver: &Bound<'py, PyDict>,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    dt_out: Option<f64>,
+    y0: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let hinge = hinge_model(model)?;
+        let m = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        let c = conduction_from(&p, layup, nodes)?;
+        let depth = c.depth.clone();
+        let k = coupling(coupled);
+        let run = py
+            .detach(|| layered::simulate(&p, c, &o, hinge, k, &m, (t0, t1), y0.as_deref(), &out))?;
+        let n_t = run.t.len();
+        let d = PyDict::new(py);
+        let sunlit: Vec<f64> = run.t.iter().map(|&t| o.illumination(t)).collect();
+        let temps = PyArray1::from_vec(py, run.temperatures).reshape([n_t, nodes])?;
+        d.set_item("t", PyArray1::from_vec(py, run.t))?;
+        d.set_item("T_nodes", temps)?;
+        d.set_item("depth", PyArray1::from_vec(py, depth))?;
+        d.set_item("theta", PyArray1::from_vec(py, run.theta))?;
+        d.set_item("theta_dot", PyArray1::from_vec(py, run.theta_dot))?;
+        d.set_item("thermal_moment", PyArray1::from_vec(py, run.moment))?;
+        d.set_item("sunlit", PyArray1::from_vec(py, sunlit))?;
+        d.set_item("n_steps", run.stats.n_steps)?;
+        d.set_item("n_rejected", run.stats.n_rejected)?;
+        d.set_item("n_rhs", run.stats.n_rhs)?;
+        d.set_item("t_end", run.stats.t_end)?;
+        d.set_item("y_end", PyArray1::from_vec(py, run.y_end))?;
+        Ok(d)
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LAYER_FIELDS", LAYER_FIELDS.to_vec())?;
+    m.add_function(wrap_pyfunction!(validate_layer, m)?)?;
     m.add_function(wrap_pyfunction!(validate_laminate, m)?)?;
     m.add_function(wrap_pyfunction!(laminate_properties, m)?)?;
     m.add_function(wrap_pyfunction!(equivalent_panel, m)?)?;
@@ -258,5 +318,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(conduction_grid, m)?)?;
     m.add_function(wrap_pyfunction!(layered_steady_state, m)?)?;
     m.add_function(wrap_pyfunction!(layered_flutter, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_layers, m)?)?;
     Ok(())
 }
