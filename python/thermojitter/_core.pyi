@@ -127,6 +127,8 @@ def run_orbits(
     stop_at_limit: bool,
     steps_per_period: float,
     cancel: CancelToken | None = None,
+    layup: dict[str, Any] | None = None,
+    nodes: int | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---

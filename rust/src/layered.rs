@@ -22,7 +22,8 @@ use crate::integrate::{Dyn, OdeSystem, State};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::system::{Coupling, Sunlight};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::allocator::Allocator;
+use nalgebra::{Const, DMatrix, DVector, DefaultAllocator, Dim, SVector};
 
 /// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
 /// the hinge's angular frequency), and quasi-static above. See docs/laminates.md for the
@@ -215,6 +216,21 @@ impl Layered {
         };
     }
 
+    /// M_T of a state at illumination factor `flux` (before the projected area), N m.
+    pub fn moment_of(&self, flux: f64, y: &[f64]) -> f64 {
+        let m = self.thermal_size();
+        match &self.thermal {
+            Thermal::Nodal(_) => self.conduction.moment(&y[..m]),
+            Thermal::Modal(r) => {
+                let area = match self.coupling {
+                    Coupling::ProjectedArea => y[m].cos(),
+                    Coupling::Frozen => 1.0,
+                };
+                r.moment(&self.conduction, flux * area, &y[..m])
+            }
+        }
+    }
+
     /// Node temperatures of a state at illumination factor `flux` (front first).
     pub fn node_temperatures(&self, flux: f64, y: &[f64]) -> Vec<f64> {
         let m = self.thermal_size();
@@ -341,6 +357,15 @@ impl Reduced {
         moment
     }
 
+    fn moment(&self, c: &Conduction, flux: f64, amp: &[f64]) -> f64 {
+        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let mut moment = self.fast_moment[0] * b0 + self.fast_moment[1] * b1 - c.moment_offset;
+        for (m, a) in self.moment.iter().zip(amp) {
+            moment += m * a;
+        }
+        moment
+    }
+
     fn node_temperatures(&self, c: &Conduction, flux: f64, amp: &[f64]) -> Vec<f64> {
         let n = c.nodes();
         let (_, (b0, b1)) = self.faces(c, flux, amp);
@@ -407,6 +432,62 @@ impl OdeSystem<Dyn> for LayeredOrbit {
     }
 }
 
+/// The N-node system on a state whose size S is known at compile time: the integrator's
+/// vectors then live on the stack, with no allocation per evaluation (the run-time size `Dyn`
+/// allocates every intermediate vector, which costs more than the physics of a small state).
+struct Fixed<const S: usize>(LayeredOrbit);
+
+impl<const S: usize> OdeSystem<Const<S>> for Fixed<S> {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State<Const<S>>) -> State<Const<S>> {
+        let mut dy = SVector::<f64, S>::zeros();
+        self.0
+            .system
+            .rhs_at_flux(self.0.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        dy
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.0.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.0.enter_segment(a, b);
+    }
+}
+
+/// A state vector of dimension `D` from its components.
+fn state_of<D: Dim>(v: &[f64]) -> State<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    State::<D>::from_column_slice_generic(D::from_usize(v.len()), Const::<1>, v)
+}
+
+/// Calls `$run(system, state)` with the N-node system `$orb` on a compile-time state size when
+/// its size is one of the common ones (slow-mode models keep a few modes; nodal models have a
+/// few nodes), else on the run-time size.
+macro_rules! on_fastest_state {
+    ($orb:expr, $size:expr, $run:ident ( $($arg:expr),* )) => {
+        match $size {
+            3 => $run(&mut Fixed::<3>($orb), $($arg),*),
+            4 => $run(&mut Fixed::<4>($orb), $($arg),*),
+            5 => $run(&mut Fixed::<5>($orb), $($arg),*),
+            6 => $run(&mut Fixed::<6>($orb), $($arg),*),
+            7 => $run(&mut Fixed::<7>($orb), $($arg),*),
+            8 => $run(&mut Fixed::<8>($orb), $($arg),*),
+            9 => $run(&mut Fixed::<9>($orb), $($arg),*),
+            10 => $run(&mut Fixed::<10>($orb), $($arg),*),
+            11 => $run(&mut Fixed::<11>($orb), $($arg),*),
+            12 => $run(&mut Fixed::<12>($orb), $($arg),*),
+            13 => $run(&mut Fixed::<13>($orb), $($arg),*),
+            14 => $run(&mut Fixed::<14>($orb), $($arg),*),
+            16 => $run(&mut Fixed::<16>($orb), $($arg),*),
+            18 => $run(&mut Fixed::<18>($orb), $($arg),*),
+            22 => $run(&mut Fixed::<22>($orb), $($arg),*),
+            _ => { let mut dynamic = $orb; $run(&mut dynamic, $($arg),*) }
+        }
+    };
+}
+
 /// A sampled run of the N-node system, with the temperature of every node.
 #[derive(Debug, Clone)]
 pub struct LayeredRun {
@@ -462,31 +543,188 @@ pub fn simulate(
         }
     };
     let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
-    let y_start = DVector::from_vec(system.state_from_nodes(&start[..n], start[n], start[n + 1]));
-    let mut orb = LayeredOrbit::new(system, *orbit);
-    let traj = crate::simulate::run(&mut orb, method, t_span, y_start, output)?;
-    let sys = &orb.system;
-    let m = sys.thermal_size();
+    let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
+    let size = y_start.len();
+    let orb = LayeredOrbit::new(system.clone(), *orbit);
+    let (t, y, stats, y_end) = on_fastest_state!(
+        orb,
+        size,
+        sample_run(method, t_span, &y_start, output)
+    )?;
+    let m = system.thermal_size();
     let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
     let mut run = LayeredRun {
-        t: traj.t.clone(),
-        temperatures: Vec::with_capacity(traj.t.len() * n),
-        theta: traj.column(m),
-        theta_dot: traj.column(m + 1),
-        moment: Vec::with_capacity(traj.t.len()),
-        stats: traj.stats,
+        theta: y.iter().map(|v| v[m]).collect(),
+        theta_dot: y.iter().map(|v| v[m + 1]).collect(),
+        temperatures: Vec::with_capacity(t.len() * n),
+        moment: Vec::with_capacity(t.len()),
+        t,
+        stats,
         y_end: Vec::new(),
     };
-    for (t, y) in traj.t.iter().zip(&traj.y) {
-        let temps = sys.node_temperatures(area_free(*t), y.as_slice());
-        run.moment.push(sys.conduction.moment(&temps));
+    for (t, y) in run.t.iter().zip(&y) {
+        let temps = system.node_temperatures(area_free(*t), y);
+        run.moment.push(system.conduction.moment(&temps));
         run.temperatures.extend(temps);
     }
-    let mut end = sys.node_temperatures(area_free(traj.stats.t_end), traj.y_end.as_slice());
-    end.push(traj.y_end[m]);
-    end.push(traj.y_end[m + 1]);
+    let mut end = system.node_temperatures(area_free(stats.t_end), &y_end);
+    end.push(y_end[m]);
+    end.push(y_end[m + 1]);
     run.y_end = end;
     Ok(run)
+}
+
+/// Samples of one run of `system`: times, states, counters and the end state.
+type Samples = (Vec<f64>, Vec<Vec<f64>>, crate::integrate::Stats, Vec<f64>);
+
+fn sample_run<D: Dim, S: OdeSystem<D>>(
+    system: &mut S,
+    method: &crate::integrate::Method,
+    t_span: (f64, f64),
+    y0: &[f64],
+    output: &crate::simulate::Output,
+) -> Result<Samples>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let traj = crate::simulate::run(system, method, t_span, state_of::<D>(y0), output)?;
+    let y = traj.y.iter().map(|v| v.as_slice().to_vec()).collect();
+    Ok((traj.t, y, traj.stats, traj.y_end.as_slice().to_vec()))
+}
+
+/// The summaries' view of the N-node system.
+struct LayeredView {
+    system: Layered,
+    panel: Panel,
+    orbit: Orbit,
+    coupling: Coupling,
+}
+
+impl crate::summary::SummaryView for LayeredView {
+    fn theta_eq(&self, flux: f64) -> Result<f64> {
+        Ok(equilibrium(&self.panel, &self.system.conduction, self.coupling, flux)?.theta)
+    }
+    fn angles(&self, t: f64, y: &[f64]) -> (f64, f64) {
+        let flux = self.orbit.illumination(t) * self.orbit.flux_scale(t);
+        let theta = y[self.system.thermal_size()];
+        (
+            theta,
+            self.system.moment_of(flux, y) / self.panel.hinge_stiffness,
+        )
+    }
+}
+
+/// Per-orbit summaries of the N-node system (as [`crate::summary::run_orbits`]), from `y0` =
+/// (node temperatures, θ, θ̇); the end state is returned in the same form.
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits(
+    panel: &Panel,
+    conduction: Conduction,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &crate::integrate::Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: &[f64],
+    options: crate::summary::SummaryOptions,
+    cancel: &crate::cancel::Cancel,
+) -> Result<LayeredSummaries> {
+    let n = conduction.nodes();
+    check_start(y0, n)?;
+    let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
+    let m = system.thermal_size();
+    let start = system.state_from_nodes(&y0[..n], y0[n], y0[n + 1]);
+    let view = LayeredView {
+        system: system.clone(),
+        panel: *panel,
+        orbit: *orbit,
+        coupling,
+    };
+    let orb = LayeredOrbit::new(system.clone(), *orbit);
+    let size = start.len();
+    let args = (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel);
+    let mut run = on_fastest_state!(orb, size, summarised_run(&start, m, args))?;
+    let t_end = run.stats.t_end;
+    let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);
+    let mut end = system.node_temperatures(flux, &run.y_end);
+    end.push(run.y_end[m]);
+    end.push(run.y_end[m + 1]);
+    run.y_end = end;
+    Ok(run)
+}
+
+/// The summarised run's settings, passed through the size dispatch.
+type SummaryArgs<'a> = (
+    LayeredView,
+    &'a Panel,
+    &'a Orbit,
+    &'a crate::integrate::Method,
+    f64,
+    u64,
+    u64,
+    crate::summary::SummaryOptions,
+    &'a crate::cancel::Cancel,
+);
+
+/// Per-orbit summaries of the N-node system, the end state as a plain vector.
+pub struct LayeredSummaries {
+    pub summaries: Vec<crate::summary::OrbitSummary>,
+    pub stats: crate::integrate::Stats,
+    /// Node temperatures, θ, θ̇.
+    pub y_end: Vec<f64>,
+    pub crossing: Option<crate::summary::LimitCrossing>,
+}
+
+fn summarised_run<D: Dim, S: OdeSystem<D>>(
+    system: &mut S,
+    y0: &[f64],
+    theta_index: usize,
+    args: SummaryArgs<'_>,
+) -> Result<LayeredSummaries>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel) = args;
+    let run = crate::summary::run_summarised(
+        system,
+        view,
+        panel,
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        state_of::<D>(y0),
+        theta_index,
+        options,
+        cancel,
+    )?;
+    Ok(LayeredSummaries {
+        summaries: run.summaries,
+        stats: run.stats,
+        y_end: run.y_end.as_slice().to_vec(),
+        crossing: run.crossing,
+    })
+}
+
+/// Checks a start state of node temperatures, θ and θ̇.
+fn check_start(v: &[f64], n: usize) -> Result<()> {
+    if v.len() != n + 2 {
+        return Err(Error::invalid(
+            "y0",
+            format!("{} components", v.len()),
+            &format!(
+                "must hold the {n} node temperatures, θ and θ̇ ({} values)",
+                n + 2
+            ),
+        ));
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(Error::invalid("y0", x, "every component must be finite"));
+    }
+    Ok(())
 }
 
 /// The steady state of the coupled N-node system under a constant illumination factor: node
