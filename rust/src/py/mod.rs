@@ -3,6 +3,7 @@
 
 mod beam;
 mod convert;
+mod distributed;
 mod ensemble;
 mod flutter;
 mod longrun;
@@ -384,6 +385,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     longrun::register(m)?;
     beam::register(m)?;
+    distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
     Ok(())

@@ -1,0 +1,150 @@
+//! Bindings of the distributed panel: its settings, modes, and flutter analysis.
+
+use super::convert::panel_from;
+use super::to_py;
+use crate::distributed::{DistributedPanel, Settings, Support};
+use crate::flutter::check_flux;
+use crate::system::Coupling;
+use numpy::PyArray1;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::f64::consts::PI;
+
+/// A count setting (`elements`, `modes`) as usize, named in any error.
+fn count(name: &str, value: i64) -> PyResult<usize> {
+    usize::try_from(value).map_err(|_| {
+        PyValueError::new_err(format!("{name} = {value} is invalid: must be a positive integer"))
+    })
+}
+
+/// The model from a panel mapping and a settings mapping {support, elements, modes,
+/// damping_ratio (None: hinge-equivalent), sun_angle, coupled}.
+pub(super) fn model_from(
+    panel: &Bound<'_, PyDict>,
+    settings: &Bound<'_, PyDict>,
+) -> PyResult<DistributedPanel> {
+    let p = panel_from(panel)?;
+    let item = |key: &str| -> PyResult<Bound<'_, PyAny>> {
+        settings
+            .get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("{key} is missing")))
+    };
+    let typed = |key: &str, kind: &str| PyTypeError::new_err(format!("{key} must be {kind}"));
+    let support: String = item("support")?
+        .extract()
+        .map_err(|_| typed("support", "a string"))?;
+    let elements: i64 = item("elements")?
+        .extract()
+        .map_err(|_| typed("elements", "an integer"))?;
+    let modes: i64 = item("modes")?
+        .extract()
+        .map_err(|_| typed("modes", "an integer"))?;
+    let zeta: Option<f64> = item("damping_ratio")?
+        .extract()
+        .map_err(|_| typed("damping_ratio", "a number or None"))?;
+    let sun_angle: f64 = item("sun_angle")?
+        .extract()
+        .map_err(|_| typed("sun_angle", "a number"))?;
+    let coupled: bool = item("coupled")?
+        .extract()
+        .map_err(|_| typed("coupled", "a bool"))?;
+    let defaults = Settings::new(&p);
+    let s = Settings {
+        support: Support::from_name(&support).map_err(to_py)?,
+        elements: count("elements", elements)?,
+        modes: count("modes", modes)?,
+        damping_ratio: zeta.unwrap_or(defaults.damping_ratio),
+        sun_angle,
+        coupling: if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        },
+    };
+    DistributedPanel::new(&p, s).map_err(to_py)
+}
+
+/// What the model is: node and element positions, kept frequencies, the damping ratio in use,
+/// the defaults, and the mesh's first elastic frequency.
+#[pyfunction]
+fn distributed_info<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = model_from(panel, settings)?;
+    let mesh = &m.reduction.mesh;
+    let d = PyDict::new(py);
+    d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
+    d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
+    d.set_item(
+        "frequencies_hz",
+        PyArray1::from_vec(
+            py,
+            m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect(),
+        ),
+    )?;
+    d.set_item("damping_ratio", m.settings.damping_ratio)?;
+    d.set_item("arm", mesh.arm())?;
+    d.set_item("elastic_modes", mesh.elastic_modes())?;
+    Ok(d)
+}
+
+/// The defaults of the distributed model's settings.
+#[pyfunction]
+fn distributed_defaults(py: Python<'_>, panel: &Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
+    let p = panel_from(panel)?;
+    let s = Settings::new(&p);
+    let d = PyDict::new(py);
+    d.set_item("support", s.support.name())?;
+    d.set_item("elements", s.elements)?;
+    d.set_item("modes", s.modes)?;
+    d.set_item("damping_ratio", s.damping_ratio)?;
+    d.set_item("sun_angle", s.sun_angle)?;
+    Ok(d.unbind())
+}
+
+/// Eigen-analysis of the distributed panel at its sunlit equilibrium under flux factor `flux`.
+#[pyfunction]
+fn distributed_flutter<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    flux: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = model_from(panel, settings)?;
+    check_flux(flux).map_err(to_py)?;
+    let a = py.detach(|| m.flutter(flux)).map_err(to_py)?;
+    let n = m.n();
+    let d = PyDict::new(py);
+    d.set_item("T_front", PyArray1::from_vec(py, a.equilibrium[..n].to_vec()))?;
+    d.set_item(
+        "T_back",
+        PyArray1::from_vec(py, a.equilibrium[n..2 * n].to_vec()),
+    )?;
+    let (w, slope) = m.nodal(&a.equilibrium);
+    d.set_item("deflection", PyArray1::from_vec(py, w))?;
+    d.set_item("slope", PyArray1::from_vec(py, slope))?;
+    d.set_item("theta_f", a.theta_f)?;
+    let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
+    d.set_item("eigenvalues", ev)?;
+    d.set_item("growth_rate", a.growth_rate)?;
+    let modes: Vec<(f64, f64, usize)> = a
+        .modes
+        .iter()
+        .map(|o| (o.growth_rate, o.frequency_hz, o.structural_mode))
+        .collect();
+    d.set_item("modes", modes)?;
+    d.set_item("critical_damping_ratio", a.critical_damping_ratio)?;
+    d.set_item("critical_damping", a.critical_damping)?;
+    d.set_item("damping_ratio", m.settings.damping_ratio)?;
+    Ok(d)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_flutter, m)?)?;
+    Ok(())
+}
