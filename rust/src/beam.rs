@@ -16,7 +16,7 @@
 //! correction), so a slowly varying moment gives the exact static deflection.
 
 use crate::error::{require_finite, require_non_negative, Error, Result};
-use crate::integrate::{solve, Method, OdeSystem, Sampler, Stats};
+use crate::integrate::{solve, Const, Method, OdeSystem, Sampler, Stats};
 use crate::params::{beam_first_angular_frequency, Panel};
 use crate::simulate::Output;
 use crate::system::MomentHistory;
@@ -336,7 +336,7 @@ impl ModalBeam {
     }
 }
 
-impl OdeSystem<BEAM_STATE> for ModalBeam {
+impl OdeSystem<Const<BEAM_STATE>> for ModalBeam {
     #[inline]
     fn rhs(&self, t: f64, y: &SVector<f64, BEAM_STATE>) -> SVector<f64, BEAM_STATE> {
         let m = self.moment.at(t);
@@ -388,7 +388,7 @@ pub fn respond(
     let modes = beam.end_moment_modes()?;
     let mut system = ModalBeam::new(&modes, damping_ratio, moment);
     let y0 = system.static_state(system.moment.at(t0));
-    let mut sampler = Sampler::<BEAM_STATE>::new(times);
+    let mut sampler = Sampler::<Const<BEAM_STATE>>::new(times);
     let (stats, _) = solve(&mut system, method, t0, y0, t1, &mut sampler)?;
     let residual_flex = if residual {
         modes.residual_flexibility

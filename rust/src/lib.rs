@@ -21,6 +21,9 @@ pub mod summary;
 pub mod system;
 pub mod thermal;
 
+#[cfg(test)]
+mod recorded;
+
 #[cfg(feature = "python")]
 mod py;
 

@@ -10,7 +10,7 @@ use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
-use nalgebra::Vector4;
+use nalgebra::{Vector4, U4};
 use std::ops::ControlFlow;
 
 /// Points read per step (the step end and three interior points).
@@ -209,8 +209,8 @@ struct SummaryObserver {
     error: Option<crate::Error>,
 }
 
-impl Observer<4> for SummaryObserver {
-    fn on_step(&mut self, step: &DenseStep<4>) -> ControlFlow<()> {
+impl Observer<U4> for SummaryObserver {
+    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
         let h = (step.t1 - step.t0) / READS_PER_STEP as f64;
         for j in 1..=READS_PER_STEP {
             let t = if j == READS_PER_STEP {

@@ -7,7 +7,7 @@ use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
 use crate::thermal::{one_node_rate, two_layer_rates};
 use crate::STEFAN_BOLTZMANN;
-use nalgebra::{SVector, Vector1, Vector2, Vector4};
+use nalgebra::{SVector, Vector1, Vector2, Vector4, U1, U2, U4};
 
 /// How the hinge angle feeds back on the heating (paper Sec. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,7 +75,7 @@ impl OneNode {
     }
 }
 
-impl OdeSystem<1> for OneNode {
+impl OdeSystem<U1> for OneNode {
     #[inline]
     fn rhs(&self, t: f64, y: &Vector1<f64>) -> Vector1<f64> {
         Vector1::new(one_node_rate(&self.panel, self.sun.flux(t), y[0]))
@@ -104,7 +104,7 @@ impl TwoLayer {
     }
 }
 
-impl OdeSystem<2> for TwoLayer {
+impl OdeSystem<U2> for TwoLayer {
     #[inline]
     fn rhs(&self, t: f64, y: &Vector2<f64>) -> Vector2<f64> {
         let (df, db) = two_layer_rates(&self.panel, self.sun.flux(t), y[0], y[1]);
@@ -223,7 +223,7 @@ impl Coupled {
     }
 }
 
-impl OdeSystem<4> for Coupled {
+impl OdeSystem<U4> for Coupled {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &Vector4<f64>) -> Vector4<f64> {
         self.rhs_at_flux(self.sun.flux(t), y)
@@ -303,7 +303,7 @@ pub struct DrivenHinge {
     pub moment: MomentHistory,
 }
 
-impl OdeSystem<2> for DrivenHinge {
+impl OdeSystem<U2> for DrivenHinge {
     #[inline]
     fn rhs(&self, t: f64, y: &Vector2<f64>) -> Vector2<f64> {
         let m = self.moment.at(t);

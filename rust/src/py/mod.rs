@@ -16,7 +16,8 @@ use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling, DrivenHinge, MomentHistory, OneNode, TwoLayer};
 use crate::{dynamics::thermal_moment, Error};
 use convert::{hinge_model, orbit_from, output, panel_from, solver_from, state};
-use nalgebra::SVector;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, SVector};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -52,15 +53,18 @@ fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
 }
 
 /// Column `i` of a sampled trajectory.
-fn column<const N: usize>(traj: &Trajectory<N>, i: usize) -> Vec<f64> {
-    traj.y.iter().map(|y| y[i]).collect()
+fn column<D: Dim>(traj: &Trajectory<D>, i: usize) -> Vec<f64>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    traj.column(i)
 }
 
 /// The counters and end state common to every run.
-fn run_info<'py, const N: usize>(
-    py: Python<'py>,
-    traj: &Trajectory<N>,
-) -> PyResult<Bound<'py, PyDict>> {
+fn run_info<'py, D: Dim>(py: Python<'py>, traj: &Trajectory<D>) -> PyResult<Bound<'py, PyDict>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let d = PyDict::new(py);
     d.set_item(intern!(py, "t"), array(py, traj.t.clone()))?;
     d.set_item(intern!(py, "n_steps"), traj.stats.n_steps)?;
