@@ -161,7 +161,6 @@ class DistributedSolution(_Run):
             attrs={
                 "method": self.method,
                 "support": self.support,
-                "damping_ratio": self.damping_ratio,
                 **{k: str(v) for k, v in self.settings.items()},
             },
         )
@@ -223,7 +222,13 @@ def simulate_distributed(
         n_rejected=int(raw["n_rejected"]),
         n_rhs=int(raw["n_rhs"]),
         method=method,
-        settings={**settings, "rtol": rtol, "atol": atol, "dt": dt},
+        settings={
+            **settings,
+            "damping_ratio": float(raw["damping_ratio"]),
+            "rtol": rtol,
+            "atol": atol,
+            "dt": dt,
+        },
         x=raw["x"],
         x_node=raw["x_node"],
         T_front=raw["T_front"],

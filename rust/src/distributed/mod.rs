@@ -18,6 +18,7 @@
 //! few degrees along it) and the rigid-body attitude dynamics of a free panel, whose attitude the
 //! spacecraft holds (the rigid modes receive no thermal load).
 
+pub mod run;
 pub mod structure;
 
 use crate::dynamics::thermal_moment;
@@ -150,20 +151,10 @@ impl DistributedPanel {
     }
 
     /// Per-element chord slopes ρ = D Φ q + D R M.
-    fn slopes(&self, q: &[f64], moments: &[f64]) -> Vec<f64> {
+    fn slopes(&self, q: &[f64], moments: &[f64]) -> DVector<f64> {
         let r = &self.reduction;
-        let n = self.n();
-        let mut rho = vec![0.0; n];
-        for (e, out) in rho.iter_mut().enumerate() {
-            let mut acc = 0.0;
-            for (i, qi) in q.iter().enumerate() {
-                acc += r.slope_modal[(e, i)] * qi;
-            }
-            for (j, mj) in moments.iter().enumerate() {
-                acc += r.slope_residual[(e, j)] * mj;
-            }
-            *out = acc;
-        }
+        let mut rho = &r.slope_residual * DVector::from_column_slice(moments);
+        rho.gemv(1.0, &r.slope_modal, &DVector::from_column_slice(q), 1.0);
         rho
     }
 
@@ -184,7 +175,7 @@ impl DistributedPanel {
         let q = &y[2 * n..2 * n + k];
         let v = &y[2 * n + k..];
         let areas = match self.settings.coupling {
-            Coupling::ProjectedArea => self.areas(&self.slopes(q, &moments)),
+            Coupling::ProjectedArea => self.areas(self.slopes(q, &moments).as_slice()),
             Coupling::Frozen => self.areas(&vec![0.0; n]),
         };
         for e in 0..n {
@@ -192,15 +183,12 @@ impl DistributedPanel {
             dy[e] = df;
             dy[n + e] = db;
         }
+        let force = &r.force * DVector::from_column_slice(&moments);
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
-            let mut force = 0.0;
-            for (e, m) in moments.iter().enumerate() {
-                force += r.force[(i, e)] * m;
-            }
             let w = r.omega[i];
             dy[2 * n + i] = v[i];
-            dy[2 * n + k + i] = force - 2.0 * zeta * w * v[i] - w * w * q[i];
+            dy[2 * n + k + i] = force[i] - 2.0 * zeta * w * v[i] - w * w * q[i];
         }
     }
 

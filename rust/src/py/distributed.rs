@@ -1,11 +1,11 @@
 //! Bindings of the distributed panel: its settings, modes, and flutter analysis.
 
-use super::convert::panel_from;
+use super::convert::{orbit_from, output, panel_from, solver_from};
 use super::to_py;
 use crate::distributed::{DistributedPanel, Settings, Support};
 use crate::flutter::check_flux;
 use crate::system::Coupling;
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -14,7 +14,9 @@ use std::f64::consts::PI;
 /// A count setting (`elements`, `modes`) as usize, named in any error.
 fn count(name: &str, value: i64) -> PyResult<usize> {
     usize::try_from(value).map_err(|_| {
-        PyValueError::new_err(format!("{name} = {value} is invalid: must be a positive integer"))
+        PyValueError::new_err(format!(
+            "{name} = {value} is invalid: must be a positive integer"
+        ))
     })
 }
 
@@ -118,7 +120,10 @@ fn distributed_flutter<'py>(
     let a = py.detach(|| m.flutter(flux)).map_err(to_py)?;
     let n = m.n();
     let d = PyDict::new(py);
-    d.set_item("T_front", PyArray1::from_vec(py, a.equilibrium[..n].to_vec()))?;
+    d.set_item(
+        "T_front",
+        PyArray1::from_vec(py, a.equilibrium[..n].to_vec()),
+    )?;
     d.set_item(
         "T_back",
         PyArray1::from_vec(py, a.equilibrium[n..2 * n].to_vec()),
@@ -142,7 +147,83 @@ fn distributed_flutter<'py>(
     Ok(d)
 }
 
+/// Rows of equal length as a 2-D array.
+fn matrix<'py>(
+    py: Python<'py>,
+    rows: &[Vec<f64>],
+    width: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    if rows.is_empty() {
+        return Ok(PyArray2::zeros(py, [0, width], false));
+    }
+    PyArray2::from_vec2(py, rows).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// Integrates the distributed panel on an orbit; fields sampled at the requested times.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, settings, t0, t1, *, solver, t_eval, dt_out, y0))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_distributed<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    t0: f64,
+    t1: f64,
+    solver: &Bound<'py, PyDict>,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    dt_out: Option<f64>,
+    y0: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = model_from(panel, settings)?;
+    let o = orbit_from(orbit)?;
+    let method = solver_from(solver)?;
+    let out = output(t_eval, dt_out, t0, t1)?;
+    let start = match y0 {
+        Some(v) => {
+            let v = v.as_array().to_vec();
+            if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                return Err(PyValueError::new_err(format!(
+                    "y0 is invalid: component {x} is not finite"
+                )));
+            }
+            Some(v)
+        }
+        None => None,
+    };
+    let r = py
+        .detach(|| crate::distributed::run::simulate(&m, o, &method, (t0, t1), start, &out))
+        .map_err(to_py)?;
+    let mesh = &m.reduction.mesh;
+    let (n, nodes) = (m.n(), m.n() + 1);
+    let d = PyDict::new(py);
+    d.set_item("t", PyArray1::from_vec(py, r.t))?;
+    d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
+    d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
+    d.set_item("T_front", matrix(py, &r.t_front, n)?)?;
+    d.set_item("T_back", matrix(py, &r.t_back, n)?)?;
+    d.set_item("thermal_moment", matrix(py, &r.moment, n)?)?;
+    d.set_item("deflection", matrix(py, &r.deflection, nodes)?)?;
+    d.set_item("slope", matrix(py, &r.slope, nodes)?)?;
+    d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
+    d.set_item("sunlit", PyArray1::from_vec(py, r.sunlit))?;
+    d.set_item("y_end", PyArray1::from_vec(py, r.y_end))?;
+    d.set_item("n_steps", r.stats.n_steps)?;
+    d.set_item("n_rejected", r.stats.n_rejected)?;
+    d.set_item("n_rhs", r.stats.n_rhs)?;
+    d.set_item(
+        "frequencies_hz",
+        PyArray1::from_vec(
+            py,
+            m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect(),
+        ),
+    )?;
+    d.set_item("damping_ratio", m.settings.damping_ratio)?;
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_flutter, m)?)?;
