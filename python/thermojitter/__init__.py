@@ -18,6 +18,7 @@ from thermojitter.distributed import (
     distributed_frequencies,
     simulate_distributed,
 )
+from thermojitter.errors import InternalError, ParameterError
 from thermojitter.flutter import (
     FlutterResult,
     LinearThermalResponse,
@@ -52,10 +53,12 @@ __all__ = [
     "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
+    "InternalError",
     "LinearThermalResponse",
     "Orbit",
     "OrbitSummaries",
     "Panel",
+    "ParameterError",
     "SensitivityResult",
     "Solution",
     "StabilityMap",

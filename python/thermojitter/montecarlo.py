@@ -33,6 +33,7 @@ from scipy import stats
 from scipy.stats import qmc
 
 from thermojitter import _core
+from thermojitter.errors import ParameterError
 from thermojitter.longrun import _fingerprint, _flatten
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
@@ -251,13 +252,16 @@ def _refuse_invalid(matrix: NDArray[np.float64], hint: str) -> None:
     if not bad:
         return
     by_name: dict[str, list[tuple[int, str]]] = {}
-    for row, message in bad:
-        by_name.setdefault(message.split(" ", 1)[0], []).append((row, message))
+    for row, name, message in bad:
+        by_name.setdefault(name, []).append((row, message))
     name, rows = next(iter(by_name.items()))
     row, message = rows[0]
-    raise ValueError(
-        f"{name}: {len(rows)} of {len(matrix)} samples are outside its valid range "
-        f"(sample {row}: {message}){hint}"
+    value = matrix[row, list(_core.PANEL_FIELDS).index(name)]
+    raise ParameterError(
+        name,
+        float(value),
+        message=f"{name}: {len(rows)} of {len(matrix)} samples are outside its valid range "
+        f"(sample {row}: {message}){hint}",
     )
 
 
