@@ -25,6 +25,7 @@ this module checks types, converts and presents.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -33,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import _Run
@@ -40,14 +42,6 @@ from thermojitter.simulate import Method, _check_inputs, _solver_args, _span
 
 Array = NDArray[np.float64]
 Support = Literal["free-free", "cantilever"]
-
-
-def _is_int(value: Any) -> bool:
-    return not isinstance(value, bool) and isinstance(value, (int, np.integer))
-
-
-def _is_real(value: Any) -> bool:
-    return not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
 
 
 def distributed_settings(
@@ -64,24 +58,22 @@ def distributed_settings(
     :func:`distributed_defaults`). The engine checks the values and names any bad one."""
     _check_inputs(panel)
     if not isinstance(support, str):
-        raise TypeError(f"support must be a string, not {type(support).__name__}")
+        raise TypeError(f"support must be a string, not {type_name(support)}")
     defaults = _core.distributed_defaults(panel.as_dict())
+    counts = {}
     for name, value in (("elements", elements), ("modes", modes)):
-        if value is not None and not _is_int(value):
-            raise TypeError(f"{name} must be an int, not {type(value).__name__}")
-    if damping_ratio is not None and not _is_real(damping_ratio):
-        raise TypeError(f"damping_ratio must be a number, not {type(damping_ratio).__name__}")
-    if not _is_real(sun_angle):
-        raise TypeError(f"sun_angle must be a number, not {type(sun_angle).__name__}")
-    if not isinstance(coupled, bool):
-        raise TypeError(f"coupled must be a bool, not {type(coupled).__name__}")
+        if value is None:
+            value = defaults[name]
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            raise TypeError(f"{name} must be an integer, not {type_name(value)}")
+        counts[name] = int(value)
     return {
         "support": support,
-        "elements": int(defaults["elements"] if elements is None else elements),
-        "modes": int(defaults["modes"] if modes is None else modes),
-        "damping_ratio": None if damping_ratio is None else float(damping_ratio),
-        "sun_angle": float(sun_angle),
-        "coupled": coupled,
+        "elements": counts["elements"],
+        "modes": counts["modes"],
+        "damping_ratio": None if damping_ratio is None else real("damping_ratio", damping_ratio),
+        "sun_angle": real("sun_angle", sun_angle),
+        "coupled": flag("coupled", coupled),
     }
 
 
@@ -325,8 +317,7 @@ def distributed_flutter(
         sun_angle=sun_angle,
         coupled=True,
     )
-    if not _is_real(flux):
-        raise TypeError(f"flux must be a number, not {type(flux).__name__}")
+    flux = real("flux", flux)
     pd = panel.as_dict()
     raw = _core.distributed_flutter(pd, settings, float(flux))
     info = _core.distributed_info(pd, settings)
@@ -363,3 +354,67 @@ def distributed_frequencies(
     bending frequency on its support)."""
     settings = distributed_settings(panel, support=support, elements=elements, modes=modes)
     return np.asarray(_core.distributed_info(panel.as_dict(), settings)["frequencies_hz"])
+
+
+@dataclass(frozen=True)
+class ConvergenceRow:
+    """One run of a convergence study: its setting, the largest difference of θ_f (rad) from
+    the next finer run and from the finest run, and its cost."""
+
+    elements: int
+    modes: int
+    max_change: float
+    max_error: float
+    n_steps: int
+
+
+def distributed_convergence(
+    panel: Panel,
+    orbit: Orbit,
+    *,
+    vary: Literal["elements", "modes"] = "elements",
+    values: Sequence[int] = (10, 20, 40, 80),
+    support: Support = "free-free",
+    elements: int | None = None,
+    modes: int | None = None,
+    t_span: Sequence[float] | None = None,
+    dt_out: float = 0.5,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+) -> tuple[list[ConvergenceRow], float]:
+    """θ_f through the eclipse as ``vary`` takes ``values`` (ascending), the other setting fixed
+    (default the engine's). Returns the rows and the observed order p from the last three runs,
+    p = log(|Δ₁| / |Δ₂|) / log(r), Δ the largest change between successive runs and r the ratio
+    of successive values (constant). ``t_span`` defaults to the first eclipse with 1200 s of
+    sunlight either side."""
+    from thermojitter.beam import eclipse_window
+
+    values = [int(v) for v in values]
+    if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:])):
+        raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")
+    span = eclipse_window(orbit) if t_span is None else _span(t_span)
+    runs = []
+    for v in values:
+        kw: dict[str, Any] = {"elements": elements, "modes": modes, vary: v}
+        runs.append(
+            simulate_distributed(
+                panel, orbit, span, support=support, dt_out=dt_out, rtol=rtol, atol=atol, **kw
+            )
+        )
+    finest = runs[-1].theta_f
+    rows = []
+    for i, (v, run) in enumerate(zip(values, runs)):
+        nxt = runs[i + 1].theta_f if i + 1 < len(runs) else run.theta_f
+        rows.append(
+            ConvergenceRow(
+                elements=int(run.settings["elements"]),
+                modes=int(run.settings["modes"]),
+                max_change=float(np.max(np.abs(nxt - run.theta_f))),
+                max_error=float(np.max(np.abs(finest - run.theta_f))),
+                n_steps=run.n_steps,
+            )
+        )
+    d1, d2 = rows[-3].max_change, rows[-2].max_change
+    ratio = values[-1] / values[-2]
+    order = math.log(d1 / d2) / math.log(ratio) if d1 > 0 and d2 > 0 else math.inf
+    return rows, order
