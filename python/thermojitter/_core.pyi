@@ -8,6 +8,7 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "CancelToken",
     "ConvergenceError",
     "EnsemblePool",
     "IntegrationError",
@@ -48,6 +49,14 @@ PANEL_FIELDS: list[str]
 STEFAN_BOLTZMANN: float
 
 class IntegrationError(RuntimeError): ...
+
+@final
+class CancelToken:
+    def __new__(cls) -> CancelToken: ...
+    def cancel(self) -> None: ...
+    @property
+    def cancelled(self) -> bool: ...
+
 class ConvergenceError(RuntimeError): ...
 
 def validate_panel(panel: dict[str, float]) -> None: ...
@@ -121,6 +130,7 @@ def run_orbits(
     theta_limit: float,
     stop_at_limit: bool,
     steps_per_period: float,
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---
@@ -204,4 +214,5 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
+        cancel: CancelToken | None = None,
     ) -> dict[str, Any]: ...

@@ -390,7 +390,7 @@ def distributed_convergence(
     from thermojitter.beam import eclipse_window
 
     values = [int(v) for v in values]
-    if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:])):
+    if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:], strict=False)):
         raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")
     span = eclipse_window(orbit) if t_span is None else _span(t_span)
     runs = []
@@ -403,7 +403,7 @@ def distributed_convergence(
         )
     finest = runs[-1].theta_f
     rows = []
-    for i, (v, run) in enumerate(zip(values, runs)):
+    for i, run in enumerate(runs):
         nxt = runs[i + 1].theta_f if i + 1 < len(runs) else run.theta_f
         rows.append(
             ConvergenceRow(

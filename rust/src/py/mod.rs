@@ -2,6 +2,7 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod beam;
+mod cancel;
 mod convert;
 mod distributed;
 mod ensemble;
@@ -386,5 +387,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
+    cancel::register(m)?;
     Ok(())
 }
