@@ -4,6 +4,7 @@
 mod beam;
 mod cancel;
 mod convert;
+mod distributed;
 mod ensemble;
 mod error;
 mod flutter;
@@ -383,6 +384,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     longrun::register(m)?;
     beam::register(m)?;
+    distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
     cancel::register(m)?;
