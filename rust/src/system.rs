@@ -23,8 +23,8 @@ pub enum Coupling {
 /// Illumination bookkeeping shared by every orbit-driven system: the segment being integrated
 /// decides s, so a step that ends on a shadow boundary sees the segment's own side.
 #[derive(Debug, Clone, Copy)]
-struct Sunlight {
-    orbit: Orbit,
+pub(crate) struct Sunlight {
+    pub(crate) orbit: Orbit,
     segment: (f64, f64),
     /// s over the current segment when it cannot change there: every segment of a cylindrical
     /// shadow, and the full-Sun and umbra segments of a penumbral one (the breakpoints include
@@ -33,7 +33,7 @@ struct Sunlight {
 }
 
 impl Sunlight {
-    fn new(orbit: Orbit) -> Self {
+    pub(crate) fn new(orbit: Orbit) -> Self {
         Sunlight {
             orbit,
             segment: (0.0, 0.0),
@@ -41,7 +41,7 @@ impl Sunlight {
         }
     }
 
-    fn enter(&mut self, a: f64, b: f64) {
+    pub(crate) fn enter(&mut self, a: f64, b: f64) {
         self.segment = (a, b);
         let mid = self.orbit.illumination_on(0.5 * (a + b), a, b);
         let varies = matches!(self.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
@@ -49,7 +49,7 @@ impl Sunlight {
     }
 
     #[inline]
-    fn flux(&self, t: f64) -> f64 {
+    pub(crate) fn flux(&self, t: f64) -> f64 {
         let s = match self.constant_s {
             Some(s) => s,
             None => {

@@ -2,7 +2,9 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod beam;
+mod cancel;
 mod convert;
+mod distributed;
 mod ensemble;
 mod error;
 mod flutter;
@@ -387,7 +389,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     longrun::register(m)?;
     beam::register(m)?;
+    distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
+    cancel::register(m)?;
     Ok(())
 }
