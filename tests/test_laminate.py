@@ -62,11 +62,15 @@ def test_lamination_theory_of_a_sandwich() -> None:
     t, c = 0.3e-3, 20e-3
     lam = tj.Laminate([face.layer(t), core.layer(c), face.layer(t)], 0.8, 0.8, 0.9)
     e = face.youngs_modulus
-    assert lam.bending_stiffness == pytest.approx(e * t * (c + t) ** 2 / 2 + e * t**3 / 6, rel=1e-12)
+    assert lam.bending_stiffness == pytest.approx(
+        e * t * (c + t) ** 2 / 2 + e * t**3 / 6, rel=1e-12
+    )
     assert lam.neutral_axis == pytest.approx(c / 2 + t, rel=1e-12)
     rho_h = 2 * face.density * t + core.density * c
     assert lam.mass_per_area == pytest.approx(rho_h, rel=1e-12)
-    assert lam.thermal_resistance == pytest.approx(2 * t / face.conductivity + c / core.conductivity)
+    assert lam.thermal_resistance == pytest.approx(
+        2 * t / face.conductivity + c / core.conductivity
+    )
 
 
 def test_from_laminate_gives_the_layup_its_panel() -> None:
@@ -117,7 +121,9 @@ def test_node_temperatures_over_time_and_depth() -> None:
     assert ds["T_nodes"].dims == ("t", "node") and ds["depth"].size == 20
     # Restart from the end state: same continuation.
     again = tj.simulate(p, GEO, (t0 + 400.0, t0 + 500.0), layers=20, y0=sol.y_end, dt_out=50.0)
-    assert again.T_nodes is not None and again.T_nodes[0] == pytest.approx(sol.T_nodes[-1], rel=1e-12)
+    assert again.T_nodes is not None and again.T_nodes[0] == pytest.approx(
+        sol.T_nodes[-1], rel=1e-12
+    )
 
 
 def test_layers_is_checked() -> None:

@@ -87,7 +87,12 @@ class Laminate:
                     f"layers[{i}] must be a thermojitter.Layer, not {type(layer).__name__}"
                 )
         object.__setattr__(self, "layers", layers)
-        for name in ("emissivity_front", "emissivity_back", "absorptivity", "reference_temperature"):
+        for name in (
+            "emissivity_front",
+            "emissivity_back",
+            "absorptivity",
+            "reference_temperature",
+        ):
             object.__setattr__(self, name, _number(name, getattr(self, name)))
         _core.validate_laminate(self.as_dict())
 

@@ -92,9 +92,13 @@ def _check_inputs(panel: Panel, orbit: Orbit | None = None) -> None:
 def check_layers(layers: Any) -> int:
     """``layers`` as a node count (an int >= 2; the engine checks it against the layup)."""
     if isinstance(layers, bool) or not isinstance(layers, (int, np.integer)):
-        raise TypeError(f"layers must be an int (nodes through the thickness), not {type(layers).__name__}")
+        raise TypeError(
+            f"layers must be an int (nodes through the thickness), not {type(layers).__name__}"
+        )
     if layers < 2:
-        raise ValueError(f"layers = {layers!r} is invalid: must be >= 2 (nodes through the thickness)")
+        raise ValueError(
+            f"layers = {layers!r} is invalid: must be >= 2 (nodes through the thickness)"
+        )
     return int(layers)
 
 

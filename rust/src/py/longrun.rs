@@ -7,6 +7,7 @@ use super::laminate::conduction_from;
 use crate::layered;
 use crate::summary::{run_orbits_cancellable as run, OrbitSummary, SummaryOptions};
 use crate::system::Coupling;
+use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -87,7 +88,7 @@ fn run_orbits<'py>(
                 }
             }
             None => {
-                let y = state::<4>(&y0)?;
+                let y = state(&y0, U4)?;
                 let run = py.detach(|| {
                     run(
                         &p,
