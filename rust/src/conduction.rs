@@ -19,6 +19,7 @@
 use crate::error::{Error, Result};
 use crate::laminate::{linear_moment, Laminate};
 use crate::params::Panel;
+use crate::thermal::ThermalModel;
 use crate::STEFAN_BOLTZMANN;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
@@ -206,22 +207,34 @@ impl Conduction {
         )
     }
 
-    /// dT/dt at every node (writes into `rate`).
-    pub fn rates(&self, flux: f64, t: &[f64], rate: &mut [f64]) {
+    /// Net heat flow into every node, W/m² (writes into `out`): the face inputs and conduction.
+    pub fn node_flows(&self, flux: f64, t: &[f64], out: &mut [f64]) {
         let n = self.nodes();
         let (qf, qb) = self.face_inputs(flux, t[0], t[n - 1]);
-        for r in rate.iter_mut() {
-            *r = 0.0;
-        }
-        rate[0] += qf;
-        rate[n - 1] += qb;
+        out.fill(0.0);
+        out[0] += qf;
+        out[n - 1] += qb;
         for e in 0..n - 1 {
             let q = self.conductance[e] * (t[e] - t[e + 1]);
-            rate[e] -= q;
-            rate[e + 1] += q;
+            out[e] -= q;
+            out[e + 1] += q;
         }
-        for (r, c) in rate.iter_mut().zip(&self.capacity) {
-            *r /= c;
+    }
+
+    /// The moment scale of [`ThermalModel`]: the moment per kelvin of a linear profile's
+    /// face-to-face difference, N m/K (χ a E I / d for a homogeneous plate); 1 if that is zero.
+    pub fn moment_per_face_kelvin(&self) -> f64 {
+        let d = self.depth[self.nodes() - 1];
+        let m: f64 = self
+            .moment_weight
+            .iter()
+            .zip(&self.depth)
+            .map(|(mu, s)| mu * (1.0 - s / d))
+            .sum();
+        if m != 0.0 && m.is_finite() {
+            m
+        } else {
+            1.0
         }
     }
 
@@ -318,6 +331,42 @@ impl Conduction {
             shapes,
             total_capacity: total,
         }
+    }
+}
+
+/// The nodal model as a thermal model of the engine's seam: temperatures front to back, the
+/// thermal moment as an equivalent face-to-face difference times
+/// [`Conduction::moment_per_face_kelvin`]. (Laminates through the Python API run on
+/// [`crate::layered`], which also removes the fast conduction modes.)
+impl ThermalModel for Conduction {
+    fn size(&self) -> usize {
+        self.nodes()
+    }
+    fn names(&self) -> Vec<String> {
+        let n = self.nodes();
+        (0..n)
+            .map(|i| match i {
+                0 => "T_front".to_string(),
+                i if i + 1 == n => "T_back".to_string(),
+                i => format!("T_{i}"),
+            })
+            .collect()
+    }
+    fn heat_flows(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
+        self.node_flows(flux, temps, out);
+    }
+    fn capacity(&self, i: usize) -> f64 {
+        self.capacity[i]
+    }
+    fn gradient(&self, temps: &[f64]) -> f64 {
+        self.moment(temps) / self.moment_per_face_kelvin()
+    }
+    fn moment_per_kelvin(&self) -> f64 {
+        self.moment_per_face_kelvin()
+    }
+    fn initial_guess(&self, flux: f64, out: &mut [f64]) {
+        let t = (self.absorbed * flux / (self.radiation_front + self.radiation_back)).powf(0.25);
+        out.fill(t);
     }
 }
 

@@ -546,11 +546,8 @@ pub fn simulate(
     let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
     let size = y_start.len();
     let orb = LayeredOrbit::new(system.clone(), *orbit);
-    let (t, y, stats, y_end) = on_fastest_state!(
-        orb,
-        size,
-        sample_run(method, t_span, &y_start, output)
-    )?;
+    let (t, y, stats, y_end) =
+        on_fastest_state!(orb, size, sample_run(method, t_span, &y_start, output))?;
     let m = system.thermal_size();
     let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
     let mut run = LayeredRun {
@@ -644,7 +641,17 @@ pub fn run_orbits(
     };
     let orb = LayeredOrbit::new(system.clone(), *orbit);
     let size = start.len();
-    let args = (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel);
+    let args = (
+        view,
+        panel,
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        options,
+        cancel,
+    );
     let mut run = on_fastest_state!(orb, size, summarised_run(&start, m, args))?;
     let t_end = run.stats.t_end;
     let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);
@@ -1264,5 +1271,58 @@ mod tests {
         println!("two nodes vs two layers over one GEO orbit: worst relative difference {worst:e}; steps {} vs {}", lay.stats.n_steps, two.stats.n_steps);
 
         assert!(worst < 1e-10, "{worst}");
+    }
+
+    #[test]
+    fn the_seams_coupled_system_runs_the_nodal_model_alike() {
+        // The N-node model registered as a thermal model of the seam (thermal::model) and run by
+        // its generic coupled system agrees with this module's nodal system.
+        use crate::dynamics::Hinge;
+        use crate::integrate::{Dyn, Method, Tolerances};
+        use crate::simulate::{run, Output};
+        use crate::system::Coupled as Generic;
+        let p = Panel::paper();
+        let o = Orbit::geo_equinox();
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let nodes = 7;
+        let thermal = crate::thermal::model(&p, nodes as u32).unwrap();
+        let mut generic =
+            Generic::compose(thermal, Hinge::new(&p, model), o, coupling, Dyn(nodes + 2)).unwrap();
+        let eq = equilibrium(
+            &p,
+            &Conduction::homogeneous(&p, nodes).unwrap(),
+            coupling,
+            1.0,
+        )
+        .unwrap();
+        let mut start = eq.temperatures.clone();
+        start.extend([eq.theta, 0.0]);
+        let method = Method::Dopri5(Tolerances::default());
+        let (entry, _) = o.shadow_intervals(0.0, o.period)[0];
+        let span = (entry - 100.0, entry + 900.0);
+        let out = Output::Every(50.0);
+        let c = Conduction::homogeneous(&p, nodes).unwrap();
+        let ours = simulate(
+            &p,
+            c,
+            &o,
+            model,
+            coupling,
+            &method,
+            span,
+            Some(&start),
+            &out,
+        )
+        .unwrap();
+        let theirs = run(&mut generic, &method, span, DVector::from_vec(start), &out).unwrap();
+        for (k, y) in theirs.y.iter().enumerate() {
+            assert!(
+                (ours.theta[k] - y[nodes]).abs() < 1e-7 * eq.theta.abs(),
+                "{k}"
+            );
+            for i in 0..nodes {
+                assert!((ours.temperatures[k * nodes + i] / y[i] - 1.0).abs() < 1e-9);
+            }
+        }
     }
 }

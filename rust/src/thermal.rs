@@ -19,7 +19,15 @@ pub fn model(panel: &Panel, layers: u32) -> Result<Box<dyn ThermalModel + Send +
     match layers {
         1 => Ok(Box::new(OneNode::new(panel))),
         2 => Ok(Box::new(TwoLayer::new(panel))),
-        other => Err(Error::invalid("layers", other, "must be 1 or 2")),
+        // N nodes through one homogeneous layer (the N-node conduction model).
+        n if n >= 3 && (n as usize) <= crate::conduction::MAX_NODES => Ok(Box::new(
+            crate::conduction::Conduction::homogeneous(panel, n as usize)?,
+        )),
+        other => Err(Error::invalid(
+            "layers",
+            other,
+            &format!("must be between 1 and {}", crate::conduction::MAX_NODES),
+        )),
     }
 }
 
