@@ -28,7 +28,7 @@ use nalgebra::{Const, DMatrix, DVector, DefaultAllocator, Dim, SVector};
 /// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
 /// the hinge's angular frequency), and quasi-static above. See docs/laminates.md for the
 /// measurement behind the value.
-pub const FAST_MODE_FACTOR: f64 = 20.0;
+pub const FAST_MODE_FACTOR: f64 = 2.0;
 
 /// The thermal coordinates of the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,6 +117,10 @@ pub struct Reduced {
     compliance: [[f64; 2]; 2],
     /// Moment of the fast modes per unit face input, Σ_fast (μᵀφ_k) φ_face / (C_tot λ_k).
     fast_moment: [f64; 2],
+    /// The same with λ_k², for the first-order lag: G = Σ_fast φ_face φ_faceᵀ / (C_tot λ_k²)
+    /// (K m² s/W) and Σ_fast (μᵀφ_k) φ_face / (C_tot λ_k²).
+    lag_compliance: [[f64; 2]; 2],
+    lag_moment: [f64; 2],
     /// Indices of the kept modes in `modes`.
     kept: Vec<usize>,
     /// The full modal basis (for initial states and node temperatures).
@@ -204,7 +208,9 @@ impl Layered {
         let moment_rate = match &self.thermal {
             Thermal::Nodal(r) => r.rates(flux * area, &y[..m], dy),
             Thermal::Modal(r) => {
-                r.rates_and_moment(&self.conduction, flux * area, &y[..m], dy)
+                let flux_rate = self.area_rate(sin, om) * flux;
+                r.evaluate(&self.conduction, flux * area, flux_rate, &y[..m], dy)
+                    .0
                     * self.inverse_inertia
             }
         };
@@ -216,17 +222,34 @@ impl Layered {
         };
     }
 
+    /// d(projected-area factor)/dt = −sin θ θ̇ with the two-way coupling, 0 when frozen.
+    #[inline]
+    fn area_rate(&self, sin: f64, theta_dot: f64) -> f64 {
+        match self.coupling {
+            Coupling::ProjectedArea => -sin * theta_dot,
+            Coupling::Frozen => 0.0,
+        }
+    }
+
+    /// (flux × area factor, its rate) in state y under the illumination factor `flux`.
+    fn flux_and_rate(&self, flux: f64, y: &[f64]) -> (f64, f64) {
+        let m = self.thermal_size();
+        let (sin, cos) = sin_cos(y[m]);
+        let area = match self.coupling {
+            Coupling::ProjectedArea => cos,
+            Coupling::Frozen => 1.0,
+        };
+        (flux * area, flux * self.area_rate(sin, y[m + 1]))
+    }
+
     /// M_T of a state at illumination factor `flux` (before the projected area), N m.
     pub fn moment_of(&self, flux: f64, y: &[f64]) -> f64 {
         let m = self.thermal_size();
         match &self.thermal {
             Thermal::Nodal(_) => self.conduction.moment(&y[..m]),
             Thermal::Modal(r) => {
-                let area = match self.coupling {
-                    Coupling::ProjectedArea => sin_cos(y[m]).1,
-                    Coupling::Frozen => 1.0,
-                };
-                r.moment(&self.conduction, flux * area, &y[..m])
+                let (f, rate) = self.flux_and_rate(flux, y);
+                r.moment(&self.conduction, f, rate, &y[..m])
             }
         }
     }
@@ -237,11 +260,8 @@ impl Layered {
         match &self.thermal {
             Thermal::Nodal(_) => y[..m].to_vec(),
             Thermal::Modal(r) => {
-                let area = match self.coupling {
-                    Coupling::ProjectedArea => sin_cos(y[m]).1,
-                    Coupling::Frozen => 1.0,
-                };
-                r.node_temperatures(&self.conduction, flux * area, &y[..m])
+                let (f, rate) = self.flux_and_rate(flux, y);
+                r.node_temperatures(&self.conduction, f, rate, &y[..m])
             }
         }
     }
@@ -273,6 +293,8 @@ impl Reduced {
             moment: Vec::new(),
             compliance: [[0.0; 2]; 2],
             fast_moment: [0.0; 2],
+            lag_compliance: [[0.0; 2]; 2],
+            lag_moment: [0.0; 2],
             kept: Vec::new(),
             modes: modes.clone(),
         };
@@ -291,11 +313,14 @@ impl Reduced {
                 r.moment.push(mode_moment);
             } else {
                 let w = 1.0 / (total * lambda);
+                let w2 = w / lambda;
                 for i in 0..2 {
                     for j in 0..2 {
                         r.compliance[i][j] += face[i] * face[j] * w;
+                        r.lag_compliance[i][j] += face[i] * face[j] * w2;
                     }
                     r.fast_moment[i] += mode_moment * face[i] * w;
+                    r.lag_moment[i] += mode_moment * face[i] * w2;
                 }
             }
         }
@@ -346,37 +371,105 @@ impl Reduced {
         )
     }
 
-    /// Rates of the kept modes (into dy[..m]) and the thermal moment.
+    /// Rates of the kept modes (into dy[..m]) and the thermal moment, under the flux factor
+    /// `flux` (projected area included) changing at `flux_rate` (1/s).
+    ///
+    /// A fast mode k follows its forcing g_k = φ_kᵀ b / C_tot (b: the heat entering at the faces)
+    /// as q_k = g_k/λ_k − ġ_k/λ_k² + …: the first term is the quasi-static response, the second
+    /// its lag to first order, which is what lets a swinging panel pump energy through the
+    /// conduction (thermal flutter); without it the slaved modes would have no lag at all.
+    /// ḃ comes from the rate of the flux and of the face temperatures (the slow modes' rates
+    /// plus the fast modes' own F ḃ, a 2×2 solve); the lag's effect on ḃ is of the next order.
     #[inline]
-    fn rates_and_moment(&self, c: &Conduction, flux: f64, amp: &[f64], dy: &mut [f64]) -> f64 {
-        let (_, (b0, b1)) = self.faces(c, flux, amp);
-        let mut moment = self.fast_moment[0] * b0 + self.fast_moment[1] * b1 - c.moment_offset;
+    fn evaluate(
+        &self,
+        c: &Conduction,
+        flux: f64,
+        flux_rate: f64,
+        amp: &[f64],
+        dy: &mut [f64],
+    ) -> (f64, [f64; 2], [f64; 2]) {
+        let (u, (b0, b1)) = self.faces(c, flux, amp);
+        // Zero-order rates of the slow modes and of the faces they carry.
+        let mut slow_rate = [0.0, 0.0];
         for k in 0..amp.len() {
             dy[k] = -self.rates[k] * amp[k] + self.front[k] * b0 + self.back[k] * b1;
+            slow_rate[0] += self.front_shape[k] * dy[k];
+            slow_rate[1] += self.back_shape[k] * dy[k];
+        }
+        // u̇ = u̇_slow + F ḃ, ḃ = (α C ḟ − d₀ u̇₀, −d₁ u̇₁): (I + F D) u̇ = u̇_slow + F (α C ḟ, 0).
+        let f = &self.compliance;
+        let d = [
+            4.0 * c.radiation_front * u[0] * u[0] * u[0],
+            4.0 * c.radiation_back * u[1] * u[1] * u[1],
+        ];
+        let heating_rate = c.absorbed * flux_rate;
+        let rhs = [
+            slow_rate[0] + f[0][0] * heating_rate,
+            slow_rate[1] + f[1][0] * heating_rate,
+        ];
+        let j = [
+            [1.0 + f[0][0] * d[0], f[0][1] * d[1]],
+            [f[1][0] * d[0], 1.0 + f[1][1] * d[1]],
+        ];
+        let inv_det = 1.0 / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
+        let face_rate = [
+            (j[1][1] * rhs[0] - j[0][1] * rhs[1]) * inv_det,
+            (j[0][0] * rhs[1] - j[1][0] * rhs[0]) * inv_det,
+        ];
+        let b_rate = [heating_rate - d[0] * face_rate[0], -d[1] * face_rate[1]];
+        // The lag lowers the faces by G ḃ, which raises what they take in by d G ḃ.
+        let g = &self.lag_compliance;
+        let lag = [
+            g[0][0] * b_rate[0] + g[0][1] * b_rate[1],
+            g[1][0] * b_rate[0] + g[1][1] * b_rate[1],
+        ];
+        let b = [b0 + d[0] * lag[0], b1 + d[1] * lag[1]];
+        let mut moment = self.fast_moment[0] * b[0] + self.fast_moment[1] * b[1]
+            - (self.lag_moment[0] * b_rate[0] + self.lag_moment[1] * b_rate[1])
+            - c.moment_offset;
+        for k in 0..amp.len() {
+            dy[k] = -self.rates[k] * amp[k] + self.front[k] * b[0] + self.back[k] * b[1];
             moment += self.moment[k] * amp[k];
         }
-        moment
+        (moment, b, b_rate)
     }
 
-    fn moment(&self, c: &Conduction, flux: f64, amp: &[f64]) -> f64 {
-        let (_, (b0, b1)) = self.faces(c, flux, amp);
-        let mut moment = self.fast_moment[0] * b0 + self.fast_moment[1] * b1 - c.moment_offset;
-        for (m, a) in self.moment.iter().zip(amp) {
-            moment += m * a;
+    /// Runs `f` with a scratch slice of `m` rates (on the stack for the usual sizes).
+    fn with_scratch<R>(m: usize, f: impl FnOnce(&mut [f64]) -> R) -> R {
+        let mut stack = [0.0; 32];
+        if m <= stack.len() {
+            f(&mut stack[..m])
+        } else {
+            f(&mut vec![0.0; m])
         }
-        moment
     }
 
-    fn node_temperatures(&self, c: &Conduction, flux: f64, amp: &[f64]) -> Vec<f64> {
+    fn moment(&self, c: &Conduction, flux: f64, flux_rate: f64, amp: &[f64]) -> f64 {
+        Self::with_scratch(amp.len(), |dy| self.evaluate(c, flux, flux_rate, amp, dy).0)
+    }
+
+    fn node_temperatures(
+        &self,
+        c: &Conduction,
+        flux: f64,
+        flux_rate: f64,
+        amp: &[f64],
+    ) -> Vec<f64> {
         let n = c.nodes();
-        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let (_, b, b_rate) =
+            Self::with_scratch(amp.len(), |dy| self.evaluate(c, flux, flux_rate, amp, dy));
         let total = self.modes.total_capacity;
         let mut t = vec![0.0; n];
         for (k, &lambda) in self.modes.rates.iter().enumerate() {
             let phi = self.modes.shapes.column(k);
             let q = match self.kept.iter().position(|&j| j == k) {
                 Some(p) => amp[p],
-                None => (phi[0] * b0 + phi[n - 1] * b1) / (total * lambda),
+                None => {
+                    let g = (phi[0] * b[0] + phi[n - 1] * b[1]) / total;
+                    let g_rate = (phi[0] * b_rate[0] + phi[n - 1] * b_rate[1]) / total;
+                    (g - g_rate / lambda) / lambda
+                }
             };
             for i in 0..n {
                 t[i] += phi[i] * q;
@@ -1401,5 +1494,60 @@ mod tests {
             s.jitter_rms,
             eq.theta
         );
+    }
+
+    /// The growth rate of the reduced model (finite-difference Jacobian) for several cuts,
+    /// against the full nodal model's. `cargo test --release -- --ignored reduced_growth --nocapture`
+    #[test]
+    #[ignore]
+    fn reduced_growth_measurement() {
+        for (name, p, lam) in examples() {
+            let p = Panel { damping: 0.0, ..p };
+            let c = Conduction::new(&p, &lam, 20).unwrap();
+            let full =
+                analyse(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0).unwrap();
+            let eq = full.equilibrium.clone();
+            println!("{name}: full growth {:.6e}", full.growth_rate);
+            for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 1e9] {
+                let sys = Layered::new(
+                    &p,
+                    c.clone(),
+                    HingeModel::Nonlinear,
+                    Coupling::ProjectedArea,
+                    factor,
+                )
+                .unwrap();
+                let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+                let n = y.len();
+                let mut jac = DMatrix::zeros(n, n);
+                for j in 0..n {
+                    // θ and θ̇ enter through small terms: a step large enough to rise above
+                    // rounding (the right-hand side is smooth, the truncation error O(h²)).
+                    let h = if j + 2 >= n {
+                        1e-4
+                    } else {
+                        1e-6 * y[j].abs().max(1e-6)
+                    };
+                    let (mut yp, mut ym) = (y.clone(), y.clone());
+                    yp[j] += h;
+                    ym[j] -= h;
+                    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+                    sys.rhs_at_flux(1.0, &yp, &mut fp);
+                    sys.rhs_at_flux(1.0, &ym, &mut fm);
+                    for i in 0..n {
+                        jac[(i, j)] = (fp[i] - fm[i]) / (2.0 * h);
+                    }
+                }
+                let g = jac
+                    .complex_eigenvalues()
+                    .iter()
+                    .map(|z| z.re)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                println!(
+                    "  factor {factor:>6}: state {n:>2}, growth {g:.6e} ({:+.2e} relative)",
+                    g / full.growth_rate - 1.0
+                );
+            }
+        }
     }
 }
