@@ -52,19 +52,23 @@ def main() -> None:
     args = parser.parse_args()
     orbit = tj.Orbit.geo_equinox()
     print(f"CPU: {cpu_model()}; Python {platform.python_version()}")
-    print(f"one GEO orbit ({orbit.period:.0f} s), rk45 rtol 1e-8, atol 1e-10; median of {args.repeats}")
+    print(
+        f"one GEO orbit ({orbit.period:.0f} s), rk45 rtol 1e-8, atol 1e-10; median of {args.repeats}"
+    )
     print()
     print(f"| panel | run | model | wall s | steps | ns/step | x two-layer |")
     print(f"|---|---|---|---|---|---|---|")
     worst = 0.0
     for name, panel in (("CFRP wing", wing()), ("Al boom", boom())):
         runs: dict[str, Callable[[int | None], int]] = {
-            "simulate": lambda layers, p=panel: tj.simulate(
-                p, orbit, (0.0, orbit.period), layers=layers, t_eval=[orbit.period]
-            ).n_steps,
-            "simulate_orbits": lambda layers, p=panel: tj.simulate_orbits(
-                p, orbit, 1, layers=layers, progress=False
-            ).n_steps,
+            "simulate": lambda layers, p=panel: (
+                tj.simulate(
+                    p, orbit, (0.0, orbit.period), layers=layers, t_eval=[orbit.period]
+                ).n_steps
+            ),
+            "simulate_orbits": lambda layers, p=panel: (
+                tj.simulate_orbits(p, orbit, 1, layers=layers, progress=False).n_steps
+            ),
         }
         for run_name, run in runs.items():
             results = {}

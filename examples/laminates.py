@@ -45,17 +45,24 @@ def wing() -> tj.Panel:
 def boom() -> tj.Panel:
     """A 2 m strip of 1 mm aluminium 6061, painted (α 0.4, ε 0.8 on both sides)."""
     layup = tj.Laminate(
-        [mat.ALUMINIUM_6061.layer(1e-3)], emissivity_front=0.8, emissivity_back=0.8, absorptivity=0.4
+        [mat.ALUMINIUM_6061.layer(1e-3)],
+        emissivity_front=0.8,
+        emissivity_back=0.8,
+        absorptivity=0.4,
     )
     return with_damping(tj.Panel.from_laminate(layup, length=2.0))
 
 
 def compare(name: str, panel: tj.Panel, nodes: int) -> None:
     orbit = tj.Orbit.geo_equinox()
-    print(f"## {name}: {len(panel.layup.layers) if panel.layup else 1} layer(s), "
-          f"f_n = {tj.natural_frequency(panel):.3f} Hz, c_d = {panel.damping:.3g} N m s/rad")
+    print(
+        f"## {name}: {len(panel.layup.layers) if panel.layup else 1} layer(s), "
+        f"f_n = {tj.natural_frequency(panel):.3f} Hz, c_d = {panel.damping:.3g} N m s/rad"
+    )
     print()
-    print("| model | T_front K | T_back K | θ_eq rad | exit peak rad | jitter peak rad | jitter RMS rad | c_d* N m s/rad |")
+    print(
+        "| model | T_front K | T_back K | θ_eq rad | exit peak rad | jitter peak rad | jitter RMS rad | c_d* N m s/rad |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for layers in (None, nodes):
         eq = tj.flutter(panel, layers=layers)

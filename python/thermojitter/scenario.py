@@ -9,7 +9,8 @@ A scenario has four tables, each optional::
     preset = "geo_equinox"
 
     [simulation]   # t_start, t_end or orbits or years, model, coupled, method, rtol, atol, dt,
-                   # dt_out, keep ("samples" | "orbits"), theta_limit_deg, on_limit
+                   # dt_out, keep ("samples" | "orbits"), theta_limit_deg, on_limit,
+                   # layers (nodes through the thickness: the N-node model)
     orbits = 1
 
     [output]       # format = "csv" | "parquet", plots = true
@@ -92,6 +93,9 @@ class SimulationSettings:
     """With keep = "orbits": |θ| beyond which the hinge model is not trusted, deg."""
     on_limit: str = "stop"
     """With keep = "orbits": "stop" at the first crossing of theta_limit_deg, or "flag" it."""
+    layers: int | None = None
+    """Nodes through the thickness of the N-node model (one homogeneous layer for a [panel]);
+    None: the two-layer model."""
 
     def span(self, orbit: Orbit) -> tuple[float, float]:
         """(t0, t1) in s: t_end if given, else t_start + orbits · period (one orbit by default)."""
@@ -270,6 +274,14 @@ def _simulation(path: Path, table: dict[str, Any]) -> SimulationSettings:
             out[key] = _choice(path, s + key, value, ON_LIMIT)
         elif key in ("t_start", "t_end"):
             out[key] = _real(path, s + key, value)
+        elif key == "layers":
+            if isinstance(value, bool) or not isinstance(value, int) or value < 2:
+                raise ScenarioError(
+                    path,
+                    s + key,
+                    f"must be an integer >= 2 (nodes through the thickness), not {value!r}",
+                )
+            out[key] = value
         else:
             out[key] = _positive(path, s + key, value)
     given = [k for k in ("t_end", "orbits", "years") if k in out]

@@ -197,7 +197,7 @@ impl Conduction {
 
     /// Heat flowing into the two face nodes from outside, W/m²: absorbed minus emitted at the
     /// front (flux factor `flux` already includes the projected area), emitted at the back.
-    #[inline]
+    #[inline(always)]
     pub fn face_inputs(&self, flux: f64, t_front: f64, t_back: f64) -> (f64, f64) {
         let f4 = (t_front * t_front) * (t_front * t_front);
         let b4 = (t_back * t_back) * (t_back * t_back);

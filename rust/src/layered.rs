@@ -327,21 +327,21 @@ impl Reduced {
         r
     }
 
-    /// Face temperatures u = u_slow + F b(u) and face inputs b, by Newton's method.
-    #[inline]
-    fn faces(&self, c: &Conduction, flux: f64, amp: &[f64]) -> ([f64; 2], (f64, f64)) {
+    /// Face temperatures u = u_slow + F b(u), the face inputs b(u), and (I + F D)⁻¹ with
+    /// D = diag(4 σ ε u³) (the Jacobian of that equation, reused for the face rates).
+    ///
+    /// From the fast modes' response to the slow faces' inputs, u₁ = u_slow + F b(u_slow), one
+    /// Newton step. The fast modes' face compliance F is small against radiation (|F D| ≲ 0.05
+    /// for a honeycomb core, 1e-5 for aluminium), so u₁ is within ~1e-6 of the root and the
+    /// step lands within rounding of it (measured: a second step changes u by ~3e-16 of T).
+    #[inline(always)]
+    fn faces(&self, c: &Conduction, flux: f64, amp: &[f64]) -> ([f64; 2], [f64; 2], [[f64; 2]; 2]) {
         let mut slow = [0.0, 0.0];
         for ((a, f), b) in amp.iter().zip(&self.front_shape).zip(&self.back_shape) {
             slow[0] += f * a;
             slow[1] += b * a;
         }
         let f = &self.compliance;
-        // Start from the fast modes' response to the slow faces' inputs, then one Newton step
-        // on g(u) = u − slow − F b(u) (∂b/∂u = −diag(d)). The fast modes' face compliance is
-        // small against radiation (|F d| ≲ 0.05 for a honeycomb core, 1e-5 for aluminium), so
-        // the start is within ~1e-6 of the root and one step lands within rounding of it
-        // (measured: the next correction is ~3e-16 of T); b at the new point follows to the
-        // same order from its derivative.
         let b = c.face_inputs(flux, slow[0], slow[1]);
         let u = [
             slow[0] + f[0][0] * b.0 + f[0][1] * b.1,
@@ -356,19 +356,18 @@ impl Reduced {
             4.0 * c.radiation_front * u[0] * u[0] * u[0],
             4.0 * c.radiation_back * u[1] * u[1] * u[1],
         ];
-        let j = [
-            [1.0 + f[0][0] * d[0], f[0][1] * d[1]],
-            [f[1][0] * d[0], 1.0 + f[1][1] * d[1]],
+        let inv_det = 1.0
+            / ((1.0 + f[0][0] * d[0]) * (1.0 + f[1][1] * d[1]) - f[0][1] * d[1] * f[1][0] * d[0]);
+        let inverse = [
+            [(1.0 + f[1][1] * d[1]) * inv_det, -f[0][1] * d[1] * inv_det],
+            [-f[1][0] * d[0] * inv_det, (1.0 + f[0][0] * d[0]) * inv_det],
         ];
-        let inv_det = 1.0 / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
-        let du = [
-            (j[1][1] * g[0] - j[0][1] * g[1]) * inv_det,
-            (j[0][0] * g[1] - j[1][0] * g[0]) * inv_det,
+        let u = [
+            u[0] - (inverse[0][0] * g[0] + inverse[0][1] * g[1]),
+            u[1] - (inverse[1][0] * g[0] + inverse[1][1] * g[1]),
         ];
-        (
-            [u[0] - du[0], u[1] - du[1]],
-            (b.0 + d[0] * du[0], b.1 + d[1] * du[1]),
-        )
+        let b = c.face_inputs(flux, u[0], u[1]);
+        (u, [b.0, b.1], inverse)
     }
 
     /// Rates of the kept modes (into dy[..m]) and the thermal moment, under the flux factor
@@ -380,7 +379,7 @@ impl Reduced {
     /// conduction (thermal flutter); without it the slaved modes would have no lag at all.
     /// ḃ comes from the rate of the flux and of the face temperatures (the slow modes' rates
     /// plus the fast modes' own F ḃ, a 2×2 solve); the lag's effect on ḃ is of the next order.
-    #[inline]
+    #[inline(always)]
     fn evaluate(
         &self,
         c: &Conduction,
@@ -389,7 +388,7 @@ impl Reduced {
         amp: &[f64],
         dy: &mut [f64],
     ) -> (f64, [f64; 2], [f64; 2]) {
-        let (u, (b0, b1)) = self.faces(c, flux, amp);
+        let (u, [b0, b1], inverse) = self.faces(c, flux, amp);
         // Zero-order rates of the slow modes and of the faces they carry.
         let mut slow_rate = [0.0, 0.0];
         for k in 0..amp.len() {
@@ -397,7 +396,9 @@ impl Reduced {
             slow_rate[0] += self.front_shape[k] * dy[k];
             slow_rate[1] += self.back_shape[k] * dy[k];
         }
-        // u̇ = u̇_slow + F ḃ, ḃ = (α C ḟ − d₀ u̇₀, −d₁ u̇₁): (I + F D) u̇ = u̇_slow + F (α C ḟ, 0).
+        // u̇ = u̇_slow + F ḃ, ḃ = (α C ḟ − d₀ u̇₀, −d₁ u̇₁): (I + F D) u̇ = u̇_slow + F (α C ḟ, 0),
+        // with the faces' (I + F D)⁻¹ (taken at the slow faces: the difference is of the next
+        // order in this first-order term).
         let f = &self.compliance;
         let d = [
             4.0 * c.radiation_front * u[0] * u[0] * u[0],
@@ -408,14 +409,9 @@ impl Reduced {
             slow_rate[0] + f[0][0] * heating_rate,
             slow_rate[1] + f[1][0] * heating_rate,
         ];
-        let j = [
-            [1.0 + f[0][0] * d[0], f[0][1] * d[1]],
-            [f[1][0] * d[0], 1.0 + f[1][1] * d[1]],
-        ];
-        let inv_det = 1.0 / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
         let face_rate = [
-            (j[1][1] * rhs[0] - j[0][1] * rhs[1]) * inv_det,
-            (j[0][0] * rhs[1] - j[1][0] * rhs[0]) * inv_det,
+            inverse[0][0] * rhs[0] + inverse[0][1] * rhs[1],
+            inverse[1][0] * rhs[0] + inverse[1][1] * rhs[1],
         ];
         let b_rate = [heating_rate - d[0] * face_rate[0], -d[1] * face_rate[1]];
         // The lag lowers the faces by G ḃ, which raises what they take in by d G ḃ.
@@ -1548,6 +1544,52 @@ mod tests {
                     g / full.growth_rate - 1.0
                 );
             }
+        }
+    }
+
+    #[test]
+    #[ignore]
+    fn rhs_cost() {
+        use crate::integrate::OdeSystem;
+        for (name, p, lam) in examples() {
+            let c = Conduction::new(&p, &lam, 20).unwrap();
+            let sys = Layered::new(
+                &p,
+                c.clone(),
+                HingeModel::Nonlinear,
+                Coupling::ProjectedArea,
+                FAST_MODE_FACTOR,
+            )
+            .unwrap();
+            let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+            let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 1e-3);
+            let mut dy = vec![0.0; y.len()];
+            let n = 10_000_000;
+            let start = std::time::Instant::now();
+            let mut acc = 0.0;
+            for i in 0..n {
+                sys.rhs_at_flux(1.0 - (i & 1) as f64 * 1e-9, &y, &mut dy);
+                acc += dy[0];
+            }
+            let t1 = start.elapsed().as_secs_f64() / n as f64 * 1e9;
+            let two = Coupled::new(
+                p,
+                Orbit::geo_equinox(),
+                HingeModel::Nonlinear,
+                Coupling::ProjectedArea,
+            );
+            let y4 =
+                nalgebra::Vector4::new(eq.temperatures[0], eq.temperatures[19], eq.theta, 1e-3);
+            let start = std::time::Instant::now();
+            for i in 0..n {
+                let d = two.rhs(1.0 + (i & 1) as f64 * 1e-9, &y4);
+                acc += d[0];
+            }
+            let t2 = start.elapsed().as_secs_f64() / n as f64 * 1e9;
+            println!(
+                "{name}: state {} rhs {t1:.1} ns, two-layer rhs {t2:.1} ns ({acc:e})",
+                y.len()
+            );
         }
     }
 }

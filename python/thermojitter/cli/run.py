@@ -103,6 +103,7 @@ def simulate_scenario(
                 dt=sim.dt,
                 t_eval=t_eval,
                 y0=y0,
+                layers=sim.layers,
             )
             # the sample at b starts the next orbit's piece; only the last piece keeps its end
             keep = slice(None) if last else slice(0, len(inside))
@@ -173,6 +174,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         dt=sim.dt,
         theta_limit=math.radians(sim.theta_limit_deg),
         on_limit=sim.on_limit,  # type: ignore[arg-type]
+        layers=sim.layers,
         checkpoint=out / "checkpoint.json",
         progress=not args.no_progress,
         stop=STOP,
@@ -257,6 +259,7 @@ def run_command(args: argparse.Namespace) -> int:
             "atol": sim.atol,
             "dt": sim.dt,
             "dt_out": sim.dt_out,
+            "layers": sim.layers,
             **counters,
         },
         "shadow_intervals_s": [list(iv) for iv in intervals],
