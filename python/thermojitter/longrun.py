@@ -33,6 +33,12 @@ SUMMARY_FIELDS = (
 )  # fmt: skip
 """Columns of the per-orbit summaries (angles rad, times s; NaN where an orbit has no eclipse)."""
 
+HYBRID_COUNTERS = (
+    "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
+)  # fmt: skip
+"""How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
+integrator of the non-linear model and the hinge-resolved fallback."""
+
 DEFAULT_THETA_LIMIT = math.radians(20.0)
 """|θ| beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
 meant for modest angles)."""
@@ -60,6 +66,19 @@ class OrbitSummaries:
     interrupted: bool = False
     """True when Ctrl-C ended the run early; the columns hold the finished orbits."""
     settings: dict[str, Any] = field(default_factory=dict)
+    propagation: dict[str, float] = field(default_factory=dict)
+    """Hybrid runs: simulated time (s) by linear arcs (``t_linear``), by the non-linear model
+    (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
+    full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``)."""
+
+    @property
+    def nonlinear_fraction(self) -> float:
+        """Share of the simulated time integrated with the full non-linear model (1 unless hybrid)."""
+        p = self.propagation
+        if not p:
+            return 1.0
+        total = p["t_linear"] + p["t_exponential"] + p["t_fallback"]
+        return (p["t_exponential"] + p["t_fallback"]) / total if total > 0 else 0.0
 
     def __getattr__(self, name: str) -> NDArray[Any]:
         columns = self.__dict__.get("columns", {})
@@ -151,7 +170,7 @@ def simulate_orbits(
     t_start: float = 0.0,
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
-    method: Literal["rk45", "rk4"] = "rk45",
+    method: Literal["rk45", "rk4", "hybrid"] = "rk45",
     rtol: float = 1e-8,
     atol: float = 1e-10,
     dt: float | None = None,
@@ -166,6 +185,7 @@ def simulate_orbits(
     max_steps: int = 500_000_000,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
+    hybrid: dict[str, float] | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -233,10 +253,15 @@ def simulate_orbits(
         "orbits_per_call": orbits_per_call,
         "steps_per_period": float(steps_per_period),
     }
+    hybrid_settings = {k: float(v) for k, v in (hybrid or {}).items()}
+    if method == "hybrid":
+        settings["hybrid"] = hybrid_settings
     core_args: dict[str, Any] = {
         "model": model,
         "coupled": bool(coupled),
-        "solver": solver_settings(method, rtol, atol, dt, math.inf, max_steps),
+        "solver": solver_settings(
+            "rk45" if method == "hybrid" else method, rtol, atol, dt, math.inf, max_steps
+        ),
         "window": float(window),
         "theta_limit": float(theta_limit),
         "stop_at_limit": on_limit == "stop",
@@ -246,7 +271,9 @@ def simulate_orbits(
     columns = _empty_columns()
     y = [float(v) for v in y0]
     next_index = 0
-    counters = {"n_steps": 0, "n_rhs": 0}
+    counters: dict[str, Any] = {"n_steps": 0, "n_rhs": 0}
+    if method == "hybrid":
+        counters.update({name: 0 for name in HYBRID_COUNTERS})
     crossing: tuple[float, int, float] | None = None
     path = Path(checkpoint) if checkpoint is not None else None
     if path is not None:
@@ -266,7 +293,9 @@ def simulate_orbits(
             # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same places.
             count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
             t0 = float(t_start) + next_index * orbit.period
-            raw = _core.run_orbits(
+            run = _core.run_orbits_hybrid if method == "hybrid" else _core.run_orbits
+            extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
+            raw = run(
                 panel.as_dict(),
                 orbit.as_dict(),
                 t_start=t0,
@@ -274,12 +303,15 @@ def simulate_orbits(
                 n_orbits=count,
                 y0=y,
                 **core_args,
+                **extra,
             )
             for name in SUMMARY_FIELDS:
                 columns[name].extend(np.asarray(raw[name]).tolist())
             y = list(raw["y_end"])
             counters["n_steps"] += int(raw["n_steps"])
             counters["n_rhs"] += int(raw["n_rhs"])
+            for name in HYBRID_COUNTERS if method == "hybrid" else ():
+                counters[name] += raw[name]
             if crossing is None and raw["crossing"] is not None:
                 crossing = tuple(raw["crossing"])  # type: ignore[assignment]
             if raw["stopped"]:
@@ -310,6 +342,7 @@ def simulate_orbits(
         t_end=float(columns["t_end"][-1]) if columns["t_end"] else float(t_start),
         n_steps=counters["n_steps"],
         n_rhs=counters["n_rhs"],
+        propagation={k: counters[k] for k in HYBRID_COUNTERS if k in counters},
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,

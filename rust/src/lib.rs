@@ -10,6 +10,7 @@ pub mod dynamics;
 pub mod ensemble;
 pub mod error;
 pub mod flutter;
+pub mod hybrid;
 pub mod integrate;
 pub mod orbit;
 pub mod params;

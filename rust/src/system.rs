@@ -7,7 +7,7 @@ use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
 use crate::thermal::{one_node_rate, two_layer_rates};
 use crate::STEFAN_BOLTZMANN;
-use nalgebra::{SVector, Vector1, Vector2, Vector4};
+use nalgebra::{Matrix4, SVector, Vector1, Vector2, Vector4};
 
 /// How the hinge angle feeds back on the heating (paper Sec. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -217,6 +217,70 @@ impl Coupled {
         Vector4::new(dtf, dtb, om, acc)
     }
 
+    /// ∂f/∂y of [`Coupled::rhs_at_flux`] at any state (the exponential integrator of the hybrid
+    /// propagator linearises about the current state; [`crate::flutter::jacobian`] is its value at
+    /// the sunlit equilibrium).
+    pub fn jacobian_at_flux(&self, flux: f64, y: &Vector4<f64>) -> Matrix4<f64> {
+        let r = &self.rates;
+        let (tf, tb, th, om) = (y[0], y[1], y[2], y[3]);
+        let (sin, cos) = match (self.coupling, self.model) {
+            (Coupling::Frozen, HingeModel::Linear) => (0.0, 1.0),
+            _ => sin_cos(th),
+        };
+        let d_heating = match self.coupling {
+            Coupling::ProjectedArea => -r.heating * flux * sin,
+            Coupling::Frozen => 0.0,
+        };
+        let rad_f = 4.0 * r.radiation_front * tf * tf * tf;
+        let rad_b = 4.0 * r.radiation_back * tb * tb * tb;
+        let (a_tf, a_tb, a_th, a_om) = match self.model {
+            HingeModel::Linear => (r.moment, -r.moment, -r.stiffness, -r.damping),
+            HingeModel::Nonlinear => {
+                // acc = N / D with N = forced − 3 ω² s c, D = 1 + 3 s².
+                let inertia = 1.0 + 3.0 * sin * sin;
+                let forced = r.moment * (tf - tb) - r.damping * om - r.stiffness * th;
+                let n = forced - 3.0 * om * om * sin * cos;
+                let cos2 = cos * cos - sin * sin;
+                let dn_dth = -r.stiffness - 3.0 * om * om * cos2;
+                let dd_dth = 6.0 * sin * cos;
+                (
+                    r.moment / inertia,
+                    -r.moment / inertia,
+                    (dn_dth * inertia - n * dd_dth) / (inertia * inertia),
+                    (-r.damping - 6.0 * om * sin * cos) / inertia,
+                )
+            }
+        };
+        Matrix4::new(
+            -r.conduction - rad_f,
+            r.conduction,
+            d_heating,
+            0.0,
+            r.conduction,
+            -r.conduction - rad_b,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            a_tf,
+            a_tb,
+            a_th,
+            a_om,
+        )
+    }
+
+    /// ∂f/∂(flux) at state y: the absorbed flux only enters the front layer's heat balance.
+    pub fn flux_sensitivity(&self, y: &Vector4<f64>) -> Vector4<f64> {
+        Vector4::new(
+            self.rates.heating * Self::area_factor(self.coupling, y[2]),
+            0.0,
+            0.0,
+            0.0,
+        )
+    }
+
     /// Illumination factor (s × flux scale) inside the current segment at time t.
     pub fn flux_at(&self, t: f64) -> f64 {
         self.sun.flux(t)
@@ -332,6 +396,44 @@ pub fn state(t_front: f64, t_back: f64, theta: f64, theta_dot: f64) -> SVector<f
 mod tests {
     use super::*;
     use crate::dynamics::thermal_moment;
+
+    /// The analytic Jacobian away from any equilibrium (swinging, hot, cold) against central
+    /// differences of the right-hand side.
+    #[test]
+    fn jacobian_matches_finite_differences_anywhere() {
+        let panel = Panel::paper();
+        let states = [
+            Vector4::new(380.0, 368.0, 0.085, 0.0),
+            Vector4::new(250.0, 262.0, -0.3, 0.02),
+            Vector4::new(120.0, 119.0, 0.6, -0.7),
+        ];
+        for model in [HingeModel::Nonlinear, HingeModel::Linear] {
+            for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+                let sys = Coupled::new(panel, Orbit::geo_equinox(), model, coupling);
+                for y in &states {
+                    let jac = sys.jacobian_at_flux(0.9, y);
+                    for j in 0..4 {
+                        let h = 1e-6 * y[j].abs().max(1e-3);
+                        let (mut yp, mut ym) = (*y, *y);
+                        yp[j] += h;
+                        ym[j] -= h;
+                        let col = (sys.rhs_at_flux(0.9, &yp) - sys.rhs_at_flux(0.9, &ym)) / (2.0 * h);
+                        for i in 0..4 {
+                            let tol = 1e-6 * jac.column(j).amax().max(1e-9);
+                            assert!(
+                                (col[i] - jac[(i, j)]).abs() < tol,
+                                "{model:?} {coupling:?} {y} ({i},{j}): {} vs {}",
+                                col[i],
+                                jac[(i, j)]
+                            );
+                        }
+                    }
+                    let dflux = (sys.rhs_at_flux(0.9 + 1e-6, y) - sys.rhs_at_flux(0.9 - 1e-6, y)) / 2e-6;
+                    assert!((dflux - sys.flux_sensitivity(y)).amax() < 1e-6 * dflux.amax());
+                }
+            }
+        }
+    }
 
     /// The folded coefficients give the rates of the textbook form of the equations.
     #[test]

@@ -2,7 +2,8 @@
 
 use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
 use super::to_py;
-use crate::summary::{run_orbits as run, SummaryOptions};
+use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
+use crate::summary::{run_orbits as run, OrbitRun, SummaryOptions};
 use crate::system::Coupling;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -60,6 +61,13 @@ fn run_orbits<'py>(
             )
         })
         .map_err(to_py)?;
+    summary_dict(py, &out)
+}
+
+
+
+/// The summaries of a run as columns, with its counters.
+fn summary_dict<'py>(py: Python<'py>, out: &OrbitRun) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let col = |f: fn(&crate::summary::OrbitSummary) -> f64| -> Vec<f64> {
         out.summaries.iter().map(f).collect()
@@ -96,7 +104,89 @@ fn run_orbits<'py>(
     Ok(d)
 }
 
+/// Like `run_orbits`, with the hybrid propagator (the solver is the full integration it falls
+/// back to); adds how the simulated time was split between linear arcs, the exponential
+/// integrator and the fallback.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, hybrid))]
+#[allow(clippy::too_many_arguments)]
+fn run_orbits_hybrid<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    model: &str,
+    coupled: bool,
+    solver: &Bound<'py, PyDict>,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vec<f64>,
+    window: f64,
+    theta_limit: f64,
+    stop_at_limit: bool,
+    steps_per_period: f64,
+    hybrid: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = panel_from(panel)?;
+    let o = orbit_from(orbit)?;
+    let hinge = hinge_model(model)?;
+    let coupling = if coupled {
+        Coupling::ProjectedArea
+    } else {
+        Coupling::Frozen
+    };
+    let m = solver_from(solver)?;
+    let y = state::<4>(&y0)?;
+    let options = SummaryOptions {
+        window,
+        theta_limit,
+        stop_at_limit,
+        steps_per_period,
+    };
+    let settings = hybrid_from(hybrid)?;
+    let out = py
+        .detach(|| {
+            run_hybrid(
+                &p, &o, hinge, coupling, &m, t_start, first_index, n_orbits, y, options, &settings,
+            )
+        })
+        .map_err(to_py)?;
+    let d = summary_dict(py, &out.run)?;
+    d.set_item("t_linear", out.t_linear)?;
+    d.set_item("t_exponential", out.t_exponential)?;
+    d.set_item("t_fallback", out.t_fallback)?;
+    d.set_item("n_arcs", out.n_arcs)?;
+    d.set_item("n_exp_steps", out.n_exp_steps)?;
+    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+    Ok(d)
+}
+
+/// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
+pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
+    let mut s = HybridSettings::default();
+    for (key, value) in d.iter() {
+        let key: String = key.extract()?;
+        let v: f64 = value.extract()?;
+        match key.as_str() {
+            "rtol" => s.tolerances.rtol = v,
+            "atol_temperature" => s.tolerances.atol_temperature = v,
+            "atol_angle" => s.tolerances.atol_angle = v,
+            "max_step" => s.tolerances.max_step = v,
+            "linear_tolerance" => s.linear_tolerance = v,
+            "linear_amplitude" => s.linear_amplitude = v,
+            other => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "hybrid setting {other:?} is unknown"
+                )))
+            }
+        }
+    }
+    s.validate().map_err(to_py)?;
+    Ok(s)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_orbits, m)?)?;
+    m.add_function(wrap_pyfunction!(run_orbits_hybrid, m)?)?;
     Ok(())
 }

@@ -1,0 +1,527 @@
+//! The hybrid long-run propagator: the same per-orbit summaries as the hinge-resolved integration
+//! of [`crate::summary::run_orbits`], at a small fraction of the cost.
+//!
+//! Three regimes, chosen as the run goes:
+//!
+//! - **Linear arcs** (sunlit, near the equilibrium): the linearised system about the sunlit
+//!   equilibrium, with the Sun's slow distance drift as a forcing, propagated exactly in modal form
+//!   ([`linear`]), one arc per orbit at most; the summaries over the arc come from the closed form.
+//!   No numerical dissipation, so weak flutter grows at exactly the eigenvalue's rate.
+//! - **Exponential stretches** (shadow crossings and the thermal recovery after them): the full
+//!   non-linear model, integrated by the exponential Rosenbrock method [`exprb`], whose step is set
+//!   by the slow thermal non-linearity rather than the hinge period.
+//! - **Full integration** (the fallback): Dormand–Prince with the step capped at T_n/40, as
+//!   [`crate::summary::run_orbits`], for an orbit at a time, where the oscillation is too large for
+//!   the linearisation or the modal decomposition is ill-conditioned.
+//!
+//! The switch back to linear arcs is guarded by a measured criterion: the non-linear remainder
+//! r = f(y) − A (y − y_eq), expressed as the static angle error it would cause (|A⁻¹|_θ·|r|), must
+//! be below `linear_tolerance`, the oscillation below `linear_amplitude`, the plate in full Sun and
+//! past the last shadow exit by the summary window.
+
+pub mod expm;
+pub mod exprb;
+pub mod linear;
+
+use crate::dynamics::{thermal_moment, HingeModel};
+use crate::error::{require_positive, Error, Result};
+use crate::integrate::{solve, DenseStep, Method, OdeSystem, Stats};
+use crate::orbit::{Eclipse, Orbit};
+use crate::params::Panel;
+use crate::steady::equilibrium;
+use crate::summary::{
+    resolve_hinge, Collector, OrbitRun, SummaryObserver, SummaryOptions, STEPS_PER_HINGE_PERIOD,
+};
+use crate::system::{Coupled, Coupling};
+use exprb::{ExpStep, ExpTolerances};
+use linear::Arc;
+use nalgebra::Vector4;
+
+/// Settings of the hybrid propagator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HybridSettings {
+    /// Error control of the exponential stretches.
+    pub tolerances: ExpTolerances,
+    /// Largest non-linear remainder, as a static angle error (rad), at which the state is handed
+    /// back to linear propagation.
+    pub linear_tolerance: f64,
+    /// Largest oscillation amplitude |θ − θ_eq| (rad) propagated linearly; larger oscillations
+    /// are integrated in full.
+    pub linear_amplitude: f64,
+}
+
+impl Default for HybridSettings {
+    fn default() -> Self {
+        HybridSettings {
+            tolerances: ExpTolerances {
+                rtol: 1e-8,
+                atol_temperature: 1e-6,
+                atol_angle: 1e-10,
+                max_step: 60.0,
+            },
+            linear_tolerance: 1e-7,
+            linear_amplitude: 0.01,
+        }
+    }
+}
+
+impl HybridSettings {
+    pub fn validate(&self) -> Result<()> {
+        require_positive("hybrid.rtol", self.tolerances.rtol)?;
+        require_positive("hybrid.atol_temperature", self.tolerances.atol_temperature)?;
+        require_positive("hybrid.atol_angle", self.tolerances.atol_angle)?;
+        require_positive("hybrid.max_step", self.tolerances.max_step)?;
+        require_positive("hybrid.linear_tolerance", self.linear_tolerance)?;
+        require_positive("hybrid.linear_amplitude", self.linear_amplitude)
+    }
+}
+
+/// A hybrid run: the summaries and how the simulated time was split between the regimes.
+#[derive(Debug, Clone)]
+pub struct HybridRun {
+    pub run: OrbitRun,
+    /// Simulated time propagated by linear arcs, by the exponential integrator (full non-linear
+    /// model) and by the hinge-resolved fallback (full non-linear model), s.
+    pub t_linear: f64,
+    pub t_exponential: f64,
+    pub t_fallback: f64,
+    pub n_arcs: u64,
+    pub n_exp_steps: u64,
+    pub n_fallback_steps: u64,
+}
+
+/// What the state at a sunlit time allows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Regime {
+    Linear,
+    NonLinear,
+    Large,
+}
+
+struct Driver<'a> {
+    panel: Panel,
+    orbit: Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    settings: &'a HybridSettings,
+    fallback: Method,
+    system: Coupled,
+    obs: SummaryObserver,
+    t_start: f64,
+    t_end: f64,
+    t: f64,
+    y: Vector4<f64>,
+    h_exp: f64,
+    stats: Stats,
+    out: HybridRun,
+    /// Static θ per kelvin of gradient, rad/K.
+    theta_per_kelvin: f64,
+    /// Units of the state for the modal decomposition.
+    scale: Vector4<f64>,
+}
+
+/// Integrates orbits `first_index .. first_index + n_orbits` from (t_start, y0) with the hybrid
+/// propagator and summarises each orbit; `method` is the full integration used as the fallback.
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits_hybrid(
+    panel: &Panel,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vector4<f64>,
+    options: SummaryOptions,
+    settings: &HybridSettings,
+) -> Result<HybridRun> {
+    require_positive("window", options.window)?;
+    require_positive("theta_limit", options.theta_limit)?;
+    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    settings.validate()?;
+    panel.validate()?;
+    orbit.validate()?;
+    method.validate()?;
+    if n_orbits == 0 {
+        return Err(Error::invalid("n_orbits", 0, "must be >= 1"));
+    }
+    crate::error::require_finite("t_start", t_start)?;
+    if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
+        return Err(Error::invalid("y0", y0[i], "every component must be finite"));
+    }
+    let steps = if options.steps_per_period > 0.0 {
+        options.steps_per_period
+    } else {
+        STEPS_PER_HINGE_PERIOD
+    };
+    let collector = Collector::new(
+        panel,
+        orbit,
+        coupling,
+        options,
+        t_start,
+        first_index,
+        n_orbits,
+        &y0,
+    )?;
+    let t_end = t_start + n_orbits as f64 * orbit.period;
+    let t_ref = equilibrium(panel, coupling, orbit.flux_scale(t_start))
+        .map(|e| e.t_front)
+        .unwrap_or(300.0);
+    let wn = panel.natural_angular_frequency();
+    let mut d = Driver {
+        panel: *panel,
+        orbit: *orbit,
+        model,
+        coupling,
+        settings,
+        fallback: resolve_hinge(method, panel, steps),
+        system: Coupled::new(*panel, *orbit, model, coupling),
+        obs: SummaryObserver {
+            collector,
+            error: None,
+        },
+        t_start,
+        t_end,
+        t: t_start,
+        y: y0,
+        h_exp: 1.0,
+        stats: Stats {
+            t_end: t_start,
+            ..Stats::default()
+        },
+        out: HybridRun {
+            run: OrbitRun {
+                summaries: Vec::new(),
+                stats: Stats::default(),
+                y_end: y0,
+                crossing: None,
+            },
+            t_linear: 0.0,
+            t_exponential: 0.0,
+            t_fallback: 0.0,
+            n_arcs: 0,
+            n_exp_steps: 0,
+            n_fallback_steps: 0,
+        },
+        theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
+        scale: Vector4::new(1.0, 1.0, 1.0 / t_ref, wn / t_ref),
+    };
+    d.run()?;
+    let Driver {
+        mut obs,
+        mut out,
+        mut stats,
+        t,
+        y,
+        ..
+    } = d;
+    obs.collector.close();
+    stats.t_end = t;
+    stats.stopped = t < t_end && obs.collector.crossing.is_some();
+    out.run = OrbitRun {
+        summaries: obs.collector.done,
+        stats,
+        y_end: y,
+        crossing: obs.collector.crossing,
+    };
+    Ok(out)
+}
+
+impl Driver<'_> {
+    fn stopped(&self) -> bool {
+        self.obs.collector.options.stop_at_limit && self.obs.collector.crossing.is_some()
+    }
+
+    /// End of the orbit that holds (t, t + dt].
+    fn orbit_end(&self, t: f64) -> f64 {
+        let p = self.orbit.period;
+        let k = ((t - self.t_start) / p).floor();
+        let mut end = self.t_start + (k + 1.0) * p;
+        if end - t <= 1e-9 * p {
+            end += p;
+        }
+        end.min(self.t_end)
+    }
+
+    fn run(&mut self) -> Result<()> {
+        let mut fallback_until = f64::NEG_INFINITY;
+        while self.t < self.t_end && !self.stopped() {
+            if self.t < fallback_until {
+                self.full(fallback_until.min(self.t_end))?;
+                continue;
+            }
+            let horizon = (self.t + self.orbit.period).min(self.t_end);
+            let eclipses = self.orbit.eclipses(self.t, horizon);
+            let in_shadow = eclipses
+                .iter()
+                .any(|e| e.outer.0 <= self.t && self.t < e.outer.1);
+            if !in_shadow {
+                match self.regime(self.t, &self.y)? {
+                    Regime::Linear => {
+                        let next_contact = eclipses
+                            .iter()
+                            .map(|e| e.outer.0)
+                            .filter(|&c| c > self.t)
+                            .fold(f64::INFINITY, f64::min);
+                        let end = next_contact.min(self.orbit_end(self.t));
+                        match self.linear(end)? {
+                            None => {}
+                            Some(()) => fallback_until = self.t + self.orbit.period,
+                        }
+                        continue;
+                    }
+                    Regime::Large => {
+                        fallback_until = self.t + self.orbit.period;
+                        continue;
+                    }
+                    Regime::NonLinear => {}
+                }
+            }
+            if self.exponential(horizon, &eclipses)? {
+                fallback_until = self.t + self.orbit.period;
+            }
+        }
+        Ok(())
+    }
+
+    /// The sunlit equilibrium and Jacobian at the flux of time t.
+    fn reference(&self, flux: f64) -> Result<(Vector4<f64>, nalgebra::Matrix4<f64>)> {
+        let eq = equilibrium(&self.panel, self.coupling, flux)?;
+        let y_ref = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+        Ok((y_ref, self.system.jacobian_at_flux(flux, &y_ref)))
+    }
+
+    /// Amplitude of the hinge oscillation about the quasi-static deflection M_T/K_el, from the
+    /// dynamic part and its rate.
+    fn oscillation(&self, y: &Vector4<f64>, f: &Vector4<f64>) -> f64 {
+        let d = y[2] - self.theta_per_kelvin * (y[0] - y[1]);
+        let d_rate = y[3] - self.theta_per_kelvin * (f[0] - f[1]);
+        let s = y[2].sin();
+        let inertia = match self.model {
+            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
+            HingeModel::Linear => 1.0,
+        };
+        let w2 = self.panel.hinge_stiffness / (self.panel.hinge_inertia() * inertia);
+        (d * d + d_rate * d_rate / w2).sqrt()
+    }
+
+    /// May the state at sunlit time t be propagated linearly?
+    fn regime(&self, t: f64, y: &Vector4<f64>) -> Result<Regime> {
+        if self.orbit.illumination(t) < 1.0 {
+            return Ok(Regime::NonLinear);
+        }
+        let flux = self.orbit.flux_scale(t);
+        let f = self.system.rhs_at_flux(flux, y);
+        let (y_ref, a) = self.reference(flux)?;
+        let dev = y - y_ref;
+        let amplitude = (dev[2] * dev[2] + dev[3] * dev[3] / self.panel.natural_angular_frequency().powi(2)).sqrt();
+        if amplitude.max(self.oscillation(y, &f)) > self.settings.linear_amplitude {
+            return Ok(Regime::Large);
+        }
+        let r = f - a * dev;
+        let Some(inv) = a.try_inverse() else {
+            return Ok(Regime::NonLinear);
+        };
+        let static_error: f64 = (0..4).map(|i| (inv[(2, i)] * r[i]).abs()).sum();
+        Ok(if static_error <= self.settings.linear_tolerance {
+            Regime::Linear
+        } else {
+            Regime::NonLinear
+        })
+    }
+
+    /// A linear arc from t to `end` (same orbit, full Sun). Returns Some(()) when the arc had to
+    /// stop early for the fallback (oscillation too large, decomposition ill-conditioned).
+    fn linear(&mut self, end: f64) -> Result<Option<()>> {
+        let t0 = self.t;
+        let flux0 = self.orbit.flux_scale(t0);
+        let flux1 = self.orbit.flux_scale(end);
+        let (y_ref, a) = self.reference(flux0)?;
+        let b = self.system.flux_sensitivity(&y_ref) * ((flux1 - flux0) / (end - t0));
+        let Ok(arc) = Arc::new(&a, &b, &y_ref, &self.y, end - t0, &self.scale) else {
+            return Ok(Some(()));
+        };
+        let theta = arc.signal(&Vector4::new(0.0, 0.0, 1.0, 0.0));
+        let k = self.theta_per_kelvin;
+        let dynamic = arc.signal(&Vector4::new(-k, k, 1.0, 0.0));
+        let limit = self.settings.linear_amplitude;
+        let mut length = end - t0;
+        let mut early = false;
+        if theta.envelope_max(0.0, length) > limit {
+            // Propagate only while the oscillation stays small (its envelope is monotonic).
+            let (mut lo, mut hi) = (0.0, length);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if theta.envelope_max(0.0, mid) > limit {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            length = lo;
+            early = true;
+        }
+        let (lo, hi) = theta.extremes(0.0, length);
+        let theta_limit = self.obs.collector.options.theta_limit;
+        if hi > theta_limit || lo < -theta_limit {
+            // Leave the crossing of the validity limit to the full integration.
+            return Ok(Some(()));
+        }
+        if length > 0.0 {
+            let (dlo, dhi) = dynamic.extremes(0.0, length);
+            let sq = dynamic.integral_sq(length);
+            let extremes = |a: f64, b: f64| theta.extremes(a - t0, b - t0);
+            self.obs.collector.record_span(
+                t0,
+                t0 + length,
+                &extremes,
+                dlo.abs().max(dhi.abs()),
+                sq,
+            )?;
+            self.y = arc.state(length);
+            self.t = if early { t0 + length } else { end };
+            self.out.t_linear += length;
+            self.out.n_arcs += 1;
+        }
+        Ok(early.then_some(()))
+    }
+
+    /// The hinge-resolved full integration from t to `end`.
+    fn full(&mut self, end: f64) -> Result<()> {
+        let (stats, y) = solve(
+            &mut self.system,
+            &self.fallback,
+            self.t,
+            self.y,
+            end,
+            &mut self.obs,
+        )?;
+        if let Some(e) = self.obs.error.take() {
+            return Err(e);
+        }
+        self.out.t_fallback += stats.t_end - self.t;
+        self.out.n_fallback_steps += stats.n_steps;
+        self.stats.n_steps += stats.n_steps;
+        self.stats.n_rejected += stats.n_rejected;
+        self.stats.n_rhs += stats.n_rhs;
+        self.t = if stats.stopped { stats.t_end } else { end };
+        self.y = y;
+        Ok(())
+    }
+
+    /// The non-linear model by the exponential integrator from t, until the state may go back to
+    /// linear arcs, or `horizon`. Returns true when the oscillation grew too large for it (the
+    /// caller falls back to the full integration).
+    fn exponential(&mut self, horizon: f64, eclipses: &[Eclipse]) -> Result<bool> {
+        let start = self.t;
+        let mut cuts = vec![self.t];
+        cuts.extend(self.orbit.breakpoints(self.t, horizon));
+        cuts.push(horizon);
+        let window = self.obs.collector.options.window;
+        let period = 2.0 * std::f64::consts::PI / self.panel.natural_angular_frequency();
+        let mut large = false;
+        let mut done = false;
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if b <= a || done {
+                continue;
+            }
+            self.system.enter_segment(a, b);
+            let system = self.system;
+            let settings = self.settings;
+            let mut t = self.t;
+            let mut y = self.y;
+            let mut h = self.h_exp;
+            let mut failure: Option<Error> = None;
+            let this = &mut *self;
+            let (acc, rej, stop) = exprb::segment(
+                &system,
+                a,
+                b,
+                &mut t,
+                &mut y,
+                &mut h,
+                &settings.tolerances,
+                |st: &ExpStep| -> Result<bool> {
+                    this.read_step(st, period)?;
+                    if this.stopped() {
+                        return Ok(true);
+                    }
+                    let t1 = st.t1;
+                    let shadow = eclipses.iter().any(|e| e.outer.0 <= t1 && t1 < e.outer.1);
+                    let release = eclipses
+                        .iter()
+                        .filter(|e| e.outer.0 <= t1)
+                        .map(|e| e.outer.1 + window)
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    if this.oscillation(&st.y1, &st.f1) > settings.linear_amplitude {
+                        large = true;
+                        return Ok(true);
+                    }
+                    if !shadow && t1 >= release && t1 < b {
+                        match this.regime(t1, &st.y1) {
+                            Ok(Regime::Linear) => return Ok(true),
+                            Ok(_) => {}
+                            Err(e) => failure = Some(e),
+                        }
+                    }
+                    Ok(failure.is_some())
+                },
+            )
+            .or_else(|e| match e {
+                // A step that cannot be made small enough: let the full integration take over.
+                Error::Integration { .. } => {
+                    large = true;
+                    Ok((0, 0, true))
+                }
+                other => Err(other),
+            })?;
+            if let Some(e) = failure {
+                return Err(e);
+            }
+            self.t = t;
+            self.y = y;
+            self.h_exp = h;
+            self.out.n_exp_steps += acc;
+            self.stats.n_steps += acc;
+            self.stats.n_rejected += rej;
+            self.stats.n_rhs += 3 * (acc + rej);
+            done = stop;
+        }
+        self.out.t_exponential += self.t - start;
+        Ok(large)
+    }
+
+    /// Feeds one exponential step to the summaries: four points of its Hermite interpolant when
+    /// the step resolves the hinge period, else bands θ_qs ± a (the quasi-static deflection and the
+    /// oscillation's amplitude, interpolated between the step's ends).
+    fn read_step(&mut self, st: &ExpStep, period: f64) -> Result<()> {
+        let dense = DenseStep::hermite(st.t0, st.t1, st.y0, st.y1, &st.f0, &st.f1);
+        let h = (st.t1 - st.t0) / 4.0;
+        let resolved = st.t1 - st.t0 <= period / 8.0;
+        let (a0, a1) = (self.oscillation(&st.y0, &st.f0), self.oscillation(&st.y1, &st.f1));
+        for j in 1..=4 {
+            let t = if j == 4 { st.t1 } else { st.t0 + j as f64 * h };
+            let y = if j == 4 { st.y1 } else { dense.eval(t) };
+            if resolved {
+                self.obs.collector.read(t, &y, h)?;
+            } else {
+                let frac = j as f64 / 4.0;
+                let amp = a0 + (a1 - a0) * frac;
+                let quasi_static =
+                    thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+                self.obs.collector.record(
+                    t,
+                    quasi_static - amp,
+                    quasi_static + amp,
+                    amp,
+                    0.5 * amp * amp * h,
+                    h,
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
