@@ -213,7 +213,8 @@ impl Collector {
         dynamic_abs: f64,
         sq: f64,
     ) -> Result<()> {
-        self.advance(t_b)?;
+        // The orbit that holds the span's middle (its ends may round onto a neighbour's edge).
+        self.advance(0.5 * (t_a + t_b))?;
         let (lo, hi) = extremes(t_a, t_b);
         let s = &mut self.current;
         s.theta_max = s.theta_max.max(hi);
@@ -227,7 +228,7 @@ impl Collector {
         let (entry, exit) = (s.t_entry, s.t_exit);
         for (start, is_entry) in [(entry, true), (exit, false)] {
             let (a, b) = (t_a.max(start), t_b.min(start + w));
-            if !(a <= b) {
+            if start.is_nan() || !(a <= b) {
                 continue; // no window, or no overlap
             }
             let (l, h) = extremes(a, b);

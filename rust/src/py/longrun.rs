@@ -174,6 +174,7 @@ pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
             "max_step" => s.tolerances.max_step = v,
             "linear_tolerance" => s.linear_tolerance = v,
             "linear_amplitude" => s.linear_amplitude = v,
+            "resolved_amplitude" => s.resolved_amplitude = v,
             other => {
                 return Err(pyo3::exceptions::PyValueError::new_err(format!(
                     "hybrid setting {other:?} is unknown"
