@@ -61,7 +61,7 @@ impl Default for HybridSettings {
             tolerances: ExpTolerances {
                 rtol: 1e-4,
                 atol_temperature: 1e-2,
-                atol_angle: 1e-8,
+                atol_angle: 1e-7,
                 max_step: 300.0,
             },
             linear_tolerance: 1e-7,
