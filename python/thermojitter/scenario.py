@@ -21,7 +21,6 @@ Every problem is a :class:`ScenarioError` naming the file, the key and the reaso
 from __future__ import annotations
 
 import math
-import re
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
@@ -29,6 +28,7 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
+from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
@@ -125,9 +125,6 @@ class Scenario:
     """Tables a command adds to the format (e.g. [flutter]), checked by that command."""
 
 
-_ENGINE_MESSAGE = re.compile(r"^(\w+) = ")
-
-
 def _real(path: Path, key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ScenarioError(path, key, f"must be a number, not {_toml_type(value)} {value!r}")
@@ -191,20 +188,22 @@ def _validated(path: Path, section: str, build: Any, base: Any, values: dict[str
         try:
             build(**{**base, key: value})
         except (ValueError, TypeError) as exc:
-            raise _engine_error(path, section, str(exc), key) from None
+            raise _engine_error(path, section, exc, key) from None
     try:
         return build(**{**base, **values})
     except (ValueError, TypeError) as exc:
-        raise _engine_error(path, section, str(exc), None) from None
+        raise _engine_error(path, section, exc, None) from None
 
 
-def _engine_error(path: Path, section: str, message: str, key: str | None) -> ScenarioError:
-    match = _ENGINE_MESSAGE.match(message)
-    if match:
-        return ScenarioError(
-            path, f"{section}.{match.group(1)}", message[len(match.group(1)) + 1 :]
-        )
-    return ScenarioError(path, f"{section}.{key}" if key else section, message)
+def _engine_error(path: Path, section: str, exc: Exception, key: str | None) -> ScenarioError:
+    """The scenario key of an error from the API: the parameter a ParameterError names, else the
+    key being checked."""
+    if isinstance(exc, ParameterError):
+        reason = f"= {exc.value!r} is invalid"
+        if exc.allowed:
+            reason += f": {exc.allowed}"
+        return ScenarioError(path, f"{section}.{exc.parameter}", reason)
+    return ScenarioError(path, f"{section}.{key}" if key else section, str(exc))
 
 
 def _panel(path: Path, table: dict[str, Any]) -> Panel:

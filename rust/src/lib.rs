@@ -6,6 +6,8 @@
 //! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
 
 pub mod beam;
+pub mod cancel;
+pub mod distributed;
 pub mod dynamics;
 pub mod ensemble;
 pub mod error;
@@ -20,6 +22,9 @@ pub mod steady;
 pub mod summary;
 pub mod system;
 pub mod thermal;
+
+#[cfg(test)]
+mod recorded;
 
 #[cfg(feature = "python")]
 mod py;

@@ -1,8 +1,9 @@
 //! High-level runs: integrate a system over a span and keep its state at the requested times.
 
 use crate::error::{Error, Result};
-use crate::integrate::{check_span, solve, Method, OdeSystem, Sampler, Stats};
-use nalgebra::SVector;
+use crate::integrate::{check_span, output, solve, Method, OdeSystem, Sampler, State, Stats};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim};
 
 /// Where to report the solution.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,12 +16,25 @@ pub enum Output {
 
 /// Sampled solution of one run.
 #[derive(Debug, Clone)]
-pub struct Trajectory<const N: usize> {
+pub struct Trajectory<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     pub t: Vec<f64>,
-    pub y: Vec<SVector<f64, N>>,
+    pub y: Vec<State<D>>,
     pub stats: Stats,
     /// State at `stats.t_end`.
-    pub y_end: SVector<f64, N>,
+    pub y_end: State<D>,
+}
+
+impl<D: Dim> Trajectory<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// Component `i` of every sample.
+    pub fn column(&self, i: usize) -> Vec<f64> {
+        self.y.iter().map(|y| y[i]).collect()
+    }
 }
 
 /// Largest number of samples a single run may keep (about 160 MB for the coupled state).
@@ -40,7 +54,7 @@ impl Output {
                         &format!("would keep {n:.0} samples (more than {MAX_SAMPLES}); use a larger dt_out or per-orbit summaries"),
                     ));
                 }
-                Ok(Sampler::<1>::every(t0, t1, *dt).times_owned())
+                Ok(output::every(t0, t1, *dt))
             }
             Output::Times(ts) => {
                 if ts.len() > MAX_SAMPLES {
@@ -67,13 +81,16 @@ impl Output {
 }
 
 /// Integrates `system` over [t0, t1] from y0 and samples it as `output` asks.
-pub fn run<const N: usize, S: OdeSystem<N>>(
+pub fn run<D: Dim, S: OdeSystem<D>>(
     system: &mut S,
     method: &Method,
     t_span: (f64, f64),
-    y0: SVector<f64, N>,
+    y0: State<D>,
     output: &Output,
-) -> Result<Trajectory<N>> {
+) -> Result<Trajectory<D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let (t0, t1) = t_span;
     check_span(t0, t1)?;
     let mut sampler = Sampler::new(output.sample_times(t0, t1)?);
@@ -84,10 +101,4 @@ pub fn run<const N: usize, S: OdeSystem<N>>(
         stats,
         y_end,
     })
-}
-
-impl<const N: usize> Sampler<N> {
-    fn times_owned(self) -> Vec<f64> {
-        self.into_times()
-    }
 }

@@ -3,6 +3,7 @@
 //! Each accepted step is read at four evenly spaced points of its dense output, fine enough to
 //! catch the peaks of an oscillation that needs tens of steps per period.
 
+use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::Result;
 use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
@@ -10,7 +11,7 @@ use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
-use nalgebra::Vector4;
+use nalgebra::{Vector4, U4};
 use std::ops::ControlFlow;
 
 /// Points read per step (the step end and three interior points).
@@ -131,6 +132,7 @@ pub(crate) struct Collector {
 
 impl Collector {
     /// A collector whose first orbit `first_index` starts at `t_start` in state y0.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
         panel: &Panel,
         orbit: &Orbit,
@@ -219,7 +221,8 @@ impl Collector {
         let s = &mut self.current;
         s.theta_max = s.theta_max.max(hi);
         s.theta_min = s.theta_min.min(lo);
-        let dev = |lo: f64, hi: f64| (hi - s.theta_eq).abs().max((lo - s.theta_eq).abs());
+        let eq = s.theta_eq;
+        let dev = |lo: f64, hi: f64| (hi - eq).abs().max((lo - eq).abs());
         s.amplitude = s.amplitude.max(dev(lo, hi));
         s.jitter_peak = s.jitter_peak.max(dynamic_abs);
         self.sq_sum += sq;
@@ -228,18 +231,18 @@ impl Collector {
         let (entry, exit) = (s.t_entry, s.t_exit);
         for (start, is_entry) in [(entry, true), (exit, false)] {
             let (a, b) = (t_a.max(start), t_b.min(start + w));
-            if start.is_nan() || !(a <= b) {
+            if start.is_nan() || a > b {
                 continue; // no window, or no overlap
             }
             let (l, h) = extremes(a, b);
+            let d = dev(l, h);
             let s = &mut self.current;
-            let d = (h - s.theta_eq).abs().max((l - s.theta_eq).abs());
             if is_entry {
-                s.entry_theta_min = if s.entry_theta_min.is_nan() { l } else { s.entry_theta_min.min(l) };
-                s.entry_peak = if s.entry_peak.is_nan() { d } else { s.entry_peak.max(d) };
+                s.entry_theta_min = nan_min(s.entry_theta_min, l);
+                s.entry_peak = nan_max(s.entry_peak, d);
             } else {
-                s.exit_theta_max = if s.exit_theta_max.is_nan() { h } else { s.exit_theta_max.max(h) };
-                s.exit_peak = if s.exit_peak.is_nan() { d } else { s.exit_peak.max(d) };
+                s.exit_theta_max = nan_max(s.exit_theta_max, h);
+                s.exit_peak = nan_max(s.exit_peak, d);
             }
         }
         Ok(())
@@ -267,28 +270,12 @@ impl Collector {
         self.duration += dt;
         let w = self.options.window;
         if t >= s.t_entry && t <= s.t_entry + w {
-            s.entry_theta_min = if s.entry_theta_min.is_nan() {
-                th_lo
-            } else {
-                s.entry_theta_min.min(th_lo)
-            };
-            s.entry_peak = if s.entry_peak.is_nan() {
-                dev
-            } else {
-                s.entry_peak.max(dev)
-            };
+            s.entry_theta_min = nan_min(s.entry_theta_min, th_lo);
+            s.entry_peak = nan_max(s.entry_peak, dev);
         }
         if t >= s.t_exit && t <= s.t_exit + w {
-            s.exit_theta_max = if s.exit_theta_max.is_nan() {
-                th_hi
-            } else {
-                s.exit_theta_max.max(th_hi)
-            };
-            s.exit_peak = if s.exit_peak.is_nan() {
-                dev
-            } else {
-                s.exit_peak.max(dev)
-            };
+            s.exit_theta_max = nan_max(s.exit_theta_max, th_hi);
+            s.exit_peak = nan_max(s.exit_peak, dev);
         }
         if self.crossing.is_none() {
             let limit = self.options.theta_limit;
@@ -311,13 +298,36 @@ impl Collector {
     }
 }
 
-pub(crate) struct SummaryObserver {
-    pub(crate) collector: Collector,
-    pub(crate) error: Option<crate::Error>,
+/// min(acc, v), where NaN in `acc` means "nothing yet".
+fn nan_min(acc: f64, v: f64) -> f64 {
+    if acc.is_nan() {
+        v
+    } else {
+        acc.min(v)
+    }
 }
 
-impl Observer<4> for SummaryObserver {
-    fn on_step(&mut self, step: &DenseStep<4>) -> ControlFlow<()> {
+/// max(acc, v), where NaN in `acc` means "nothing yet".
+fn nan_max(acc: f64, v: f64) -> f64 {
+    if acc.is_nan() {
+        v
+    } else {
+        acc.max(v)
+    }
+}
+
+pub(crate) struct SummaryObserver<'c> {
+    pub(crate) collector: Collector,
+    pub(crate) error: Option<crate::Error>,
+    pub(crate) cancel: &'c Cancel,
+}
+
+impl Observer<U4> for SummaryObserver<'_> {
+    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+        if let Err(e) = self.cancel.check() {
+            self.error = Some(e);
+            return ControlFlow::Break(());
+        }
         let h = (step.t1 - step.t0) / READS_PER_STEP as f64;
         for j in 1..=READS_PER_STEP {
             let t = if j == READS_PER_STEP {
@@ -366,6 +376,39 @@ pub fn run_orbits(
     y0: Vector4<f64>,
     options: SummaryOptions,
 ) -> Result<OrbitRun> {
+    run_orbits_cancellable(
+        panel,
+        orbit,
+        model,
+        coupling,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+        &Cancel::new(),
+    )
+}
+
+/// [`run_orbits`] that stops with [`crate::Error::Cancelled`] within one step of `cancel` being
+/// cancelled (the orbits finished before are lost with the call: callers that keep them run
+/// fewer orbits per call).
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits_cancellable(
+    panel: &Panel,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vector4<f64>,
+    options: SummaryOptions,
+    cancel: &Cancel,
+) -> Result<OrbitRun> {
+    cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
     crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
@@ -386,6 +429,7 @@ pub fn run_orbits(
     let mut observer = SummaryObserver {
         collector,
         error: None,
+        cancel,
     };
     let mut system = Coupled::new(*panel, *orbit, model, coupling);
     let t_end = t_start + n_orbits as f64 * orbit.period;

@@ -7,7 +7,7 @@ use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
 use crate::thermal::{one_node_rate, two_layer_rates};
 use crate::STEFAN_BOLTZMANN;
-use nalgebra::{Matrix4, SVector, Vector1, Vector2, Vector4};
+use nalgebra::{Matrix4, SVector, Vector1, Vector2, Vector4, U1, U2, U4};
 
 /// How the hinge angle feeds back on the heating (paper Sec. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -21,8 +21,8 @@ pub enum Coupling {
 /// Illumination bookkeeping shared by every orbit-driven system: the segment being integrated
 /// decides s, so a step that ends on a shadow boundary sees the segment's own side.
 #[derive(Debug, Clone, Copy)]
-struct Sunlight {
-    orbit: Orbit,
+pub(crate) struct Sunlight {
+    pub(crate) orbit: Orbit,
     segment: (f64, f64),
     /// s over the current segment when it cannot change there: every segment of a cylindrical
     /// shadow, and the full-Sun and umbra segments of a penumbral one (the breakpoints include
@@ -31,7 +31,7 @@ struct Sunlight {
 }
 
 impl Sunlight {
-    fn new(orbit: Orbit) -> Self {
+    pub(crate) fn new(orbit: Orbit) -> Self {
         Sunlight {
             orbit,
             segment: (0.0, 0.0),
@@ -39,7 +39,7 @@ impl Sunlight {
         }
     }
 
-    fn enter(&mut self, a: f64, b: f64) {
+    pub(crate) fn enter(&mut self, a: f64, b: f64) {
         self.segment = (a, b);
         let mid = self.orbit.illumination_on(0.5 * (a + b), a, b);
         let varies = matches!(self.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
@@ -47,7 +47,7 @@ impl Sunlight {
     }
 
     #[inline]
-    fn flux(&self, t: f64) -> f64 {
+    pub(crate) fn flux(&self, t: f64) -> f64 {
         let s = match self.constant_s {
             Some(s) => s,
             None => {
@@ -75,7 +75,7 @@ impl OneNode {
     }
 }
 
-impl OdeSystem<1> for OneNode {
+impl OdeSystem<U1> for OneNode {
     #[inline]
     fn rhs(&self, t: f64, y: &Vector1<f64>) -> Vector1<f64> {
         Vector1::new(one_node_rate(&self.panel, self.sun.flux(t), y[0]))
@@ -104,7 +104,7 @@ impl TwoLayer {
     }
 }
 
-impl OdeSystem<2> for TwoLayer {
+impl OdeSystem<U2> for TwoLayer {
     #[inline]
     fn rhs(&self, t: f64, y: &Vector2<f64>) -> Vector2<f64> {
         let (df, db) = two_layer_rates(&self.panel, self.sun.flux(t), y[0], y[1]);
@@ -287,7 +287,7 @@ impl Coupled {
     }
 }
 
-impl OdeSystem<4> for Coupled {
+impl OdeSystem<U4> for Coupled {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &Vector4<f64>) -> Vector4<f64> {
         self.rhs_at_flux(self.sun.flux(t), y)
@@ -367,7 +367,7 @@ pub struct DrivenHinge {
     pub moment: MomentHistory,
 }
 
-impl OdeSystem<2> for DrivenHinge {
+impl OdeSystem<U2> for DrivenHinge {
     #[inline]
     fn rhs(&self, t: f64, y: &Vector2<f64>) -> Vector2<f64> {
         let m = self.moment.at(t);

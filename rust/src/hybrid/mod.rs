@@ -23,6 +23,7 @@ pub mod expm;
 pub mod exprb;
 pub mod linear;
 
+use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::{require_positive, Error, Result};
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
@@ -36,7 +37,7 @@ use crate::summary::{
 use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
 use linear::Arc;
-use nalgebra::Vector4;
+use nalgebra::{Vector4, U4};
 
 /// Settings of the hybrid propagator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,12 +109,10 @@ enum Regime {
 struct Driver<'a> {
     panel: Panel,
     orbit: Orbit,
-    model: HingeModel,
-    coupling: Coupling,
     settings: &'a HybridSettings,
     fallback: Method,
     system: Coupled,
-    obs: SummaryObserver,
+    obs: SummaryObserver<'a>,
     t_start: f64,
     t_end: f64,
     t: f64,
@@ -143,7 +142,9 @@ pub fn run_orbits_hybrid(
     y0: Vector4<f64>,
     options: SummaryOptions,
     settings: &HybridSettings,
+    cancel: &Cancel,
 ) -> Result<HybridRun> {
+    cancel.check()?;
     require_positive("window", options.window)?;
     require_positive("theta_limit", options.theta_limit)?;
     crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
@@ -181,14 +182,13 @@ pub fn run_orbits_hybrid(
     let mut d = Driver {
         panel: *panel,
         orbit: *orbit,
-        model,
-        coupling,
         settings,
         fallback: resolve_hinge(method, panel, steps),
         system: Coupled::new(*panel, *orbit, model, coupling),
         obs: SummaryObserver {
             collector,
             error: None,
+            cancel,
         },
         t_start,
         t_end,
@@ -310,8 +310,8 @@ impl Judge {
 
 /// Watches the hinge-resolved fallback and ends it once the state may go back to linear arcs
 /// (checked every `CHECK_EVERY` s of simulated time, in full Sun past the last shadow's window).
-struct FallbackObserver<'a> {
-    inner: &'a mut SummaryObserver,
+struct FallbackObserver<'a, 'c> {
+    inner: &'a mut SummaryObserver<'c>,
     judge: Judge,
     eclipses: &'a [Eclipse],
     window: f64,
@@ -322,8 +322,8 @@ struct FallbackObserver<'a> {
 
 const CHECK_EVERY: f64 = 60.0;
 
-impl Observer<4> for FallbackObserver<'_> {
-    fn on_step(&mut self, step: &DenseStep<4>) -> ControlFlow<()> {
+impl Observer<U4> for FallbackObserver<'_, '_> {
+    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
         self.inner.on_step(step)?;
         let t1 = step.t1;
         if t1 < self.next_check {
@@ -374,6 +374,7 @@ impl Driver<'_> {
     fn run(&mut self) -> Result<()> {
         let mut fallback = false;
         while self.t < self.t_end && !self.stopped() {
+            self.obs.cancel.check()?;
             let horizon = (self.t + self.orbit.period).min(self.t_end);
             let eclipses = self.orbit.eclipses(self.t, horizon);
             if fallback {
@@ -539,6 +540,7 @@ impl Driver<'_> {
                 &mut h,
                 &settings.tolerances,
                 |st: &ExpStep| -> Result<bool> {
+                    this.obs.cancel.check()?;
                     this.read_step(st, period)?;
                     if this.stopped() {
                         return Ok(true);
@@ -594,7 +596,7 @@ impl Driver<'_> {
     /// the step resolves the hinge period, else bands θ_qs ± a (the quasi-static deflection and the
     /// oscillation's amplitude, interpolated between the step's ends).
     fn read_step(&mut self, st: &ExpStep, period: f64) -> Result<()> {
-        let dense = DenseStep::hermite(st.t0, st.t1, st.y0, st.y1, &st.f0, &st.f1);
+        let dense = DenseStep::<U4>::hermite(st.t0, st.t1, st.y0, st.y1, st.f0, st.f1);
         let h = (st.t1 - st.t0) / 4.0;
         let resolved = st.t1 - st.t0 <= period / 8.0;
         let (a0, a1) = (self.judge.oscillation(&st.y0, &st.f0), self.judge.oscillation(&st.y1, &st.f1));

@@ -6,9 +6,10 @@
 //! It takes the same steps as SciPy's RK45 (tests/test_controller.py); the arithmetic is arranged
 //! for short dependency chains (benches/README.md), which moves results by rounding only.
 
-use super::{rms_scaled, DenseStep, Observer, OdeSystem, Stats, Tolerances};
+use super::{rms_scaled, DenseStep, Observer, OdeSystem, State, Stats, Tolerances};
 use crate::error::{Error, Result};
-use nalgebra::SVector;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim};
 use std::ops::ControlFlow;
 
 // Butcher tableau.
@@ -50,7 +51,7 @@ pub const B_HAT: [f64; 7] = [
     1.0 / 40.0,
 ];
 /// Dense-output coefficients (Hairer, Nørsett & Wanner, dopri5).
-const D: [f64; 7] = [
+const DENSE: [f64; 7] = [
     -12715105075.0 / 11282082432.0,
     0.0,
     87487479700.0 / 32700410799.0,
@@ -66,15 +67,18 @@ const MAX_FACTOR: f64 = 10.0;
 const ERROR_EXPONENT: f64 = -1.0 / 5.0;
 
 /// Hairer's estimate of a first step for an order-4 error estimator.
-fn initial_step<const N: usize, S: OdeSystem<N>>(
+fn initial_step<D: Dim, S: OdeSystem<D>>(
     system: &S,
     t0: f64,
-    y0: &SVector<f64, N>,
-    f0: &SVector<f64, N>,
+    y0: &State<D>,
+    f0: &State<D>,
     interval: f64,
     tol: &Tolerances,
     stats: &mut Stats,
-) -> f64 {
+) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+{
     let scale = y0.map(|v| tol.atol + v.abs() * tol.rtol);
     let d0 = rms_scaled(y0, &scale);
     let d1 = rms_scaled(f0, &scale);
@@ -98,75 +102,82 @@ fn initial_step<const N: usize, S: OdeSystem<N>>(
 
 /// One trial step: the new state, the stage slopes k1..k7 (k7 = f(t_new, y_new)) and the
 /// difference between the fifth- and fourth-order solutions.
-#[derive(Debug, Clone, Copy)]
-pub struct Step<const N: usize> {
-    pub y_new: SVector<f64, N>,
-    pub k: [SVector<f64, N>; 7],
-    pub err: SVector<f64, N>,
+#[derive(Debug, Clone)]
+pub struct Step<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    pub y_new: State<D>,
+    pub k: [State<D>; 7],
+    pub err: State<D>,
 }
 
 /// The stages of one Dormand–Prince step from (t, y) to t_new, given k1 = f(t, y).
 #[inline(always)]
-pub fn step<const N: usize, S: OdeSystem<N>>(
+pub fn step<D: Dim, S: OdeSystem<D>>(
     system: &S,
     t: f64,
     t_new: f64,
-    y0: &SVector<f64, N>,
-    k1: &SVector<f64, N>,
-) -> Step<N> {
+    y0: &State<D>,
+    k1: &State<D>,
+) -> Step<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let h = t_new - t;
-    let y0 = *y0;
-    let k1 = *k1;
     // Each stage's state is y0 + Σ k_j (a_j h), summed in stage order: the newest slope enters
     // last, through one multiply and one add, which keeps the chain from stage to stage short.
     let k2 = system.rhs(t + C[1] * h, &(y0 + k1 * (A21 * h)));
-    let k3 = system.rhs(t + C[2] * h, &(y0 + k1 * (A3[0] * h) + k2 * (A3[1] * h)));
+    let k3 = system.rhs(t + C[2] * h, &(y0 + k1 * (A3[0] * h) + &k2 * (A3[1] * h)));
     let k4 = system.rhs(
         t + C[3] * h,
-        &(y0 + k1 * (A4[0] * h) + k2 * (A4[1] * h) + k3 * (A4[2] * h)),
+        &(y0 + k1 * (A4[0] * h) + &k2 * (A4[1] * h) + &k3 * (A4[2] * h)),
     );
     let k5 = system.rhs(
         t + C[4] * h,
-        &(y0 + k1 * (A5[0] * h) + k2 * (A5[1] * h) + k3 * (A5[2] * h) + k4 * (A5[3] * h)),
+        &(y0 + k1 * (A5[0] * h) + &k2 * (A5[1] * h) + &k3 * (A5[2] * h) + &k4 * (A5[3] * h)),
     );
     let k6 = system.rhs(
         t_new,
         &(y0 + k1 * (A6[0] * h)
-            + k2 * (A6[1] * h)
-            + k3 * (A6[2] * h)
-            + k4 * (A6[3] * h)
-            + k5 * (A6[4] * h)),
+            + &k2 * (A6[1] * h)
+            + &k3 * (A6[2] * h)
+            + &k4 * (A6[3] * h)
+            + &k5 * (A6[4] * h)),
     );
     let y_new = y0
         + k1 * (B[0] * h)
-        + k3 * (B[2] * h)
-        + k4 * (B[3] * h)
-        + k5 * (B[4] * h)
-        + k6 * (B[5] * h);
+        + &k3 * (B[2] * h)
+        + &k4 * (B[3] * h)
+        + &k5 * (B[4] * h)
+        + &k6 * (B[5] * h);
     let k7 = system.rhs(t_new, &y_new);
     let err = k1 * ((B[0] - B_HAT[0]) * h)
-        + k3 * ((B[2] - B_HAT[2]) * h)
-        + k4 * ((B[3] - B_HAT[3]) * h)
-        + k5 * ((B[4] - B_HAT[4]) * h)
-        + k6 * ((B[5] - B_HAT[5]) * h)
-        + k7 * ((B[6] - B_HAT[6]) * h);
+        + &k3 * ((B[2] - B_HAT[2]) * h)
+        + &k4 * ((B[3] - B_HAT[3]) * h)
+        + &k5 * ((B[4] - B_HAT[4]) * h)
+        + &k6 * ((B[5] - B_HAT[5]) * h)
+        + &k7 * ((B[6] - B_HAT[6]) * h);
     Step {
         y_new,
-        k: [k1, k2, k3, k4, k5, k6, k7],
+        k: [k1.clone(), k2, k3, k4, k5, k6, k7],
         err,
     }
 }
 
 /// Integrates one segment [a, b] on which the right-hand side is smooth; `y` goes from y(a) to y(b).
-pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
+pub(super) fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &S,
     a: f64,
     b: f64,
-    y: &mut SVector<f64, N>,
+    y: &mut State<D>,
     tol: &Tolerances,
     stats: &mut Stats,
     observer: &mut O,
-) -> Result<ControlFlow<()>> {
+) -> Result<ControlFlow<()>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let mut t = a;
     let mut k1 = system.rhs(t, y);
     stats.n_rhs += 1;
@@ -188,7 +199,7 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
             let t_new = if t + h_abs >= b { b } else { t + h_abs };
             let h = t_new - t;
 
-            let y0 = *y;
+            let y0 = y.clone();
             let Step { y_new, k, err } = step(system, t, t_new, &y0, &k1);
             stats.n_rhs += 6;
             // The error's scale is known before the last stage is, so its reciprocal is ready
@@ -198,7 +209,7 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
             });
             // err_norm² (the RMS norm squared): err_norm < 1 when this is < 1 (but for the one
             // double just below 1, whose root rounds to 1), so the root is taken on rejection only.
-            let mean_square = err.component_mul(&weight).norm_squared() / N as f64;
+            let mean_square = err.component_mul(&weight).norm_squared() / y0.len() as f64;
 
             if mean_square < 1.0 {
                 // NaN fails this test, so a non-finite state is rejected and shrinks h.
@@ -217,11 +228,12 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
                 }
                 stats.n_steps += 1;
                 let [_, _, k3, k4, k5, k6, k7] = k;
+                *y = y_new.clone();
+                let next_k1 = k7.clone();
                 let dense = DenseStep::dopri5(t, t_new, y0, y_new, [k1, k3, k4, k5, k6, k7]);
-                *y = y_new;
                 t = t_new;
                 stats.t_end = t;
-                k1 = k7;
+                k1 = next_k1;
                 h_abs = (h * factor).min(tol.max_step);
                 if observer.on_step(&dense).is_break() {
                     return Ok(ControlFlow::Break(()));
@@ -254,17 +266,26 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
 
 /// Hairer's continuous extension of one step: the coefficients r1..r5 of the interpolant in
 /// [`DenseStep`] from y0, diff = y1 − y0 and the slopes (k1, k3, k4, k5, k6, k7).
-pub(super) fn dense_coefficients<const N: usize>(
+pub(super) fn dense_coefficients<D: Dim>(
     h: f64,
-    y0: &SVector<f64, N>,
-    diff: &SVector<f64, N>,
-    k: &[SVector<f64, N>; 6],
-) -> [SVector<f64, N>; 5] {
+    y0: &State<D>,
+    diff: State<D>,
+    k: &[State<D>; 6],
+) -> [State<D>; 5]
+where
+    DefaultAllocator: Allocator<D>,
+{
     let [k1, k3, k4, k5, k6, k7] = k;
-    let bspl = k1 * h - diff;
-    let r4 = diff - k7 * h - bspl;
-    let r5 = (k1 * D[0] + k3 * D[2] + k4 * D[3] + k5 * D[4] + k6 * D[5] + k7 * D[6]) * h;
-    [*y0, *diff, bspl, r4, r5]
+    let bspl = k1 * h - &diff;
+    let r4 = &diff - k7 * h - &bspl;
+    let r5 = (k1 * DENSE[0]
+        + k3 * DENSE[2]
+        + k4 * DENSE[3]
+        + k5 * DENSE[4]
+        + k6 * DENSE[5]
+        + k7 * DENSE[6])
+        * h;
+    [y0.clone(), diff, bspl, r4, r5]
 }
 
 /// The next representable f64 above x (x finite).

@@ -1,4 +1,6 @@
-//! Explicit Runge–Kutta integrators generic over a small ODE trait on nalgebra fixed-size vectors.
+//! Explicit Runge–Kutta integrators generic over a small ODE trait and over the state's dimension:
+//! `Const<N>` for a size known at compile time (the hinge model's four states, on the stack, as
+//! fast as hand-written code) or `Dyn` for one chosen at run time (many layers, many elements).
 //!
 //! The span is cut at the system's breakpoints (shadow entries and exits) and every segment is
 //! integrated on its own, so no step straddles a discontinuity of the right-hand side. Results are
@@ -10,15 +12,24 @@ pub mod output;
 pub mod rk4;
 
 use crate::error::{require_positive, Error, Result};
-use nalgebra::SVector;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OVector};
 use std::cell::OnceCell;
 use std::ops::ControlFlow;
 
+pub use nalgebra::{Const, Dyn};
 pub use output::{Sampler, StepCounter};
 
-/// An ODE y' = f(t, y) with a state of N components.
-pub trait OdeSystem<const N: usize> {
-    fn rhs(&self, t: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
+/// A state vector of dimension `D`: `Const<N>` (N known at compile time) or `Dyn`.
+pub type State<D> = OVector<f64, D>;
+
+/// An ODE y' = f(t, y) whose state has dimension `D`.
+pub trait OdeSystem<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// f(t, y), of the same dimension as y.
+    fn rhs(&self, t: f64, y: &State<D>) -> State<D>;
 
     /// Times in (t0, t1) where the right-hand side is discontinuous, sorted.
     fn breakpoints(&self, _t0: f64, _t1: f64) -> Vec<f64> {
@@ -36,41 +47,49 @@ pub trait OdeSystem<const N: usize> {
 /// keeps the stage slopes and builds r1..r5 on the first call of [`DenseStep::eval`], so steps
 /// that no observer samples cost nothing more.
 #[derive(Debug, Clone)]
-pub struct DenseStep<const N: usize> {
+pub struct DenseStep<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     pub t0: f64,
     pub t1: f64,
-    pub y0: SVector<f64, N>,
-    pub y1: SVector<f64, N>,
-    /// (f0, f1) for Hermite; (k1, k3, k4, k5, k6, k7) for Dormand–Prince.
-    slopes: [SVector<f64, N>; 6],
-    kind: Interpolant,
-    r: OnceCell<[SVector<f64, N>; 5]>,
+    pub y0: State<D>,
+    pub y1: State<D>,
+    slopes: Slopes<D>,
+    r: OnceCell<[State<D>; 5]>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Interpolant {
-    Hermite,
-    Dopri5,
+/// The slopes an interpolant is built from.
+#[derive(Debug, Clone)]
+enum Slopes<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// (f0, f1): the cubic Hermite interpolant.
+    Hermite([State<D>; 2]),
+    /// (k1, k3, k4, k5, k6, k7): Dormand–Prince's continuous extension.
+    Dopri5([State<D>; 6]),
 }
 
-impl<const N: usize> DenseStep<N> {
+impl<D: Dim> DenseStep<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
     /// The cubic Hermite interpolant from values and slopes at both ends.
     pub fn hermite(
         t0: f64,
         t1: f64,
-        y0: SVector<f64, N>,
-        y1: SVector<f64, N>,
-        f0: &SVector<f64, N>,
-        f1: &SVector<f64, N>,
+        y0: State<D>,
+        y1: State<D>,
+        f0: State<D>,
+        f1: State<D>,
     ) -> Self {
-        let zero = SVector::zeros();
         DenseStep {
             t0,
             t1,
             y0,
             y1,
-            slopes: [*f0, *f1, zero, zero, zero, zero],
-            kind: Interpolant::Hermite,
+            slopes: Slopes::Hermite([f0, f1]),
             r: OnceCell::new(),
         }
     }
@@ -79,40 +98,39 @@ impl<const N: usize> DenseStep<N> {
     pub(crate) fn dopri5(
         t0: f64,
         t1: f64,
-        y0: SVector<f64, N>,
-        y1: SVector<f64, N>,
-        slopes: [SVector<f64, N>; 6],
+        y0: State<D>,
+        y1: State<D>,
+        slopes: [State<D>; 6],
     ) -> Self {
         DenseStep {
             t0,
             t1,
             y0,
             y1,
-            slopes,
-            kind: Interpolant::Dopri5,
+            slopes: Slopes::Dopri5(slopes),
             r: OnceCell::new(),
         }
     }
 
     /// The interpolant's coefficients r1..r5.
-    fn coefficients(&self) -> [SVector<f64, N>; 5] {
+    fn coefficients(&self) -> [State<D>; 5] {
         let h = self.t1 - self.t0;
-        let diff = self.y1 - self.y0;
-        match self.kind {
-            Interpolant::Hermite => {
-                let [f0, f1, ..] = &self.slopes;
-                let r3 = f0 * h - diff;
-                let r4 = diff - f1 * h - r3;
-                [self.y0, diff, r3, r4, SVector::zeros()]
+        let diff = &self.y1 - &self.y0;
+        match &self.slopes {
+            Slopes::Hermite([f0, f1]) => {
+                let r3 = f0 * h - &diff;
+                let r4 = &diff - f1 * h - &r3;
+                let zero = r4.map(|_| 0.0);
+                [self.y0.clone(), diff, r3, r4, zero]
             }
-            Interpolant::Dopri5 => dopri5::dense_coefficients(h, &self.y0, &diff, &self.slopes),
+            Slopes::Dopri5(k) => dopri5::dense_coefficients(h, &self.y0, diff, k),
         }
     }
 
     /// Value of the interpolant at t in [t0, t1].
-    pub fn eval(&self, t: f64) -> SVector<f64, N> {
+    pub fn eval(&self, t: f64) -> State<D> {
         if t == self.t1 {
-            return self.y1;
+            return self.y1.clone();
         }
         let th = (t - self.t0) / (self.t1 - self.t0);
         let th1 = 1.0 - th;
@@ -122,9 +140,12 @@ impl<const N: usize> DenseStep<N> {
 }
 
 /// What the observer is told after each accepted step.
-pub trait Observer<const N: usize> {
+pub trait Observer<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     /// Return `ControlFlow::Break(())` to stop the integration after this step.
-    fn on_step(&mut self, step: &DenseStep<N>) -> ControlFlow<()>;
+    fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()>;
 }
 
 /// Which integrator, with its settings.
@@ -199,14 +220,17 @@ pub struct Stats {
 
 /// Integrates `system` from (t0, y0) to t1 with `method`, cutting at the system's breakpoints.
 /// Returns the counters and the state at `stats.t_end`.
-pub fn solve<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
+pub fn solve<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &mut S,
     method: &Method,
     t0: f64,
-    y0: SVector<f64, N>,
+    y0: State<D>,
     t1: f64,
     observer: &mut O,
-) -> Result<(Stats, SVector<f64, N>)> {
+) -> Result<(Stats, State<D>)>
+where
+    DefaultAllocator: Allocator<D>,
+{
     method.validate()?;
     check_span(t0, t1)?;
     if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
@@ -260,13 +284,16 @@ pub fn check_span(t0: f64, t1: f64) -> Result<()> {
 
 /// RMS norm of x / scale, as used by the error controller.
 #[inline]
-pub(crate) fn rms_scaled<const N: usize>(x: &SVector<f64, N>, scale: &SVector<f64, N>) -> f64 {
+pub(crate) fn rms_scaled<D: Dim>(x: &State<D>, scale: &State<D>) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+{
     let mut acc = 0.0;
-    for i in 0..N {
+    for i in 0..x.len() {
         let r = x[i] / scale[i];
         acc += r * r;
     }
-    (acc / N as f64).sqrt()
+    (acc / x.len() as f64).sqrt()
 }
 
 #[cfg(test)]

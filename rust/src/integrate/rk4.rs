@@ -1,21 +1,25 @@
 //! Classical fourth-order Runge–Kutta with a fixed step.
 
-use super::{DenseStep, Observer, OdeSystem, Stats};
+use super::{DenseStep, Observer, OdeSystem, State, Stats};
 use crate::error::Result;
-use nalgebra::SVector;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim};
 use std::ops::ControlFlow;
 
 /// Integrates the segment [a, b] in n equal steps, n = ceil((b − a)/dt), so the last step lands
 /// exactly on b. Dense output is the cubic Hermite interpolant (slopes at both step ends).
-pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
+pub(super) fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &S,
     a: f64,
     b: f64,
-    y: &mut SVector<f64, N>,
+    y: &mut State<D>,
     dt: f64,
     stats: &mut Stats,
     observer: &mut O,
-) -> Result<ControlFlow<()>> {
+) -> Result<ControlFlow<()>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     // The small allowance keeps a span that is a whole number of dt from gaining a sliver step.
     let n = (((b - a) / dt) * (1.0 - 1e-12)).ceil().max(1.0) as u64;
     let h = (b - a) / n as f64;
@@ -28,11 +32,11 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
         } else {
             a + (i + 1) as f64 * h
         };
-        let y0 = *y;
-        let k2 = system.rhs(t + 0.5 * h, &(y0 + k1 * (0.5 * h)));
-        let k3 = system.rhs(t + 0.5 * h, &(y0 + k2 * (0.5 * h)));
-        let k4 = system.rhs(t_new, &(y0 + k3 * h));
-        let y_new = y0 + (k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0);
+        let y0 = y.clone();
+        let k2 = system.rhs(t + 0.5 * h, &(&y0 + &k1 * (0.5 * h)));
+        let k3 = system.rhs(t + 0.5 * h, &(&y0 + &k2 * (0.5 * h)));
+        let k4 = system.rhs(t_new, &(&y0 + &k3 * h));
+        let y_new = &y0 + (&k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0);
         // Slope at the step end: the next step's first stage, so it costs nothing extra.
         let f_new = system.rhs(t_new, &y_new);
         stats.n_rhs += 4;
@@ -43,9 +47,9 @@ pub(super) fn segment<const N: usize, S: OdeSystem<N>, O: Observer<N>>(
                 reason: format!("state component {i} is not finite; reduce dt"),
             });
         }
-        let dense = DenseStep::hermite(t, t_new, y0, y_new, &k1, &f_new);
-        *y = y_new;
+        *y = y_new.clone();
         stats.t_end = t_new;
+        let dense = DenseStep::hermite(t, t_new, y0, y_new, k1, f_new.clone());
         k1 = f_new;
         if observer.on_step(&dense).is_break() {
             return Ok(ControlFlow::Break(()));

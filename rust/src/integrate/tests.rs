@@ -3,7 +3,7 @@
 use super::dopri5::{A21, A3, A4, A5, A6, B, B_HAT, C};
 use super::output::EveryStep;
 use super::*;
-use nalgebra::Vector2;
+use nalgebra::{Vector2, U1, U2};
 
 /// Harmonic oscillator y'' = −y with a jump of the forcing at t = 1 (a breakpoint).
 struct Oscillator {
@@ -11,7 +11,7 @@ struct Oscillator {
     jump_at: Option<f64>,
 }
 
-impl OdeSystem<2> for Oscillator {
+impl OdeSystem<U2> for Oscillator {
     fn rhs(&self, _t: f64, y: &Vector2<f64>) -> Vector2<f64> {
         Vector2::new(y[1], -y[0] + self.forcing_on_segment)
     }
@@ -271,7 +271,7 @@ fn step_guard_stops_runaway_integrations() {
 
 /// y' = y², blowing up at t = 1: the integrator must report an error, not return inf or NaN.
 struct BlowUp;
-impl OdeSystem<1> for BlowUp {
+impl OdeSystem<U1> for BlowUp {
     fn rhs(&self, _t: f64, y: &nalgebra::Vector1<f64>) -> nalgebra::Vector1<f64> {
         nalgebra::Vector1::new(y[0] * y[0])
     }
@@ -298,4 +298,47 @@ fn blow_up_is_an_error() {
         &mut StepCounter::default(),
     );
     assert!(r.is_err());
+}
+
+/// The oscillator with its size chosen at run time.
+struct DynOscillator(Oscillator);
+
+impl OdeSystem<Dyn> for DynOscillator {
+    fn rhs(&self, t: f64, y: &State<Dyn>) -> State<Dyn> {
+        let f = self.0.rhs(t, &Vector2::new(y[0], y[1]));
+        State::<Dyn>::from_column_slice(f.as_slice())
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.0.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.0.enter_segment(a, b);
+    }
+}
+
+#[test]
+fn a_run_time_size_gives_the_same_bits_as_a_fixed_one() {
+    let times: Vec<f64> = (0..=40).map(|i| i as f64 * 0.07).collect();
+    let methods = [
+        Method::Dopri5(Tolerances::default()),
+        Method::Rk4 { dt: 0.01 },
+    ];
+    for method in methods {
+        let jump = || Oscillator {
+            forcing_on_segment: 0.0,
+            jump_at: Some(1.0),
+        };
+        let mut fixed = Sampler::new(times.clone());
+        let (s1, y1) = solve(&mut jump(), &method, 0.0, exact_free(0.0), 2.8, &mut fixed).unwrap();
+        let mut dynamic = Sampler::new(times.clone());
+        let y0 = State::<Dyn>::from_column_slice(exact_free(0.0).as_slice());
+        let mut sys = DynOscillator(jump());
+        let (s2, y2) = solve(&mut sys, &method, 0.0, y0, 2.8, &mut dynamic).unwrap();
+        assert_eq!(s1, s2);
+        assert_eq!(y1.as_slice(), y2.as_slice());
+        assert_eq!(fixed.t, dynamic.t);
+        for (a, b) in fixed.y.iter().zip(&dynamic.y) {
+            assert_eq!(a.as_slice(), b.as_slice());
+        }
+    }
 }

@@ -1,11 +1,11 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
 use super::convert::{output, panel_from, solver_from};
-use super::to_py;
+use super::error::invalid;
+use super::error::shield;
 use crate::beam::{respond, FreeFreeBeam, BEAM_MODES};
 use crate::system::MomentHistory;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::f64::consts::PI;
@@ -13,12 +13,13 @@ use std::f64::consts::PI;
 fn beam_from(panel: &Bound<'_, PyDict>, n_elements: i64) -> PyResult<FreeFreeBeam> {
     let p = panel_from(panel)?;
     let n = usize::try_from(n_elements).map_err(|_| {
-        PyValueError::new_err(format!(
-            "n_elements = {n_elements} is invalid: must be even, between 2 and {}",
-            crate::beam::MAX_ELEMENTS
-        ))
+        invalid(
+            "n_elements",
+            n_elements,
+            &format!("must be even, between 2 and {}", crate::beam::MAX_ELEMENTS),
+        )
     })?;
-    FreeFreeBeam::new(&p, n).map_err(to_py)
+    Ok(FreeFreeBeam::new(&p, n)?)
 }
 
 /// Modes of the free–free beam: the first `n_modes` elastic frequencies (Hz) and deflection
@@ -30,59 +31,59 @@ fn beam_modes<'py>(
     n_elements: i64,
     n_modes: i64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let beam = beam_from(panel, n_elements)?;
-    let (modes, moment_modes) = py
-        .detach(|| Ok::<_, crate::Error>((beam.modes()?, beam.end_moment_modes()?)))
-        .map_err(to_py)?;
-    let elastic = modes.eigenvalues.len() - 2;
-    let k = usize::try_from(n_modes)
-        .ok()
-        .filter(|&k| k >= 1 && k <= elastic)
-        .ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "n = {n_modes} is invalid: must be between 1 and {elastic} (elastic modes of the mesh)"
-            ))
-        })?;
-    let freqs: Vec<f64> = modes.elastic_angular_frequencies()[..k]
-        .iter()
-        .map(|w| w / (2.0 * PI))
-        .collect();
-    let nodes = beam.n_elements + 1;
-    let x: Vec<f64> = (0..nodes)
-        .map(|j| beam.length * j as f64 / beam.n_elements as f64)
-        .collect();
-    let shapes: Vec<Vec<f64>> = (0..nodes)
-        .map(|j| (0..k).map(|c| modes.shapes[(2 * j, c + 2)]).collect())
-        .collect();
-    let t = beam.translation();
-    let total_mass = t.dot(&(beam.mass_matrix() * &t));
-    let d = PyDict::new(py);
-    d.set_item("frequencies_hz", PyArray1::from_vec(py, freqs))?;
-    d.set_item(
-        "rigid_eigenvalues",
-        PyArray1::from_vec(py, modes.rigid_eigenvalues().to_vec()),
-    )?;
-    d.set_item("x", PyArray1::from_vec(py, x))?;
-    d.set_item(
-        "shapes",
-        PyArray2::from_vec2(py, &shapes).map_err(|e| PyValueError::new_err(e.to_string()))?,
-    )?;
-    d.set_item("total_mass", total_mass)?;
-    d.set_item("flexibility", moment_modes.flexibility)?;
-    d.set_item("residual_flexibility", moment_modes.residual_flexibility)?;
-    d.set_item(
-        "kept_frequencies_hz",
-        PyArray1::from_vec(
-            py,
-            moment_modes
-                .kept
-                .iter()
-                .map(|(w, _, _)| w / (2.0 * PI))
-                .collect(),
-        ),
-    )?;
-    d.set_item("max_kept_modes", BEAM_MODES)?;
-    Ok(d)
+    shield(|| {
+        let beam = beam_from(panel, n_elements)?;
+        let (modes, moment_modes) =
+            py.detach(|| Ok::<_, crate::Error>((beam.modes()?, beam.end_moment_modes()?)))?;
+        let elastic = modes.eigenvalues.len() - 2;
+        let k = usize::try_from(n_modes)
+            .ok()
+            .filter(|&k| k >= 1 && k <= elastic)
+            .ok_or_else(|| {
+                invalid(
+                    "n",
+                    n_modes,
+                    &format!("must be between 1 and {elastic} (elastic modes of the mesh)"),
+                )
+            })?;
+        let freqs: Vec<f64> = modes.elastic_angular_frequencies()[..k]
+            .iter()
+            .map(|w| w / (2.0 * PI))
+            .collect();
+        let nodes = beam.n_elements + 1;
+        let x: Vec<f64> = (0..nodes)
+            .map(|j| beam.length * j as f64 / beam.n_elements as f64)
+            .collect();
+        let shapes: Vec<Vec<f64>> = (0..nodes)
+            .map(|j| (0..k).map(|c| modes.shapes[(2 * j, c + 2)]).collect())
+            .collect();
+        let t = beam.translation();
+        let total_mass = t.dot(&(beam.mass_matrix() * &t));
+        let d = PyDict::new(py);
+        d.set_item("frequencies_hz", PyArray1::from_vec(py, freqs))?;
+        d.set_item(
+            "rigid_eigenvalues",
+            PyArray1::from_vec(py, modes.rigid_eigenvalues().to_vec()),
+        )?;
+        d.set_item("x", PyArray1::from_vec(py, x))?;
+        d.set_item("shapes", PyArray2::from_vec2(py, &shapes)?)?;
+        d.set_item("total_mass", total_mass)?;
+        d.set_item("flexibility", moment_modes.flexibility)?;
+        d.set_item("residual_flexibility", moment_modes.residual_flexibility)?;
+        d.set_item(
+            "kept_frequencies_hz",
+            PyArray1::from_vec(
+                py,
+                moment_modes
+                    .kept
+                    .iter()
+                    .map(|(w, _, _)| w / (2.0 * PI))
+                    .collect(),
+            ),
+        )?;
+        d.set_item("max_kept_modes", BEAM_MODES)?;
+        Ok(d)
+    })
 }
 
 /// Static tip deflection relative to the centre (m) under end moments ±`moment` (N m).
@@ -93,9 +94,10 @@ fn beam_static(
     n_elements: i64,
     moment: f64,
 ) -> PyResult<f64> {
-    let beam = beam_from(panel, n_elements)?;
-    py.detach(|| beam.static_tip_deflection(moment))
-        .map_err(to_py)
+    shield(|| {
+        let beam = beam_from(panel, n_elements)?;
+        Ok(py.detach(|| beam.static_tip_deflection(moment))?)
+    })
 }
 
 /// Modal transient response to end moments ±M(t) given as samples (`moment_t`, `moment`).
@@ -116,25 +118,26 @@ fn beam_response<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let beam = beam_from(panel, n_elements)?;
-    let m = solver_from(solver)?;
-    let out = output(t_eval, dt_out, t0, t1)?;
-    let history = MomentHistory::Samples {
-        t: moment_t.as_array().to_vec(),
-        moment: moment.as_array().to_vec(),
-    };
-    history.validate().map_err(to_py)?;
-    let r = py
-        .detach(|| respond(&beam, history, damping_ratio, residual, &m, (t0, t1), &out))
-        .map_err(to_py)?;
-    let d = PyDict::new(py);
-    d.set_item("t", PyArray1::from_vec(py, r.t))?;
-    d.set_item("eta", PyArray1::from_vec(py, r.eta))?;
-    d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
-    d.set_item("n_steps", r.stats.n_steps)?;
-    d.set_item("n_rejected", r.stats.n_rejected)?;
-    d.set_item("n_rhs", r.stats.n_rhs)?;
-    Ok(d)
+    shield(|| {
+        let beam = beam_from(panel, n_elements)?;
+        let m = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        let history = MomentHistory::Samples {
+            t: moment_t.as_array().to_vec(),
+            moment: moment.as_array().to_vec(),
+        };
+        history.validate()?;
+        let r =
+            py.detach(|| respond(&beam, history, damping_ratio, residual, &m, (t0, t1), &out))?;
+        let d = PyDict::new(py);
+        d.set_item("t", PyArray1::from_vec(py, r.t))?;
+        d.set_item("eta", PyArray1::from_vec(py, r.eta))?;
+        d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
+        d.set_item("n_steps", r.stats.n_steps)?;
+        d.set_item("n_rejected", r.stats.n_rejected)?;
+        d.set_item("n_rhs", r.stats.n_rhs)?;
+        Ok(d)
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,6 +1,6 @@
 //! Python values to engine types, with errors that name the parameter.
 
-use super::to_py;
+use super::error::invalid;
 use crate::dynamics::HingeModel;
 use crate::integrate::{Method, Tolerances};
 use crate::orbit::Shadow;
@@ -8,10 +8,10 @@ use crate::simulate::Output;
 use crate::{Orbit, Panel};
 use nalgebra::SVector;
 use numpy::PyReadonlyArray1;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyBool, PyDict, PyString};
 
 /// A float entry of a mapping, named in any error. The key may be an interned Python string, so
 /// that the lookup neither builds nor hashes a new string.
@@ -21,16 +21,23 @@ where
 {
     let v = d
         .get_item(key)?
-        .ok_or_else(|| PyValueError::new_err(format!("{key} is missing")))?;
-    v.extract::<f64>().map_err(|_| {
-        PyTypeError::new_err(format!(
-            "{key} must be a number, not {}",
-            v.get_type()
-                .name()
-                .map(|n| n.to_string())
-                .unwrap_or_default()
-        ))
-    })
+        .ok_or_else(|| invalid(&key.to_string(), "missing", "is required"))?;
+    // A bool is not a number (Python would read True as 1.0).
+    if v.is_instance_of::<PyBool>() {
+        return Err(type_error(&key.to_string(), "a number", &v));
+    }
+    v.extract::<f64>()
+        .map_err(|_| type_error(&key.to_string(), "a number", &v))
+}
+
+/// A TypeError naming the parameter, the type expected and the type given.
+pub fn type_error(name: &str, expected: &str, given: &Bound<'_, PyAny>) -> PyErr {
+    let kind = given
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_default();
+    PyTypeError::new_err(format!("{name} must be {expected}, not {kind}"))
 }
 
 /// The panel's field names as interned Python strings, built once.
@@ -46,9 +53,9 @@ pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
     });
     let mut p = Panel::paper();
     for (name, key) in Panel::FIELDS.iter().zip(keys) {
-        p.set(name, float_item(d, key.bind(py))?).map_err(to_py)?;
+        p.set(name, float_item(d, key.bind(py))?)?;
     }
-    p.validate().map_err(to_py)?;
+    p.validate()?;
     Ok(p)
 }
 
@@ -63,7 +70,7 @@ fn optional_item<'py, T: FromPyObjectOwned<'py>>(
         Some(v) => v
             .extract::<T>()
             .map(Some)
-            .map_err(|_| PyTypeError::new_err(format!("{key} must be {kind}"))),
+            .map_err(|_| type_error(key, kind, &v)),
     }
 }
 
@@ -73,7 +80,7 @@ fn optional_item<'py, T: FromPyObjectOwned<'py>>(
 pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
     let base = Orbit::geo_equinox();
     let shadow = match optional_item::<String>(d, "shadow", "a string")? {
-        Some(name) => Shadow::from_name(&name).map_err(to_py)?,
+        Some(name) => Shadow::from_name(&name)?,
         None => base.shadow,
     };
     let o = Orbit {
@@ -89,7 +96,7 @@ pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
             None => base.epoch_day,
         },
     };
-    o.validate().map_err(to_py)?;
+    o.validate()?;
     Ok(o)
 }
 
@@ -97,9 +104,11 @@ pub fn hinge_model(name: &str) -> PyResult<HingeModel> {
     match name {
         "nonlinear" => Ok(HingeModel::Nonlinear),
         "linear" => Ok(HingeModel::Linear),
-        other => Err(PyValueError::new_err(format!(
-            "model = {other:?} is invalid: must be 'nonlinear' or 'linear'"
-        ))),
+        other => Err(invalid(
+            "model",
+            format!("{other:?}"),
+            "must be 'nonlinear' or 'linear'",
+        )),
     }
 }
 
@@ -121,38 +130,36 @@ pub fn method(
         "rk4" => match dt {
             Some(dt) => Method::Rk4 { dt },
             None => {
-                return Err(PyValueError::new_err(
-                    "dt is required with method='rk4' (the fixed step, s)",
+                return Err(invalid(
+                    "dt",
+                    "None",
+                    "is required with method='rk4' (the fixed step, s)",
                 ))
             }
         },
         other => {
-            return Err(PyValueError::new_err(format!(
-                "method = {other:?} is invalid: must be 'rk45' or 'rk4'"
-            )))
+            return Err(invalid(
+                "method",
+                format!("{other:?}"),
+                "must be 'rk45' or 'rk4'",
+            ))
         }
     };
-    m.validate().map_err(to_py)?;
+    m.validate()?;
     Ok(m)
 }
 
 /// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
 /// run function receives it.
 pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
-    let name: String = d
-        .get_item("method")?
-        .ok_or_else(|| PyValueError::new_err("method is missing"))?
-        .extract()
-        .map_err(|_| PyTypeError::new_err("method must be a string"))?;
+    let name: String = optional_item(d, "method", "a string")?
+        .ok_or_else(|| invalid("method", "missing", "is required"))?;
     let dt = match d.get_item("dt")? {
         Some(v) if !v.is_none() => Some(float_item(d, "dt")?),
         _ => None,
     };
-    let max_steps: u64 = d
-        .get_item("max_steps")?
-        .ok_or_else(|| PyValueError::new_err("max_steps is missing"))?
-        .extract()
-        .map_err(|_| PyValueError::new_err("max_steps must be an integer >= 1"))?;
+    let max_steps: u64 = optional_item(d, "max_steps", "an integer >= 1")?
+        .ok_or_else(|| invalid("max_steps", "missing", "is required"))?;
     method(
         &name,
         float_item(d, "rtol")?,
@@ -169,28 +176,37 @@ pub fn output(
     t0: f64,
     t1: f64,
 ) -> PyResult<Output> {
-    crate::integrate::check_span(t0, t1).map_err(to_py)?;
+    crate::integrate::check_span(t0, t1)?;
     let out = match (t_eval, dt_out) {
-        (Some(_), Some(_)) => return Err(PyValueError::new_err("give t_eval or dt_out, not both")),
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "dt_out",
+                "given",
+                "give t_eval or dt_out, not both",
+            ))
+        }
         (Some(ts), None) => Output::Times(ts.as_array().to_vec()),
         (None, Some(dt)) => Output::Every(dt),
-        (None, None) => return Err(PyValueError::new_err("t_eval or dt_out is required")),
+        (None, None) => return Err(invalid("dt_out", "None", "t_eval or dt_out is required")),
     };
-    out.sample_times(t0, t1).map_err(to_py)?;
+    out.sample_times(t0, t1)?;
     Ok(out)
 }
 
 pub fn state<const N: usize>(v: &[f64]) -> PyResult<SVector<f64, N>> {
     if v.len() != N {
-        return Err(PyValueError::new_err(format!(
-            "y0 has {} components; expected {N}",
-            v.len()
-        )));
+        return Err(invalid(
+            "y0",
+            format!("{v:?}"),
+            &format!("must have {N} components, not {}", v.len()),
+        ));
     }
     if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "y0 = {v:?} is invalid: component {x} is not finite"
-        )));
+        return Err(invalid(
+            "y0",
+            format!("{v:?}"),
+            &format!("component {x} is not finite"),
+        ));
     }
     Ok(SVector::from_column_slice(v))
 }

@@ -1,12 +1,13 @@
 //! Bindings of batched runs: a rayon pool of its own, and the check of a design up front.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, solver_from};
-use super::to_py;
+use super::error::invalid;
+use super::error::shield;
 use crate::ensemble::{pool, run_batch, EnsembleSettings, SampleMetrics};
 use crate::system::Coupling;
 use crate::Panel;
 use numpy::{PyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::ThreadPool;
@@ -15,32 +16,42 @@ use rayon::ThreadPool;
 fn panels_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Panel>> {
     let a = rows.as_array();
     if a.ncols() != Panel::FIELDS.len() {
-        return Err(PyValueError::new_err(format!(
-            "panels has {} columns; expected {} (PANEL_FIELDS)",
-            a.ncols(),
-            Panel::FIELDS.len()
-        )));
+        return Err(invalid(
+            "panels",
+            format!("{} columns", a.ncols()),
+            &format!("must have {} columns (PANEL_FIELDS)", Panel::FIELDS.len()),
+        ));
     }
     a.rows()
         .into_iter()
         .map(|row| {
             let mut p = Panel::paper();
             for (name, &v) in Panel::FIELDS.iter().zip(row.iter()) {
-                p.set(name, v).map_err(to_py)?;
+                p.set(name, v)?;
             }
             Ok(p)
         })
         .collect()
 }
 
-/// Every row that the panel validation refuses, as (row, message naming the parameter).
+/// Every row that the panel validation refuses, as (row, parameter, message).
 #[pyfunction]
-fn check_panels(panels: PyReadonlyArray2<'_, f64>) -> PyResult<Vec<(usize, String)>> {
-    Ok(panels_from(&panels)?
-        .iter()
-        .enumerate()
-        .filter_map(|(i, p)| p.validate().err().map(|e| (i, e.to_string())))
-        .collect())
+fn check_panels(panels: PyReadonlyArray2<'_, f64>) -> PyResult<Vec<(usize, String, String)>> {
+    shield(|| {
+        Ok(panels_from(&panels)?
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| {
+                p.validate().err().map(|e| {
+                    let name = match &e {
+                        crate::Error::InvalidParameter { name, .. } => name.clone(),
+                        _ => String::new(),
+                    };
+                    (i, name, e.to_string())
+                })
+            })
+            .collect())
+    })
 }
 
 /// A rayon thread pool of its own; batches run on it with the GIL released. Several Python
@@ -56,12 +67,14 @@ impl EnsemblePool {
     #[pyo3(signature = (threads=None))]
     fn new(threads: Option<usize>) -> PyResult<Self> {
         if threads == Some(0) {
-            return Err(PyValueError::new_err(
-                "threads = 0 is invalid: must be >= 1 (or None for one per core)",
+            return Err(invalid(
+                "threads",
+                0,
+                "must be >= 1 (or None for one per core)",
             ));
         }
         Ok(EnsemblePool {
-            pool: pool(threads.unwrap_or(0)).map_err(to_py)?,
+            pool: pool(threads.unwrap_or(0))?,
         })
     }
 
@@ -71,7 +84,7 @@ impl EnsemblePool {
     }
 
     /// Runs one sample per row of `panels`; returns the metrics as columns.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, cancel=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -85,51 +98,53 @@ impl EnsemblePool {
         window: f64,
         threshold: Option<f64>,
         stop_at_threshold: bool,
+        cancel: Option<&Bound<'py, CancelToken>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let ps = panels_from(&panels)?;
-        let settings = EnsembleSettings {
-            orbit: orbit_from(orbit)?,
-            model: hinge_model(model)?,
-            coupling: if coupled {
-                Coupling::ProjectedArea
-            } else {
-                Coupling::Frozen
-            },
-            method: solver_from(solver)?,
-            n_orbits,
-            window,
-            threshold,
-            stop_at_threshold,
-        };
-        let pool = &self.pool;
-        let out = py
-            .detach(|| run_batch(pool, &ps, &settings))
-            .map_err(to_py)?;
-        let d = PyDict::new(py);
-        let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };
-        for (name, values) in [
-            ("theta_eq", col(|m| m.theta_eq)),
-            ("growth_rate", col(|m| m.growth_rate)),
-            ("frequency_hz", col(|m| m.frequency_hz)),
-            ("critical_damping", col(|m| m.critical_damping)),
-            ("theta_abs_max", col(|m| m.theta_abs_max)),
-            ("amplitude", col(|m| m.amplitude)),
-            ("entry_peak", col(|m| m.entry_peak)),
-            ("exit_peak", col(|m| m.exit_peak)),
-            ("jitter_rms", col(|m| m.jitter_rms)),
-            ("jitter_peak", col(|m| m.jitter_peak)),
-            ("t_threshold", col(|m| m.t_threshold)),
-            ("t_reached", col(|m| m.t_reached)),
-        ] {
-            d.set_item(name, PyArray1::from_vec(py, values))?;
-        }
-        let stable: Vec<bool> = out.iter().map(|m| m.stable()).collect();
-        d.set_item("stable", PyArray1::from_vec(py, stable))?;
-        let steps: Vec<u64> = out.iter().map(|m| m.n_steps).collect();
-        d.set_item("n_steps", PyArray1::from_vec(py, steps))?;
-        let errors: Vec<Option<String>> = out.into_iter().map(|m| m.error).collect();
-        d.set_item("error", errors)?;
-        Ok(d)
+        let cancel = token(cancel);
+        shield(|| {
+            let ps = panels_from(&panels)?;
+            let settings = EnsembleSettings {
+                orbit: orbit_from(orbit)?,
+                model: hinge_model(model)?,
+                coupling: if coupled {
+                    Coupling::ProjectedArea
+                } else {
+                    Coupling::Frozen
+                },
+                method: solver_from(solver)?,
+                n_orbits,
+                window,
+                threshold,
+                stop_at_threshold,
+            };
+            let pool = &self.pool;
+            let out = py.detach(|| run_batch(pool, &ps, &settings, &cancel))?;
+            let d = PyDict::new(py);
+            let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };
+            for (name, values) in [
+                ("theta_eq", col(|m| m.theta_eq)),
+                ("growth_rate", col(|m| m.growth_rate)),
+                ("frequency_hz", col(|m| m.frequency_hz)),
+                ("critical_damping", col(|m| m.critical_damping)),
+                ("theta_abs_max", col(|m| m.theta_abs_max)),
+                ("amplitude", col(|m| m.amplitude)),
+                ("entry_peak", col(|m| m.entry_peak)),
+                ("exit_peak", col(|m| m.exit_peak)),
+                ("jitter_rms", col(|m| m.jitter_rms)),
+                ("jitter_peak", col(|m| m.jitter_peak)),
+                ("t_threshold", col(|m| m.t_threshold)),
+                ("t_reached", col(|m| m.t_reached)),
+            ] {
+                d.set_item(name, PyArray1::from_vec(py, values))?;
+            }
+            let stable: Vec<bool> = out.iter().map(|m| m.stable()).collect();
+            d.set_item("stable", PyArray1::from_vec(py, stable))?;
+            let steps: Vec<u64> = out.iter().map(|m| m.n_steps).collect();
+            d.set_item("n_steps", PyArray1::from_vec(py, steps))?;
+            let errors: Vec<Option<String>> = out.into_iter().map(|m| m.error).collect();
+            d.set_item("error", errors)?;
+            Ok(d)
+        })
     }
 }
 

@@ -1,9 +1,10 @@
 //! Bindings of summarised long runs.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
-use super::to_py;
+use super::error::shield;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
-use crate::summary::{run_orbits as run, OrbitRun, SummaryOptions};
+use crate::summary::{run_orbits_cancellable as run, OrbitRun, SummaryOptions};
 use crate::system::Coupling;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -11,7 +12,7 @@ use pyo3::types::PyDict;
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -28,25 +29,27 @@ fn run_orbits<'py>(
     theta_limit: f64,
     stop_at_limit: bool,
     steps_per_period: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = panel_from(panel)?;
-    let o = orbit_from(orbit)?;
-    let hinge = hinge_model(model)?;
-    let coupling = if coupled {
-        Coupling::ProjectedArea
-    } else {
-        Coupling::Frozen
-    };
-    let m = solver_from(solver)?;
-    let y = state::<4>(&y0)?;
-    let options = SummaryOptions {
-        window,
-        theta_limit,
-        stop_at_limit,
-        steps_per_period,
-    };
-    let out = py
-        .detach(|| {
+    let cancel = token(cancel);
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let hinge = hinge_model(model)?;
+        let coupling = if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        };
+        let m = solver_from(solver)?;
+        let y = state::<4>(&y0)?;
+        let options = SummaryOptions {
+            window,
+            theta_limit,
+            stop_at_limit,
+            steps_per_period,
+        };
+        let out = py.detach(|| {
             run(
                 &p,
                 &o,
@@ -58,13 +61,12 @@ fn run_orbits<'py>(
                 n_orbits,
                 y,
                 options,
+                &cancel,
             )
-        })
-        .map_err(to_py)?;
-    summary_dict(py, &out)
+        })?;
+        summary_dict(py, &out)
+    })
 }
-
-
 
 /// The summaries of a run as columns, with its counters.
 fn summary_dict<'py>(py: Python<'py>, out: &OrbitRun) -> PyResult<Bound<'py, PyDict>> {
@@ -104,11 +106,12 @@ fn summary_dict<'py>(py: Python<'py>, out: &OrbitRun) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+
 /// Like `run_orbits`, with the hybrid propagator (the solver is the full integration it falls
 /// back to); adds how the simulated time was split between linear arcs, the exponential
 /// integrator and the fallback.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, hybrid))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, hybrid, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits_hybrid<'py>(
     py: Python<'py>,
@@ -126,39 +129,52 @@ fn run_orbits_hybrid<'py>(
     stop_at_limit: bool,
     steps_per_period: f64,
     hybrid: &Bound<'py, PyDict>,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = panel_from(panel)?;
-    let o = orbit_from(orbit)?;
-    let hinge = hinge_model(model)?;
-    let coupling = if coupled {
-        Coupling::ProjectedArea
-    } else {
-        Coupling::Frozen
-    };
-    let m = solver_from(solver)?;
-    let y = state::<4>(&y0)?;
-    let options = SummaryOptions {
-        window,
-        theta_limit,
-        stop_at_limit,
-        steps_per_period,
-    };
-    let settings = hybrid_from(hybrid)?;
-    let out = py
-        .detach(|| {
+    let cancel = token(cancel);
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let hinge = hinge_model(model)?;
+        let coupling = if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        };
+        let m = solver_from(solver)?;
+        let y = state::<4>(&y0)?;
+        let options = SummaryOptions {
+            window,
+            theta_limit,
+            stop_at_limit,
+            steps_per_period,
+        };
+        let settings = hybrid_from(hybrid)?;
+        let out = py.detach(|| {
             run_hybrid(
-                &p, &o, hinge, coupling, &m, t_start, first_index, n_orbits, y, options, &settings,
+                &p,
+                &o,
+                hinge,
+                coupling,
+                &m,
+                t_start,
+                first_index,
+                n_orbits,
+                y,
+                options,
+                &settings,
+                &cancel,
             )
-        })
-        .map_err(to_py)?;
-    let d = summary_dict(py, &out.run)?;
-    d.set_item("t_linear", out.t_linear)?;
-    d.set_item("t_exponential", out.t_exponential)?;
-    d.set_item("t_fallback", out.t_fallback)?;
-    d.set_item("n_arcs", out.n_arcs)?;
-    d.set_item("n_exp_steps", out.n_exp_steps)?;
-    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
-    Ok(d)
+        })?;
+        let d = summary_dict(py, &out.run)?;
+        d.set_item("t_linear", out.t_linear)?;
+        d.set_item("t_exponential", out.t_exponential)?;
+        d.set_item("t_fallback", out.t_fallback)?;
+        d.set_item("n_arcs", out.n_arcs)?;
+        d.set_item("n_exp_steps", out.n_exp_steps)?;
+        d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+        Ok(d)
+    })
 }
 
 /// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
@@ -177,12 +193,12 @@ pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
             "resolved_amplitude" => s.resolved_amplitude = v,
             other => {
                 return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "hybrid setting {other:?} is unknown"
+                    "hybrid = {{{other:?}: ...}} is invalid: not a hybrid setting"
                 )))
             }
         }
     }
-    s.validate().map_err(to_py)?;
+    s.validate()?;
     Ok(s)
 }
 

@@ -2,64 +2,48 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod beam;
+mod cancel;
 mod convert;
+mod distributed;
 mod ensemble;
+mod error;
 mod flutter;
 mod longrun;
 mod orbit;
 
 use crate::dynamics::hinge_energy;
+use crate::dynamics::thermal_moment;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
 use crate::simulate::{run, Trajectory};
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling, DrivenHinge, MomentHistory, OneNode, TwoLayer};
-use crate::{dynamics::thermal_moment, Error};
 use convert::{hinge_model, orbit_from, output, panel_from, solver_from, state};
-use nalgebra::SVector;
+use error::{invalid, shield, ConvergenceError, IntegrationError};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, SVector};
 use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::f64::consts::PI;
-
-create_exception!(
-    _core,
-    IntegrationError,
-    PyRuntimeError,
-    "The integrator could not finish the run."
-);
-create_exception!(
-    _core,
-    ConvergenceError,
-    PyRuntimeError,
-    "A non-linear solve did not converge."
-);
-
-/// Maps each engine error kind to its Python exception.
-pub(crate) fn to_py(err: Error) -> PyErr {
-    match err {
-        Error::InvalidParameter { .. } => PyValueError::new_err(err.to_string()),
-        Error::Integration { .. } => IntegrationError::new_err(err.to_string()),
-        Error::NoConvergence { .. } => ConvergenceError::new_err(err.to_string()),
-    }
-}
 
 fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_vec(py, v)
 }
 
 /// Column `i` of a sampled trajectory.
-fn column<const N: usize>(traj: &Trajectory<N>, i: usize) -> Vec<f64> {
-    traj.y.iter().map(|y| y[i]).collect()
+fn column<D: Dim>(traj: &Trajectory<D>, i: usize) -> Vec<f64>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    traj.column(i)
 }
 
 /// The counters and end state common to every run.
-fn run_info<'py, const N: usize>(
-    py: Python<'py>,
-    traj: &Trajectory<N>,
-) -> PyResult<Bound<'py, PyDict>> {
+fn run_info<'py, D: Dim>(py: Python<'py>, traj: &Trajectory<D>) -> PyResult<Bound<'py, PyDict>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let d = PyDict::new(py);
     d.set_item(intern!(py, "t"), array(py, traj.t.clone()))?;
     d.set_item(intern!(py, "n_steps"), traj.stats.n_steps)?;
@@ -76,72 +60,82 @@ fn run_info<'py, const N: usize>(
 /// Validates a panel given as a mapping of its parameters.
 #[pyfunction]
 fn validate_panel(panel: &Bound<'_, PyDict>) -> PyResult<()> {
-    panel_from(panel).map(|_| ())
+    shield(|| panel_from(panel).map(|_| ()))
 }
 
 /// Validates an orbit given as a mapping.
 #[pyfunction]
 fn validate_orbit(orbit: &Bound<'_, PyDict>) -> PyResult<()> {
-    orbit_from(orbit).map(|_| ())
+    shield(|| orbit_from(orbit).map(|_| ()))
 }
 
 /// Sunlit equilibrium (T_f, T_b, θ) under flux factor `flux`.
 #[pyfunction]
 #[pyo3(signature = (panel, coupled=true, flux=1.0))]
 fn steady_state(panel: &Bound<'_, PyDict>, coupled: bool, flux: f64) -> PyResult<(f64, f64, f64)> {
-    let p = panel_from(panel)?;
-    let coupling = if coupled {
-        Coupling::ProjectedArea
-    } else {
-        Coupling::Frozen
-    };
-    let eq = equilibrium(&p, coupling, flux).map_err(to_py)?;
-    Ok((eq.t_front, eq.t_back, eq.theta))
+    shield(|| {
+        let p = panel_from(panel)?;
+        let coupling = if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        };
+        let eq = equilibrium(&p, coupling, flux)?;
+        Ok((eq.t_front, eq.t_back, eq.theta))
+    })
 }
 
 /// K_el by criterion ("deflection", "deflection_small_angle", "frequency").
 #[pyfunction]
 #[pyo3(signature = (panel, criterion, moment=0.0))]
 fn stiffness(panel: &Bound<'_, PyDict>, criterion: &str, moment: f64) -> PyResult<f64> {
-    let p = panel_from(panel)?;
-    let c = match criterion {
-        "deflection" => StiffnessCriterion::Deflection,
-        "deflection_small_angle" => StiffnessCriterion::DeflectionSmallAngle,
-        "frequency" => StiffnessCriterion::Frequency,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "criterion = {other:?} is invalid: must be 'deflection', 'deflection_small_angle' or 'frequency'"
-            )))
-        }
-    };
-    hinge_stiffness(&p, c, moment).map_err(to_py)
+    shield(|| {
+        let p = panel_from(panel)?;
+        let c = match criterion {
+            "deflection" => StiffnessCriterion::Deflection,
+            "deflection_small_angle" => StiffnessCriterion::DeflectionSmallAngle,
+            "frequency" => StiffnessCriterion::Frequency,
+            other => {
+                return Err(invalid(
+                    "criterion",
+                    format!("{other:?}"),
+                    "must be 'deflection', 'deflection_small_angle' or 'frequency'",
+                ))
+            }
+        };
+        Ok(hinge_stiffness(&p, c, moment)?)
+    })
 }
 
 /// Derived quantities of a panel: hinge inertia, frequencies, moment per kelvin.
 #[pyfunction]
 fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
-    let p = panel_from(panel)?;
-    let d = PyDict::new(py);
-    d.set_item("half_arm", p.half_arm())?;
-    d.set_item("hinge_inertia", p.hinge_inertia())?;
-    d.set_item(
-        "natural_frequency_hz",
-        p.natural_angular_frequency() / (2.0 * PI),
-    )?;
-    d.set_item(
-        "beam_frequency_hz",
-        beam_first_angular_frequency(&p) / (2.0 * PI),
-    )?;
-    d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
-    Ok(d)
+    shield(|| {
+        let p = panel_from(panel)?;
+        let d = PyDict::new(py);
+        d.set_item("half_arm", p.half_arm())?;
+        d.set_item("hinge_inertia", p.hinge_inertia())?;
+        d.set_item(
+            "natural_frequency_hz",
+            p.natural_angular_frequency() / (2.0 * PI),
+        )?;
+        d.set_item(
+            "beam_frequency_hz",
+            beam_first_angular_frequency(&p) / (2.0 * PI),
+        )?;
+        d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
+        Ok(d)
+    })
 }
 
 /// Shadow intervals of an orbit within [t0, t1].
 #[pyfunction]
 fn shadow_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
-    let o = orbit_from(orbit)?;
-    crate::integrate::check_span(t0, t1).map_err(to_py)?;
-    Ok(o.shadow_intervals(t0, t1))
+    shield(|| {
+        let o = orbit_from(orbit)?;
+        crate::integrate::check_span(t0, t1)?;
+        Ok(o.shadow_intervals(t0, t1))
+    })
 }
 
 /// Illumination s(t) at each time.
@@ -151,9 +145,11 @@ fn illumination<'py>(
     orbit: &Bound<'py, PyDict>,
     t: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let o = orbit_from(orbit)?;
-    let s = t.as_array().iter().map(|&x| o.illumination(x)).collect();
-    Ok(array(py, s))
+    shield(|| {
+        let o = orbit_from(orbit)?;
+        let s = t.as_array().iter().map(|&x| o.illumination(x)).collect();
+        Ok(array(py, s))
+    })
 }
 
 /// Thermal moment M_T for temperature arrays.
@@ -164,14 +160,16 @@ fn moment<'py>(
     t_front: PyReadonlyArray1<'py, f64>,
     t_back: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let p = panel_from(panel)?;
-    let m = t_front
-        .as_array()
-        .iter()
-        .zip(t_back.as_array().iter())
-        .map(|(&f, &b)| thermal_moment(&p, f, b))
-        .collect();
-    Ok(array(py, m))
+    shield(|| {
+        let p = panel_from(panel)?;
+        let m = t_front
+            .as_array()
+            .iter()
+            .zip(t_back.as_array().iter())
+            .map(|(&f, &b)| thermal_moment(&p, f, b))
+            .collect();
+        Ok(array(py, m))
+    })
 }
 
 /// Energy of the hinge in a constant moment field (conserved when c_d = 0).
@@ -184,15 +182,17 @@ fn energy<'py>(
     theta_dot: PyReadonlyArray1<'py, f64>,
     moment: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let p = panel_from(panel)?;
-    let m = hinge_model(model)?;
-    let e = theta
-        .as_array()
-        .iter()
-        .zip(theta_dot.as_array().iter())
-        .map(|(&a, &b)| hinge_energy(&p, m, a, b, moment))
-        .collect();
-    Ok(array(py, e))
+    shield(|| {
+        let p = panel_from(panel)?;
+        let m = hinge_model(model)?;
+        let e = theta
+            .as_array()
+            .iter()
+            .zip(theta_dot.as_array().iter())
+            .map(|(&a, &b)| hinge_energy(&p, m, a, b, moment))
+            .collect();
+        Ok(array(py, e))
+    })
 }
 
 /// Integrates the coupled thermo-structural system.
@@ -212,44 +212,44 @@ fn simulate<'py>(
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = panel_from(panel)?;
-    let o = orbit_from(orbit)?;
-    let hinge = hinge_model(model)?;
-    let coupling = if coupled {
-        Coupling::ProjectedArea
-    } else {
-        Coupling::Frozen
-    };
-    let m = solver_from(solver)?;
-    let out = output(t_eval, dt_out, t0, t1)?;
-    let y_start: SVector<f64, 4> = match y0 {
-        Some(v) => state::<4>(&v)?,
-        None => {
-            let eq = equilibrium(&p, coupling, o.flux_scale(t0)).map_err(to_py)?;
-            SVector::<f64, 4>::new(eq.t_front, eq.t_back, eq.theta, 0.0)
-        }
-    };
-    let traj = py
-        .detach(|| {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let hinge = hinge_model(model)?;
+        let coupling = if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        };
+        let m = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        let y_start: SVector<f64, 4> = match y0 {
+            Some(v) => state::<4>(&v)?,
+            None => {
+                let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
+                SVector::<f64, 4>::new(eq.t_front, eq.t_back, eq.theta, 0.0)
+            }
+        };
+        let traj = py.detach(|| {
             let mut sys = Coupled::new(p, o, hinge, coupling);
             run(&mut sys, &m, (t0, t1), y_start, &out)
-        })
-        .map_err(to_py)?;
-    let d = run_info(py, &traj)?;
-    let (tf, tb) = (column(&traj, 0), column(&traj, 1));
-    let mt: Vec<f64> = tf
-        .iter()
-        .zip(&tb)
-        .map(|(&f, &b)| thermal_moment(&p, f, b))
-        .collect();
-    let sunlit: Vec<f64> = traj.t.iter().map(|&t| o.illumination(t)).collect();
-    d.set_item(intern!(py, "T_front"), array(py, tf))?;
-    d.set_item(intern!(py, "T_back"), array(py, tb))?;
-    d.set_item(intern!(py, "theta"), array(py, column(&traj, 2)))?;
-    d.set_item(intern!(py, "theta_dot"), array(py, column(&traj, 3)))?;
-    d.set_item(intern!(py, "thermal_moment"), array(py, mt))?;
-    d.set_item(intern!(py, "sunlit"), array(py, sunlit))?;
-    Ok(d)
+        })?;
+        let d = run_info(py, &traj)?;
+        let (tf, tb) = (column(&traj, 0), column(&traj, 1));
+        let mt: Vec<f64> = tf
+            .iter()
+            .zip(&tb)
+            .map(|(&f, &b)| thermal_moment(&p, f, b))
+            .collect();
+        let sunlit: Vec<f64> = traj.t.iter().map(|&t| o.illumination(t)).collect();
+        d.set_item(intern!(py, "T_front"), array(py, tf))?;
+        d.set_item(intern!(py, "T_back"), array(py, tb))?;
+        d.set_item(intern!(py, "theta"), array(py, column(&traj, 2)))?;
+        d.set_item(intern!(py, "theta_dot"), array(py, column(&traj, 3)))?;
+        d.set_item(intern!(py, "thermal_moment"), array(py, mt))?;
+        d.set_item(intern!(py, "sunlit"), array(py, sunlit))?;
+        Ok(d)
+    })
 }
 
 /// Integrates a thermal model alone: one node (eq. 1) or two layers (eq. 2, θ = 0).
@@ -268,46 +268,44 @@ fn simulate_thermal<'py>(
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = panel_from(panel)?;
-    let o = orbit_from(orbit)?;
-    let m = solver_from(solver)?;
-    let out = output(t_eval, dt_out, t0, t1)?;
-    match layers {
-        1 => {
-            let y_start = match y0 {
-                Some(v) => state::<1>(&v)?,
-                None => SVector::<f64, 1>::new(crate::thermal::one_node_equilibrium(
-                    &p,
-                    o.flux_scale(t0),
-                )),
-            };
-            let traj = py
-                .detach(|| run(&mut OneNode::new(p, o), &m, (t0, t1), y_start, &out))
-                .map_err(to_py)?;
-            let d = run_info(py, &traj)?;
-            d.set_item("T", array(py, column(&traj, 0)))?;
-            Ok(d)
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let m = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        match layers {
+            1 => {
+                let y_start = match y0 {
+                    Some(v) => state::<1>(&v)?,
+                    None => SVector::<f64, 1>::new(crate::thermal::one_node_equilibrium(
+                        &p,
+                        o.flux_scale(t0),
+                    )),
+                };
+                let traj =
+                    py.detach(|| run(&mut OneNode::new(p, o), &m, (t0, t1), y_start, &out))?;
+                let d = run_info(py, &traj)?;
+                d.set_item("T", array(py, column(&traj, 0)))?;
+                Ok(d)
+            }
+            2 => {
+                let y_start = match y0 {
+                    Some(v) => state::<2>(&v)?,
+                    None => {
+                        let eq = equilibrium(&p, Coupling::Frozen, o.flux_scale(t0))?;
+                        SVector::<f64, 2>::new(eq.t_front, eq.t_back)
+                    }
+                };
+                let traj =
+                    py.detach(|| run(&mut TwoLayer::new(p, o), &m, (t0, t1), y_start, &out))?;
+                let d = run_info(py, &traj)?;
+                d.set_item("T_front", array(py, column(&traj, 0)))?;
+                d.set_item("T_back", array(py, column(&traj, 1)))?;
+                Ok(d)
+            }
+            other => Err(invalid("layers", other, "must be 1 or 2")),
         }
-        2 => {
-            let y_start = match y0 {
-                Some(v) => state::<2>(&v)?,
-                None => {
-                    let eq = equilibrium(&p, Coupling::Frozen, o.flux_scale(t0)).map_err(to_py)?;
-                    SVector::<f64, 2>::new(eq.t_front, eq.t_back)
-                }
-            };
-            let traj = py
-                .detach(|| run(&mut TwoLayer::new(p, o), &m, (t0, t1), y_start, &out))
-                .map_err(to_py)?;
-            let d = run_info(py, &traj)?;
-            d.set_item("T_front", array(py, column(&traj, 0)))?;
-            d.set_item("T_back", array(py, column(&traj, 1)))?;
-            Ok(d)
-        }
-        other => Err(PyValueError::new_err(format!(
-            "layers = {other} is invalid: must be 1 or 2"
-        ))),
-    }
+    })
 }
 
 /// Integrates the hinge alone under a prescribed moment: a constant, or samples (t, M).
@@ -327,39 +325,41 @@ fn simulate_hinge<'py>(
     dt_out: Option<f64>,
     y0: Vec<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = panel_from(panel)?;
-    let hinge = hinge_model(model)?;
-    let m = solver_from(solver)?;
-    let out = output(t_eval, dt_out, t0, t1)?;
-    let values = moment.as_array().to_vec();
-    let history = match moment_t {
-        None if values.len() == 1 => MomentHistory::Constant(values[0]),
-        None => {
-            return Err(PyValueError::new_err(
-                "moment_t is required when moment holds samples",
-            ))
-        }
-        Some(ts) => MomentHistory::Samples {
-            t: ts.as_array().to_vec(),
-            moment: values,
-        },
-    };
-    history.validate().map_err(to_py)?;
-    let y_start = state::<2>(&y0)?;
-    let traj = py
-        .detach(|| {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let hinge = hinge_model(model)?;
+        let m = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        let values = moment.as_array().to_vec();
+        let history = match moment_t {
+            None if values.len() == 1 => MomentHistory::Constant(values[0]),
+            None => {
+                return Err(invalid(
+                    "moment_t",
+                    "None",
+                    "is required when moment holds samples",
+                ))
+            }
+            Some(ts) => MomentHistory::Samples {
+                t: ts.as_array().to_vec(),
+                moment: values,
+            },
+        };
+        history.validate()?;
+        let y_start = state::<2>(&y0)?;
+        let traj = py.detach(|| {
             let mut sys = DrivenHinge {
                 panel: p,
                 model: hinge,
                 moment: history,
             };
             run(&mut sys, &m, (t0, t1), y_start, &out)
-        })
-        .map_err(to_py)?;
-    let d = run_info(py, &traj)?;
-    d.set_item("theta", array(py, column(&traj, 0)))?;
-    d.set_item("theta_dot", array(py, column(&traj, 1)))?;
-    Ok(d)
+        })?;
+        let d = run_info(py, &traj)?;
+        d.set_item("theta", array(py, column(&traj, 0)))?;
+        d.set_item("theta_dot", array(py, column(&traj, 1)))?;
+        Ok(d)
+    })
 }
 
 #[pymodule]
@@ -384,7 +384,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     longrun::register(m)?;
     beam::register(m)?;
+    distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
+    cancel::register(m)?;
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! Bindings of the orbit options: eclipses, umbra, the Sun over the year.
 
 use super::convert::orbit_from;
-use super::to_py;
+use super::error::shield;
 use crate::orbit::Orbit;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -14,31 +14,37 @@ type EclipseRow = (f64, f64, f64, f64, f64);
 /// entry, umbra exit), NaN where there is no umbra.
 #[pyfunction]
 fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<EclipseRow>> {
-    let o = orbit_from(orbit)?;
-    crate::integrate::check_span(t0, t1).map_err(to_py)?;
-    Ok(o.eclipses(t0, t1)
-        .iter()
-        .map(|e| {
-            let (c, d) = e.umbra.unwrap_or((f64::NAN, f64::NAN));
-            (e.centre, e.outer.0, e.outer.1, c, d)
-        })
-        .collect())
+    shield(|| {
+        let o = orbit_from(orbit)?;
+        crate::integrate::check_span(t0, t1)?;
+        Ok(o.eclipses(t0, t1)
+            .iter()
+            .map(|e| {
+                let (c, d) = e.umbra.unwrap_or((f64::NAN, f64::NAN));
+                (e.centre, e.outer.0, e.outer.1, c, d)
+            })
+            .collect())
+    })
 }
 
 /// Umbra intervals of an orbit within [t0, t1], clipped.
 #[pyfunction]
 fn umbra_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
-    let o = orbit_from(orbit)?;
-    crate::integrate::check_span(t0, t1).map_err(to_py)?;
-    Ok(o.umbra_intervals(t0, t1))
+    shield(|| {
+        let o = orbit_from(orbit)?;
+        crate::integrate::check_span(t0, t1)?;
+        Ok(o.umbra_intervals(t0, t1))
+    })
 }
 
 /// Times in (t0, t1) where s(t) jumps or has a kink.
 #[pyfunction]
 fn orbit_breakpoints(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<f64>> {
-    let o = orbit_from(orbit)?;
-    crate::integrate::check_span(t0, t1).map_err(to_py)?;
-    Ok(o.breakpoints(t0, t1))
+    shield(|| {
+        let o = orbit_from(orbit)?;
+        crate::integrate::check_span(t0, t1)?;
+        Ok(o.breakpoints(t0, t1))
+    })
 }
 
 fn map_times<'py>(
@@ -59,7 +65,7 @@ fn flux_scale<'py>(
     orbit: &Bound<'py, PyDict>,
     t: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    map_times(py, orbit, t, Orbit::flux_scale)
+    shield(|| map_times(py, orbit, t, Orbit::flux_scale))
 }
 
 /// The Sun's declination at each time, rad.
@@ -69,13 +75,13 @@ fn declination<'py>(
     orbit: &Bound<'py, PyDict>,
     t: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    map_times(py, orbit, t, Orbit::declination)
+    shield(|| map_times(py, orbit, t, Orbit::declination))
 }
 
 /// Orbit period relative to the Sun (time between eclipses), s.
 #[pyfunction]
 fn synodic_period(orbit: &Bound<'_, PyDict>) -> PyResult<f64> {
-    Ok(orbit_from(orbit)?.synodic_period())
+    shield(|| Ok(orbit_from(orbit)?.synodic_period()))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,0 +1,148 @@
+"""The exceptions thermojitter raises, and the checks that name a bad argument.
+
+- :class:`ParameterError` (a ``ValueError``): a value outside its allowed range. It carries the
+  parameter's name, the value and the allowed range as attributes, so that callers (the scenario
+  parser, Monte Carlo) never read them out of the message.
+- ``TypeError``: a value of the wrong type. Types are checked, not coerced: a bool is not a number,
+  None is not False, a string is not a number.
+- :class:`IntegrationError`, :class:`ConvergenceError` (``RuntimeError``, from the engine): a run
+  that could not finish, a solve that did not converge.
+- :class:`InternalError` (``RuntimeError``): a defect caught at the engine's boundary (a panic);
+  the call's result is lost but the process lives on.
+
+This module imports nothing from the engine: the engine's binding layer builds its
+``ParameterError`` from here.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+import numpy as np
+
+
+class ParameterError(ValueError):
+    """A value outside its allowed range.
+
+    ``parameter``: the argument's name (dotted for nested ones, e.g. ``"vary.damping"``);
+    ``value``: the value given; ``allowed``: the allowed range or choices in words, or None.
+    """
+
+    def __init__(
+        self, parameter: str, value: Any, allowed: str | None = None, message: str | None = None
+    ) -> None:
+        self.parameter = parameter
+        self.value = value
+        self.allowed = allowed
+        if message is None:
+            message = f"{parameter} = {value!r} is invalid"
+            if allowed:
+                message += f": {allowed}"
+        super().__init__(message)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Crosses process boundaries (Monte Carlo workers) with its attributes.
+        return (type(self), (self.parameter, self.value, self.allowed, str(self)))
+
+
+class InternalError(RuntimeError):
+    """A defect in thermojitter caught at the engine's boundary (a Rust panic). Please report it
+    with the call that raised it."""
+
+
+def type_name(value: Any) -> str:
+    return type(value).__name__
+
+
+def real(name: str, value: Any) -> float:
+    """``value`` as a float if it is a real number (int, float, NumPy scalar; not bool, not a
+    string, not None); a TypeError naming ``name`` otherwise, a ParameterError for an integer
+    too large for a float."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, not {type_name(value)} {value!r:.60}")
+    try:
+        return float(value)
+    except OverflowError:
+        raise ParameterError(name, value, "too large for a float (|x| < 1.8e308)") from None
+
+
+def finite(name: str, value: Any) -> float:
+    """A finite real number."""
+    x = real(name, value)
+    if not math.isfinite(x):
+        raise ParameterError(name, value, "must be finite")
+    return x
+
+
+def positive(name: str, value: Any) -> float:
+    """A finite real number > 0."""
+    x = real(name, value)
+    if not (math.isfinite(x) and x > 0.0):
+        raise ParameterError(name, value, "must be finite and > 0")
+    return x
+
+
+def in_range(name: str, value: Any, low: float, high: float, unit: str = "") -> float:
+    """A real number in [low, high]."""
+    x = real(name, value)
+    if not (low <= x <= high):
+        suffix = f" {unit}" if unit else ""
+        raise ParameterError(name, value, f"must be in [{low:g}, {high:g}]{suffix}")
+    return x
+
+
+def optional_positive(name: str, value: Any) -> float | None:
+    return None if value is None else positive(name, value)
+
+
+def integer(name: str, value: Any, minimum: int = 1, maximum: int | None = None) -> int:
+    """An int (Python or NumPy, not bool) in [minimum, maximum]."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, not {type_name(value)} {value!r:.60}")
+    n = int(value)
+    if n < minimum or (maximum is not None and n > maximum):
+        allowed = f"must be an integer >= {minimum}"
+        if maximum is not None:
+            allowed = f"must be an integer in [{minimum}, {maximum}]"
+        raise ParameterError(name, value, allowed)
+    return n
+
+
+def flag(name: str, value: Any) -> bool:
+    """A bool (or NumPy bool): None, 0/1 and strings are refused, not read as truth values."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, not {type_name(value)} {value!r:.60}")
+    return bool(value)
+
+
+def choice(name: str, value: Any, allowed: tuple[str, ...]) -> str:
+    """One of the strings ``allowed``."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a string, not {type_name(value)} {value!r:.60}")
+    if value not in allowed:
+        raise ParameterError(name, value, "must be " + " or ".join(repr(a) for a in allowed))
+    return value
+
+
+def real_array(name: str, value: Any, *, finite_only: bool = True) -> np.ndarray:
+    """A 1-D contiguous float array from a number or a sequence of real numbers."""
+    if isinstance(value, (str, bytes)) or value is None:
+        raise TypeError(f"{name} must be numbers, not {type_name(value)}")
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be numbers: {exc}") from None
+    if arr.dtype == np.bool_ or not (
+        np.issubdtype(arr.dtype, np.integer) or np.issubdtype(arr.dtype, np.floating)
+    ):
+        raise TypeError(f"{name} must be real numbers, not an array of {arr.dtype}")
+    if arr.ndim > 1:
+        raise ParameterError(name, f"array of shape {arr.shape}", "must be one-dimensional")
+    with np.errstate(over="ignore"):
+        out = np.ascontiguousarray(np.atleast_1d(arr).astype(float))
+    if finite_only and not np.all(np.isfinite(out)):
+        bad = out[~np.isfinite(out)][0]
+        raise ParameterError(name, float(bad), "every value must be finite")
+    return out
