@@ -31,6 +31,7 @@ __all__ = [
     "moment",
     "orbit_breakpoints",
     "run_orbits",
+    "run_orbits_hybrid",
     "shadow_intervals",
     "simulate",
     "simulate_distributed",
@@ -130,6 +131,24 @@ def run_orbits(
     theta_limit: float,
     stop_at_limit: bool,
     steps_per_period: float,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+def run_orbits_hybrid(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    model: str,
+    coupled: bool,
+    solver: dict[str, Any],
+    t_start: float,
+    first_index: int,
+    n_orbits: int,
+    y0: list[float],
+    window: float,
+    theta_limit: float,
+    stop_at_limit: bool,
+    steps_per_period: float,
+    hybrid: dict[str, float],
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 

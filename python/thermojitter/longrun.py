@@ -73,7 +73,7 @@ class OrbitSummaries:
 
     @property
     def nonlinear_fraction(self) -> float:
-        """Share of the simulated time integrated with the full non-linear model (1 unless hybrid)."""
+        """Share of the simulated time integrated with the full non-linear model (1: not hybrid)."""
         p = self.propagation
         if not p:
             return 1.0

@@ -417,7 +417,8 @@ mod tests {
                         let (mut yp, mut ym) = (*y, *y);
                         yp[j] += h;
                         ym[j] -= h;
-                        let col = (sys.rhs_at_flux(0.9, &yp) - sys.rhs_at_flux(0.9, &ym)) / (2.0 * h);
+                        let col =
+                            (sys.rhs_at_flux(0.9, &yp) - sys.rhs_at_flux(0.9, &ym)) / (2.0 * h);
                         for i in 0..4 {
                             let tol = 1e-6 * jac.column(j).amax().max(1e-9);
                             assert!(
@@ -428,7 +429,8 @@ mod tests {
                             );
                         }
                     }
-                    let dflux = (sys.rhs_at_flux(0.9 + 1e-6, y) - sys.rhs_at_flux(0.9 - 1e-6, y)) / 2e-6;
+                    let dflux =
+                        (sys.rhs_at_flux(0.9 + 1e-6, y) - sys.rhs_at_flux(0.9 - 1e-6, y)) / 2e-6;
                     assert!((dflux - sys.flux_sensitivity(y)).amax() < 1e-6 * dflux.amax());
                 }
             }

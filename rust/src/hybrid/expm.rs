@@ -48,7 +48,11 @@ pub fn expm<const M: usize>(a: &SMatrix<f64, M, M>) -> SMatrix<f64, M, M> {
 }
 
 /// φ1(a) w1 + φ2(a) w2 for a 4×4 `a` (one exponential of a 6×6 matrix).
-pub fn phi12(a: &SMatrix<f64, 4, 4>, w1: &SVector<f64, 4>, w2: &SVector<f64, 4>) -> SVector<f64, 4> {
+pub fn phi12(
+    a: &SMatrix<f64, 4, 4>,
+    w1: &SVector<f64, 4>,
+    w2: &SVector<f64, 4>,
+) -> SVector<f64, 4> {
     // The vectors are scaled to the size of `a` so that they do not set the number of squarings.
     let gamma = balance(a, &[w1, w2]);
     let mut m = SMatrix::<f64, 6, 6>::zeros();

@@ -8,9 +8,11 @@
 //! non-linear remainder (T⁴ radiation, the cos θ projected area, the penumbra's s(t)), not by the
 //! hinge period:
 //!
-//!     U  = u + h φ1(hJ) f(t, u) + h² φ2(hJ) v
-//!     D  = g(t + h, U) − g(t, u)
-//!     u⁺ = U + 2h φ3(hJ) D          (third order; U is the embedded second-order solution)
+//! ```text
+//! U  = u + h φ1(hJ) f(t, u) + h² φ2(hJ) v
+//! D  = g(t + h, U) − g(t, u)
+//! u⁺ = U + 2h φ3(hJ) D          (third order; U is the embedded second-order solution)
+//! ```
 
 use super::expm::{phi12, phi3};
 use crate::error::{Error, Result};
@@ -78,7 +80,7 @@ pub fn segment(
             let step = h.min(tol.max_step).min(b - t0);
             let t1 = if t0 + step >= b { b } else { t0 + step };
             let hs = t1 - t0;
-            if !(hs > 1e-9 * t0.abs().max(1.0)) {
+            if hs.is_nan() || hs <= 1e-9 * t0.abs().max(1.0) {
                 return Err(Error::Integration {
                     t: t0,
                     reason: format!(
@@ -139,11 +141,12 @@ pub fn segment(
             }
             rejected += 1;
             rejected_here = true;
-            *h = hs * if err.is_finite() {
-                (0.9 * err.powf(-1.0 / 3.0)).max(0.2)
-            } else {
-                0.2
-            };
+            *h = hs
+                * if err.is_finite() {
+                    (0.9 * err.powf(-1.0 / 3.0)).max(0.2)
+                } else {
+                    0.2
+                };
         }
     }
     Ok((accepted, rejected, false))

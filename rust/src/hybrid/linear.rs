@@ -63,7 +63,8 @@ impl Arc {
             }
             // Inverse iteration with a slightly perturbed shift: two solves give the eigenvector
             // to rounding.
-            let shift = lam + C64::new(1e-10 * lam.norm().max(1e-12), 1e-10 * lam.norm().max(1e-12));
+            let shift =
+                lam + C64::new(1e-10 * lam.norm().max(1e-12), 1e-10 * lam.norm().max(1e-12));
             let m = abc - Matrix4::<C64>::identity() * shift;
             let mlu = m.lu();
             let mut x = Vector4::new(
@@ -89,10 +90,13 @@ impl Arc {
         let v = Matrix4::<C64>::from_columns(&vecs);
         let h0 = y0 - y_ref - p0;
         let h0b: Vector4<C64> = Vector4::from_fn(|i, _| C64::new(h0[i] / scale[i], 0.0));
-        let c = v.lu().solve(&h0b).ok_or_else(|| fail("eigenvectors not independent"))?;
+        let c = v
+            .lu()
+            .solve(&h0b)
+            .ok_or_else(|| fail("eigenvectors not independent"))?;
         let back = v * c;
         let err = (back - h0b).norm();
-        if !(err <= 1e-9 * h0b.norm().max(1e-300)) {
+        if err.is_nan() || err > 1e-9 * h0b.norm().max(1e-300) {
             return Err(fail("eigenvectors nearly dependent"));
         }
         let mut modes = [Vector4::<C64>::zeros(); 4];
@@ -122,10 +126,7 @@ impl Arc {
 
     /// The functional w·y(τ).
     pub fn signal(&self, w: &Vector4<f64>) -> Signal {
-        let mut a = [C64::new(0.0, 0.0); 4];
-        for k in 0..4 {
-            a[k] = (0..4).map(|i| self.modes[k][i] * w[i]).sum();
-        }
+        let a = self.modes.map(|m| (0..4).map(|i| m[i] * w[i]).sum::<C64>());
         let omega = self.lambda.iter().map(|l| l.im.abs()).fold(0.0, f64::max);
         Signal {
             q0: w.dot(&self.base),
@@ -189,7 +190,10 @@ impl Signal {
     pub fn integral_sq(&self, length: f64) -> f64 {
         let l = length;
         let (q0, q1) = (self.q0, self.q1);
-        let mut total = C64::new(q0 * q0 * l + q0 * q1 * l * l + q1 * q1 * l * l * l / 3.0, 0.0);
+        let mut total = C64::new(
+            q0 * q0 * l + q0 * q1 * l * l + q1 * q1 * l * l * l / 3.0,
+            0.0,
+        );
         for k in 0..4 {
             // ∫ e^{λτ} = L φ1(λL), ∫ τ e^{λτ} = L² (φ1 − φ2)(λL).
             let (p1, p2) = phi12(self.lambda[k] * l);

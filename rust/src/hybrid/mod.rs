@@ -27,7 +27,6 @@ use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::{require_positive, Error, Result};
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
-use std::ops::ControlFlow;
 use crate::orbit::{Eclipse, Orbit};
 use crate::params::Panel;
 use crate::steady::equilibrium;
@@ -38,6 +37,7 @@ use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
 use linear::Arc;
 use nalgebra::{Vector4, U4};
+use std::ops::ControlFlow;
 
 /// Settings of the hybrid propagator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,7 +157,11 @@ pub fn run_orbits_hybrid(
     }
     crate::error::require_finite("t_start", t_start)?;
     if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
-        return Err(Error::invalid("y0", y0[i], "every component must be finite"));
+        return Err(Error::invalid(
+            "y0",
+            y0[i],
+            "every component must be finite",
+        ));
     }
     let steps = if options.steps_per_period > 0.0 {
         options.steps_per_period
@@ -290,7 +294,9 @@ impl Judge {
         let f = self.system.rhs_at_flux(flux, y);
         let (y_ref, a) = self.reference(flux)?;
         let dev = y - y_ref;
-        let amplitude = (dev[2] * dev[2] + dev[3] * dev[3] / self.panel.natural_angular_frequency().powi(2)).sqrt();
+        let amplitude = (dev[2] * dev[2]
+            + dev[3] * dev[3] / self.panel.natural_angular_frequency().powi(2))
+        .sqrt();
         if amplitude.max(self.oscillation(y, &f)) > self.settings.linear_amplitude {
             return Ok(Regime::Large);
         }
@@ -305,7 +311,6 @@ impl Judge {
             Regime::NonLinear
         })
     }
-
 }
 
 /// Watches the hinge-resolved fallback and ends it once the state may go back to linear arcs
@@ -330,7 +335,10 @@ impl Observer<U4> for FallbackObserver<'_, '_> {
             return ControlFlow::Continue(());
         }
         self.next_check = t1 + CHECK_EVERY;
-        let shadow = self.eclipses.iter().any(|e| e.outer.0 <= t1 && t1 < e.outer.1);
+        let shadow = self
+            .eclipses
+            .iter()
+            .any(|e| e.outer.0 <= t1 && t1 < e.outer.1);
         let release = self
             .eclipses
             .iter()
@@ -599,7 +607,10 @@ impl Driver<'_> {
         let dense = DenseStep::<U4>::hermite(st.t0, st.t1, st.y0, st.y1, st.f0, st.f1);
         let h = (st.t1 - st.t0) / 4.0;
         let resolved = st.t1 - st.t0 <= period / 8.0;
-        let (a0, a1) = (self.judge.oscillation(&st.y0, &st.f0), self.judge.oscillation(&st.y1, &st.f1));
+        let (a0, a1) = (
+            self.judge.oscillation(&st.y0, &st.f0),
+            self.judge.oscillation(&st.y1, &st.f1),
+        );
         for j in 1..=4 {
             let t = if j == 4 { st.t1 } else { st.t0 + j as f64 * h };
             let y = if j == 4 { st.y1 } else { dense.eval(t) };
@@ -621,5 +632,178 @@ impl Driver<'_> {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flutter::{analyse, critical_damping};
+    use crate::integrate::Tolerances;
+    use crate::orbit::Shadow;
+    use crate::summary::{run_orbits, OrbitSummary};
+
+    fn options() -> SummaryOptions {
+        SummaryOptions {
+            window: 600.0,
+            theta_limit: 0.35,
+            stop_at_limit: true,
+            steps_per_period: STEPS_PER_HINGE_PERIOD,
+        }
+    }
+
+    fn start(panel: &Panel, orbit: &Orbit, kick: f64) -> Vector4<f64> {
+        let eq = equilibrium(panel, Coupling::ProjectedArea, orbit.flux_scale(0.0)).unwrap();
+        Vector4::new(eq.t_front, eq.t_back, eq.theta + kick, 0.0)
+    }
+
+    fn hybrid(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> HybridRun {
+        run_orbits_hybrid(
+            panel,
+            orbit,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            &Method::Dopri5(Tolerances::default()),
+            0.0,
+            0,
+            n,
+            y0,
+            options(),
+            &HybridSettings::default(),
+            &Cancel::new(),
+        )
+        .unwrap()
+    }
+
+    /// Within 2 %, or 1e-6 rad where the full run's value is below 5e-5 rad (NaN matches NaN).
+    fn close(name: &str, k: usize, full: f64, hyb: f64) {
+        if full.is_nan() {
+            assert!(
+                hyb.is_nan(),
+                "{name}[{k}]: {hyb} where the full run has none"
+            );
+            return;
+        }
+        let ok = if full.abs() < 5e-5 {
+            (hyb - full).abs() <= 1e-6
+        } else {
+            (hyb / full - 1.0).abs() <= 0.02
+        };
+        assert!(ok, "{name}[{k}]: hybrid {hyb:e} vs full {full:e}");
+    }
+
+    fn compare(full: &[OrbitSummary], hyb: &[OrbitSummary]) {
+        assert_eq!(full.len(), hyb.len());
+        for (k, (f, h)) in full.iter().zip(hyb).enumerate() {
+            close("amplitude", k, f.amplitude, h.amplitude);
+            close("exit_peak", k, f.exit_peak, h.exit_peak);
+            close("entry_peak", k, f.entry_peak, h.entry_peak);
+            close("jitter_rms", k, f.jitter_rms, h.jitter_rms);
+            close("theta_max", k, f.theta_max, h.theta_max);
+            close("theta_min", k, f.theta_min, h.theta_min);
+        }
+    }
+
+    #[test]
+    fn penumbra_eclipses_match_the_hinge_resolved_run() {
+        // Three orbits of the spring eclipse season: penumbra, eccentric Sun, moving declination.
+        let panel = Panel::paper();
+        let orbit = Orbit::geo_year(70.0);
+        let y0 = start(&panel, &orbit, 0.0);
+        let full = run_orbits(
+            &panel,
+            &orbit,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            &Method::Dopri5(Tolerances::default()),
+            0.0,
+            0,
+            3,
+            y0,
+            options(),
+        )
+        .unwrap();
+        let hyb = hybrid(&panel, &orbit, 3, y0);
+        compare(&full.summaries, &hyb.run.summaries);
+        assert!(hyb.t_linear > 2.0 * orbit.period, "{}", hyb.t_linear);
+        assert!(hyb.t_exponential > 0.0 && hyb.t_fallback == 0.0);
+        assert!(hyb.run.stats.n_steps * 50 < full.stats.n_steps);
+        let total = hyb.t_linear + hyb.t_exponential + hyb.t_fallback;
+        assert!((total - 3.0 * orbit.period).abs() < 1e-6 * total);
+    }
+
+    #[test]
+    fn weak_flutter_in_permanent_sunlight_grows_at_the_eigenvalue() {
+        let base = Panel {
+            solar_constant: 1361.0 * 1.034,
+            ..Panel::paper()
+        };
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let crit = critical_damping(&base, model, coupling, 1.0).unwrap();
+        let orbit = Orbit {
+            shadow: Shadow::None,
+            ..Orbit::geo_equinox()
+        };
+        for damping in [crit - 0.1, crit + 0.1] {
+            let panel = Panel { damping, ..base };
+            let predicted = analyse(&panel, model, coupling, 1.0).unwrap().growth_rate;
+            let run = hybrid(&panel, &orbit, 4, start(&panel, &orbit, 1e-6));
+            let s = &run.run.summaries;
+            let measured = (s[3].amplitude / s[1].amplitude).ln() / (2.0 * orbit.period);
+            assert!(
+                (measured / predicted - 1.0).abs() < 0.01,
+                "c_d {damping}: {measured:e} vs {predicted:e}"
+            );
+            assert_eq!(run.t_linear, 4.0 * orbit.period);
+        }
+    }
+
+    #[test]
+    fn a_flux_jump_rings_in_the_full_integration_and_matches_it() {
+        let panel = Panel::paper();
+        let orbit = Orbit::geo_equinox();
+        let y0 = start(&panel, &orbit, 0.0);
+        let full = run_orbits(
+            &panel,
+            &orbit,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            &Method::Dopri5(Tolerances::default()),
+            0.0,
+            0,
+            2,
+            y0,
+            options(),
+        )
+        .unwrap();
+        let hyb = hybrid(&panel, &orbit, 2, y0);
+        compare(&full.summaries, &hyb.run.summaries);
+        assert!(hyb.t_fallback > 0.0 && hyb.t_linear > orbit.period);
+    }
+
+    #[test]
+    fn the_validity_limit_stops_a_fluttering_panel_like_the_full_run() {
+        let panel = Panel {
+            damping: 0.0,
+            ..Panel::paper()
+        };
+        let orbit = Orbit::geo_equinox();
+        let run = hybrid(&panel, &orbit, 20, start(&panel, &orbit, 0.0));
+        let c = run
+            .run
+            .crossing
+            .expect("an undamped panel must leave the limit");
+        assert!(c.theta.abs() > 0.35 && run.run.stats.stopped);
+        assert_eq!(run.run.summaries.last().unwrap().index, c.orbit);
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        let s = HybridSettings {
+            linear_tolerance: -1.0,
+            ..HybridSettings::default()
+        };
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.starts_with("hybrid.linear_tolerance"), "{e}");
     }
 }

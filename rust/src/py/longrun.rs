@@ -106,7 +106,6 @@ fn summary_dict<'py>(py: Python<'py>, out: &OrbitRun) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
-
 /// Like `run_orbits`, with the hybrid propagator (the solver is the full integration it falls
 /// back to); adds how the simulated time was split between linear arcs, the exponential
 /// integrator and the fallback.
