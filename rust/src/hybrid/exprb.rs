@@ -15,6 +15,7 @@
 //! ```
 
 use super::expm::{phi12, phi3};
+use super::jacobian::Linearisation;
 use crate::error::{Error, Result};
 use crate::system::Coupled;
 use nalgebra::Vector4;
@@ -42,14 +43,21 @@ pub struct ExpStep {
 
 /// ∂f/∂t through the illumination (s(t) in a penumbra, the Sun's distance) inside the segment
 /// [a, b], by a one-sided difference that stays inside it.
-fn time_derivative(system: &Coupled, t: f64, y: &Vector4<f64>, a: f64, b: f64) -> Vector4<f64> {
+fn time_derivative(
+    system: &Coupled,
+    lin: &Linearisation,
+    t: f64,
+    y: &Vector4<f64>,
+    a: f64,
+    b: f64,
+) -> Vector4<f64> {
     let delta = 1e-2_f64.min(0.5 * (b - a));
     let dflux = if t + delta <= b {
         (system.flux_at(t + delta) - system.flux_at(t)) / delta
     } else {
         (system.flux_at(t) - system.flux_at((t - delta).max(a))) / delta
     };
-    system.flux_sensitivity(y) * dflux
+    lin.flux_sensitivity(y) * dflux
 }
 
 /// Integrates the segment [a, b] (no breakpoint inside; the system has entered it) from (t, y),
@@ -59,6 +67,7 @@ fn time_derivative(system: &Coupled, t: f64, y: &Vector4<f64>, a: f64, b: f64) -
 #[allow(clippy::too_many_arguments)]
 pub fn segment(
     system: &Coupled,
+    lin: &Linearisation,
     a: f64,
     b: f64,
     t: &mut f64,
@@ -73,8 +82,8 @@ pub fn segment(
         let t0 = *t;
         let y0 = *y;
         let flux = system.flux_at(t0);
-        let jac = system.jacobian_at_flux(flux, &y0);
-        let v = time_derivative(system, t0, &y0, a, b);
+        let jac = lin.jacobian(flux, &y0);
+        let v = time_derivative(system, lin, t0, &y0, a, b);
         let mut rejected_here = false;
         loop {
             let step = h.min(tol.max_step).min(b - t0);

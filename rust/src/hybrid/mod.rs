@@ -21,6 +21,7 @@
 
 pub mod expm;
 pub mod exprb;
+pub mod jacobian;
 pub mod linear;
 
 use crate::cancel::Cancel;
@@ -35,6 +36,7 @@ use crate::summary::{
 };
 use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
+use jacobian::Linearisation;
 use linear::Arc;
 use nalgebra::{Vector4, U4};
 use std::ops::ControlFlow;
@@ -225,6 +227,7 @@ pub fn run_orbits_hybrid(
             coupling,
             settings: *settings,
             system: Coupled::new(*panel, *orbit, model, coupling),
+            lin: Linearisation::new(panel, model, coupling),
             theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
         },
         scale: Vector4::new(1.0, 1.0, 1.0 / t_ref, wn / t_ref),
@@ -260,6 +263,7 @@ struct Judge {
     coupling: Coupling,
     settings: HybridSettings,
     system: Coupled,
+    lin: Linearisation,
     theta_per_kelvin: f64,
 }
 
@@ -268,7 +272,7 @@ impl Judge {
     fn reference(&self, flux: f64) -> Result<(Vector4<f64>, nalgebra::Matrix4<f64>)> {
         let eq = equilibrium(&self.panel, self.coupling, flux)?;
         let y_ref = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-        Ok((y_ref, self.system.jacobian_at_flux(flux, &y_ref)))
+        Ok((y_ref, self.lin.jacobian(flux, &y_ref)))
     }
 
     /// Amplitude of the hinge oscillation about the quasi-static deflection M_T/K_el, from the
@@ -424,7 +428,7 @@ impl Driver<'_> {
         let flux0 = self.orbit.flux_scale(t0);
         let flux1 = self.orbit.flux_scale(end);
         let (y_ref, a) = self.judge.reference(flux0)?;
-        let b = self.system.flux_sensitivity(&y_ref) * ((flux1 - flux0) / (end - t0));
+        let b = self.judge.lin.flux_sensitivity(&y_ref) * ((flux1 - flux0) / (end - t0));
         let Ok(arc) = Arc::new(&a, &b, &y_ref, &self.y, end - t0, &self.scale) else {
             return Ok(Some(()));
         };
@@ -533,6 +537,7 @@ impl Driver<'_> {
             }
             self.system.enter_segment(a, b);
             let system = self.system;
+            let lin = self.judge.lin;
             let settings = self.settings;
             let mut t = self.t;
             let mut y = self.y;
@@ -541,6 +546,7 @@ impl Driver<'_> {
             let this = &mut *self;
             let (acc, rej, stop) = exprb::segment(
                 &system,
+                &lin,
                 a,
                 b,
                 &mut t,

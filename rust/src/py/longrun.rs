@@ -6,6 +6,7 @@ use super::error::shield;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::summary::{run_orbits_cancellable as run, OrbitRun, SummaryOptions};
 use crate::system::Coupling;
+use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -42,7 +43,7 @@ fn run_orbits<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
-        let y = state::<4>(&y0)?;
+        let y = state(&y0, U4)?;
         let options = SummaryOptions {
             window,
             theta_limit,
@@ -141,7 +142,7 @@ fn run_orbits_hybrid<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
-        let y = state::<4>(&y0)?;
+        let y = state(&y0, U4)?;
         let options = SummaryOptions {
             window,
             theta_limit,
