@@ -234,5 +234,7 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
+        validity_limit: float = 0.3490658503988659,
+        hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
     ) -> dict[str, Any]: ...

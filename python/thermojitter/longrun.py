@@ -170,7 +170,7 @@ def simulate_orbits(
     t_start: float = 0.0,
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
-    method: Literal["rk45", "rk4", "hybrid"] = "rk45",
+    method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
     rtol: float = 1e-8,
     atol: float = 1e-10,
     dt: float | None = None,
@@ -200,6 +200,15 @@ def simulate_orbits(
       (polled between chunks, for callers that handle SIGINT and report it themselves), silently.
     - ``progress``: a tqdm bar on stderr with the remaining time (in Jupyter a widget; also when
       stderr is not a terminal); ``None``: only when stderr is a terminal; ``False``: none.
+    - ``method``: ``"hybrid"`` (default) propagates the sunlit arcs exactly in the linearised
+      system's modal form and integrates only the shadow crossings and their thermal recovery
+      with the full non-linear model (an exponential integrator), falling back on the
+      hinge-resolved rk45 where the oscillation is too large for either; the per-orbit
+      summaries agree with rk45's within 2 % and it is hundreds of times faster on GEO.
+      ``result.propagation`` says how the simulated time was split. ``"rk45"``/``"rk4"``
+      integrate everything (rk45 resolves the hinge period, see ``steps_per_period``).
+      ``hybrid``: optional engine settings (``rtol``, ``atol_temperature``, ``atol_angle``,
+      ``max_step``, ``linear_tolerance``, ``linear_amplitude``, ``resolved_amplitude``).
     - ``steps_per_period``: rk45's step is capped at T_n/steps_per_period, T_n the hinge's natural
       period (0: error control alone). Without the cap the step grows, once the oscillation is
       small against ``atol``, to where the method's own dissipation exceeds a weak flutter's
