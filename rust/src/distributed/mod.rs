@@ -89,20 +89,23 @@ pub struct DistributedPanel {
 }
 
 /// Absorbed-area factor of an element: cos(ψ + atan ρ), zero once the Sun is behind the front.
+/// Written as (cos ψ − ρ sin ψ)/√(1 + ρ²), one square root instead of an arctangent and a
+/// cosine on the hot path; `sun` is (sin ψ, cos ψ).
 #[inline]
-fn incidence(sun_angle: f64, slope: f64) -> f64 {
-    (sun_angle + slope.atan()).cos().max(0.0)
+fn incidence(sun: (f64, f64), slope: f64) -> f64 {
+    let (s, c) = sun;
+    ((c - slope * s) / (1.0 + slope * slope).sqrt()).max(0.0)
 }
 
-/// d incidence / d ρ.
+/// d incidence / d ρ = −(sin ψ + ρ cos ψ)/(1 + ρ²)^{3/2} (zero where the factor is clamped).
 #[inline]
-fn incidence_slope(sun_angle: f64, slope: f64) -> f64 {
-    let a = sun_angle + slope.atan();
-    if a.cos() <= 0.0 {
-        0.0
-    } else {
-        -a.sin() / (1.0 + slope * slope)
+fn incidence_slope(sun: (f64, f64), slope: f64) -> f64 {
+    let (s, c) = sun;
+    if c - slope * s <= 0.0 {
+        return 0.0;
     }
+    let r2 = 1.0 + slope * slope;
+    -(s + slope * c) / (r2 * r2.sqrt())
 }
 
 impl DistributedPanel {
@@ -151,19 +154,31 @@ impl DistributedPanel {
     }
 
     /// Per-element chord slopes ρ = D Φ q + D R M.
-    fn slopes(&self, q: &[f64], moments: &[f64]) -> DVector<f64> {
+    fn slopes(&self, q: &[f64], moments: &[f64]) -> Vec<f64> {
         let r = &self.reduction;
-        let mut rho = &r.slope_residual * DVector::from_column_slice(moments);
-        rho.gemv(1.0, &r.slope_modal, &DVector::from_column_slice(q), 1.0);
+        let n = self.n();
+        let mut rho = vec![0.0; n];
+        // Column by column (the matrices are column-major): each pass is a contiguous axpy.
+        let columns = r
+            .slope_residual
+            .as_slice()
+            .chunks_exact(n)
+            .zip(moments)
+            .chain(r.slope_modal.as_slice().chunks_exact(n).zip(q));
+        for (col, x) in columns {
+            for (out, a) in rho.iter_mut().zip(col) {
+                *out += a * x;
+            }
+        }
         rho
     }
 
     /// Absorbed-area factor of each element for chord slopes `rho`.
     fn areas(&self, rho: &[f64]) -> Vec<f64> {
-        let psi = self.settings.sun_angle;
+        let sun = self.settings.sun_angle.sin_cos();
         match self.settings.coupling {
-            Coupling::ProjectedArea => rho.iter().map(|r| incidence(psi, *r)).collect(),
-            Coupling::Frozen => vec![psi.cos(); rho.len()],
+            Coupling::ProjectedArea => rho.iter().map(|r| incidence(sun, *r)).collect(),
+            Coupling::Frozen => vec![sun.1; rho.len()],
         }
     }
 
@@ -175,7 +190,7 @@ impl DistributedPanel {
         let q = &y[2 * n..2 * n + k];
         let v = &y[2 * n + k..];
         let areas = match self.settings.coupling {
-            Coupling::ProjectedArea => self.areas(self.slopes(q, &moments).as_slice()),
+            Coupling::ProjectedArea => self.areas(&self.slopes(q, &moments)),
             Coupling::Frozen => self.areas(&vec![0.0; n]),
         };
         for e in 0..n {
@@ -183,12 +198,12 @@ impl DistributedPanel {
             dy[e] = df;
             dy[n + e] = db;
         }
-        let force = &r.force * DVector::from_column_slice(&moments);
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
             let w = r.omega[i];
+            let force: f64 = (0..n).map(|e| r.force[(i, e)] * moments[e]).sum();
             dy[2 * n + i] = v[i];
-            dy[2 * n + k + i] = force[i] - 2.0 * zeta * w * v[i] - w * w * q[i];
+            dy[2 * n + k + i] = force - 2.0 * zeta * w * v[i] - w * w * q[i];
         }
     }
 
@@ -248,6 +263,7 @@ impl DistributedPanel {
         let n = self.n();
         let p = &self.panel;
         let psi = self.settings.sun_angle;
+        let sun = psi.sin_cos();
         let coupled = self.settings.coupling == Coupling::ProjectedArea;
         let hc = 0.5 * p.heat_capacity();
         let mu = self.element_moment(1.0, 0.0);
@@ -289,7 +305,7 @@ impl DistributedPanel {
                 jac[(n + e, e)] += jbf;
                 jac[(n + e, n + e)] += jbb;
                 if coupled {
-                    let g = absorbed * incidence_slope(psi, rho[e]) * mu;
+                    let g = absorbed * incidence_slope(sun, rho[e]) * mu;
                     for j in 0..n {
                         jac[(e, j)] += g * fs[(e, j)];
                         jac[(e, n + j)] -= g * fs[(e, j)];
@@ -332,7 +348,7 @@ impl DistributedPanel {
         let r = &self.reduction;
         let hc = 0.5 * p.heat_capacity();
         let mu = self.element_moment(1.0, 0.0);
-        let psi = self.settings.sun_angle;
+        let sun = self.settings.sun_angle.sin_cos();
         let moments = self.moments(y);
         let q = &y[2 * n..2 * n + k];
         let mut j = DMatrix::zeros(2 * n + 2 * k, 2 * n + 2 * k);
@@ -346,7 +362,7 @@ impl DistributedPanel {
             j[(n + e, n + e)] += jbb / hc;
             if self.settings.coupling == Coupling::ProjectedArea {
                 // Heating through the chord slope, which moves with every moment and mode.
-                let g = absorbed * incidence_slope(psi, rho[e]) / hc;
+                let g = absorbed * incidence_slope(sun, rho[e]) / hc;
                 for m in 0..n {
                     j[(e, m)] += g * r.slope_residual[(e, m)] * mu;
                     j[(e, n + m)] -= g * r.slope_residual[(e, m)] * mu;
