@@ -7,6 +7,7 @@
 
 pub mod beam;
 pub mod cancel;
+pub mod conduction;
 pub mod distributed;
 pub mod dynamics;
 pub mod ensemble;
@@ -14,6 +15,8 @@ pub mod error;
 pub mod flutter;
 pub mod hybrid;
 pub mod integrate;
+pub mod laminate;
+pub mod layered;
 pub mod orbit;
 pub mod params;
 pub mod simulate;

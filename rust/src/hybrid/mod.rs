@@ -32,7 +32,8 @@ use crate::orbit::{Eclipse, Orbit};
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::summary::{
-    resolve_hinge, Collector, OrbitRun, SummaryObserver, SummaryOptions, STEPS_PER_HINGE_PERIOD,
+    resolve_hinge, Collector, OrbitRun, SummaryObserver, SummaryOptions, TwoLayerView,
+    STEPS_PER_HINGE_PERIOD,
 };
 use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
@@ -114,7 +115,7 @@ struct Driver<'a> {
     settings: &'a HybridSettings,
     fallback: Method,
     system: Coupled,
-    obs: SummaryObserver<'a>,
+    obs: SummaryObserver<'a, TwoLayerView>,
     t_start: f64,
     t_end: f64,
     t: f64,
@@ -170,16 +171,11 @@ pub fn run_orbits_hybrid(
     } else {
         STEPS_PER_HINGE_PERIOD
     };
-    let collector = Collector::new(
-        panel,
-        orbit,
+    let view = TwoLayerView {
+        panel: *panel,
         coupling,
-        options,
-        t_start,
-        first_index,
-        n_orbits,
-        &y0,
-    )?;
+    };
+    let collector = Collector::new(view, orbit, options, t_start, first_index, n_orbits, y0[2])?;
     let t_end = t_start + n_orbits as f64 * orbit.period;
     let t_ref = equilibrium(panel, coupling, orbit.flux_scale(t_start))
         .map(|e| e.t_front)
@@ -320,7 +316,7 @@ impl Judge {
 /// Watches the hinge-resolved fallback and ends it once the state may go back to linear arcs
 /// (checked every `CHECK_EVERY` s of simulated time, in full Sun past the last shadow's window).
 struct FallbackObserver<'a, 'c> {
-    inner: &'a mut SummaryObserver<'c>,
+    inner: &'a mut SummaryObserver<'c, TwoLayerView>,
     judge: Judge,
     eclipses: &'a [Eclipse],
     window: f64,
@@ -621,7 +617,7 @@ impl Driver<'_> {
             let t = if j == 4 { st.t1 } else { st.t0 + j as f64 * h };
             let y = if j == 4 { st.y1 } else { dense.eval(t) };
             if resolved {
-                self.obs.collector.read(t, &y, h)?;
+                self.obs.collector.read(t, y.as_slice(), h)?;
             } else {
                 let frac = j as f64 / 4.0;
                 let amp = a0 + (a1 - a0) * frac;

@@ -3,17 +3,27 @@
 use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
 use super::error::shield;
+use super::laminate::conduction_from;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
-use crate::summary::{run_orbits_cancellable as run, OrbitRun, SummaryOptions};
+use crate::layered;
+use crate::summary::{run_orbits_cancellable as run, OrbitSummary, SummaryOptions};
 use crate::system::Coupling;
 use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+/// What either model's summarised run hands back.
+struct Summarised {
+    summaries: Vec<OrbitSummary>,
+    stats: crate::integrate::Stats,
+    y_end: Vec<f64>,
+    crossing: Option<crate::summary::LimitCrossing>,
+}
+
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -31,6 +41,8 @@ fn run_orbits<'py>(
     stop_at_limit: bool,
     steps_per_period: f64,
     cancel: Option<&Bound<'py, CancelToken>>,
+    layup: Option<&Bound<'py, PyDict>>,
+    nodes: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cancel = token(cancel);
     shield(|| {
@@ -43,34 +55,70 @@ fn run_orbits<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
-        let y = state(&y0, U4)?;
         let options = SummaryOptions {
             window,
             theta_limit,
             stop_at_limit,
             steps_per_period,
         };
-        let out = py.detach(|| {
-            run(
-                &p,
-                &o,
-                hinge,
-                coupling,
-                &m,
-                t_start,
-                first_index,
-                n_orbits,
-                y,
-                options,
-                &cancel,
-            )
-        })?;
+        let out = match nodes {
+            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
+            Some(n) => {
+                let c = conduction_from(&p, layup, n)?;
+                let run = py.detach(|| {
+                    layered::run_orbits(
+                        &p,
+                        c,
+                        &o,
+                        hinge,
+                        coupling,
+                        &m,
+                        t_start,
+                        first_index,
+                        n_orbits,
+                        &y0,
+                        options,
+                        &cancel,
+                    )
+                })?;
+                Summarised {
+                    summaries: run.summaries,
+                    stats: run.stats,
+                    y_end: run.y_end,
+                    crossing: run.crossing,
+                }
+            }
+            None => {
+                let y = state(&y0, U4)?;
+                let run = py.detach(|| {
+                    run(
+                        &p,
+                        &o,
+                        hinge,
+                        coupling,
+                        &m,
+                        t_start,
+                        first_index,
+                        n_orbits,
+                        y,
+                        options,
+                        &cancel,
+                    )
+                })?;
+                Summarised {
+                    summaries: run.summaries,
+                    stats: run.stats,
+                    y_end: run.y_end.as_slice().to_vec(),
+                    crossing: run.crossing,
+                }
+            }
+        };
         summary_dict(py, &out)
     })
 }
 
 /// The summaries of a run as columns, with its counters.
-fn summary_dict<'py>(py: Python<'py>, out: &OrbitRun) -> PyResult<Bound<'py, PyDict>> {
+fn summary_dict<'py>(py: Python<'py>, out: &Summarised) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let col = |f: fn(&crate::summary::OrbitSummary) -> f64| -> Vec<f64> {
         out.summaries.iter().map(f).collect()
@@ -102,7 +150,7 @@ fn summary_dict<'py>(py: Python<'py>, out: &OrbitRun) -> PyResult<Bound<'py, PyD
     d.set_item("n_rhs", out.stats.n_rhs)?;
     d.set_item("t_reached", out.stats.t_end)?;
     d.set_item("stopped", out.stats.stopped)?;
-    d.set_item("y_end", out.y_end.as_slice().to_vec())?;
+    d.set_item("y_end", out.y_end.clone())?;
     d.set_item("crossing", out.crossing.map(|c| (c.t, c.orbit, c.theta)))?;
     Ok(d)
 }
@@ -166,7 +214,16 @@ fn run_orbits_hybrid<'py>(
                 &cancel,
             )
         })?;
-        let d = summary_dict(py, &out.run)?;
+        let run = out.run;
+        let d = summary_dict(
+            py,
+            &Summarised {
+                summaries: run.summaries,
+                stats: run.stats,
+                y_end: run.y_end.as_slice().to_vec(),
+                crossing: run.crossing,
+            },
+        )?;
         d.set_item("t_linear", out.t_linear)?;
         d.set_item("t_exponential", out.t_exponential)?;
         d.set_item("t_fallback", out.t_fallback)?;
