@@ -34,7 +34,7 @@ SUMMARY_FIELDS = (
 """Columns of the per-orbit summaries (angles rad, times s; NaN where an orbit has no eclipse)."""
 
 DEFAULT_THETA_LIMIT = math.radians(20.0)
-"""|θ| beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
+"""abs(θ) beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
 meant for modest angles)."""
 
 
@@ -44,10 +44,10 @@ class OrbitSummaries:
 
     Columns (one value per orbit): ``index``, ``t_start``, ``t_end``, ``theta_eq`` (sunlit
     equilibrium at that orbit's flux), ``theta_max``, ``theta_min``, ``amplitude``
-    (max |θ − θ_eq|), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
+    (max abs(θ − θ_eq)), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
     the quasi-static deflection), ``t_entry``/``t_exit`` (umbra), ``entry_theta_min`` and
     ``exit_theta_max`` (in the window after entry and exit), ``entry_peak``/``exit_peak``
-    (max |θ − θ_eq| in those windows).
+    (max abs(θ − θ_eq) in those windows).
     """
 
     columns: dict[str, NDArray[Any]]
@@ -56,7 +56,7 @@ class OrbitSummaries:
     n_steps: int = 0
     n_rhs: int = 0
     limit_crossing: tuple[float, int, float] | None = None
-    """(t s, orbit index, θ rad) where |θ| first passed theta_limit, or None."""
+    """(t s, orbit index, θ rad) where abs(θ) first passed theta_limit, or None."""
     interrupted: bool = False
     """True when Ctrl-C ended the run early; the columns hold the finished orbits."""
     settings: dict[str, Any] = field(default_factory=dict)
@@ -171,7 +171,7 @@ def simulate_orbits(
 
     Memory grows with the number of orbits, not of steps (a 10-year GEO run keeps ~3650 rows).
 
-    - ``theta_limit`` (rad): the hinge model's range of validity; when |θ| passes it the run
+    - ``theta_limit`` (rad): the hinge model's range of validity; when abs(θ) passes it the run
       stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.

@@ -52,11 +52,11 @@ METRICS = (
 - ``theta_eq``: sunlit equilibrium angle at full Sun;
 - ``growth_rate``, ``frequency_hz``, ``stable``: linear stability of that equilibrium
   (``tj.flutter``); ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
-- ``theta_abs_max``: max |θ| over the horizon; ``amplitude``: max |θ − θ_eq|;
-- ``entry_peak``/``exit_peak``: max |θ − θ_eq| within ``window`` s after a shadow entry / exit;
+- ``theta_abs_max``: max abs(θ) over the horizon; ``amplitude``: max abs(θ − θ_eq);
+- ``entry_peak``/``exit_peak``: max abs(θ − θ_eq) within ``window`` s after a shadow entry / exit;
 - ``jitter_rms``/``jitter_peak``: of θ − M_T/K_el (the oscillation about the quasi-static
   deflection) over the horizon;
-- ``t_threshold``: first time |θ| passed ``threshold`` (NaN: never, or no threshold);
+- ``t_threshold``: first time abs(θ) passed ``threshold`` (NaN: never, or no threshold);
 - ``t_reached``: where the integration ended (the horizon, unless stopped at the threshold);
 - ``n_steps``: accepted integrator steps; ``error``: why a sample failed (None when it did not;
   its numbers are then NaN).
@@ -374,7 +374,7 @@ def _dask_client(backend: Any) -> tuple[Any, bool]:
             "backend='dask' needs dask.distributed: pip install 'thermojitter[dask]'"
         ) from exc
     if backend == "dask":
-        return Client(LocalCluster()), True
+        return Client(LocalCluster(dashboard_address=":0")), True  # any free port
     if isinstance(backend, str):
         return Client(backend), True
     raise ValueError(
@@ -690,7 +690,7 @@ def monte_carlo(
       (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
       ``frame.attrs["seed"]``; required with ``checkpoint``).
     - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
-    - ``threshold`` (rad): time the first |θ| above it (``t_threshold``); with
+    - ``threshold`` (rad): time the first abs(θ) above it (``t_threshold``); with
       ``stop_at_threshold`` a sample stops there.
     - ``threads``: rayon threads on this machine (default: one per core). ``backend``: None (this
       machine), ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``;
