@@ -70,8 +70,16 @@ class Cluster:
         for i in range(n):
             self.workers.append(
                 dask(
-                    "worker", self.address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
-                    "--name", f"w{i}", "--host", "127.0.0.1",
+                    "worker",
+                    self.address,
+                    "--nthreads",
+                    "1",
+                    "--no-nanny",
+                    "--no-dashboard",
+                    "--name",
+                    f"w{i}",
+                    "--host",
+                    "127.0.0.1",
                 )  # fmt: skip
             )
         from distributed import Client

@@ -82,6 +82,7 @@ def simulate(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float] | None,
+    layers: int = 2,
 ) -> dict[str, Any]: ...
 def simulate_thermal(
     panel: dict[str, float],
