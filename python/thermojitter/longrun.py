@@ -24,7 +24,7 @@ from thermojitter import _core
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import Interruptible, progress_bar, report_interrupted
-from thermojitter.simulate import _check_inputs, solver_settings, steady_state
+from thermojitter.simulate import check_inputs, solver_settings, steady_state
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -80,7 +80,7 @@ class OrbitSummaries:
         return pd.DataFrame(self.columns).set_index("index")
 
 
-def _fingerprint(settings: dict[str, Any]) -> str:
+def settings_fingerprint(settings: dict[str, Any]) -> str:
     return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
 
 
@@ -99,7 +99,7 @@ def _save_checkpoint(
 ) -> None:
     """Writes atomically: a killed writer leaves the previous checkpoint intact."""
     payload = {
-        "fingerprint": _fingerprint(settings),
+        "fingerprint": settings_fingerprint(settings),
         "settings": settings,
         "next_index": next_index,
         "y": y,
@@ -118,11 +118,11 @@ def _save_checkpoint(
     os.replace(tmp, path)
 
 
-def _flatten(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+def flatten_settings(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
     for key, value in settings.items():
         if isinstance(value, dict):
-            flat.update(_flatten(value, f"{prefix}{key}."))
+            flat.update(flatten_settings(value, f"{prefix}{key}."))
         else:
             flat[prefix + key] = value
     return flat
@@ -133,8 +133,8 @@ def _load_checkpoint(path: Path, settings: dict[str, Any]) -> dict[str, Any] | N
         return None
     with open(path) as fh:
         payload: dict[str, Any] = json.load(fh)
-    if payload.get("fingerprint") != _fingerprint(settings):
-        old, new = _flatten(payload.get("settings", {})), _flatten(settings)
+    if payload.get("fingerprint") != settings_fingerprint(settings):
+        old, new = flatten_settings(payload.get("settings", {})), flatten_settings(settings)
         changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         raise ValueError(
             f"checkpoint {path} was written for other settings (differs in: "
@@ -186,7 +186,7 @@ def simulate_orbits(
       growth rate, and flutter near the critical damping goes unseen. With 40 the measured growth
       is within 1 % of the eigen-analysis; it costs about twice the steps of error control alone.
     """
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
         raise ValueError(f"n_orbits = {n_orbits!r} is invalid: must be an integer >= 1")
     if (
