@@ -59,7 +59,7 @@ METRICS = (
   deflection) over the horizon;
 - ``t_threshold``/``orbit_threshold``: first time (s) and orbit at which abs(θ) passed
   ``threshold`` (NaN: never, or no threshold);
-- ``orbit_limit``: first orbit whose abs(θ) passed the hinge model's validity limit (20°; NaN: none);
+- ``orbit_limit``: first orbit whose abs(θ) passed the validity limit (20°; NaN: none);
 - ``amplitude_slope``: growth (> 0) or decay of the per-orbit amplitude over the run, the
   least-squares slope of ln(amplitude) against the orbit index, 1/orbit;
 - ``t_nonlinear``: simulated time integrated with the full non-linear model, s (the whole run
