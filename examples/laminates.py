@@ -66,7 +66,7 @@ def compare(name: str, panel: tj.Panel, nodes: int) -> None:
     print("|---|---|---|---|---|---|---|---|")
     for layers in (None, nodes):
         eq = tj.flutter(panel, layers=layers)
-        run = tj.simulate_orbits(panel, orbit, 1, layers=layers, progress=False)
+        run = tj.simulate_orbits(panel, orbit, 1, layers=layers, progress=False, method="rk45")
         label = "two-layer" if layers is None else f"{layers} nodes"
         print(
             f"| {label} | {eq.equilibrium.T_front:.2f} | {eq.equilibrium.T_back:.2f} |"
