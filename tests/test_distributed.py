@@ -124,8 +124,9 @@ def test_bad_support_and_types() -> None:
         tj.distributed_flutter(PAPER, elements=4.0)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="coupled"):
         tj.simulate_distributed(PAPER, GEO, (0.0, 1.0), coupled=1)  # type: ignore[arg-type]
+    # layers >= 3 is the N-node conduction model per element (thermal::model); 0 is refused.
     with pytest.raises(ValueError, match="layers"):
-        tj.distributed_flutter(PAPER, elements=4, layers=7)
+        tj.distributed_flutter(PAPER, elements=4, layers=0)
     with pytest.raises(ValueError, match="y0"):
         tj.simulate_distributed(PAPER, GEO, (0.0, 1.0), elements=4, y0=np.ones(3))
 

@@ -54,7 +54,8 @@ def scenario_keys_help() -> str:
                 "the span is one of t_end (s), orbits, years; model = nonlinear | linear; "
                 "method = rk45 | rk4 (dt = step, s); dt_out = output interval, s; keep = "
                 '"samples" | "orbits" (one summary row per orbit, resumable, with '
-                'theta_limit_deg and on_limit = "stop" | "flag")',
+                'theta_limit_deg and on_limit = "stop" | "flag"); layers = nodes through '
+                "the thickness (the N-node model)",
             ),
             table("output", ["format", "plots"], 'format = "csv" | "parquet"; plots = true'),
         ]
