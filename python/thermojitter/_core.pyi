@@ -32,6 +32,8 @@ __all__ = [
     "flux_scale",
     "illumination",
     "laminate_properties",
+    "linear_delta_t",
+    "linear_thermal",
     "layered_flutter",
     "layered_steady_state",
     "materials",
@@ -196,6 +198,13 @@ def declination(orbit: dict[str, Any], t: _F) -> _F: ...
 def synodic_period(orbit: dict[str, Any]) -> float: ...
 
 # --- stability map (issue 4)
+def linear_thermal(
+    panel: dict[str, float],
+    flux: float = 1.0,
+    omega: float | None = None,
+    t_star: float | None = None,
+) -> dict[str, Any]: ...
+def linear_delta_t(fields: dict[str, float], t: _F, phi: float, delta_t0: float | None) -> _F: ...
 def stability_map(
     panel: dict[str, float],
     x_name: str,

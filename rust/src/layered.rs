@@ -546,11 +546,8 @@ pub fn simulate(
     let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
     let size = y_start.len();
     let orb = LayeredOrbit::new(system.clone(), *orbit);
-    let (t, y, stats, y_end) = on_fastest_state!(
-        orb,
-        size,
-        sample_run(method, t_span, &y_start, output)
-    )?;
+    let (t, y, stats, y_end) =
+        on_fastest_state!(orb, size, sample_run(method, t_span, &y_start, output))?;
     let m = system.thermal_size();
     let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
     let mut run = LayeredRun {
@@ -644,7 +641,17 @@ pub fn run_orbits(
     };
     let orb = LayeredOrbit::new(system.clone(), *orbit);
     let size = start.len();
-    let args = (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel);
+    let args = (
+        view,
+        panel,
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        options,
+        cancel,
+    );
     let mut run = on_fastest_state!(orb, size, summarised_run(&start, m, args))?;
     let t_end = run.stats.t_end;
     let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);

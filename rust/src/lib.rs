@@ -16,6 +16,7 @@ pub mod flutter;
 pub mod integrate;
 pub mod laminate;
 pub mod layered;
+pub mod linear;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
