@@ -8,12 +8,14 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "CASE_A_PANEL",
     "CancelToken",
     "ConvergenceError",
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
     "PANEL_FIELDS",
+    "PAPER_PANEL",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -58,6 +60,8 @@ __all__ = [
 ]
 
 PANEL_FIELDS: list[str]
+PAPER_PANEL: dict[str, float]
+CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
 
 class IntegrationError(RuntimeError): ...
