@@ -8,6 +8,15 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "leo_orbit",
+    "eclipse_duration",
+    "SIDEREAL_DAY",
+    "PERIHELION_DAY",
+    "MU_EARTH",
+    "GEO_RADIUS",
+    "GEO_EQUINOX_ORBIT",
+    "EQUINOX_DAY",
+    "EARTH_RADIUS",
     "CASE_A_PANEL",
     "CancelToken",
     "ConvergenceError",
@@ -61,6 +70,13 @@ __all__ = [
 
 PANEL_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
+GEO_RADIUS: float
+EARTH_RADIUS: float
+SIDEREAL_DAY: float
+MU_EARTH: float
+EQUINOX_DAY: float
+PERIHELION_DAY: float
+GEO_EQUINOX_ORBIT: dict[str, Any]
 CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
 
@@ -199,6 +215,8 @@ def umbra_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[f
 def orbit_breakpoints(orbit: dict[str, Any], t0: float, t1: float) -> list[float]: ...
 def flux_scale(orbit: dict[str, Any], t: _F) -> _F: ...
 def declination(orbit: dict[str, Any], t: _F) -> _F: ...
+def eclipse_duration(orbit: dict[str, Any]) -> float: ...
+def leo_orbit(altitude: float) -> dict[str, Any]: ...
 def synodic_period(orbit: dict[str, Any]) -> float: ...
 
 # --- stability map (issue 4)
