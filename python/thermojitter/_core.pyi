@@ -41,6 +41,7 @@ __all__ = [
     "equivalent_panel",
     "flutter",
     "flux_scale",
+    "hinge_equivalent_damping_ratio",
     "illumination",
     "laminate_properties",
     "linear_delta_t",
@@ -190,6 +191,7 @@ def beam_response(
 # --- distributed panel (rust/src/py/distributed.rs) ---
 
 def distributed_defaults(panel: dict[str, float]) -> dict[str, Any]: ...
+def hinge_equivalent_damping_ratio(panel: dict[str, float]) -> float: ...
 def distributed_info(panel: dict[str, float], settings: dict[str, Any]) -> dict[str, Any]: ...
 def distributed_flutter(
     panel: dict[str, float], settings: dict[str, Any], flux: float

@@ -25,7 +25,7 @@ from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import Interruptible, progress_bar, report_interrupted
 from thermojitter.simulate import (
-    _check_inputs,
+    check_inputs,
     check_layers,
     layup_dict,
     solver_settings,
@@ -40,7 +40,7 @@ SUMMARY_FIELDS = (
 """Columns of the per-orbit summaries (angles rad, times s; NaN where an orbit has no eclipse)."""
 
 DEFAULT_THETA_LIMIT = math.radians(20.0)
-"""|θ| beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
+"""abs(θ) beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
 meant for modest angles)."""
 
 
@@ -50,10 +50,10 @@ class OrbitSummaries:
 
     Columns (one value per orbit): ``index``, ``t_start``, ``t_end``, ``theta_eq`` (sunlit
     equilibrium at that orbit's flux), ``theta_max``, ``theta_min``, ``amplitude``
-    (max |θ − θ_eq|), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
+    (max abs(θ − θ_eq)), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
     the quasi-static deflection), ``t_entry``/``t_exit`` (umbra), ``entry_theta_min`` and
     ``exit_theta_max`` (in the window after entry and exit), ``entry_peak``/``exit_peak``
-    (max |θ − θ_eq| in those windows).
+    (max abs(θ − θ_eq) in those windows).
     """
 
     columns: dict[str, NDArray[Any]]
@@ -62,7 +62,7 @@ class OrbitSummaries:
     n_steps: int = 0
     n_rhs: int = 0
     limit_crossing: tuple[float, int, float] | None = None
-    """(t s, orbit index, θ rad) where |θ| first passed theta_limit, or None."""
+    """(t s, orbit index, θ rad) where abs(θ) first passed theta_limit, or None."""
     interrupted: bool = False
     """True when Ctrl-C ended the run early; the columns hold the finished orbits."""
     settings: dict[str, Any] = field(default_factory=dict)
@@ -86,7 +86,7 @@ class OrbitSummaries:
         return pd.DataFrame(self.columns).set_index("index")
 
 
-def _fingerprint(settings: dict[str, Any]) -> str:
+def settings_fingerprint(settings: dict[str, Any]) -> str:
     return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
 
 
@@ -105,7 +105,7 @@ def _save_checkpoint(
 ) -> None:
     """Writes atomically: a killed writer leaves the previous checkpoint intact."""
     payload = {
-        "fingerprint": _fingerprint(settings),
+        "fingerprint": settings_fingerprint(settings),
         "settings": settings,
         "next_index": next_index,
         "y": y,
@@ -124,11 +124,11 @@ def _save_checkpoint(
     os.replace(tmp, path)
 
 
-def _flatten(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+def flatten_settings(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
     for key, value in settings.items():
         if isinstance(value, dict):
-            flat.update(_flatten(value, f"{prefix}{key}."))
+            flat.update(flatten_settings(value, f"{prefix}{key}."))
         else:
             flat[prefix + key] = value
     return flat
@@ -139,8 +139,8 @@ def _load_checkpoint(path: Path, settings: dict[str, Any]) -> dict[str, Any] | N
         return None
     with open(path) as fh:
         payload: dict[str, Any] = json.load(fh)
-    if payload.get("fingerprint") != _fingerprint(settings):
-        old, new = _flatten(payload.get("settings", {})), _flatten(settings)
+    if payload.get("fingerprint") != settings_fingerprint(settings):
+        old, new = flatten_settings(payload.get("settings", {})), flatten_settings(settings)
         changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         raise ValueError(
             f"checkpoint {path} was written for other settings (differs in: "
@@ -178,7 +178,7 @@ def simulate_orbits(
 
     Memory grows with the number of orbits, not of steps (a 10-year GEO run keeps ~3650 rows).
 
-    - ``theta_limit`` (rad): the hinge model's range of validity; when |θ| passes it the run
+    - ``theta_limit`` (rad): the hinge model's range of validity; when abs(θ) passes it the run
       stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.
@@ -195,7 +195,7 @@ def simulate_orbits(
     - ``layers=N``: the N-node through-thickness model on the panel's layup (see
       :func:`thermojitter.simulate`); ``y0`` and ``y_end`` are then (node temperatures…, θ, θ̇).
     """
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
         raise ValueError(f"n_orbits = {n_orbits!r} is invalid: must be an integer >= 1")
     if (

@@ -34,11 +34,11 @@ from scipy.stats import qmc
 
 from thermojitter import _core
 from thermojitter.errors import ParameterError
-from thermojitter.longrun import _fingerprint, _flatten
+from thermojitter.longrun import flatten_settings, settings_fingerprint
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import progress_bar, report_interrupted
-from thermojitter.simulate import _check_inputs, solver_settings
+from thermojitter.simulate import check_inputs, solver_settings
 
 Sampler = Literal["random", "lhs", "sobol"]
 
@@ -52,11 +52,11 @@ METRICS = (
 - ``theta_eq``: sunlit equilibrium angle at full Sun;
 - ``growth_rate``, ``frequency_hz``, ``stable``: linear stability of that equilibrium
   (``tj.flutter``); ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
-- ``theta_abs_max``: max |θ| over the horizon; ``amplitude``: max |θ − θ_eq|;
-- ``entry_peak``/``exit_peak``: max |θ − θ_eq| within ``window`` s after a shadow entry / exit;
+- ``theta_abs_max``: max abs(θ) over the horizon; ``amplitude``: max abs(θ − θ_eq);
+- ``entry_peak``/``exit_peak``: max abs(θ − θ_eq) within ``window`` s after a shadow entry / exit;
 - ``jitter_rms``/``jitter_peak``: of θ − M_T/K_el (the oscillation about the quasi-static
   deflection) over the horizon;
-- ``t_threshold``: first time |θ| passed ``threshold`` (NaN: never, or no threshold);
+- ``t_threshold``: first time abs(θ) passed ``threshold`` (NaN: never, or no threshold);
 - ``t_reached``: where the integration ended (the horizon, unless stopped at the threshold);
 - ``n_steps``: accepted integrator steps; ``error``: why a sample failed (None when it did not;
   its numbers are then NaN).
@@ -374,7 +374,7 @@ def _dask_client(backend: Any) -> tuple[Any, bool]:
             "backend='dask' needs dask.distributed: pip install 'thermojitter[dask]'"
         ) from exc
     if backend == "dask":
-        return Client(LocalCluster()), True
+        return Client(LocalCluster(dashboard_address=":0")), True  # any free port
     if isinstance(backend, str):
         return Client(backend), True
     raise ValueError(
@@ -446,11 +446,11 @@ def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_si
     """Creates or checks the manifest; returns the chunk size the directory was started with."""
     directory.mkdir(parents=True, exist_ok=True)
     manifest = directory / "manifest.json"
-    fingerprint = _fingerprint(settings)
+    fingerprint = settings_fingerprint(settings)
     if manifest.exists():
         saved = json.loads(manifest.read_text())
         if saved.get("fingerprint") != fingerprint:
-            old, new = _flatten(saved.get("settings", {})), _flatten(settings)
+            old, new = flatten_settings(saved.get("settings", {})), flatten_settings(settings)
             changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
             raise ValueError(
                 f"checkpoint {directory} was written for other settings (differs in: "
@@ -690,7 +690,7 @@ def monte_carlo(
       (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
       ``frame.attrs["seed"]``; required with ``checkpoint``).
     - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
-    - ``threshold`` (rad): time the first |θ| above it (``t_threshold``); with
+    - ``threshold`` (rad): time the first abs(θ) above it (``t_threshold``); with
       ``stop_at_threshold`` a sample stops there.
     - ``threads``: rayon threads on this machine (default: one per core). ``backend``: None (this
       machine), ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``;
@@ -702,7 +702,7 @@ def monte_carlo(
 
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     vary = _check_vary(vary)
     n = _check_n(n)
     seed = _check_seed(seed, checkpoint)
@@ -756,7 +756,7 @@ def sweep(
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
     arguments are the same."""
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     if not isinstance(grid, Mapping) or not grid:
         raise ValueError("grid must be a non-empty mapping of panel parameter names to values")
     _check_names(list(grid), "grid")
@@ -841,7 +841,7 @@ def sensitivity(
         ) from exc
     import pandas as pd
 
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     vary = _check_vary(vary)
     n = _check_n(n, 2)
     seed = _check_seed(seed, None)

@@ -138,10 +138,6 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
         d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
         d.set_item("flexural_stiffness", p.flexural_stiffness())?;
         d.set_item("matching_moment_scale", p.matching_moment_scale())?;
-        d.set_item(
-            "beam_damping_ratio",
-            crate::beam::hinge_equivalent_damping_ratio(&p),
-        )?;
         Ok(d)
     })
 }
