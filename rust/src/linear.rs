@@ -2,8 +2,10 @@
 //!
 //! With ε_f = ε_b = ε and T⁴ linearised about a common T*:
 //!
-//!     d(ΔT)/dt + q ΔT = p cos θ,   p = 2 α C/(m c),   q = (4 K + 8 σ ε T*³)/(m c)
-//!     θ̈ + r θ̇ + ω_n² θ = s ΔT,   r = c_d / I_B,     s = χ a E I/(I_B d)
+//! ```text
+//! d(ΔT)/dt + q ΔT = p cos θ,   p = 2 α C/(m c),   q = (4 K + 8 σ ε T*³)/(m c)
+//! θ̈ + r θ̇ + ω_n² θ = s ΔT,   r = c_d / I_B,     s = χ a E I/(I_B d)
+//! ```
 //!
 //! A swing δθ about the sunlit tilt θ* modulates the forcing by −p sin θ* δθ; the gradient answers
 //! through 1/(q + iω), a lag that feeds the swing a negative damping s p sin θ*/(q² + ω_n²)
