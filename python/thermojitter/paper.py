@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from thermojitter import plots
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.progress import progress_bar
 from thermojitter.results import Solution, ThermalSolution
 from thermojitter.signals import (
     detrend,
@@ -955,11 +956,7 @@ def run_paper(
     chosen = list(SECTIONS if sections is None else sections)
     started = time.perf_counter()
 
-    bar: Any = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=sum(s.figures for s in chosen), unit="fig", desc="paper", leave=False)
+    bar = progress_bar(sum(s.figures for s in chosen), unit="fig", desc="paper", enabled=progress)
 
     def check() -> None:
         if stop is not None and stop():
