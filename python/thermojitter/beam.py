@@ -46,8 +46,8 @@ def default_damping_ratio(panel: Panel) -> float:
     at the hinge's rate c_d/(2 I_B), whatever K_el the hinge uses, and ζ equals the hinge's own
     c_d / (2 sqrt(K_el I_B)) when K_el follows the frequency criterion. Every mode gets this ζ.
     """
-    omega1 = 2.0 * math.pi * beam_frequency(panel)
-    return panel.damping / (2.0 * panel.hinge_inertia * omega1)
+    check_inputs(panel)
+    return float(_core.hinge_equivalent_damping_ratio(panel.as_dict()))
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ from thermojitter import _core
 from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.results import _Run
+from thermojitter.results import Run
 from thermojitter.simulate import Method, check_inputs, solver_args, time_span
 
 Array = NDArray[np.float64]
@@ -93,7 +93,7 @@ def distributed_defaults(panel: Panel | None = None) -> dict[str, Any]:
 
 
 @dataclass(frozen=True)
-class DistributedSolution(_Run):
+class DistributedSolution(Run):
     """The distributed panel at the reported times.
 
     ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
