@@ -291,7 +291,11 @@ def test_examples_load() -> None:
 
 BAD = {
     "unknown key": ("[panel]\nmas_per_length = 5.0\n", "panel.mas_per_length", "unknown key"),
-    "negative mass": ("[panel]\nmass_per_length = -5.51\n", "panel.mass_per_length", "> 0"),
+    "negative mass": (
+        "[panel]\nmass_per_length = -5.51\n",
+        "panel.mass_per_length",
+        "must be in [0.001, 10000]",
+    ),
     "wrong type": ('[panel]\nmass_per_length = "heavy"\n', "panel.mass_per_length", "number"),
     "wrong type bool": ("[simulation]\ncoupled = 1\n", "simulation.coupled", "true or false"),
     "unknown table": ("[panels]\nlength = 3.0\n", "panels", "unknown table"),

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Equilibrium
@@ -65,13 +66,16 @@ def flutter(
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
     if orbit is not None:
         if flux is not None:
-            raise ValueError("give flux or orbit (with t), not both")
+            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
         if not isinstance(orbit, Orbit):
             raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
-        flux = float(orbit.flux_scale(float(t))[0])
+        flux = float(orbit.flux_scale(checks.real("t", t))[0])
     elif flux is None:
         flux = 1.0
-    raw = _core.flutter(panel.as_dict(), model, bool(coupled), float(flux))
+    flux = checks.real("flux", flux)
+    coupled = checks.flag("coupled", coupled)
+    checks.choice("model", model, ("nonlinear", "linear"))
+    raw = _core.flutter(panel.as_dict(), model, coupled, flux)
     tf, tb, th = raw["equilibrium"]
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
     return FlutterResult(
@@ -93,6 +97,8 @@ Axis = tuple[str, ArrayLike]
 
 DEFAULT_X: tuple[str, NDArray[np.float64]] = ("damping", np.linspace(0.0, 5.0, 51))
 """Default x axis of :func:`stability_map`: hinge damping c_d, N m s/rad."""
+MAX_GRID_POINTS = 4_000_000
+"""Most points of a :func:`stability_map` grid (one eigen-analysis each, ~ a microsecond)."""
 DEFAULT_Y: tuple[str, NDArray[np.float64]] = ("conductance", np.linspace(5.0, 60.0, 56))
 """Default y axis of :func:`stability_map`: through-thickness conductance K, W/(m² K)."""
 
@@ -126,15 +132,12 @@ def _axis(which: str, axis: object) -> tuple[str, NDArray[np.float64]]:
         raise TypeError(f"{which} must be a (parameter name, values) tuple")
     name, raw = axis
     if name not in _core.PANEL_FIELDS:
-        raise ValueError(
-            f"{which} = {name!r} is invalid: not a panel parameter; one of "
-            + ", ".join(_core.PANEL_FIELDS)
+        raise checks.ParameterError(
+            which, name, "not a panel parameter; one of " + ", ".join(_core.PANEL_FIELDS)
         )
-    values = np.asarray(raw, dtype=float)
-    if values.ndim != 1 or values.size == 0:
-        raise ValueError(f"{which} values for {name!r} must be a non-empty 1-D sequence")
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"{which} values for {name!r} must be finite")
+    values = checks.real_array(f"{which}[{name!r}]", raw)
+    if values.size == 0:
+        raise checks.ParameterError(f"{which}[{name!r}]", raw, "must hold at least one value")
     return name, values
 
 
@@ -159,16 +162,16 @@ def stability_map(
     x_name, xs = _axis("x", x)
     y_name, ys = _axis("y", y)
     if x_name == y_name:
-        raise ValueError(f"y = {y_name!r} is invalid: must differ from the x parameter")
+        raise checks.ParameterError("y", y_name, "must differ from the x parameter")
+    if xs.size * ys.size > MAX_GRID_POINTS:
+        raise checks.ParameterError(
+            "x", f"{xs.size} x {ys.size} points", f"the grid may hold at most {MAX_GRID_POINTS}"
+        )
+    coupled = checks.flag("coupled", coupled)
+    flux = checks.real("flux", flux)
+    checks.choice("model", model, ("nonlinear", "linear"))
     raw = _core.stability_map(
-        panel.as_dict(),
-        x_name,
-        xs.tolist(),
-        y_name,
-        ys.tolist(),
-        model,
-        bool(coupled),
-        float(flux),
+        panel.as_dict(), x_name, xs.tolist(), y_name, ys.tolist(), model, coupled, flux
     )
     return StabilityMap(
         x_name=x_name,
@@ -313,23 +316,19 @@ def linear_thermal_response(
 
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
-    flux = float(flux)
-    if not (math.isfinite(flux) and flux > 0.0):
-        raise ValueError(f"flux = {flux} is invalid: must be finite and > 0")
+    flux = checks.positive("flux", flux)
     eq = steady_state(panel, flux=flux)
     derived = _core.derived(panel.as_dict())
     inertia = float(derived["hinge_inertia"])
     omega_n = math.sqrt(panel.hinge_stiffness / inertia)
     if omega is None:
         omega = omega_n
-    omega = float(omega)
-    if not (math.isfinite(omega) and omega >= 0.0):
-        raise ValueError(f"omega = {omega} is invalid: must be finite and >= 0")
+    omega = checks.finite("omega", omega)
+    if omega < 0.0:
+        raise checks.ParameterError("omega", omega, "must be finite and >= 0")
     if T_star is None:
         T_star = 0.5 * (eq.T_front + eq.T_back)
-    T_star = float(T_star)
-    if not (math.isfinite(T_star) and T_star > 0.0):
-        raise ValueError(f"T_star = {T_star} is invalid: must be finite and > 0")
+    T_star = checks.positive("T_star", T_star)
     mc = panel.mass_per_length * panel.specific_heat
     eps = 0.5 * (panel.emissivity_front + panel.emissivity_back)
     sigma = float(_core.STEFAN_BOLTZMANN)

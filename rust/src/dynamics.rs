@@ -11,6 +11,44 @@ pub enum HingeModel {
     Linear,
 }
 
+/// |θ| the hinge model describes, rad: its two rigid halves fold by θ each, so beyond π/2 they
+/// would pass through each other (and the paper's use is for a few degrees).
+pub const MAX_HINGE_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Checks an angle given to the hinge model (a start state, a limit): within ±π/2 rad. The
+/// message says what a value in degrees would have been, the likely slip.
+pub fn check_hinge_angle(name: &str, theta: f64) -> crate::Result<()> {
+    if theta.is_finite() && theta.abs() <= MAX_HINGE_ANGLE {
+        return Ok(());
+    }
+    let mut reason = "must be within ±π/2 rad (the hinge model's range)".to_string();
+    if theta.is_finite() && theta.abs() <= 360.0 {
+        reason += &format!(
+            "; if degrees were meant, {theta}° = {:.6} rad",
+            theta.to_radians()
+        );
+    }
+    Err(crate::Error::invalid(name, theta, &reason))
+}
+
+/// The static angle M/K_el of a moment on the hinge, checked against the hinge model's range:
+/// a larger moment would fold the panel beyond what the model describes.
+pub fn check_moment(panel: &Panel, moment: f64) -> crate::Result<()> {
+    let angle = moment / panel.hinge_stiffness;
+    if angle.is_finite() && angle.abs() <= MAX_HINGE_ANGLE {
+        return Ok(());
+    }
+    Err(crate::Error::invalid(
+        "moment",
+        moment,
+        &format!(
+            "gives a static angle M/K_el = {angle:.3e} rad, beyond the hinge model's range \
+             (|M| <= {:.4e} N m with this hinge_stiffness)",
+            MAX_HINGE_ANGLE * panel.hinge_stiffness
+        ),
+    ))
+}
+
 /// M_T = χ a E I (T_f − T_b) / d, N m.
 #[inline]
 pub fn thermal_moment(panel: &Panel, t_front: f64, t_back: f64) -> f64 {

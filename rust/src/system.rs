@@ -83,6 +83,9 @@ impl OdeSystem<U1> for OneNode {
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)
     }
+    fn check_span(&self, t0: f64, t1: f64) -> crate::Result<()> {
+        self.sun.orbit.check_span(t0, t1)
+    }
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
@@ -112,6 +115,9 @@ impl OdeSystem<U2> for TwoLayer {
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)
+    }
+    fn check_span(&self, t0: f64, t1: f64) -> crate::Result<()> {
+        self.sun.orbit.check_span(t0, t1)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
@@ -231,6 +237,9 @@ impl OdeSystem<U4> for Coupled {
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)
     }
+    fn check_span(&self, t0: f64, t1: f64) -> crate::Result<()> {
+        self.sun.orbit.check_span(t0, t1)
+    }
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
@@ -260,6 +269,17 @@ impl MomentHistory {
                 let w = (t - ts[i]) / (ts[i + 1] - ts[i]);
                 moment[i] + w * (moment[i + 1] - moment[i])
             }
+        }
+    }
+
+    /// Checks every value against the hinge model's range for this panel
+    /// ([`crate::dynamics::check_moment`]).
+    pub fn check_against(&self, panel: &crate::Panel) -> crate::Result<()> {
+        match self {
+            MomentHistory::Constant(m) => crate::dynamics::check_moment(panel, *m),
+            MomentHistory::Samples { moment, .. } => moment
+                .iter()
+                .try_for_each(|&m| crate::dynamics::check_moment(panel, m)),
         }
     }
 

@@ -39,6 +39,7 @@ fn run_orbits<'py>(
         };
         let m = solver_from(solver)?;
         let y = state::<4>(&y0)?;
+        crate::dynamics::check_hinge_angle("theta_limit", theta_limit)?;
         let options = SummaryOptions {
             window,
             theta_limit,

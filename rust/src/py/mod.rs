@@ -131,7 +131,7 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
 fn shadow_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        crate::integrate::check_span(t0, t1)?;
+        o.check_span(t0, t1)?;
         Ok(o.shadow_intervals(t0, t1))
     })
 }
@@ -145,7 +145,11 @@ fn illumination<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        let s = t.as_array().iter().map(|&x| o.illumination(x)).collect();
+        let t = t.as_array();
+        for &x in t.iter() {
+            crate::Orbit::check_time(x)?;
+        }
+        let s = t.iter().map(|&x| o.illumination(x)).collect();
         Ok(array(py, s))
     })
 }
@@ -222,7 +226,11 @@ fn simulate<'py>(
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
         let y_start: SVector<f64, 4> = match y0 {
-            Some(v) => state::<4>(&v)?,
+            Some(v) => {
+                let y = state::<4>(&v)?;
+                crate::dynamics::check_hinge_angle("y0[2]", y[2])?;
+                y
+            }
             None => {
                 let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
                 SVector::<f64, 4>::new(eq.t_front, eq.t_back, eq.theta, 0.0)
@@ -344,7 +352,9 @@ fn simulate_hinge<'py>(
             },
         };
         history.validate()?;
+        history.check_against(&p)?;
         let y_start = state::<2>(&y0)?;
+        crate::dynamics::check_hinge_angle("y0[0]", y_start[0])?;
         let traj = py.detach(|| {
             let mut sys = DrivenHinge {
                 panel: p,
