@@ -11,7 +11,8 @@ from hypothesis import given, settings
 
 import thermojitter as tj
 from conftest import GEO, PAPER, panels
-from thermojitter.beam import FIGURES, dominant_frequency, main_beam
+from thermojitter import cli
+from thermojitter.beam import FIGURES, dominant_frequency
 
 EI = PAPER.youngs_modulus * PAPER.bending_inertia
 L = PAPER.length
@@ -170,7 +171,7 @@ def test_frequency_criterion_matches_frequency_but_not_angle(
 
 def test_beam_command_writes_figures_and_summary(tmp_path: object) -> None:
     out = str(tmp_path)
-    assert main_beam(["--out", out, "--no-calibrate"]) == 0
+    assert cli.main(["beam", "--out", out, "--no-calibrate"]) == 0
     with open(f"{out}/beam_summary.json") as fh:
         summary = json.load(fh)
     for name in FIGURES.values():

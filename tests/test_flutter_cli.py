@@ -9,7 +9,7 @@ import pytest
 
 import thermojitter as tj
 from conftest import PAPER
-from thermojitter.flutter_cli import flutter_command
+from thermojitter.cli.flutter import flutter_command
 
 
 def test_default_run_prints_the_analysis_and_writes_map_and_json(tmp_path: Path, capsys):

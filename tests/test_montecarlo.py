@@ -241,11 +241,11 @@ def test_killed_run_resumes_to_the_same_frame(tmp_path: Path) -> None:
 
 def test_ctrl_c_stops_the_run_and_keeps_the_finished_chunks(tmp_path: Path) -> None:
     path = tmp_path / "ckpt"
-    script = _child(path).replace("tj.monte_carlo(", "try:\n    tj.monte_carlo(", 1)
+    script = _child(path).replace("tj.monte_carlo(", "df = tj.monte_carlo(", 1)
     script = script.replace(
-        "\n                       chunk_size", "\n                           chunk_size"
+        "\n                       chunk_size", "\n                            chunk_size"
     )
-    script += "except KeyboardInterrupt:\n    print('interrupted')\n"
+    script += "print('interrupted' if df.attrs['interrupted'] else 'finished', len(df))\n"
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while len(list(path.glob("chunk-*.parquet"))) < 2:
@@ -254,9 +254,11 @@ def test_ctrl_c_stops_the_run_and_keeps_the_finished_chunks(tmp_path: Path) -> N
         time.sleep(0.01)
     proc.send_signal(signal.SIGINT)
     out, _ = proc.communicate(timeout=60)
-    assert proc.returncode == 0 and out.strip() == "interrupted"
+    word, kept = out.split()
+    assert proc.returncode == 0 and word == "interrupted"
     finished = sorted(path.glob("chunk-*.parquet"))
     assert 2 <= len(finished) < 30
+    assert int(kept) == 2 * len(finished)  # the frame returned holds the finished chunks
     assert not list(path.glob("*.tmp"))
     for chunk in finished:  # each one whole
         assert pd.read_parquet(chunk)["sample"].size == 2
@@ -275,7 +277,9 @@ def test_sobol_indices_find_the_parameter_that_matters() -> None:
         tj.sensitivity(PAPER, LOW, vary, metric="error", n=4, **FAST)
 
 
-def test_mc_command_writes_samples_and_plots(tmp_path: Path) -> None:
+def test_mc_command_writes_samples_and_plots(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     scenario = tmp_path / "s.toml"
     scenario.write_text(
         textwrap.dedent("""
@@ -307,5 +311,7 @@ def test_mc_command_writes_samples_and_plots(tmp_path: Path) -> None:
     )
     np.testing.assert_array_equal(frame["exit_peak"], expected["exit_peak"])
     scenario.write_text("[vary]\ncolour = ['uniform', 0, 1]\n")
-    with pytest.raises(ValueError, match="colour"):
-        mc_command([str(scenario), "--n", "2", "--out", str(out / "x"), "--no-progress"])
+    # Bad input: one line naming the key, exit code 2 (the command's one error path).
+    code = mc_command([str(scenario), "--n", "2", "--out", str(out / "x"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2 and "colour" in err and err.count("\n") == 1

@@ -8,6 +8,7 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "CancelToken",
     "ConvergenceError",
     "EnsemblePool",
     "IntegrationError",
@@ -18,6 +19,9 @@ __all__ = [
     "beam_static",
     "check_panels",
     "declination",
+    "distributed_defaults",
+    "distributed_flutter",
+    "distributed_info",
     "derived",
     "eclipses",
     "energy",
@@ -29,6 +33,7 @@ __all__ = [
     "run_orbits",
     "shadow_intervals",
     "simulate",
+    "simulate_distributed",
     "simulate_hinge",
     "simulate_thermal",
     "stability_map",
@@ -44,6 +49,14 @@ PANEL_FIELDS: list[str]
 STEFAN_BOLTZMANN: float
 
 class IntegrationError(RuntimeError): ...
+
+@final
+class CancelToken:
+    def __new__(cls) -> CancelToken: ...
+    def cancel(self) -> None: ...
+    @property
+    def cancelled(self) -> bool: ...
+
 class ConvergenceError(RuntimeError): ...
 
 def validate_panel(panel: dict[str, float]) -> None: ...
@@ -69,6 +82,7 @@ def simulate(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float] | None,
+    layers: int = 2,
 ) -> dict[str, Any]: ...
 def simulate_thermal(
     panel: dict[str, float],
@@ -117,6 +131,7 @@ def run_orbits(
     theta_limit: float,
     stop_at_limit: bool,
     steps_per_period: float,
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---
@@ -136,6 +151,26 @@ def beam_response(
     solver: dict[str, Any],
     t_eval: _F | None,
     dt_out: float | None,
+) -> dict[str, Any]: ...
+
+# --- distributed panel (rust/src/py/distributed.rs) ---
+
+def distributed_defaults(panel: dict[str, float]) -> dict[str, Any]: ...
+def distributed_info(panel: dict[str, float], settings: dict[str, Any]) -> dict[str, Any]: ...
+def distributed_flutter(
+    panel: dict[str, float], settings: dict[str, Any], flux: float
+) -> dict[str, Any]: ...
+def simulate_distributed(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    settings: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    solver: dict[str, Any],
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: _F | None,
 ) -> dict[str, Any]: ...
 
 # --- orbit options (issue 4)
@@ -180,4 +215,5 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
+        cancel: CancelToken | None = None,
     ) -> dict[str, Any]: ...

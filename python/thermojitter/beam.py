@@ -15,7 +15,6 @@ model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly 
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 from collections.abc import Sequence
@@ -29,6 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 from thermojitter import _core
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness
+from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
+from thermojitter.signals import spectrum as spectrum  # public here too, as before
 from thermojitter.simulate import Method, Model, _check_inputs, _solver_args, _span, simulate
 
 Array = NDArray[np.float64]
@@ -36,8 +37,6 @@ Criterion = Literal["deflection", "deflection_small_angle", "frequency"]
 
 DEFAULT_MARGIN = 1200.0
 """Time before shadow entry and after shadow exit in the default comparison window, s."""
-DEFAULT_F_MIN = 0.02
-"""Lowest frequency searched for the dominant jitter frequency, Hz (above the orbital drift)."""
 
 
 def default_damping_ratio(panel: Panel) -> float:
@@ -178,35 +177,13 @@ class FreeFreeBeam:
         return self.response(times, moments, **kwargs).theta_f
 
 
-def spectrum(t: ArrayLike, x: ArrayLike) -> tuple[Array, Array]:
-    """One-sided amplitude spectrum of a uniformly sampled signal (mean removed, Hann window):
-    frequencies (Hz) and amplitudes (same unit as x)."""
-    ts = np.asarray(t, dtype=float)
-    xs = np.asarray(x, dtype=float)
-    if ts.size < 8 or ts.size != xs.size:
-        raise ValueError(f"t holds {ts.size} samples: need 8 or more, as many as x")
-    steps = np.diff(ts)
-    if not np.allclose(steps, steps[0], rtol=1e-6, atol=0.0):
-        raise ValueError("t must be uniformly spaced for the FFT")
-    window = np.hanning(xs.size)
-    amp = np.abs(np.fft.rfft((xs - xs.mean()) * window)) * 2.0 / window.sum()
-    return np.fft.rfftfreq(xs.size, steps[0]), amp
-
-
-def dominant_frequency(t: ArrayLike, x: ArrayLike, f_min: float = DEFAULT_F_MIN) -> float:
-    """The frequency (Hz) of the largest spectral peak above ``f_min``, refined by a parabola
-    through the peak bin and its neighbours."""
-    f, a = spectrum(t, x)
-    idx = np.nonzero(f >= f_min)[0]
-    if idx.size < 3:
-        raise ValueError(f"f_min = {f_min} is invalid: leaves fewer than 3 frequency bins")
-    k = int(idx[np.argmax(a[idx])])
-    if 0 < k < a.size - 1:
-        y0, y1, y2 = np.log(a[k - 1 : k + 2] + 1e-300)
-        denom = y0 - 2.0 * y1 + y2
-        shift = 0.5 * (y0 - y2) / denom if denom != 0 else 0.0
-        return float(f[k] + shift * (f[1] - f[0]))
-    return float(f[k])
+CRITERION_LABELS = {
+    "panel": "panel value",
+    "deflection": "deflection criterion",
+    "deflection_small_angle": "4EI/L",
+    "frequency": "frequency criterion, 5.21 EI/L",
+}
+"""Words for each ``BeamComparison.criterion``."""
 
 
 @dataclass(frozen=True)
@@ -240,6 +217,11 @@ class BeamComparison:
     def frequency_mismatch(self) -> float:
         """(f_hinge − f_n)/f_n of the dominant jitter frequency of θ."""
         return (self.hinge_frequency - self.natural_frequency) / self.natural_frequency
+
+    @property
+    def criterion_label(self) -> str:
+        """How K_el was chosen, in words (for figures and reports)."""
+        return CRITERION_LABELS.get(self.criterion, self.criterion)
 
     @property
     def theta_deg(self) -> Array:
@@ -409,7 +391,27 @@ def _calibrations(cmp: BeamComparison, panel: Panel, orbit: Orbit) -> dict[str, 
         "deflection_small_angle": 4.0 * ei_l,
         "frequency": freq,
     }
+    out["note"] = calibration_note(out["stiffness_damping"], panel.damping, cmp.frequency_mismatch)
     return out
+
+
+def calibration_note(fit: dict[str, Any], damping: float, mismatch: float) -> str:
+    """What the fit of K_el and c_d alone to the beam's θ_f means, in words: its damping is not a
+    physical estimate (the report and summary.json carry this beside the numbers)."""
+    c = fit["parameters"]["damping"]
+    c_err = fit["standard_errors"]["damping"]
+    k = fit["parameters"]["hinge_stiffness"]
+    return (
+        f"Fitting K_el and c_d alone to the beam's θ_f gives K_el = {k:.0f} N m/rad "
+        f"({fit['hinge_stiffness_over_EI_L']:.2f} EI/L, the static deflection of the beam) "
+        f"and c_d = {c:.0f} ± {c_err:.0f} N m s/rad against the {damping:g} of the run: with "
+        f"K_el matching the deflection, the hinge rings {100 * abs(mismatch):.0f}% "
+        f"{'below' if mismatch < 0 else 'above'} the beam's f_n, so the least-squares fit "
+        "cannot put its jitter in phase with the beam's and removes it with a "
+        "large damping instead. That c_d describes the mismatch of frequencies, not the "
+        "structure's damping; fitting χ as well (K_el, c_d, χ) matches both and gives a "
+        "physical damping."
+    )
 
 
 def beam_comparison_figures(
@@ -431,10 +433,7 @@ def beam_comparison_figures(
     the element count), ``paper`` (:data:`PAPER_NUMBERS`) and, with ``calibrate``, the hinge
     parameters fitted to the beam's θ_f (``calibration``).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from thermojitter import plots
 
     panel = Panel.paper() if panel is None else panel
     orbit = Orbit.geo_equinox() if orbit is None else orbit
@@ -449,52 +448,12 @@ def beam_comparison_figures(
         ),
     }
     figures: dict[str, str] = {}
-
-    def save(fig: Any, key: str) -> None:
-        path = out / FIGURES[key]
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        figures[key] = str(path)
-
     for key, case in (("fig22", cases["deflection"]), ("fig22b", cases["frequency"])):
-        fig, ax = plt.subplots(figsize=(8, 4))
-        minutes = (case.t - case.t[0]) / 60.0
-        ax.plot(minutes, case.theta_deg, lw=0.6, label="hinge model θ")
-        ax.plot(minutes, case.theta_f_deg, lw=0.6, label="beam θ_f (finite elements)")
-        ax.set_xlabel(f"time from t = {case.t[0]:.0f} s (min)")
-        ax.set_ylabel("angle (deg)")
-        ax.set_title(
-            f"K_el = {case.hinge_stiffness:.0f} N m/rad ({case.criterion}); "
-            f"RMSE {case.rmse_deg:.2f}°"
-        )
-        ax.legend(loc="best")
-        ax.grid(alpha=0.3)
-        save(fig, key)
-
+        path = out / FIGURES[key]
+        figures[key] = str(plots.beam_time_figure(case, orbit, plots.BEAM_NUMBERS[key], path))
     for key, case in (("fig23", cases["deflection"]), ("fig24", cases["frequency"])):
-        fig, ax = plt.subplots(figsize=(8, 4))
-        for signal, label in ((case.theta_deg, "θ (hinge)"), (case.theta_f_deg, "θ_f (beam)")):
-            f, a = spectrum(case.t, signal)
-            keep = f <= 0.5
-            ax.semilogy(f[keep], a[keep], lw=0.8, label=label)
-        ax.axvline(case.natural_frequency, color="k", ls="--", lw=0.8)
-        ax.text(
-            case.natural_frequency,
-            ax.get_ylim()[1],
-            f" f_n = {case.natural_frequency:.3f} Hz",
-            va="top",
-            fontsize=8,
-        )
-        ax.set_xlabel("frequency (Hz)")
-        ax.set_ylabel("amplitude (deg)")
-        ax.set_title(
-            f"FFT, K_el = {case.hinge_stiffness:.0f} N m/rad: θ peak "
-            f"{case.hinge_frequency:.4f} Hz ({100 * case.frequency_mismatch:+.1f}% vs f_n)"
-        )
-        ax.legend(loc="best")
-        ax.grid(alpha=0.3, which="both")
-        save(fig, key)
+        path = out / FIGURES[key]
+        figures[key] = str(plots.beam_spectrum_figure(case, plots.BEAM_NUMBERS[key], path))
 
     beam = FreeFreeBeam(panel, n_elements)
     result: dict[str, Any] = {
@@ -533,12 +492,11 @@ def beam_report_markdown(result: dict[str, Any]) -> str:
         "|---|---|---|",
         f"| beam f_n (Hz) | {beam['natural_frequencies_hz'][0]:.4f} "
         f"| {paper['natural_frequency_hz']} |",
-        f"| jitter frequency of θ, K_el = {d['hinge_stiffness']:.0f} (deflection) (Hz) "
+        f"| jitter frequency of θ, K_el = {d['hinge_stiffness']:.0f} (Table 1) (Hz) "
         f"| {d['hinge_frequency_hz']:.4f} | – |",
         f"| its mismatch with f_n | {100 * d['frequency_mismatch']:+.1f}% "
         f"| about {100 * paper['frequency_mismatch']:.0f}% |",
-        f"| RMSE θ − θ_f, K_el = {d['hinge_stiffness']:.0f} (deflection) | "
-        f"{d['rmse_deg']:.2f}° | – |",
+        f"| RMSE θ − θ_f, K_el = {d['hinge_stiffness']:.0f} (Table 1) | {d['rmse_deg']:.2f}° | – |",
         f"| RMSE θ − θ_f, K_el = {f['hinge_stiffness']:.0f} = 5.21 EI/L (frequency) | "
         f"{f['rmse_deg']:.2f}° | {paper['rmse_deg']}° |",
         f"| its frequency mismatch | {100 * f['frequency_mismatch']:+.2f}% | ≈ 0 |",
@@ -564,8 +522,8 @@ def beam_report_markdown(result: dict[str, Any]) -> str:
             "",
             f"- K_el, c_d: K_el = {two['parameters']['hinge_stiffness']:.0f} N m/rad "
             f"({two['hinge_stiffness_over_EI_L']:.2f} EI/L), c_d = "
-            f"{two['parameters']['damping']:.0f} N m s/rad, residual "
-            f"{two['residual_rms_deg']:.3f}° (the fit damps out the jitter it cannot phase-match)",
+            f"{two['parameters']['damping']:.0f} ± {two['standard_errors']['damping']:.0f} "
+            f"N m s/rad, residual {two['residual_rms_deg']:.3f}°. {cal['note']}",
             f"- K_el, c_d, χ: K_el = {three['parameters']['hinge_stiffness']:.0f} N m/rad "
             f"({three['hinge_stiffness_over_EI_L']:.2f} EI/L), c_d = "
             f"{three['parameters']['damping']:.1f}, χ = {three['parameters']['moment_scale']:.3f},"
@@ -592,17 +550,3 @@ def write_beam_comparison(out: str | Path, n_elements: int = 100, calibrate: boo
         )
     print(f"beam f_n = {result['beam']['natural_frequencies_hz'][0]:.4f} Hz; wrote {path}")
     return 0
-
-
-def main_beam(argv: Sequence[str] | None = None) -> int:
-    """The beam comparison from a command line of its own (``--out``, ``--elements``,
-    ``--no-calibrate``); ``thermojitter beam`` calls :func:`write_beam_comparison` directly."""
-    parser = argparse.ArgumentParser(
-        prog="thermojitter beam",
-        description="Compare the hinge model with a finite-element free-free beam (paper 4.3).",
-    )
-    parser.add_argument("--out", default="beam-out", help="output directory (default: beam-out)")
-    parser.add_argument("--elements", type=int, default=100, help="beam elements (even)")
-    parser.add_argument("--no-calibrate", action="store_true", help="skip the hinge fits")
-    args = parser.parse_args(None if argv is None else list(argv))
-    return write_beam_comparison(args.out, args.elements, not args.no_calibrate)

@@ -13,7 +13,11 @@ from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.progress import progress_bar
 from thermojitter.results import Equilibrium
+
+MAP_BLOCK = 20_000
+"""Grid points per engine call of :func:`stability_map` (about 40 ms each)."""
 
 
 @dataclass(frozen=True)
@@ -149,13 +153,15 @@ def stability_map(
     *,
     coupled: bool = True,
     flux: float = 1.0,
+    progress: bool = True,
 ) -> StabilityMap:
     """Growth rate of the sunlit equilibrium with two panel parameters swept over a grid.
 
     ``x`` and ``y`` are ``(name, values)`` with ``name`` any :class:`Panel` field; the other
     fields keep the values of ``panel``. The grid is analysed in parallel by the engine (one
     eigen-analysis per point, the same as :func:`flutter`); the result does not depend on the
-    number of threads.
+    number of threads. A grid that takes more than a second shows a progress bar (``progress``);
+    Ctrl-C stops it between blocks of rows and raises ``KeyboardInterrupt``.
     """
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
@@ -170,16 +176,38 @@ def stability_map(
     coupled = checks.flag("coupled", coupled)
     flux = checks.real("flux", flux)
     checks.choice("model", model, ("nonlinear", "linear"))
-    raw = _core.stability_map(
-        panel.as_dict(), x_name, xs.tolist(), y_name, ys.tolist(), model, coupled, flux
-    )
+    # Blocks of rows of about MAP_BLOCK points: each a parallel engine call, with progress and
+    # Ctrl-C between them.
+    rows_per_block = max(1, MAP_BLOCK // xs.size)
+    growth, frequency = [], []
+    bar = progress_bar(ys.size, unit="row", desc="stability map", enabled=progress, delay=1.0)
+    try:
+        for start in range(0, ys.size, rows_per_block):
+            block = ys[start : start + rows_per_block]
+            raw = _core.stability_map(
+                panel.as_dict(),
+                x_name,
+                xs.tolist(),
+                y_name,
+                block.tolist(),
+                model,
+                coupled,
+                flux,
+            )
+            growth.append(np.asarray(raw["growth_rate"], dtype=float).reshape(block.size, -1))
+            frequency.append(np.asarray(raw["frequency_hz"], dtype=float).reshape(block.size, -1))
+            if bar is not None:
+                bar.update(block.size)
+    finally:
+        if bar is not None:
+            bar.close()
     return StabilityMap(
         x_name=x_name,
         x=xs,
         y_name=y_name,
         y=ys,
-        growth_rate=np.asarray(raw["growth_rate"], dtype=float).reshape(ys.size, xs.size),
-        frequency_hz=np.asarray(raw["frequency_hz"], dtype=float).reshape(ys.size, xs.size),
+        growth_rate=np.concatenate(growth),
+        frequency_hz=np.concatenate(frequency),
         model=model,
         coupled=bool(coupled),
         flux=float(flux),

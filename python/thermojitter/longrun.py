@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 import warnings
 from collections.abc import Callable
@@ -25,6 +24,7 @@ from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.progress import Interruptible, progress_bar, report_interrupted
 from thermojitter.simulate import _check_inputs, _state, solver_settings, steady_state
 
 SUMMARY_FIELDS = (
@@ -188,7 +188,7 @@ def simulate_orbits(
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: float = 10.0,
     orbits_per_call: int = 1,
-    progress: bool | None = None,
+    progress: bool | None = True,
     max_steps: int = 500_000_000,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
@@ -201,9 +201,11 @@ def simulate_orbits(
       stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.
-    - Ctrl-C returns the finished orbits with ``interrupted=True``; so does ``stop()`` turning
-      True (polled between chunks, for callers that handle SIGINT themselves).
-    - ``progress``: a tqdm bar (default: when stderr is a terminal and tqdm is installed).
+    - Ctrl-C stops within one integration step and returns the finished orbits with
+      ``interrupted=True``, saying so in one line on stderr. So does ``stop()`` turning True
+      (polled between chunks, for callers that handle SIGINT and report it themselves), silently.
+    - ``progress``: a tqdm bar on stderr with the remaining time (in Jupyter a widget; also when
+      stderr is not a terminal); ``None``: only when stderr is a terminal; ``False``: none.
     - ``steps_per_period``: rk45's step is capped at T_n/steps_per_period, T_n the hinge's natural
       period (0: error control alone). Without the cap the step grows, once the oscillation is
       small against ``atol``, to where the method's own dissipation exceeds a weak flutter's
@@ -272,16 +274,18 @@ def simulate_orbits(
             columns, y, next_index, counters, crossing = _restore(path, saved)
             _check_extension(path, saved, n_orbits, orbits_per_call, next_index)
 
-    bar = _progress_bar(progress, n_orbits, next_index)
-    interrupted = False
+    bar = progress_bar(n_orbits, initial=next_index, unit="orbit", enabled=progress)
+    interrupted = report = False
     stopped = crossing is not None and on_limit == "stop"
     last_save = time.monotonic()
+    engine = Interruptible()
     try:
         while next_index < n_orbits and not stopped:
             # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same places.
             count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
             t0 = float(t_start) + next_index * orbit.period
-            raw = _core.run_orbits(
+            raw = engine.call(
+                _core.run_orbits,
                 panel.as_dict(),
                 orbit.as_dict(),
                 t_start=t0,
@@ -310,14 +314,27 @@ def simulate_orbits(
                 )
                 last_save = time.monotonic()
             if stop is not None and stop() and next_index < n_orbits and not stopped:
-                raise KeyboardInterrupt
+                interrupted = True  # the caller asked, and reports it
+                break
     except KeyboardInterrupt:
-        interrupted = True
+        interrupted = report = True
     finally:
+        engine.__exit__()
         if bar is not None:
             bar.close()
         if path is not None:
             _save_checkpoint(path, settings, n_orbits, columns, y, next_index, counters, crossing)
+    if report:
+        kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
+        if path is not None:
+            report_interrupted(
+                f"{kept} (checkpoint {path})", "run it again with the same checkpoint to resume"
+            )
+        else:
+            report_interrupted(
+                f"{kept} (returned, interrupted=True)",
+                "pass checkpoint=FILE to make a run resumable",
+            )
 
     return OrbitSummaries(
         columns={
@@ -331,15 +348,3 @@ def simulate_orbits(
         interrupted=interrupted,
         settings=settings,
     )
-
-
-def _progress_bar(progress: bool | None, total: int, done: int) -> Any:
-    if progress is None:
-        progress = sys.stderr.isatty()
-    if not progress:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=total, initial=done, unit="orbit", desc="thermojitter", leave=False)

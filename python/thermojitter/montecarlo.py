@@ -36,6 +36,7 @@ from thermojitter import checkpoint as checkpoints
 from thermojitter.errors import ParameterError
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.simulate import _check_inputs, solver_settings
 
 Sampler = Literal["random", "lhs", "sobol"]
@@ -300,10 +301,12 @@ def _options(
     }
 
 
-def _run_chunk(pool: Any, panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str, Any]:
+def _run_chunk(
+    pool: Any, panels: NDArray[np.float64], options: dict[str, Any], cancel: Any = None
+) -> dict[str, Any]:
     opts = dict(options)
     orbit = opts.pop("orbit")
-    raw = pool.run(panels, orbit, **opts)
+    raw = pool.run(panels, orbit, cancel=cancel, **opts)
     out: dict[str, Any] = {m: np.asarray(raw[m], dtype=float) for m in _FLOAT_METRICS}
     out["stable"] = np.asarray(raw["stable"], dtype=bool)
     out["n_steps"] = np.asarray(raw["n_steps"], dtype=np.int64)
@@ -343,14 +346,18 @@ def _local_chunks(
     threads: int | None,
 ) -> Generator[tuple[int, dict[str, Any]], None, None]:
     """Yields (chunk, metrics) as chunks finish. Two chunks are in flight at once on one rayon
-    pool, so the pool's threads stay busy while a chunk finishes its last samples."""
+    pool, so the pool's threads stay busy while a chunk finishes its last samples. Leaving early
+    (Ctrl-C in the consumer) cancels the engine's token: the running chunks stop within one
+    integration step and are dropped."""
     pool = _core.EnsemblePool(threads)
+    token = _core.CancelToken()
     with cf.ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermojitter") as ex:
-        futures = {ex.submit(_run_chunk, pool, matrix[a:b], options): k for k, a, b in todo}
+        futures = {ex.submit(_run_chunk, pool, matrix[a:b], options, token): k for k, a, b in todo}
         try:
             for fut in cf.as_completed(futures):
                 yield futures[fut], fut.result()
         finally:
+            token.cancel()
             for fut in futures:
                 fut.cancel()
 
@@ -521,20 +528,32 @@ def _default_chunk_size(n: int) -> int:
     return max(1, min(64, math.ceil(n / 16)))
 
 
-def _frame(names: Sequence[str], values: NDArray[np.float64], chunks: list[dict[str, Any]]) -> Any:
+def _frame(
+    names: Sequence[str],
+    values: NDArray[np.float64],
+    chunks: list[dict[str, Any]],
+    rows: NDArray[np.int64] | None = None,
+) -> Any:
+    """The samples' frame; ``rows``: the sample numbers the chunks hold (default: all)."""
     import pandas as pd
 
-    data: dict[str, Any] = {name: values[:, j].copy() for j, name in enumerate(names)}
+    if rows is None:
+        rows = np.arange(len(values))
+    data: dict[str, Any] = {name: values[rows, j] for j, name in enumerate(names)}
     for m in METRICS:
         if m == "error":
             errors = [e for c in chunks for e in c["error"]]
             data[m] = pd.Series(errors, dtype=object)
         else:
-            data[m] = np.concatenate([np.asarray(c[m]) for c in chunks])
+            data[m] = np.concatenate([np.asarray(c[m]) for c in chunks] or [np.empty(0)])
     data["stable"] = data["stable"].astype(bool)
     data["n_steps"] = data["n_steps"].astype(np.int64)
     frame = pd.DataFrame(data)
-    frame.index = pd.RangeIndex(len(values), name="sample")
+    frame.index = (
+        pd.RangeIndex(len(values), name="sample")
+        if len(rows) == len(values)
+        else pd.Index(rows, name="sample")
+    )
     return frame
 
 
@@ -579,8 +598,11 @@ def _run_design(
                 done[k] = chunk
     todo = [c for c in bounds if c[0] not in done]
 
-    bar = _progress_bar(progress, n, sum(b - a for k, a, b in bounds if k in done))
+    bar = progress_bar(
+        n, initial=sum(b - a for k, a, b in bounds if k in done), unit="sample", enabled=progress
+    )
     client, owned = (None, False) if backend is None else _dask_client(backend)
+    interrupted = False
     try:
         if todo:
             stream: Generator[tuple[int, dict[str, Any]], None, None] = (
@@ -601,12 +623,14 @@ def _run_design(
                             written.add(k)
                         if bar is not None:
                             bar.update(stop - start)
-                except BaseException:
+                except BaseException as exc:
                     # A finished chunk whose write was interrupted is written before leaving.
                     if directory is not None and not failed_write:
                         for k in sorted(set(done) - written):
                             _write_chunk(directory, k, bounds[k][1], done[k], request)
-                    raise
+                    if not isinstance(exc, KeyboardInterrupt):
+                        raise
+                    interrupted = True
     finally:
         if bar is not None:
             bar.close()
@@ -615,19 +639,21 @@ def _run_design(
             client.close()
             if cluster is not None:
                 cluster.close()
-    frame = _frame(names, values, [done[k] for k, _, _ in bounds])
+    finished = [(k, a, b) for k, a, b in bounds if k in done]
+    rows = np.concatenate([np.arange(a, b) for _, a, b in finished] or [np.empty(0, np.int64)])
+    frame = _frame(names, values, [done[k] for k, _, _ in finished], rows.astype(np.int64))
     frame.attrs["settings"] = settings
+    frame.attrs["interrupted"] = interrupted
+    if interrupted:
+        kept = f"kept {len(frame)} of {n} samples (frame.attrs['interrupted'] is True)"
+        if directory is not None:
+            report_interrupted(
+                f"{kept}; finished chunks are in {directory}",
+                "run the same call again to resume",
+            )
+        else:
+            report_interrupted(kept, "pass checkpoint=DIR to make a run resumable")
     return frame
-
-
-def _progress_bar(progress: bool, total: int, done: int) -> Any:
-    if not progress:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=total, initial=done, unit="sample", desc="thermojitter", leave=False)
 
 
 def _check_seed(seed: Any, checkpoint: Any) -> int:
@@ -819,6 +845,8 @@ class SensitivityResult:
     indices: Any
     metric: str
     samples: Any
+    interrupted: bool = False
+    """True when Ctrl-C stopped the run: ``samples`` holds the finished ones, ``indices`` NaN."""
 
 
 def sensitivity(
@@ -896,6 +924,13 @@ def sensitivity(
         names, values, matrix, options, settings, threads=threads, backend=backend,
         checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
     )  # fmt: skip
+    if samples.attrs["interrupted"]:
+        nan = np.full(len(names), np.nan)
+        indices = pd.DataFrame(
+            {k: nan for k in ("S1", "S1_conf", "ST", "ST_conf")},
+            index=pd.Index(names, name="parameter"),
+        )
+        return SensitivityResult(indices=indices, metric=metric, samples=samples, interrupted=True)
     y = samples[metric].to_numpy(dtype=float)
     missing = np.flatnonzero(~np.isfinite(y))
     if missing.size:

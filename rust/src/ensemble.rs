@@ -5,6 +5,7 @@
 //! by one thread from its own inputs only, so the results do not depend on the number of threads
 //! or on how a batch is cut into chunks.
 
+use crate::cancel::Cancel;
 use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
 use crate::flutter::{analyse, critical_damping};
@@ -12,7 +13,7 @@ use crate::integrate::Method;
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
-use crate::summary::{run_orbits, OrbitRun, SummaryOptions};
+use crate::summary::{run_orbits_cancellable, OrbitRun, SummaryOptions};
 use crate::system::Coupling;
 use nalgebra::Vector4;
 use rayon::prelude::*;
@@ -144,8 +145,14 @@ fn reduce(run: &OrbitRun) -> (f64, f64, f64, f64, f64, f64) {
     (theta_abs_max, amplitude, entry, exit, rms, jitter_peak)
 }
 
-/// One sample: the flutter analysis and the summarised run of `panel`.
-pub fn run_sample(panel: &Panel, settings: &EnsembleSettings) -> Result<SampleMetrics> {
+/// One sample: the flutter analysis and the summarised run of `panel` (stops with
+/// `Error::Cancelled` within one step of `cancel` being cancelled).
+pub fn run_sample(
+    panel: &Panel,
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+) -> Result<SampleMetrics> {
+    cancel.check()?;
     panel.validate()?;
     let s = settings;
     let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
@@ -159,8 +166,8 @@ pub fn run_sample(panel: &Panel, settings: &EnsembleSettings) -> Result<SampleMe
         stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
         steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
     };
-    let run = run_orbits(
-        panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
+    let run = run_orbits_cancellable(
+        panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options, cancel,
     )?;
     let (theta_abs_max, amplitude, entry_peak, exit_peak, jitter_rms, jitter_peak) = reduce(&run);
     Ok(SampleMetrics {
@@ -191,25 +198,31 @@ pub fn pool(threads: usize) -> Result<ThreadPool> {
 
 /// Runs every panel on `pool`, results in input order. A sample that fails (an invalid panel,
 /// an integration that cannot finish) keeps its error in its metrics; the batch goes on.
+/// Cancelling `cancel` stops every sample within one step and the batch returns
+/// `Error::Cancelled` (a batch is kept whole or not at all).
 pub fn run_batch(
     pool: &ThreadPool,
     panels: &[Panel],
     settings: &EnsembleSettings,
+    cancel: &Cancel,
 ) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
-    Ok(pool.install(|| {
+    let out = pool.install(|| {
         panels
             .par_iter()
             .with_max_len(1)
-            .map(|p| run_sample(p, settings).unwrap_or_else(SampleMetrics::failed))
+            .map(|p| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed))
             .collect()
-    }))
+    });
+    cancel.check()?;
+    Ok(out)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::integrate::Tolerances;
+    use crate::summary::run_orbits;
 
     fn settings() -> EnsembleSettings {
         EnsembleSettings {
@@ -271,12 +284,12 @@ mod tests {
     #[test]
     fn results_do_not_depend_on_threads_or_order() {
         let s = settings();
-        let one = run_batch(&pool(1).unwrap(), &panels(), &s).unwrap();
-        let two = run_batch(&pool(2).unwrap(), &panels(), &s).unwrap();
+        let one = run_batch(&pool(1).unwrap(), &panels(), &s, &Cancel::new()).unwrap();
+        let two = run_batch(&pool(2).unwrap(), &panels(), &s, &Cancel::new()).unwrap();
         assert_eq!(bits(&one), bits(&two));
         let mut reversed = panels();
         reversed.reverse();
-        let mut back = run_batch(&pool(2).unwrap(), &reversed, &s).unwrap();
+        let mut back = run_batch(&pool(2).unwrap(), &reversed, &s, &Cancel::new()).unwrap();
         back.reverse();
         assert_eq!(bits(&one), bits(&back));
     }
@@ -285,7 +298,7 @@ mod tests {
     fn a_sample_equals_its_single_run_and_flutter_analysis() {
         let s = settings();
         let p = panels()[3];
-        let m = run_sample(&p, &s).unwrap();
+        let m = run_sample(&p, &s, &Cancel::new()).unwrap();
         let a = analyse(&p, s.model, s.coupling, 1.0).unwrap();
         assert_eq!(m.growth_rate, a.growth_rate);
         assert_eq!(m.stable(), a.stable());
@@ -319,7 +332,7 @@ mod tests {
     fn a_bad_panel_fails_alone() {
         let mut ps = panels();
         ps[2].emissivity_front = 1.5;
-        let out = run_batch(&pool(2).unwrap(), &ps, &settings()).unwrap();
+        let out = run_batch(&pool(2).unwrap(), &ps, &settings(), &Cancel::new()).unwrap();
         let err = out[2].error.as_deref().unwrap();
         assert!(err.starts_with("emissivity_front"), "{err}");
         assert!(out[2].growth_rate.is_nan());
@@ -336,25 +349,28 @@ mod tests {
             damping: 0.0,
             ..Panel::paper()
         };
-        let base = run_sample(&p, &s).unwrap();
+        let base = run_sample(&p, &s, &Cancel::new()).unwrap();
         let limit = 0.5 * (base.theta_abs_max + base.theta_eq.abs());
         s.threshold = Some(limit);
-        let flagged = run_sample(&p, &s).unwrap();
+        let flagged = run_sample(&p, &s, &Cancel::new()).unwrap();
         assert!(flagged.t_threshold > 0.0 && flagged.t_threshold < s.orbit.period);
         assert_eq!(flagged.t_reached, s.orbit.period);
         s.stop_at_threshold = true;
-        let stopped = run_sample(&p, &s).unwrap();
+        let stopped = run_sample(&p, &s, &Cancel::new()).unwrap();
         assert_eq!(stopped.t_threshold, flagged.t_threshold);
         assert!(stopped.t_reached < s.orbit.period);
         s.threshold = None;
-        assert!(run_sample(&p, &s).unwrap().t_threshold.is_nan());
+        assert!(run_sample(&p, &s, &Cancel::new())
+            .unwrap()
+            .t_threshold
+            .is_nan());
     }
 
     #[test]
     fn settings_are_checked() {
         let mut s = settings();
         s.n_orbits = 0;
-        let e = run_batch(&pool(1).unwrap(), &panels(), &s).unwrap_err();
+        let e = run_batch(&pool(1).unwrap(), &panels(), &s, &Cancel::new()).unwrap_err();
         assert!(e.to_string().starts_with("horizon"), "{e}");
         let mut s = settings();
         s.threshold = Some(-1.0);
@@ -363,5 +379,29 @@ mod tests {
             .unwrap_err()
             .to_string()
             .starts_with("threshold"));
+    }
+
+    #[test]
+    fn a_cancelled_batch_stops_within_a_step() {
+        let mut s = settings();
+        // Hours of work if nothing stopped it: 2 samples of 100 000 orbits each.
+        s.n_orbits = 100_000;
+        let cancel = Cancel::new();
+        let started = std::time::Instant::now();
+        let out = std::thread::scope(|scope| {
+            let batch = scope.spawn(|| run_batch(&pool(2).unwrap(), &panels()[..2], &s, &cancel));
+            std::thread::sleep(std::time::Duration::from_millis(200));
+            cancel.cancel();
+            batch.join().unwrap()
+        });
+        assert_eq!(out.unwrap_err(), Error::Cancelled);
+        assert!(
+            started.elapsed().as_secs_f64() < 5.0,
+            "{:?}",
+            started.elapsed()
+        );
+        // Cancelled before it starts: nothing runs.
+        let e = run_batch(&pool(1).unwrap(), &panels(), &settings(), &cancel).unwrap_err();
+        assert_eq!(e, Error::Cancelled);
     }
 }

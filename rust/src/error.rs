@@ -17,6 +17,9 @@ pub enum Error {
     /// A non-linear solve (equilibrium, root-finding) did not converge.
     #[error("{what} did not converge: {reason}")]
     NoConvergence { what: String, reason: String },
+    /// The caller cancelled the work (see `crate::cancel::Cancel`).
+    #[error("cancelled")]
+    Cancelled,
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

@@ -6,6 +6,8 @@
 //! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
 
 pub mod beam;
+pub mod cancel;
+pub mod distributed;
 pub mod dynamics;
 pub mod ensemble;
 pub mod error;

@@ -3,6 +3,7 @@
 //! Each accepted step is read at four evenly spaced points of its dense output, fine enough to
 //! catch the peaks of an oscillation that needs tens of steps per period.
 
+use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::Result;
 use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
@@ -208,13 +209,18 @@ impl Collector {
     }
 }
 
-struct SummaryObserver {
+struct SummaryObserver<'c> {
     collector: Collector,
     error: Option<crate::Error>,
+    cancel: &'c Cancel,
 }
 
-impl Observer<U4> for SummaryObserver {
+impl Observer<U4> for SummaryObserver<'_> {
     fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+        if let Err(e) = self.cancel.check() {
+            self.error = Some(e);
+            return ControlFlow::Break(());
+        }
         let h = (step.t1 - step.t0) / READS_PER_STEP as f64;
         for j in 1..=READS_PER_STEP {
             let t = if j == READS_PER_STEP {
@@ -263,6 +269,39 @@ pub fn run_orbits(
     y0: Vector4<f64>,
     options: SummaryOptions,
 ) -> Result<OrbitRun> {
+    run_orbits_cancellable(
+        panel,
+        orbit,
+        model,
+        coupling,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+        &Cancel::new(),
+    )
+}
+
+/// [`run_orbits`] that stops with [`crate::Error::Cancelled`] within one step of `cancel` being
+/// cancelled (the orbits finished before are lost with the call: callers that keep them run
+/// fewer orbits per call).
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits_cancellable(
+    panel: &Panel,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vector4<f64>,
+    options: SummaryOptions,
+    cancel: &Cancel,
+) -> Result<OrbitRun> {
+    cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
     crate::dynamics::check_hinge_angle("y0[2]", y0[2])?;
@@ -312,6 +351,7 @@ pub fn run_orbits(
     let mut observer = SummaryObserver {
         collector,
         error: None,
+        cancel,
     };
     let mut system = Coupled::new(*panel, *orbit, model, coupling);
     let (stats, y_end) = solve(&mut system, method, t_start, y0, t_end, &mut observer)?;

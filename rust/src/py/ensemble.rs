@@ -1,5 +1,6 @@
 //! Bindings of batched runs: a rayon pool of its own, and the check of a design up front.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
@@ -83,7 +84,7 @@ impl EnsemblePool {
     }
 
     /// Runs one sample per row of `panels`; returns the metrics as columns.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, cancel=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -97,7 +98,9 @@ impl EnsemblePool {
         window: f64,
         threshold: Option<f64>,
         stop_at_threshold: bool,
+        cancel: Option<&Bound<'py, CancelToken>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let cancel = token(cancel);
         shield(|| {
             let ps = panels_from(&panels)?;
             let settings = EnsembleSettings {
@@ -115,7 +118,7 @@ impl EnsemblePool {
                 stop_at_threshold,
             };
             let pool = &self.pool;
-            let out = py.detach(|| run_batch(pool, &ps, &settings))?;
+            let out = py.detach(|| run_batch(pool, &ps, &settings, &cancel))?;
             let d = PyDict::new(py);
             let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };
             for (name, values) in [

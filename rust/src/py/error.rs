@@ -5,7 +5,7 @@
 
 use crate::Error;
 use pyo3::create_exception;
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
@@ -66,6 +66,7 @@ impl From<Error> for PyErr {
             } => parameter_error(name, value, reason, message),
             Error::Integration { .. } => IntegrationError::new_err(message),
             Error::NoConvergence { .. } => ConvergenceError::new_err(message),
+            Error::Cancelled => PyKeyboardInterrupt::new_err(message),
         }
     }
 }

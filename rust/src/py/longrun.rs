@@ -1,16 +1,18 @@
 //! Bindings of summarised long runs.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
 use super::error::shield;
-use crate::summary::{run_orbits as run, SummaryOptions};
+use crate::summary::{run_orbits_cancellable as run, SummaryOptions};
 use crate::system::Coupling;
+use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -27,7 +29,9 @@ fn run_orbits<'py>(
     theta_limit: f64,
     stop_at_limit: bool,
     steps_per_period: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
@@ -38,7 +42,7 @@ fn run_orbits<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
-        let y = state::<4>(&y0)?;
+        let y = state(&y0, U4)?;
         crate::dynamics::check_hinge_angle("theta_limit", theta_limit)?;
         let options = SummaryOptions {
             window,
@@ -58,6 +62,7 @@ fn run_orbits<'py>(
                 n_orbits,
                 y,
                 options,
+                &cancel,
             )
         })?;
         let d = PyDict::new(py);

@@ -26,15 +26,15 @@ from typing import Any, Literal, cast
 import numpy as np
 
 from thermojitter import _core
+from thermojitter.cli.common import UserError, out_dir
 from thermojitter.flutter import (
     FlutterResult,
-    StabilityMap,
     flutter,
     linear_thermal_response,
     stability_map,
 )
 from thermojitter.orbit import Orbit
-from thermojitter.panel import PANEL_UNITS, Panel
+from thermojitter.panel import Panel
 from thermojitter.scenario import ScenarioError, load_scenario
 
 DEFAULT_X = "damping:0:5:51"
@@ -43,35 +43,29 @@ ModelName = Literal["nonlinear", "linear"]
 MODELS: tuple[ModelName, ...] = ("nonlinear", "linear")
 
 
-class FlutterInputError(ValueError):
-    """A bad scenario file or option (one line, exit code 2)."""
-
-
 def parse_axis(text: str, which: str) -> tuple[str, np.ndarray]:
     """``NAME:START:STOP:N`` → (name, N values from START to STOP)."""
     parts = str(text).split(":")
     if len(parts) != 4:
-        raise FlutterInputError(f"{which} = {text!r}: expected NAME:START:STOP:N")
+        raise UserError(f"{which} = {text!r}: expected NAME:START:STOP:N")
     name = parts[0]
     if name not in _core.PANEL_FIELDS:
-        raise FlutterInputError(
+        raise UserError(
             f"{which} = {text!r}: {name!r} is not a panel parameter; one of "
             + ", ".join(_core.PANEL_FIELDS)
         )
     try:
         start, stop, n = float(parts[1]), float(parts[2]), int(parts[3])
     except ValueError:
-        raise FlutterInputError(
-            f"{which} = {text!r}: START, STOP must be numbers, N an integer"
-        ) from None
+        raise UserError(f"{which} = {text!r}: START, STOP must be numbers, N an integer") from None
     if not (math.isfinite(start) and math.isfinite(stop)) or n < 1 or n > 2000:
-        raise FlutterInputError(f"{which} = {text!r}: need finite bounds and 1 <= N <= 2000")
+        raise UserError(f"{which} = {text!r}: need finite bounds and 1 <= N <= 2000")
     return name, np.linspace(start, stop, n)
 
 
 def _number(path: Path, key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise FlutterInputError(f"{path}: {key} must be a number, not {type(value).__name__}")
+        raise UserError(f"{path}: {key} must be a number, not {type(value).__name__}")
     return float(value)
 
 
@@ -86,48 +80,21 @@ def _analysis_record(r: FlutterResult) -> dict[str, Any]:
     }
 
 
-def plot_map(m: StabilityMap, panel: Panel, path: Path) -> None:
-    """Growth-rate colour map with the zero contour (the flutter boundary)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import TwoSlopeNorm
-
-    g = m.growth_rate * 1e4
-    lo, hi = float(g.min()), float(g.max())
-    fig, ax = plt.subplots(figsize=(7.0, 5.2), layout="constrained")
-    if lo < 0.0 < hi:
-        norm: Any = TwoSlopeNorm(vcenter=0.0, vmin=lo, vmax=hi)
-    else:
-        norm = None
-    if m.x.size > 1 and m.y.size > 1:
-        filled: Any = ax.contourf(m.x, m.y, g, levels=40, cmap="RdBu_r", norm=norm)
-        if lo < 0.0 < hi:
-            zero = ax.contour(m.x, m.y, g, levels=[0.0], colors="k", linewidths=1.5)
-            ax.clabel(zero, fmt={0.0: "growth rate = 0"}, fontsize=8)
-    else:
-        filled = ax.scatter(
-            np.repeat(m.x[None, :], m.y.size, 0), np.repeat(m.y[:, None], m.x.size, 1), c=g
-        )
-    fig.colorbar(filled, ax=ax, label="growth rate (1e-4 1/s); > 0: flutter")
-    ax.plot(
-        getattr(panel, m.x_name), getattr(panel, m.y_name), "k*", markersize=12, label="scenario"
-    )
-    ax.set_xlabel(f"{m.x_name} ({PANEL_UNITS.get(m.x_name, '-')})")
-    ax.set_ylabel(f"{m.y_name} ({PANEL_UNITS.get(m.y_name, '-')})")
-    ax.set_title(f"Thermal flutter of the sunlit equilibrium ({m.model} hinge, flux x{m.flux:.3f})")
-    ax.legend(loc="upper right")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
 def flutter_command(argv: Sequence[str] | None = None) -> int:
-    """Runs ``thermojitter flutter``; returns the exit code (0, or 2 for bad input)."""
-    parser = argparse.ArgumentParser(
-        prog="thermojitter flutter",
+    """``thermojitter flutter ARGS``; returns the exit code (0, or 2 for bad input)."""
+    from thermojitter.cli import main
+
+    return main(["flutter", *(sys.argv[1:] if argv is None else argv)])
+
+
+def add_parser(sub: Any) -> None:
+    parser = sub.add_parser(
+        "flutter",
+        help="flutter analysis without integration: growth rate, critical damping, stability map",
         description="Flutter analysis of a scenario without integration: growth rate, "
-        "frequency and critical damping at the sunlit equilibrium, and a stability map.",
+        "frequency and critical damping at the sunlit equilibrium, and a stability map "
+        "(stability_map.png, flutter.json).",
+        epilog="Example: thermojitter flutter examples/paper.toml --out out/flutter",
     )
     parser.add_argument("scenario", nargs="?", help="TOML scenario (default: Table 1 at GEO)")
     parser.add_argument("--out", default="out/flutter", help="output directory")
@@ -139,15 +106,10 @@ def flutter_command(argv: Sequence[str] | None = None) -> int:
         "--uncoupled", action="store_true", help="freeze the projected area (no pumping)"
     )
     parser.add_argument("--no-plot", action="store_true", help="skip the PNG")
-    args = parser.parse_args(argv)
-    try:
-        return _run(args)
-    except FlutterInputError as e:
-        print(f"thermojitter flutter: error: {e}", file=sys.stderr)
-        return 2
+    parser.set_defaults(handler=run, stop_flag=False)
 
 
-def _run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int:
     panel, orbit, options = Panel.paper(), Orbit.geo_equinox(), {}
     source = "Table 1 (paper), GEO equinox"
     if args.scenario is not None:
@@ -155,15 +117,15 @@ def _run(args: argparse.Namespace) -> int:
         try:
             scenario = load_scenario(path, extra_sections=("flutter",))
         except ScenarioError as e:
-            raise FlutterInputError(str(e)) from None
+            raise UserError(str(e)) from None
         panel, orbit, options = scenario.panel, scenario.orbit, scenario.extra["flutter"]
         unknown = set(options) - {"model", "coupled", "flux", "x", "y"}
         if unknown:
-            raise FlutterInputError(f"{path}: flutter.{sorted(unknown)[0]}: unknown key")
+            raise UserError(f"{path}: flutter.{sorted(unknown)[0]}: unknown key")
         source = str(path)
     raw_model = args.model or options.get("model", "nonlinear")
     if raw_model not in MODELS:
-        raise FlutterInputError(f"model = {raw_model!r}: must be 'nonlinear' or 'linear'")
+        raise UserError(f"model = {raw_model!r}: must be 'nonlinear' or 'linear'")
     model = cast(ModelName, raw_model)
     coupled = not args.uncoupled and options.get("coupled", True) is not False
     if args.flux is not None:
@@ -173,11 +135,11 @@ def _run(args: argparse.Namespace) -> int:
     else:
         flux = float(orbit.flux_scale(0.0)[0])
     if not (math.isfinite(flux) and flux > 0.0):
-        raise FlutterInputError(f"flux = {flux}: must be finite and > 0")
+        raise UserError(f"flux = {flux}: must be finite and > 0")
     x = parse_axis(args.x or options.get("x", DEFAULT_X), "x")
     y = parse_axis(args.y or options.get("y", DEFAULT_Y), "y")
     if x[0] == y[0]:
-        raise FlutterInputError(f"x and y are both {x[0]!r}: choose two different parameters")
+        raise UserError(f"x and y are both {x[0]!r}: choose two different parameters")
 
     try:
         results = {m: flutter(panel, m, coupled=coupled, flux=flux) for m in MODELS}
@@ -193,7 +155,7 @@ def _run(args: argparse.Namespace) -> int:
         }
         smap = stability_map(panel, x=x, y=y, model=model, coupled=coupled, flux=flux)
     except ValueError as e:
-        raise FlutterInputError(str(e)) from None
+        raise UserError(str(e)) from None
 
     eq = results["nonlinear"].equilibrium
     lines = [
@@ -222,11 +184,12 @@ def _run(args: argparse.Namespace) -> int:
         )
     print("\n".join(lines))
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = out_dir(args.out)
     png = out / "stability_map.png"
     if not args.no_plot:
-        plot_map(smap, panel, png)
+        from thermojitter.plots import stability_map_figure
+
+        stability_map_figure(smap, panel, png)
     record = {
         "scenario": source,
         "panel": panel.as_dict(),
@@ -265,7 +228,3 @@ def _run(args: argparse.Namespace) -> int:
     (out / "flutter.json").write_text(json.dumps(record, indent=2))
     print(f"  wrote {out / 'flutter.json'}" + ("" if args.no_plot else f" and {png}"))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(flutter_command())

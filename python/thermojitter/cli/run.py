@@ -1,0 +1,314 @@
+"""``thermojitter run SCENARIO.toml --out DIR``: one simulation from a scenario file, as a time
+series (``keep = "samples"``) or as one summary per orbit (``keep = "orbits"``, resumable)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from thermojitter.cli.common import STOP, Interrupted, UserError, out_dir
+from thermojitter.progress import progress_bar, report_interrupted
+from thermojitter.scenario import Scenario, ScenarioError, load_scenario
+
+MAX_ROWS = 20_000_000
+"""Largest time series ``run`` will keep (rows); more asks for a larger dt_out."""
+
+MAX_ORBITS = 100_000
+"""Longest run ``run`` accepts, in orbits (about 270 years of GEO)."""
+
+COLUMNS = ("T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit")
+
+SCENARIO_KEYS = """\
+[panel]       any Panel field (SI units; Table 1 for the rest): length, width, thickness,
+              mass_per_length, specific_heat, absorptivity, emissivity_front, emissivity_back,
+              conductance, youngs_modulus, bending_inertia, hinge_stiffness, damping,
+              moment_scale, solar_constant, ... (python -c "import thermojitter as tj;
+              print(tj.Panel.paper())" lists them with their values)
+[orbit]       preset = "geo_equinox" | "geo_year" | "leo" | "sunlit"; start_date = "YYYY-MM-DD"
+              (geo_year); altitude (leo, m); and/or any Orbit field: radius, earth_radius,
+              period, phase0, shadow ("none" | "cylindrical" | "penumbra"), season,
+              eccentric_sun, ...
+[simulation]  t_start (s); the span: t_end (s) or orbits or years; model = "nonlinear" |
+              "linear"; coupled = true; method = "rk45" | "rk4"; rtol, atol; dt (rk4 step, s);
+              dt_out (output interval, s); keep = "samples" | "orbits" (one summary row per
+              orbit, resumable); theta_limit_deg and on_limit = "stop" | "flag" (keep = "orbits")
+[output]      format = "csv" | "parquet"; plots = true | false"""
+
+
+def _chunks(t0: float, t1: float, period: float) -> list[tuple[float, float]]:
+    """[t0, t1] cut at every whole orbit after t0 (one progress step per orbit)."""
+    n = max(1, math.ceil((t1 - t0) / period - 1e-9))
+    edges = [t0 + k * period for k in range(n)] + [t1]
+    return [(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
+
+
+def simulate_scenario(
+    scenario: Scenario, *, progress: bool = True, stop: Any = None
+) -> tuple[dict[str, Any], dict[str, Any], bool]:
+    """Runs a scenario orbit by orbit (each continuing from the last state).
+
+    Returns (columns with "t", counters, interrupted). On Ctrl-C (or when ``stop()`` turns
+    True, polled after each orbit) the orbits finished so far are returned with
+    interrupted = True."""
+    from thermojitter.simulate import simulate
+
+    sim = scenario.simulation
+    t0, t1 = sim.span(scenario.orbit)
+    n_rows = (t1 - t0) / sim.dt_out + 1
+    if n_rows > MAX_ROWS:
+        raise ScenarioError(
+            scenario.source,
+            "simulation.dt_out",
+            f"{sim.dt_out} s over {t1 - t0:.6g} s gives {n_rows:.3g} rows, more than "
+            f"{MAX_ROWS:.0e}: choose a larger dt_out",
+        )
+    n_orbits = (t1 - t0) / scenario.orbit.period
+    if n_orbits > MAX_ORBITS:
+        raise ScenarioError(
+            scenario.source,
+            "simulation",
+            f"the span covers {n_orbits:.3g} orbits, more than {MAX_ORBITS:.0e}: shorten it",
+        )
+    grid = t0 + sim.dt_out * np.arange(int(math.floor((t1 - t0) / sim.dt_out)) + 1)
+    if grid[-1] < t1:
+        grid = np.append(grid, t1)
+    pieces: list[dict[str, np.ndarray]] = []
+    counters = {"n_steps": 0, "n_rejected": 0, "n_rhs": 0}
+    chunks = _chunks(t0, t1, scenario.orbit.period)
+    y0: Any = None
+    interrupted = False
+    bar: Any = None
+    if len(chunks) > 1:
+        bar = progress_bar(len(chunks), unit="orbit", desc="run", enabled=progress, delay=2.0)
+    try:
+        for i, (a, b) in enumerate(chunks):
+            last = i == len(chunks) - 1
+            inside = grid[(grid >= a) & (grid < b)]
+            t_eval = np.append(inside, b)
+            sol = simulate(
+                scenario.panel,
+                scenario.orbit,
+                (a, b),
+                model=sim.model,  # type: ignore[arg-type]
+                coupled=sim.coupled,
+                method=sim.method,  # type: ignore[arg-type]
+                rtol=sim.rtol,
+                atol=sim.atol,
+                dt=sim.dt,
+                t_eval=t_eval,
+                y0=y0,
+            )
+            # the sample at b starts the next orbit's piece; only the last piece keeps its end
+            keep = slice(None) if last else slice(0, len(inside))
+            pieces.append({"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in COLUMNS}})
+            for key in counters:
+                counters[key] += int(getattr(sol, key))
+            y0 = [float(v) for v in sol.y_end]
+            if bar is not None:
+                bar.update(1)
+            if stop is not None and stop() and not last:
+                raise KeyboardInterrupt
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        if bar is not None:
+            bar.close()
+    names = ("t", *COLUMNS)
+    columns = {
+        name: np.concatenate([p[name] for p in pieces]) if pieces else np.empty(0) for name in names
+    }
+    return columns, counters, interrupted
+
+
+def write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
+    try:
+        import pandas as pd
+    except ImportError:
+        raise UserError(
+            "writing time series needs pandas: pip install 'thermojitter[cli]'"
+        ) from None
+    frame = pd.DataFrame(columns)
+    if fmt == "parquet":
+        target = path.with_suffix(".parquet")
+        try:
+            frame.to_parquet(target, index=False)
+        except ImportError:
+            raise UserError("Parquet output needs pyarrow: pip install pyarrow") from None
+    else:
+        target = path.with_suffix(".csv")
+        frame.to_csv(target, index=False)  # shortest round-trip representation
+    return target
+
+
+def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) -> int:
+    """`run` with keep = "orbits": one summary row per orbit, resumable from out/checkpoint.json."""
+    from thermojitter.longrun import simulate_orbits
+
+    sim = scenario.simulation
+    n = sim.n_orbits(scenario.orbit)
+    n_orbits = max(1, int(round(n)))
+    # A span in years is rounded to whole orbits; an explicit one must already be whole.
+    if sim.years is None and abs(n - n_orbits) > 1e-6 * max(n, 1.0):
+        raise ScenarioError(
+            scenario.source, "simulation", f"keep = 'orbits' needs whole orbits; the span is {n:g}"
+        )
+    fmt = args.format or scenario.output.format
+    started = time.perf_counter()
+    runs = simulate_orbits(
+        scenario.panel,
+        scenario.orbit,
+        n_orbits,
+        t_start=sim.t_start,
+        model=sim.model,  # type: ignore[arg-type]
+        coupled=sim.coupled,
+        method=sim.method,  # type: ignore[arg-type]
+        rtol=sim.rtol,
+        atol=sim.atol,
+        dt=sim.dt,
+        theta_limit=math.radians(sim.theta_limit_deg),
+        on_limit=sim.on_limit,  # type: ignore[arg-type]
+        checkpoint=out / "checkpoint.json",
+        progress=not args.no_progress,
+        stop=STOP,
+    )
+    written = [write_series(out / "orbits", dict(runs.columns), fmt).name]
+    if scenario.output.plots and not args.no_plots and len(runs) > 1 and not runs.interrupted:
+        from thermojitter.plots import orbit_summary_figure
+
+        written.append(orbit_summary_figure(out, runs.columns, Path(scenario.source).stem).name)
+    crossing = runs.limit_crossing
+    files = [*written, "run.json", "checkpoint.json"]
+    meta: dict[str, Any] = {
+        "scenario": scenario.source,
+        "keep": "orbits",
+        "orbits_requested": n_orbits,
+        "orbits_done": len(runs),
+        "interrupted": runs.interrupted,
+        "limit_crossing": None
+        if crossing is None
+        else {"t_s": crossing[0], "orbit": crossing[1], "theta_deg": math.degrees(crossing[2])},
+        "n_steps": runs.n_steps,
+        "n_rhs": runs.n_rhs,
+        "settings": runs.settings,
+        "columns": "angles in rad, times in s; see thermojitter.OrbitSummaries",
+        "files": files,
+        "wall_time_s": round(time.perf_counter() - started, 2),
+    }
+    (out / "run.json").write_text(json.dumps(meta, indent=2) + "\n")
+    if runs.interrupted:
+        report_interrupted(
+            f"kept {len(runs)} of {n_orbits} orbits in {out / 'checkpoint.json'}",
+            "run the same command again to resume",
+        )
+        raise Interrupted
+    note = ""
+    if crossing is not None:
+        note = (
+            f"; |θ| passed {sim.theta_limit_deg:g}° at t = {crossing[0]:.0f} s "
+            f"(orbit {crossing[1]})"
+        )
+    print(
+        f"wrote {', '.join(meta['files'])} to {args.out} ({len(runs)} orbits, "
+        f"{runs.n_steps} steps, {meta['wall_time_s']} s{note})"
+    )
+    return 0
+
+
+def run_command(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
+    out = out_dir(args.out)
+    if scenario.simulation.keep == "orbits":
+        return run_orbits_command(args, scenario, out)
+    fmt = args.format or scenario.output.format
+    make_plots = scenario.output.plots and not args.no_plots
+    started = time.perf_counter()
+    columns, counters, interrupted = simulate_scenario(
+        scenario, progress=not args.no_progress, stop=STOP
+    )
+    t = columns["t"]
+    written = []
+    if len(t):
+        written.append(write_series(out / "timeseries", columns, fmt).name)
+    intervals = scenario.orbit.shadow_intervals(float(t[0]), float(t[-1])) if len(t) else []
+    if make_plots and len(t) > 1 and not interrupted:
+        from thermojitter.plots import run_figures
+
+        title = Path(scenario.source).stem
+        written += [p.name for p in run_figures(out, t, columns, scenario.orbit, title=title)]
+    sim = scenario.simulation
+    files = [*written, "run.json"]
+    meta = {
+        "scenario": scenario.source,
+        "interrupted": interrupted,
+        "panel": scenario.panel.as_dict(),
+        "orbit": scenario.orbit.as_dict(),
+        "simulation": {
+            "t_span_s": list(sim.span(scenario.orbit)),
+            "model": sim.model,
+            "coupled": sim.coupled,
+            "method": sim.method,
+            "rtol": sim.rtol,
+            "atol": sim.atol,
+            "dt": sim.dt,
+            "dt_out": sim.dt_out,
+            **counters,
+        },
+        "shadow_intervals_s": [list(iv) for iv in intervals],
+        "columns": {
+            "t": "s",
+            "T_front": "K",
+            "T_back": "K",
+            "theta": "rad",
+            "theta_dot": "rad/s",
+            "thermal_moment": "N m",
+            "sunlit": "illuminated fraction",
+        },
+        "theta_min_deg": float(np.degrees(columns["theta"].min())) if len(t) else None,
+        "theta_max_deg": float(np.degrees(columns["theta"].max())) if len(t) else None,
+        "files": files,
+        "wall_time_s": round(time.perf_counter() - started, 2),
+    }
+    (out / "run.json").write_text(json.dumps(meta, indent=2) + "\n")
+    if interrupted:
+        report_interrupted(
+            f"kept {len(t)} samples up to t = {t[-1] if len(t) else 0:.0f} s in {args.out}",
+            "run the command again for the whole span",
+        )
+        raise Interrupted
+    print(
+        f"wrote {', '.join(files)} to {args.out} ({len(t)} samples, "
+        f"{counters['n_steps']} steps, {meta['wall_time_s']} s)"
+    )
+    return 0
+
+
+def add_parser(sub: Any) -> None:
+    run = sub.add_parser(
+        "run",
+        help="run one simulation from a TOML scenario file",
+        description=(
+            "Run one simulation from a TOML scenario file and write the time series "
+            "(timeseries.csv or .parquet: t [s], T_front, T_back [K], theta [rad], "
+            "theta_dot [rad/s], thermal_moment [N m], sunlit), run.json (settings, step counts) "
+            'and plots (temperatures.png, theta.png) into --out; with keep = "orbits", one '
+            "summary row per orbit (orbits.csv, orbits.png), resumable from checkpoint.json."
+        ),
+        epilog="Scenario keys (every table optional):\n"
+        + SCENARIO_KEYS
+        + "\n\nExample: thermojitter run examples/paper.toml --out out/run",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    run.add_argument("scenario", metavar="SCENARIO.toml", help="the scenario file")
+    run.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    run.add_argument(
+        "--format", choices=("csv", "parquet"), help="override [output] format of the file"
+    )
+    run.add_argument("--no-plots", action="store_true", help="write no plots")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.set_defaults(handler=run_command, stop_flag=True)

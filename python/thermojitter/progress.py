@@ -1,0 +1,96 @@
+"""Progress bars and Ctrl-C for the long calls (long runs, Monte Carlo, sweeps, maps, commands).
+
+One home for how a long call looks while it runs and how it stops:
+
+- :func:`progress_bar` is a ``tqdm.auto`` bar on stderr (a widget in Jupyter, text elsewhere,
+  also when stderr is not a terminal) with the remaining time estimated from the rate so far.
+- :class:`Interruptible` runs engine calls in a worker thread with a cancellation token, so that
+  Ctrl-C reaches the waiting thread at once, the engine stops within one integration step, and
+  the caller keeps what finished.
+- :func:`report_interrupted` is the one line a stopped call prints: what was kept and how to go on.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import sys
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+from thermojitter import _core
+
+T = TypeVar("T")
+
+BAR_FORMAT = "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} {unit} [{elapsed}<{remaining}]"
+"""Done, total and the remaining time (tqdm's estimate from the rate so far)."""
+
+
+def progress_bar(
+    total: int,
+    *,
+    unit: str,
+    initial: int = 0,
+    desc: str = "thermojitter",
+    enabled: bool | None = True,
+    delay: float = 0.0,
+) -> Any:
+    """A tqdm bar on stderr, or None when ``enabled`` is false or tqdm is not installed.
+
+    ``enabled=None`` means "when stderr is a terminal". Outside a terminal (a log file, a pipe, a
+    notebook's captured stderr) the bar is redrawn at most every few seconds. ``delay``: seconds
+    before the bar first appears (short calls then show nothing)."""
+    if enabled is None:
+        enabled = sys.stderr.isatty()
+    if not enabled:
+        return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return None
+    interactive = sys.stderr.isatty()
+    return tqdm(
+        total=total,
+        initial=initial,
+        unit=unit,
+        desc=desc,
+        file=sys.stderr,
+        leave=False,
+        delay=delay,
+        mininterval=0.1 if interactive else 2.0,
+        bar_format=BAR_FORMAT,
+        dynamic_ncols=interactive,
+    )
+
+
+def report_interrupted(kept: str, resume: str) -> None:
+    """The one line a call stopped by Ctrl-C prints on stderr: what it kept, how to go on."""
+    print(f"thermojitter: interrupted; {kept}; {resume}", file=sys.stderr, flush=True)
+
+
+class Interruptible:
+    """Runs engine calls in one worker thread, each given ``cancel=`` a shared token.
+
+    The calling thread waits on the result, which Ctrl-C interrupts at once (a thread inside the
+    engine, with the GIL released, would only notice at the end of the call). On Ctrl-C the token
+    is cancelled, the engine stops within one integration step, and :meth:`call` re-raises
+    ``KeyboardInterrupt`` once the worker is idle again. Use as a context manager."""
+
+    def __init__(self) -> None:
+        self.token = _core.CancelToken()
+        self._executor = cf.ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermojitter")
+
+    def call(self, fn: Callable[..., T], /, *args: Any, **kwargs: Any) -> T:
+        future = self._executor.submit(fn, *args, cancel=self.token, **kwargs)
+        try:
+            return future.result()
+        except KeyboardInterrupt:
+            self.token.cancel()
+            cf.wait([future])
+            raise
+
+    def __enter__(self) -> Interruptible:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.token.cancel()  # whatever is still running stops; nothing new starts
+        self._executor.shutdown(wait=True)
