@@ -99,6 +99,24 @@ def _check_inputs(panel: Panel, orbit: Orbit = _NO_ORBIT) -> None:
         raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
 
 
+def check_layers(layers: Any) -> int:
+    """``layers`` as a node count (an int >= 2; the engine checks it against the layup)."""
+    if isinstance(layers, bool) or not isinstance(layers, (int, np.integer)):
+        raise TypeError(
+            f"layers must be an int (nodes through the thickness), not {type(layers).__name__}"
+        )
+    if layers < 2:
+        raise ValueError(
+            f"layers = {layers!r} is invalid: must be >= 2 (nodes through the thickness)"
+        )
+    return int(layers)
+
+
+def layup_dict(panel: Panel) -> dict[str, Any] | None:
+    """The panel's layup as the engine takes it (None: one homogeneous layer)."""
+    return None if panel.layup is None else panel.layup.as_dict()
+
+
 def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:
     """The sunlit equilibrium of the coupled system (θ̇ = 0, all rates zero).
 
@@ -128,6 +146,7 @@ def simulate(
     y0: Sequence[float] | None = None,
     max_step: float = float("inf"),
     max_steps: int = 500_000_000,
+    layers: int | None = None,
 ) -> Solution:
     """Integrates the coupled thermo-structural model over ``t_span`` (s).
 
@@ -146,12 +165,51 @@ def simulate(
     growth studies pass ``max_step`` ≈ T_n/40 (T_n = 1/natural_frequency), or use
     :func:`thermojitter.simulate_orbits`, which does so by default.
 
+    ``layers=N`` runs the N-node through-thickness model (nodes on both faces, on every layer
+    interface and inside the layers) on the panel's layup (:meth:`Panel.from_laminate`), or on
+    one homogeneous layer for a plain panel, where ``layers=2`` is the two-layer model itself.
+    The solution then carries ``T_nodes`` (time × node, K) and ``depth`` (m below the front
+    face); ``y0`` is (node temperatures…, θ, θ̇).
+
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
     """
     _check_inputs(panel, orbit)
     t0, t1 = _span(t_span)
     args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    settings = {"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled}
+    if layers is not None:
+        nodes = check_layers(layers)
+        raw = _core.simulate_layers(
+            panel.as_dict(),
+            layup_dict(panel),
+            nodes,
+            orbit.as_dict(),
+            t0,
+            t1,
+            model=model,
+            coupled=bool(coupled),
+            y0=None if y0 is None else [float(v) for v in y0],
+            **args,
+        )
+        temps = np.asarray(raw["T_nodes"])
+        return Solution(
+            t=raw["t"],
+            n_steps=raw["n_steps"],
+            n_rejected=raw["n_rejected"],
+            n_rhs=raw["n_rhs"],
+            method=method,
+            settings={**settings, "layers": nodes},
+            T_front=temps[:, 0],
+            T_back=temps[:, -1],
+            theta=raw["theta"],
+            theta_dot=raw["theta_dot"],
+            thermal_moment=raw["thermal_moment"],
+            sunlit=raw["sunlit"],
+            y_end=raw["y_end"],
+            T_nodes=temps,
+            depth=raw["depth"],
+        )
     raw = _core.simulate(
         panel.as_dict(),
         orbit.as_dict(),
@@ -168,7 +226,7 @@ def simulate(
         n_rejected=raw["n_rejected"],
         n_rhs=raw["n_rhs"],
         method=method,
-        settings={"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled},
+        settings=settings,
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         theta=raw["theta"],

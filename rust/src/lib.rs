@@ -7,12 +7,15 @@
 
 pub mod beam;
 pub mod cancel;
+pub mod conduction;
 pub mod distributed;
 pub mod dynamics;
 pub mod ensemble;
 pub mod error;
 pub mod flutter;
 pub mod integrate;
+pub mod laminate;
+pub mod layered;
 pub mod orbit;
 pub mod params;
 pub mod simulate;

@@ -6,13 +6,39 @@
 use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::Result;
-use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
+use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, State, Stats};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
-use nalgebra::{Vector4, U4};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, Vector4};
 use std::ops::ControlFlow;
+
+/// How the summaries read a model's state: the hinge angle and the quasi-static angle
+/// M_T/K_el at (t, y), and the sunlit equilibrium angle under a flux factor.
+pub trait SummaryView {
+    fn theta_eq(&self, flux: f64) -> Result<f64>;
+    /// (θ, M_T/K_el) at time t in state y.
+    fn angles(&self, t: f64, y: &[f64]) -> (f64, f64);
+}
+
+/// The two-layer system's view: state (T_f, T_b, θ, θ̇).
+struct TwoLayerView {
+    panel: Panel,
+    coupling: Coupling,
+}
+
+impl SummaryView for TwoLayerView {
+    fn theta_eq(&self, flux: f64) -> Result<f64> {
+        Ok(equilibrium(&self.panel, self.coupling, flux)?.theta)
+    }
+    #[inline]
+    fn angles(&self, _t: f64, y: &[f64]) -> (f64, f64) {
+        let quasi_static = thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+        (y[2], quasi_static)
+    }
+}
 
 /// Points read per step (the step end and three interior points).
 const READS_PER_STEP: usize = 4;
@@ -117,10 +143,9 @@ pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> M
     }
 }
 
-struct Collector {
-    panel: Panel,
+struct Collector<V> {
+    view: V,
     orbit: Orbit,
-    coupling: Coupling,
     options: SummaryOptions,
     first_index: u64,
     t_start: f64,
@@ -131,13 +156,13 @@ struct Collector {
     crossing: Option<LimitCrossing>,
 }
 
-impl Collector {
+impl<V: SummaryView> Collector<V> {
     fn open(&mut self, index: u64) -> Result<OrbitSummary> {
         let t0 = self.t_start + (index - self.first_index) as f64 * self.orbit.period;
         let t1 = t0 + self.orbit.period;
         let flux = self.orbit.flux_scale(0.5 * (t0 + t1));
         let theta_eq = if flux > 0.0 {
-            equilibrium(&self.panel, self.coupling, flux)?.theta
+            self.view.theta_eq(flux)?
         } else {
             0.0
         };
@@ -157,19 +182,19 @@ impl Collector {
         self.duration = 0.0;
     }
 
-    fn read(&mut self, t: f64, y: &Vector4<f64>, dt: f64) -> Result<()> {
+    fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
         while t > self.current.t_end {
             self.close();
             let next = self.current.index + 1;
             self.current = self.open(next)?;
         }
-        let th = y[2];
+        let (th, quasi_static) = self.view.angles(t, y);
         let s = &mut self.current;
         s.theta_max = s.theta_max.max(th);
         s.theta_min = s.theta_min.min(th);
         let dev = (th - s.theta_eq).abs();
         s.amplitude = s.amplitude.max(dev);
-        let dynamic = th - thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+        let dynamic = th - quasi_static;
         s.jitter_peak = s.jitter_peak.max(dynamic.abs());
         self.sq_sum += dynamic * dynamic * dt;
         self.duration += dt;
@@ -209,14 +234,17 @@ impl Collector {
     }
 }
 
-struct SummaryObserver<'c> {
-    collector: Collector,
+struct SummaryObserver<'c, V> {
+    collector: Collector<V>,
     error: Option<crate::Error>,
     cancel: &'c Cancel,
 }
 
-impl Observer<U4> for SummaryObserver<'_> {
-    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+impl<D: Dim, V: SummaryView> Observer<D> for SummaryObserver<'_, V>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()> {
         if let Err(e) = self.cancel.check() {
             self.error = Some(e);
             return ControlFlow::Break(());
@@ -228,12 +256,12 @@ impl Observer<U4> for SummaryObserver<'_> {
             } else {
                 step.t0 + j as f64 * h
             };
-            let y = if j == READS_PER_STEP {
-                step.y1
+            let read = if j == READS_PER_STEP {
+                self.collector.read(t, step.y1.as_slice(), h)
             } else {
-                step.eval(t)
+                self.collector.read(t, step.eval(t).as_slice(), h)
             };
-            if let Err(e) = self.collector.read(t, &y, h) {
+            if let Err(e) = read {
                 self.error = Some(e);
                 return ControlFlow::Break(());
             }
@@ -301,10 +329,70 @@ pub fn run_orbits_cancellable(
     options: SummaryOptions,
     cancel: &Cancel,
 ) -> Result<OrbitRun> {
+    let mut system = Coupled::new(*panel, *orbit, model, coupling);
+    let view = TwoLayerView {
+        panel: *panel,
+        coupling,
+    };
+    let run = run_summarised(
+        &mut system,
+        view,
+        panel,
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        2,
+        options,
+        cancel,
+    )?;
+    Ok(OrbitRun {
+        summaries: run.summaries,
+        stats: run.stats,
+        y_end: run.y_end,
+        crossing: run.crossing,
+    })
+}
+
+/// A summarised run of any model: the summaries, the counters and the end state.
+#[derive(Debug, Clone)]
+pub struct Summarised<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    pub summaries: Vec<OrbitSummary>,
+    pub stats: Stats,
+    pub y_end: State<D>,
+    pub crossing: Option<LimitCrossing>,
+}
+
+/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` (whose
+/// component `theta_index` is θ) and summarises each orbit through `view`; the step is capped
+/// by `panel`'s hinge period as [`SummaryOptions::steps_per_period`] asks.
+#[allow(clippy::too_many_arguments)]
+pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
+    system: &mut S,
+    view: V,
+    panel: &Panel,
+    orbit: &Orbit,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: State<D>,
+    theta_index: usize,
+    options: SummaryOptions,
+    cancel: &Cancel,
+) -> Result<Summarised<D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
-    crate::dynamics::check_hinge_angle("y0[2]", y0[2])?;
+    crate::dynamics::check_hinge_angle(&format!("y0[{theta_index}]"), y0[theta_index])?;
     if !(0.0..=MAX_STEPS_PER_PERIOD).contains(&options.steps_per_period) {
         return Err(crate::Error::invalid(
             "steps_per_period",
@@ -332,9 +420,8 @@ pub fn run_orbits_cancellable(
         )
     })?;
     let mut collector = Collector {
-        panel: *panel,
+        view,
         orbit: *orbit,
-        coupling,
         options,
         first_index,
         t_start,
@@ -345,7 +432,7 @@ pub fn run_orbits_cancellable(
         crossing: None,
     };
     collector.current = collector.open(first_index)?;
-    let y0_theta = y0[2];
+    let y0_theta = y0[theta_index];
     collector.current.theta_max = y0_theta;
     collector.current.theta_min = y0_theta;
     let mut observer = SummaryObserver {
@@ -353,14 +440,13 @@ pub fn run_orbits_cancellable(
         error: None,
         cancel,
     };
-    let mut system = Coupled::new(*panel, *orbit, model, coupling);
-    let (stats, y_end) = solve(&mut system, method, t_start, y0, t_end, &mut observer)?;
+    let (stats, y_end) = solve(system, method, t_start, y0, t_end, &mut observer)?;
     if let Some(e) = observer.error {
         return Err(e);
     }
     let mut c = observer.collector;
     c.close();
-    Ok(OrbitRun {
+    Ok(Summarised {
         summaries: c.done,
         stats,
         y_end,

@@ -3,16 +3,26 @@
 use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
 use super::error::shield;
-use crate::summary::{run_orbits_cancellable as run, SummaryOptions};
+use super::laminate::conduction_from;
+use crate::layered;
+use crate::summary::{run_orbits_cancellable as run, OrbitSummary, SummaryOptions};
 use crate::system::Coupling;
 use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+/// What either model's summarised run hands back.
+struct Summarised {
+    summaries: Vec<OrbitSummary>,
+    stats: crate::integrate::Stats,
+    y_end: Vec<f64>,
+    crossing: Option<crate::summary::LimitCrossing>,
+}
+
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -30,6 +40,8 @@ fn run_orbits<'py>(
     stop_at_limit: bool,
     steps_per_period: f64,
     cancel: Option<&Bound<'py, CancelToken>>,
+    layup: Option<&Bound<'py, PyDict>>,
+    nodes: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cancel = token(cancel);
     shield(|| {
@@ -42,7 +54,6 @@ fn run_orbits<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
-        let y = state(&y0, U4)?;
         crate::dynamics::check_hinge_angle("theta_limit", theta_limit)?;
         let options = SummaryOptions {
             window,
@@ -50,21 +61,58 @@ fn run_orbits<'py>(
             stop_at_limit,
             steps_per_period,
         };
-        let out = py.detach(|| {
-            run(
-                &p,
-                &o,
-                hinge,
-                coupling,
-                &m,
-                t_start,
-                first_index,
-                n_orbits,
-                y,
-                options,
-                &cancel,
-            )
-        })?;
+        let out = match nodes {
+            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
+            Some(n) => {
+                let c = conduction_from(&p, layup, n)?;
+                let run = py.detach(|| {
+                    layered::run_orbits(
+                        &p,
+                        c,
+                        &o,
+                        hinge,
+                        coupling,
+                        &m,
+                        t_start,
+                        first_index,
+                        n_orbits,
+                        &y0,
+                        options,
+                        &cancel,
+                    )
+                })?;
+                Summarised {
+                    summaries: run.summaries,
+                    stats: run.stats,
+                    y_end: run.y_end,
+                    crossing: run.crossing,
+                }
+            }
+            None => {
+                let y = state(&y0, U4)?;
+                let run = py.detach(|| {
+                    run(
+                        &p,
+                        &o,
+                        hinge,
+                        coupling,
+                        &m,
+                        t_start,
+                        first_index,
+                        n_orbits,
+                        y,
+                        options,
+                        &cancel,
+                    )
+                })?;
+                Summarised {
+                    summaries: run.summaries,
+                    stats: run.stats,
+                    y_end: run.y_end.as_slice().to_vec(),
+                    crossing: run.crossing,
+                }
+            }
+        };
         let d = PyDict::new(py);
         let col = |f: fn(&crate::summary::OrbitSummary) -> f64| -> Vec<f64> {
             out.summaries.iter().map(f).collect()
@@ -96,7 +144,7 @@ fn run_orbits<'py>(
         d.set_item("n_rhs", out.stats.n_rhs)?;
         d.set_item("t_reached", out.stats.t_end)?;
         d.set_item("stopped", out.stats.stopped)?;
-        d.set_item("y_end", out.y_end.as_slice().to_vec())?;
+        d.set_item("y_end", out.y_end)?;
         d.set_item("crossing", out.crossing.map(|c| (c.t, c.orbit, c.theta)))?;
         Ok(d)
     })
