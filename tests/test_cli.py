@@ -450,9 +450,13 @@ def test_run_keeps_per_orbit_summaries_and_resumes(tmp_path: Path) -> None:
     meta = json.loads((out / "run.json").read_text())
     assert meta["orbits_done"] == 3 and meta["limit_crossing"] is None
     assert (out / "orbits.png").exists()
-    # Asking for more orbits with the same settings continues from the checkpoint.
+    # The folder now holds results: a second run needs --overwrite, and then asking for more
+    # orbits with the same settings continues from the checkpoint.
     scenario.write_text(scenario.read_text().replace("orbits = 3", "orbits = 5"))
-    assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 0
+    assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 2
+    assert len((out / "orbits.csv").read_text().splitlines()) == 1 + 3
+    args = ["run", str(scenario), "--out", str(out), "--no-progress", "--overwrite"]
+    assert cli.main(args) == 0
     assert len((out / "orbits.csv").read_text().splitlines()) == 1 + 5
 
 

@@ -13,6 +13,7 @@ __all__ = [
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
+    "MAX_TIME",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
     "beam_modes",
@@ -57,6 +58,7 @@ __all__ = [
 
 PANEL_FIELDS: list[str]
 STEFAN_BOLTZMANN: float
+MAX_TIME: float
 
 class IntegrationError(RuntimeError): ...
 

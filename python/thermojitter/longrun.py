@@ -237,6 +237,15 @@ def simulate_orbits(
         checks.flag("progress", progress)
     if stop is not None and not callable(stop):
         raise TypeError(f"stop must be callable, not {type(stop).__name__}")
+    t_end = t_start + n_orbits * orbit.period
+    if not abs(t_end) <= _core.MAX_TIME:
+        # Each chunk is checked by the engine; the whole run is checked here, before any work.
+        raise checks.ParameterError(
+            "n_orbits",
+            n_orbits,
+            f"reaches t = {t_end:.4g} s; a run may reach at most {_core.MAX_TIME:g} s "
+            f"({_core.MAX_TIME / orbit.period:.4g} orbits of this one)",
+        )
     solver = solver_settings(method, rtol, atol, dt, math.inf, max_steps)
     nodes = None if layers is None else check_layers(layers)
     if y0 is not None:

@@ -385,6 +385,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConvergenceError", m.py().get_type::<ConvergenceError>())?;
     m.add("PANEL_FIELDS", crate::Panel::FIELDS.to_vec())?;
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
+    m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(steady_state, m)?)?;
