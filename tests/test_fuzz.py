@@ -1,7 +1,7 @@
-"""The fuzz harness in CI: generated hostile calls of the public API and the scenario parser, each
-in a worker process under a watchdog, give a finite result or a clear error naming the parameter
-— never a crash, a hang, a panic or a silent NaN. A short run (800 calls, about 20 s); benches/fuzz.py runs
-10,000 and prints the count of each outcome."""
+"""The fuzz harness in CI: generated hostile calls of the public API and the scenario parser,
+each in a worker process under a watchdog, give a finite result or a clear error naming the
+parameter — never a crash, a hang, a panic or a silent NaN. A short run (800 calls, about 20 s);
+benches/fuzz.py runs 10,000 and prints the count of each outcome."""
 
 from __future__ import annotations
 

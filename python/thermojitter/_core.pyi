@@ -31,6 +31,7 @@ __all__ = [
     "equivalent_panel",
     "flutter",
     "flux_scale",
+    "hinge_equivalent_damping_ratio",
     "illumination",
     "laminate_properties",
     "layered_flutter",
@@ -39,6 +40,7 @@ __all__ = [
     "moment",
     "orbit_breakpoints",
     "run_orbits",
+    "run_orbits_hybrid",
     "shadow_intervals",
     "simulate",
     "simulate_distributed",
@@ -147,6 +149,24 @@ def run_orbits(
     layup: dict[str, Any] | None = None,
     nodes: int | None = None,
 ) -> dict[str, Any]: ...
+def run_orbits_hybrid(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    model: str,
+    coupled: bool,
+    solver: dict[str, Any],
+    t_start: float,
+    first_index: int,
+    n_orbits: int,
+    y0: list[float],
+    window: float,
+    theta_limit: float,
+    stop_at_limit: bool,
+    steps_per_period: float,
+    hybrid: dict[str, float],
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---
 
@@ -170,6 +190,7 @@ def beam_response(
 # --- distributed panel (rust/src/py/distributed.rs) ---
 
 def distributed_defaults(panel: dict[str, float]) -> dict[str, Any]: ...
+def hinge_equivalent_damping_ratio(panel: dict[str, float]) -> float: ...
 def distributed_info(panel: dict[str, float], settings: dict[str, Any]) -> dict[str, Any]: ...
 def distributed_flutter(
     panel: dict[str, float], settings: dict[str, Any], flux: float
@@ -229,6 +250,8 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
+        validity_limit: float = 0.3490658503988659,
+        hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
     ) -> dict[str, Any]: ...
 

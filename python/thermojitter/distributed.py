@@ -37,8 +37,8 @@ from thermojitter import _core
 from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.results import _Run
-from thermojitter.simulate import Method, _check_inputs, _solver_args, _span
+from thermojitter.results import Run
+from thermojitter.simulate import Method, check_inputs, solver_args, time_span
 
 Array = NDArray[np.float64]
 Support = Literal["free-free", "cantilever"]
@@ -64,7 +64,7 @@ def distributed_settings(
 ) -> dict[str, Any]:
     """The model settings as the engine takes them; ``None`` picks the engine's default (see
     :func:`distributed_defaults`). The engine checks the values and names any bad one."""
-    _check_inputs(panel)
+    check_inputs(panel)
     if not isinstance(support, str):
         raise TypeError(f"support must be a string, not {type_name(support)}")
     defaults = _core.distributed_defaults(panel.as_dict())
@@ -88,12 +88,12 @@ def distributed_defaults(panel: Panel | None = None) -> dict[str, Any]:
     """The engine's default settings: support, elements, modes, damping_ratio (the
     hinge-equivalent ζ = c_d/(2 I_B ω₁) of ``panel``, default Table 1) and sun_angle (rad)."""
     panel = Panel.paper() if panel is None else panel
-    _check_inputs(panel)
+    check_inputs(panel)
     return dict(_core.distributed_defaults(panel.as_dict()))
 
 
 @dataclass(frozen=True)
-class DistributedSolution(_Run):
+class DistributedSolution(Run):
     """The distributed panel at the reported times.
 
     ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
@@ -214,8 +214,8 @@ def simulate_distributed(
       temperatures of element 0, of element 1, ..., then q[k] and q̇[k]), default the sunlit
       equilibrium at the start's flux.
     """
-    _check_inputs(panel, orbit)
-    t0, t1 = _span(t_span)
+    check_inputs(panel, orbit)
+    t0, t1 = time_span(t_span)
     settings = distributed_settings(
         panel,
         support=support,
@@ -226,7 +226,7 @@ def simulate_distributed(
         coupled=coupled,
         layers=layers,
     )
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     start = None if y0 is None else np.ascontiguousarray(np.asarray(y0, dtype=float).ravel())
     raw = _core.simulate_distributed(
         panel.as_dict(), orbit.as_dict(), settings, t0, t1, y0=start, **args
@@ -422,7 +422,7 @@ def distributed_convergence(
     values = [int(v) for v in values]
     if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:], strict=False)):
         raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")
-    span = eclipse_window(orbit) if t_span is None else _span(t_span)
+    span = eclipse_window(orbit) if t_span is None else time_span(t_span)
     runs = []
     for v in values:
         kw: dict[str, Any] = {"elements": elements, "modes": modes, vary: v}

@@ -39,7 +39,7 @@ FLUX_DATES = {"1 au": None, "perihelion": "2026-01-04", "aphelion": "2026-07-05"
 """Where the flux is taken: the nominal 1 au, and the dates of perihelion and aphelion (the
 flux scale there comes from the orbit model, about 1.0343 and 0.9674)."""
 
-SUN_ANGLES_DEG = (-60.0, -30.0, -15.0, 0.0, 15.0, 30.0, 60.0)
+SUN_ANGLES_DEG = (-60.0, -30.0, -15.0, -10.0, -5.0, 0.0, 15.0, 30.0, 60.0)
 """Sun angles of the cantilever stability table, degrees."""
 
 FIGURE = "fig_hinge_vs_distributed.png"

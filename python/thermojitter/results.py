@@ -76,6 +76,11 @@ class _Run:
         )
 
 
+Run = _Run
+"""The counters and exports every run result shares (the base of the result classes of other
+modules, such as :class:`thermojitter.distributed.DistributedSolution`)."""
+
+
 @dataclass(frozen=True)
 class Solution(_Run):
     """The coupled thermo-structural solution at the reported times.

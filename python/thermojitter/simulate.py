@@ -26,7 +26,7 @@ _MODELS = ("nonlinear", "linear")
 _METHODS = ("rk45", "rk4")
 
 
-def _span(t_span: Sequence[float]) -> tuple[float, float]:
+def time_span(t_span: Sequence[float]) -> tuple[float, float]:
     if isinstance(t_span, (str, bytes)) or not isinstance(t_span, (Sequence, np.ndarray)):
         raise TypeError(
             f"t_span must be a pair of numbers (t0, t1) in s, not {type(t_span).__name__}"
@@ -42,7 +42,7 @@ def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
     return checks.real_array("t_eval", t_eval)
 
 
-def _state(y0: Any, size: int) -> list[float] | None:
+def start_state(y0: Any, size: int) -> list[float] | None:
     """A start state of ``size`` real numbers (the engine checks their ranges)."""
     if y0 is None:
         return None
@@ -52,7 +52,7 @@ def _state(y0: Any, size: int) -> list[float] | None:
     return [float(v) for v in arr]
 
 
-def _solver_args(
+def solver_args(
     method: str,
     rtol: float,
     atol: float,
@@ -90,7 +90,7 @@ def solver_settings(
 _NO_ORBIT: Any = object()
 
 
-def _check_inputs(panel: Panel, orbit: Orbit = _NO_ORBIT) -> None:
+def check_inputs(panel: Panel, orbit: Orbit = _NO_ORBIT) -> None:
     """TypeError unless ``panel`` is a Panel (and ``orbit``, when the call takes one, an Orbit:
     None is not an orbit)."""
     if not isinstance(panel, Panel):
@@ -123,7 +123,7 @@ def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Eq
     ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
     (1: nominal; e.g. 1.033 at perihelion).
     """
-    _check_inputs(panel)
+    check_inputs(panel)
     pd = panel.as_dict()
     tf, tb, th = _core.steady_state(pd, checks.flag("coupled", coupled), checks.real("flux", flux))
     moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
@@ -174,9 +174,9 @@ def simulate(
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
     """
-    _check_inputs(panel, orbit)
-    t0, t1 = _span(t_span)
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    check_inputs(panel, orbit)
+    t0, t1 = time_span(t_span)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     settings = {"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled}
     if layers is not None:
         nodes = check_layers(layers)
@@ -217,7 +217,7 @@ def simulate(
         t1,
         model=checks.choice("model", model, _MODELS),
         coupled=checks.flag("coupled", coupled),
-        y0=_state(y0, 4),
+        y0=start_state(y0, 4),
         **args,
     )
     return Solution(
@@ -255,17 +255,17 @@ def simulate_thermal(
 ) -> ThermalSolution:
     """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
     (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     layers = checks.integer("layers", layers, 1, 2)  # type: ignore[assignment]
-    t0, t1 = _span(t_span)
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    t0, t1 = time_span(t_span)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     raw = _core.simulate_thermal(
         panel.as_dict(),
         orbit.as_dict(),
         t0,
         t1,
         layers=int(layers),
-        y0=_state(y0, int(layers)),
+        y0=start_state(y0, int(layers)),
         **args,
     )
     return ThermalSolution(
@@ -301,9 +301,9 @@ def simulate_hinge(
     """The hinge alone under a prescribed thermal moment (N m): a constant, or samples
     ``moment`` at times ``moment_t`` (linear in between, held beyond the ends).
     ``y0`` = (θ rad, θ̇ rad/s)."""
-    _check_inputs(panel)
-    t0, t1 = _span(t_span)
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    check_inputs(panel)
+    t0, t1 = time_span(t_span)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     m = checks.real_array("moment", moment)
     mt = None if moment_t is None else checks.real_array("moment_t", moment_t)
     raw = _core.simulate_hinge(
@@ -313,7 +313,7 @@ def simulate_hinge(
         model=checks.choice("model", model, _MODELS),
         moment=m,
         moment_t=mt,
-        y0=_state(y0, 2) or [],
+        y0=start_state(y0, 2) or [],
         **args,
     )
     return HingeSolution(
@@ -337,7 +337,7 @@ def hinge_energy(
 ) -> np.ndarray:
     """Energy of the hinge in a constant moment field (kinetic + spring − M θ), J.
     Conserved when c_d = 0."""
-    _check_inputs(panel)
+    check_inputs(panel)
     th = checks.real_array("theta", theta)
     om = checks.real_array("theta_dot", theta_dot)
     if th.shape != om.shape:

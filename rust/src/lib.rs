@@ -13,6 +13,7 @@ pub mod dynamics;
 pub mod ensemble;
 pub mod error;
 pub mod flutter;
+pub mod hybrid;
 pub mod integrate;
 pub mod laminate;
 pub mod layered;

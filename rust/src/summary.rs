@@ -24,9 +24,9 @@ pub trait SummaryView {
 }
 
 /// The two-layer system's view: state (T_f, T_b, θ, θ̇).
-struct TwoLayerView {
-    panel: Panel,
-    coupling: Coupling,
+pub(crate) struct TwoLayerView {
+    pub(crate) panel: Panel,
+    pub(crate) coupling: Coupling,
 }
 
 impl SummaryView for TwoLayerView {
@@ -143,20 +143,66 @@ pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> M
     }
 }
 
-struct Collector<V> {
-    view: V,
-    orbit: Orbit,
-    options: SummaryOptions,
-    first_index: u64,
-    t_start: f64,
-    done: Vec<OrbitSummary>,
-    current: OrbitSummary,
-    sq_sum: f64,
-    duration: f64,
-    crossing: Option<LimitCrossing>,
+/// Builds the per-orbit summaries from what the propagator reports: points of the solution
+/// (the integrators' dense output) or bands [θ_lo, θ_hi] that hold it (the hybrid propagator's
+/// oscillation envelopes and exactly propagated arcs).
+pub(crate) struct Collector<V> {
+    pub(crate) view: V,
+    pub(crate) orbit: Orbit,
+    pub(crate) options: SummaryOptions,
+    pub(crate) first_index: u64,
+    pub(crate) t_start: f64,
+    pub(crate) done: Vec<OrbitSummary>,
+    pub(crate) current: OrbitSummary,
+    pub(crate) sq_sum: f64,
+    pub(crate) duration: f64,
+    pub(crate) crossing: Option<LimitCrossing>,
 }
 
 impl<V: SummaryView> Collector<V> {
+    /// A collector whose first orbit `first_index` starts at `t_start` with hinge angle θ0.
+    pub(crate) fn new(
+        view: V,
+        orbit: &Orbit,
+        options: SummaryOptions,
+        t_start: f64,
+        first_index: u64,
+        n_orbits: u64,
+        theta0: f64,
+    ) -> Result<Self> {
+        // The span (and with it the eclipses and the rows kept) is checked before anything is
+        // allocated for it.
+        let t_end = t_start + n_orbits as f64 * orbit.period;
+        orbit.check_span(t_start, t_end).map_err(|_| {
+            crate::Error::invalid(
+                "n_orbits",
+                n_orbits,
+                &format!(
+                    "with t_start = {t_start} s reaches t = {t_end:e} s; at most {:e} s and \
+                     {:e} eclipses",
+                    crate::integrate::MAX_TIME,
+                    crate::orbit::MAX_ECLIPSES
+                ),
+            )
+        })?;
+        let mut collector = Collector {
+            view,
+            orbit: *orbit,
+            options,
+            first_index,
+            t_start,
+            done: Vec::with_capacity(n_orbits as usize),
+            current: OrbitSummary::new(first_index, 0.0, 0.0, 0.0, None),
+            sq_sum: 0.0,
+            duration: 0.0,
+            crossing: None,
+        };
+        collector.current = collector.open(first_index)?;
+        collector.current.theta_max = theta0;
+        collector.current.theta_min = theta0;
+        Ok(collector)
+    }
+
     fn open(&mut self, index: u64) -> Result<OrbitSummary> {
         let t0 = self.t_start + (index - self.first_index) as f64 * self.orbit.period;
         let t1 = t0 + self.orbit.period;
@@ -170,7 +216,7 @@ impl<V: SummaryView> Collector<V> {
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
     }
 
-    fn close(&mut self) {
+    pub(crate) fn close(&mut self) {
         let mut s = self.current;
         s.jitter_rms = if self.duration > 0.0 {
             (self.sq_sum / self.duration).sqrt()
@@ -182,62 +228,139 @@ impl<V: SummaryView> Collector<V> {
         self.duration = 0.0;
     }
 
-    fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
+    /// One point of the solution, standing for the interval dt before it.
+    pub(crate) fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
+        let (th, quasi_static) = self.view.angles(t, y);
+        let dynamic = th - quasi_static;
+        self.record(t, th, th, dynamic.abs(), dynamic * dynamic * dt, dt)
+    }
+
+    /// Moves on to the orbit that holds t (closing the finished ones).
+    pub(crate) fn advance(&mut self, t: f64) -> Result<()> {
         while t > self.current.t_end {
             self.close();
             let next = self.current.index + 1;
             self.current = self.open(next)?;
         }
-        let (th, quasi_static) = self.view.angles(t, y);
+        Ok(())
+    }
+
+    /// A span (t_a, t_b] inside one orbit whose θ extremes over any sub-interval `extremes` gives,
+    /// with the dynamic part's largest magnitude and ∫(dynamic)² over the span. The caller keeps
+    /// |θ| below the limit over the span.
+    pub(crate) fn record_span(
+        &mut self,
+        t_a: f64,
+        t_b: f64,
+        extremes: &dyn Fn(f64, f64) -> (f64, f64),
+        dynamic_abs: f64,
+        sq: f64,
+    ) -> Result<()> {
+        // The orbit that holds the span's middle (its ends may round onto a neighbour's edge).
+        self.advance(0.5 * (t_a + t_b))?;
+        let (lo, hi) = extremes(t_a, t_b);
         let s = &mut self.current;
-        s.theta_max = s.theta_max.max(th);
-        s.theta_min = s.theta_min.min(th);
-        let dev = (th - s.theta_eq).abs();
+        s.theta_max = s.theta_max.max(hi);
+        s.theta_min = s.theta_min.min(lo);
+        let eq = s.theta_eq;
+        let dev = |lo: f64, hi: f64| (hi - eq).abs().max((lo - eq).abs());
+        s.amplitude = s.amplitude.max(dev(lo, hi));
+        s.jitter_peak = s.jitter_peak.max(dynamic_abs);
+        self.sq_sum += sq;
+        self.duration += t_b - t_a;
+        let w = self.options.window;
+        let (entry, exit) = (s.t_entry, s.t_exit);
+        for (start, is_entry) in [(entry, true), (exit, false)] {
+            let (a, b) = (t_a.max(start), t_b.min(start + w));
+            if start.is_nan() || a > b {
+                continue; // no window, or no overlap
+            }
+            let (l, h) = extremes(a, b);
+            let d = dev(l, h);
+            let s = &mut self.current;
+            if is_entry {
+                s.entry_theta_min = nan_min(s.entry_theta_min, l);
+                s.entry_peak = nan_max(s.entry_peak, d);
+            } else {
+                s.exit_theta_max = nan_max(s.exit_theta_max, h);
+                s.exit_peak = nan_max(s.exit_peak, d);
+            }
+        }
+        Ok(())
+    }
+
+    /// θ lies in [th_lo, th_hi] at t; the dynamic part's magnitude is at most `dynamic_abs`
+    /// there, and ∫(dynamic)² over the interval dt before t is `sq`.
+    pub(crate) fn record(
+        &mut self,
+        t: f64,
+        th_lo: f64,
+        th_hi: f64,
+        dynamic_abs: f64,
+        sq: f64,
+        dt: f64,
+    ) -> Result<()> {
+        self.advance(t)?;
+        let s = &mut self.current;
+        s.theta_max = s.theta_max.max(th_hi);
+        s.theta_min = s.theta_min.min(th_lo);
+        let dev = (th_hi - s.theta_eq).abs().max((th_lo - s.theta_eq).abs());
         s.amplitude = s.amplitude.max(dev);
-        let dynamic = th - quasi_static;
-        s.jitter_peak = s.jitter_peak.max(dynamic.abs());
-        self.sq_sum += dynamic * dynamic * dt;
+        s.jitter_peak = s.jitter_peak.max(dynamic_abs);
+        self.sq_sum += sq;
         self.duration += dt;
         let w = self.options.window;
         if t >= s.t_entry && t <= s.t_entry + w {
-            s.entry_theta_min = if s.entry_theta_min.is_nan() {
-                th
-            } else {
-                s.entry_theta_min.min(th)
-            };
-            s.entry_peak = if s.entry_peak.is_nan() {
-                dev
-            } else {
-                s.entry_peak.max(dev)
-            };
+            s.entry_theta_min = nan_min(s.entry_theta_min, th_lo);
+            s.entry_peak = nan_max(s.entry_peak, dev);
         }
         if t >= s.t_exit && t <= s.t_exit + w {
-            s.exit_theta_max = if s.exit_theta_max.is_nan() {
-                th
-            } else {
-                s.exit_theta_max.max(th)
-            };
-            s.exit_peak = if s.exit_peak.is_nan() {
-                dev
-            } else {
-                s.exit_peak.max(dev)
-            };
+            s.exit_theta_max = nan_max(s.exit_theta_max, th_hi);
+            s.exit_peak = nan_max(s.exit_peak, dev);
         }
-        if self.crossing.is_none() && th.abs() > self.options.theta_limit {
-            self.crossing = Some(LimitCrossing {
-                t,
-                orbit: s.index,
-                theta: th,
-            });
+        if self.crossing.is_none() {
+            let limit = self.options.theta_limit;
+            let theta = if th_hi > limit {
+                Some(th_hi)
+            } else if th_lo < -limit {
+                Some(th_lo)
+            } else {
+                None
+            };
+            if let Some(theta) = theta {
+                self.crossing = Some(LimitCrossing {
+                    t,
+                    orbit: s.index,
+                    theta,
+                });
+            }
         }
         Ok(())
     }
 }
 
-struct SummaryObserver<'c, V> {
-    collector: Collector<V>,
-    error: Option<crate::Error>,
-    cancel: &'c Cancel,
+/// min(acc, v), where NaN in `acc` means "nothing yet".
+fn nan_min(acc: f64, v: f64) -> f64 {
+    if acc.is_nan() {
+        v
+    } else {
+        acc.min(v)
+    }
+}
+
+/// max(acc, v), where NaN in `acc` means "nothing yet".
+fn nan_max(acc: f64, v: f64) -> f64 {
+    if acc.is_nan() {
+        v
+    } else {
+        acc.max(v)
+    }
+}
+
+pub(crate) struct SummaryObserver<'c, V> {
+    pub(crate) collector: Collector<V>,
+    pub(crate) error: Option<crate::Error>,
+    pub(crate) cancel: &'c Cancel,
 }
 
 impl<D: Dim, V: SummaryView> Observer<D> for SummaryObserver<'_, V>
@@ -404,37 +527,16 @@ where
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
-    // The span (and with it the eclipses and the rows kept) is checked before anything is
-    // allocated for it.
     let t_end = t_start + n_orbits as f64 * orbit.period;
-    orbit.check_span(t_start, t_end).map_err(|_| {
-        crate::Error::invalid(
-            "n_orbits",
-            n_orbits,
-            &format!(
-                "with t_start = {t_start} s reaches t = {t_end:e} s; at most {:e} s and {:e} \
-                 eclipses",
-                crate::integrate::MAX_TIME,
-                crate::orbit::MAX_ECLIPSES
-            ),
-        )
-    })?;
-    let mut collector = Collector {
+    let collector = Collector::new(
         view,
-        orbit: *orbit,
+        orbit,
         options,
-        first_index,
         t_start,
-        done: Vec::with_capacity(n_orbits as usize),
-        current: OrbitSummary::new(first_index, 0.0, 0.0, 0.0, None),
-        sq_sum: 0.0,
-        duration: 0.0,
-        crossing: None,
-    };
-    collector.current = collector.open(first_index)?;
-    let y0_theta = y0[theta_index];
-    collector.current.theta_max = y0_theta;
-    collector.current.theta_min = y0_theta;
+        first_index,
+        n_orbits,
+        y0[theta_index],
+    )?;
     let mut observer = SummaryObserver {
         collector,
         error: None,

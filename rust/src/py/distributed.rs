@@ -97,6 +97,17 @@ fn distributed_info<'py>(
     })
 }
 
+/// ζ = c_d/(2 I_B ω₁): the modal damping ratio equivalent to the panel's hinge damping (the beam
+/// comparator's and the distributed panel's default).
+#[pyfunction]
+fn hinge_equivalent_damping_ratio(panel: &Bound<'_, PyDict>) -> PyResult<f64> {
+    shield(|| {
+        Ok(crate::beam::hinge_equivalent_damping_ratio(&panel_from(
+            panel,
+        )?))
+    })
+}
+
 /// The defaults of the distributed model's settings.
 #[pyfunction]
 fn distributed_defaults(py: Python<'_>, panel: &Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
@@ -238,6 +249,7 @@ fn simulate_distributed<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
+    m.add_function(wrap_pyfunction!(hinge_equivalent_damping_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_flutter, m)?)?;
     Ok(())

@@ -4,6 +4,7 @@ use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
+use super::longrun::hybrid_from;
 use crate::ensemble::{pool, run_batch, EnsembleSettings, SampleMetrics};
 use crate::system::Coupling;
 use crate::Panel;
@@ -84,7 +85,7 @@ impl EnsemblePool {
     }
 
     /// Runs one sample per row of `panels`; returns the metrics as columns.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, cancel=None))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=0.3490658503988659, hybrid=None, cancel=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -98,6 +99,8 @@ impl EnsemblePool {
         window: f64,
         threshold: Option<f64>,
         stop_at_threshold: bool,
+        validity_limit: f64,
+        hybrid: Option<&Bound<'py, PyDict>>,
         cancel: Option<&Bound<'py, CancelToken>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let cancel = token(cancel);
@@ -116,6 +119,8 @@ impl EnsemblePool {
                 window,
                 threshold,
                 stop_at_threshold,
+                validity_limit,
+                hybrid: hybrid.map(hybrid_from).transpose()?,
             };
             let pool = &self.pool;
             let out = py.detach(|| run_batch(pool, &ps, &settings, &cancel))?;
@@ -133,6 +138,10 @@ impl EnsemblePool {
                 ("jitter_rms", col(|m| m.jitter_rms)),
                 ("jitter_peak", col(|m| m.jitter_peak)),
                 ("t_threshold", col(|m| m.t_threshold)),
+                ("orbit_threshold", col(|m| m.orbit_threshold)),
+                ("orbit_limit", col(|m| m.orbit_limit)),
+                ("amplitude_slope", col(|m| m.amplitude_slope)),
+                ("t_nonlinear", col(|m| m.t_nonlinear)),
                 ("t_reached", col(|m| m.t_reached)),
             ] {
                 d.set_item(name, PyArray1::from_vec(py, values))?;
