@@ -288,7 +288,8 @@ def arguments(example: Example) -> tuple[Callable[..., Any], dict[str, Any]]:
 # Result fields where NaN is documented (no eclipse in an orbit, no umbra, a sample that failed).
 NAN_ALLOWED = {
     "t_entry", "t_exit", "entry_theta_min", "exit_theta_max", "entry_peak", "exit_peak",
-    "t_threshold", "eclipses", "critical_damping",
+    "t_threshold", "eclipses", "critical_damping", "orbit_threshold", "orbit_limit",
+    "amplitude_slope",
 }  # fmt: skip
 
 

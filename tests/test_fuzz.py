@@ -1,6 +1,6 @@
 """The fuzz harness in CI: generated hostile calls of the public API and the scenario parser,
 each in a worker process under a watchdog, give a finite result or a clear error naming the
-parameter — never a crash, a hang, a panic or a silent NaN. A short run (800 calls, about 20 s);
+parameter — never a crash, a hang, a panic or a silent NaN. A short run (400 calls, about 10 s);
 benches/fuzz.py runs 10,000 and prints the count of each outcome."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ def runner() -> Iterator[Runner]:
 
 
 @settings(
-    max_examples=800,
+    max_examples=400,
     deadline=None,
     database=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],

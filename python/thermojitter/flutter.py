@@ -213,6 +213,7 @@ def stability_map(
     # Ctrl-C between them.
     rows_per_block = max(1, MAP_BLOCK // xs.size)
     growth, frequency = [], []
+    checks.flag("progress", progress)
     bar = progress_bar(ys.size, unit="row", desc="stability map", enabled=progress, delay=1.0)
     try:
         for start in range(0, ys.size, rows_per_block):

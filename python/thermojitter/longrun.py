@@ -181,7 +181,8 @@ def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
         columns = {k: list(content["columns"][k]) for k in SUMMARY_FIELDS}
         next_index = int(content["next_index"])
         y = [float(v) for v in content["y"]]
-        counters = {k: int(content["counters"][k]) for k in ("n_steps", "n_rhs")}
+        counters = dict(content["counters"])
+        counters["n_steps"], counters["n_rhs"] = int(counters["n_steps"]), int(counters["n_rhs"])
         crossing = content["crossing"]
     except (KeyError, TypeError, ValueError):
         raise checkpoints.CheckpointError("checkpoint", path, "is missing fields") from None

@@ -33,6 +33,7 @@ from scipy.stats import qmc
 
 from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
+from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
@@ -593,6 +594,7 @@ def _run_design(
     progress: bool,
 ) -> Any:
     n = len(matrix)
+    checks.flag("progress", progress)
     if threads is not None and (
         isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1
     ):

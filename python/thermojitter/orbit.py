@@ -73,11 +73,8 @@ def day_of_year(date: DateLike) -> float:
     """
     if isinstance(date, bool):
         raise TypeError("start_date must be a date, an ISO date string or a day of the year")
-    if isinstance(date, (int, float)):
-        value = float(date)
-        if not math.isfinite(value):
-            raise ValueError(f"start_date = {date} is invalid: must be finite")
-        return value
+    if isinstance(date, (int, float, np.integer, np.floating)):
+        return checks.finite("start_date", date)
     if isinstance(date, str):
         try:
             parsed: _dt.date = _dt.datetime.fromisoformat(date)
