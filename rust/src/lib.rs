@@ -17,6 +17,7 @@ pub mod hybrid;
 pub mod integrate;
 pub mod laminate;
 pub mod layered;
+pub mod linear;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
