@@ -262,7 +262,7 @@ def simulate_orbits(
     window = checks.positive("window", window)
     theta_limit = checks.real("theta_limit", theta_limit)
     checkpoint_every = checks.finite("checkpoint_every", checkpoint_every)
-    steps_per_period = checks.finite("steps_per_period", steps_per_period)
+    steps_per_period = checks.in_range("steps_per_period", steps_per_period, 0.0, 1e4)
     if progress is not None:
         checks.flag("progress", progress)
     if stop is not None and not callable(stop):
