@@ -1,16 +1,20 @@
 //! Engine micro-benchmarks with std-only timing (no harness): the coupled right-hand side, one
-//! Dormand–Prince step, and one GEO orbit at rtol 1e-8 / atol 1e-10.
+//! Dormand–Prince step, one GEO orbit at rtol 1e-8 / atol 1e-10, and Monte Carlo samples of one
+//! orbit on one thread, one at a time and in lockstep lanes.
 //!
 //!     cargo bench --bench engine
 //!
 //! Each figure is the median over several batches, in ns per call (per step for the orbit).
 //! A word after `--` keeps only the benches whose name contains it: rhs, step, orbit-none,
-//! orbit-end, orbit-every (`-- orbit` runs the three orbits).
+//! orbit-end, orbit-every (`-- orbit` runs the three orbits), ensemble. The first line names the
+//! processor and the instruction sets it has and the build uses.
 
 use nalgebra::Vector4;
 use std::hint::black_box;
 use std::time::Instant;
+use thermojitter::cancel::Cancel;
 use thermojitter::dynamics::HingeModel;
+use thermojitter::ensemble::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::integrate::dopri5;
 use thermojitter::integrate::{solve, Method, OdeSystem, Sampler, StepCounter, Tolerances};
 use thermojitter::steady::equilibrium;
@@ -38,6 +42,7 @@ fn main() {
         .filter(|a| !a.starts_with('-'))
         .collect();
     let wanted = |name: &str| filter.is_empty() || filter.iter().any(|f| name.contains(f.as_str()));
+    println!("{}", thermojitter::cpu::describe());
     let panel = Panel::paper();
     let orbit = Orbit::geo_equinox();
     let eq = equilibrium(&panel, Coupling::ProjectedArea, 1.0).expect("equilibrium");
@@ -124,4 +129,64 @@ fn main() {
         black_box(&sampler.y);
         stats.n_steps
     });
+
+    let paths = [
+        ("ensemble-scalar", "one at a time ", Path::Scalar),
+        ("ensemble-lockstep", "lockstep lanes", Path::Lockstep),
+    ];
+    if paths.iter().any(|(key, _, _)| wanted(key)) {
+        // Eight panels around Table 1 on one thread, each one GEO orbit with the per-orbit
+        // summary and the flutter analysis (a Monte Carlo sample), alternating the two paths.
+        let panels: Vec<Panel> = (0..8)
+            .map(|k| Panel {
+                damping: 2.0 + 0.25 * k as f64,
+                conductance: 22.0 + 0.75 * k as f64,
+                ..panel
+            })
+            .collect();
+        let settings = EnsembleSettings {
+            orbit,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method,
+            n_orbits: 1,
+            window: 600.0,
+            threshold: None,
+            stop_at_threshold: false,
+        };
+        let one = pool(1).expect("pool");
+        let mut per_sample = [Vec::new(), Vec::new()];
+        for _ in 0..3 {
+            for (i, (key, _, path)) in paths.iter().enumerate() {
+                if !wanted(key) {
+                    continue;
+                }
+                let start = Instant::now();
+                let rows = run_batch_on(&one, &panels, &settings, &Cancel::new(), *path);
+                black_box(rows.expect("batch"));
+                per_sample[i].push(start.elapsed().as_secs_f64() / panels.len() as f64);
+            }
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied()
+        };
+        let scalar = median(&mut per_sample[0]);
+        let lanes = median(&mut per_sample[1]);
+        if let Some(s) = scalar {
+            println!(
+                "ensemble sample, {}    {:8.2} ms/sample",
+                paths[0].1,
+                1e3 * s
+            );
+        }
+        if let Some(l) = lanes {
+            let ratio = scalar.map_or(String::new(), |s| format!(" ({:.2}x)", s / l));
+            println!(
+                "ensemble sample, {}    {:8.2} ms/sample{ratio}",
+                paths[1].1,
+                1e3 * l
+            );
+        }
+    }
 }

@@ -49,6 +49,13 @@ pub fn sin_cos(theta: f64) -> (f64, f64) {
     if theta.abs() > std::f64::consts::FRAC_PI_4 {
         return theta.sin_cos();
     }
+    sin_cos_kernel(theta)
+}
+
+/// The polynomials of [`sin_cos`] alone, for |θ| ≤ π/4 (no branch, so that a loop over SIMD
+/// lanes vectorises; the caller handles the lanes beyond π/4).
+#[inline(always)]
+pub(crate) fn sin_cos_kernel(theta: f64) -> (f64, f64) {
     const S: [f64; 6] = [
         -0.16666666666666632,
         0.00833333333332249,

@@ -7,6 +7,7 @@
 
 pub mod beam;
 pub mod cancel;
+pub mod cpu;
 pub mod dynamics;
 pub mod ensemble;
 pub mod error;

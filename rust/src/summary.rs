@@ -1,10 +1,12 @@
 //! Per-orbit summaries of long runs: memory grows with the number of orbits, not of steps.
 //!
-//! Each accepted step is read at four evenly spaced points of its dense output, fine enough to
-//! catch the peaks of an oscillation that needs tens of steps per period.
+//! Each accepted step is read at its midpoint (from the dense output) and at its end: the step is
+//! capped at a fortieth of the hinge period, so two reads per step are twenty per period or more,
+//! which keeps the peaks within 0.04 % of a reading at 64 points per step
+//! (`two_reads_per_step_keep_the_peaks` below measures it).
 
 use crate::cancel::Cancel;
-use crate::dynamics::{thermal_moment, HingeModel};
+use crate::dynamics::HingeModel;
 use crate::error::Result;
 use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
 use crate::orbit::Orbit;
@@ -14,8 +16,8 @@ use crate::system::{Coupled, Coupling};
 use nalgebra::{Vector4, U4};
 use std::ops::ControlFlow;
 
-/// Points read per step (the step end and three interior points).
-const READS_PER_STEP: usize = 4;
+/// Points read per step (the step end and the interior points between).
+const READS_PER_STEP: usize = 2;
 
 /// What one orbit did. Angles in rad, times in s; NaN where an orbit has no eclipse.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,6 +117,8 @@ pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> M
 
 struct Collector {
     panel: Panel,
+    /// The panel's thermal moment per kelvin, computed once (it holds a division).
+    moment_per_kelvin: f64,
     orbit: Orbit,
     coupling: Coupling,
     options: SummaryOptions,
@@ -165,7 +169,8 @@ impl Collector {
         s.theta_min = s.theta_min.min(th);
         let dev = (th - s.theta_eq).abs();
         s.amplitude = s.amplitude.max(dev);
-        let dynamic = th - thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+        // θ − M_T/K_el, M_T as in `dynamics::thermal_moment`.
+        let dynamic = th - self.moment_per_kelvin * (y[0] - y[1]) / self.panel.hinge_stiffness;
         s.jitter_peak = s.jitter_peak.max(dynamic.abs());
         self.sq_sum += dynamic * dynamic * dt;
         self.duration += dt;
@@ -205,10 +210,12 @@ impl Collector {
     }
 }
 
-struct SummaryObserver<'c> {
+/// The observer of a summarised run (see [`prepare_orbits`]).
+pub(crate) struct SummaryObserver<'c> {
     collector: Collector,
     error: Option<crate::Error>,
     cancel: &'c Cancel,
+    reads: usize,
 }
 
 impl Observer<U4> for SummaryObserver<'_> {
@@ -217,18 +224,15 @@ impl Observer<U4> for SummaryObserver<'_> {
             self.error = Some(e);
             return ControlFlow::Break(());
         }
-        let h = (step.t1 - step.t0) / READS_PER_STEP as f64;
-        for j in 1..=READS_PER_STEP {
-            let t = if j == READS_PER_STEP {
+        let reads = self.reads;
+        let h = (step.t1 - step.t0) / reads as f64;
+        for j in 1..=reads {
+            let t = if j == reads {
                 step.t1
             } else {
                 step.t0 + j as f64 * h
             };
-            let y = if j == READS_PER_STEP {
-                step.y1
-            } else {
-                step.eval(t)
-            };
+            let y = if j == reads { step.y1 } else { step.eval(t) };
             if let Err(e) = self.collector.read(t, &y, h) {
                 self.error = Some(e);
                 return ControlFlow::Break(());
@@ -297,16 +301,68 @@ pub fn run_orbits_cancellable(
     options: SummaryOptions,
     cancel: &Cancel,
 ) -> Result<OrbitRun> {
+    let mut run = prepare_orbits(
+        panel,
+        orbit,
+        model,
+        coupling,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+        cancel,
+    )?;
+    let outcome = solve(
+        &mut run.system,
+        &run.method,
+        run.t0,
+        run.y0,
+        run.t1,
+        &mut run.observer,
+    );
+    finish_orbits(run.observer, outcome)
+}
+
+/// A summarised run set up but not yet integrated: integrate `system` with `method` from
+/// (`t0`, `y0`) to `t1` into `observer` (with [`solve`], or in lockstep with other runs), then
+/// hand the outcome to [`finish_orbits`].
+pub(crate) struct PreparedOrbits<'c> {
+    pub system: Coupled,
+    pub method: Method,
+    pub t0: f64,
+    pub t1: f64,
+    pub y0: Vector4<f64>,
+    pub observer: SummaryObserver<'c>,
+}
+
+/// Checks the settings and sets up a summarised run (see [`run_orbits_cancellable`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn prepare_orbits<'c>(
+    panel: &Panel,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vector4<f64>,
+    options: SummaryOptions,
+    cancel: &'c Cancel,
+) -> Result<PreparedOrbits<'c>> {
     cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
     crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
-    let method = &resolve_hinge(method, panel, options.steps_per_period);
+    let method = resolve_hinge(method, panel, options.steps_per_period);
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
     let mut collector = Collector {
         panel: *panel,
+        moment_per_kelvin: panel.moment_per_kelvin(),
         orbit: *orbit,
         coupling,
         options,
@@ -322,14 +378,27 @@ pub fn run_orbits_cancellable(
     let y0_theta = y0[2];
     collector.current.theta_max = y0_theta;
     collector.current.theta_min = y0_theta;
-    let mut observer = SummaryObserver {
-        collector,
-        error: None,
-        cancel,
-    };
-    let mut system = Coupled::new(*panel, *orbit, model, coupling);
-    let t_end = t_start + n_orbits as f64 * orbit.period;
-    let (stats, y_end) = solve(&mut system, method, t_start, y0, t_end, &mut observer)?;
+    Ok(PreparedOrbits {
+        system: Coupled::new(*panel, *orbit, model, coupling),
+        method,
+        t0: t_start,
+        t1: t_start + n_orbits as f64 * orbit.period,
+        y0,
+        observer: SummaryObserver {
+            collector,
+            error: None,
+            cancel,
+            reads: READS_PER_STEP,
+        },
+    })
+}
+
+/// The summaries of a prepared run from the outcome of its integration.
+pub(crate) fn finish_orbits(
+    observer: SummaryObserver<'_>,
+    outcome: Result<(Stats, Vector4<f64>)>,
+) -> Result<OrbitRun> {
+    let (stats, y_end) = outcome?;
     if let Some(e) = observer.error {
         return Err(e);
     }
@@ -411,6 +480,86 @@ mod tests {
         let d = (whole.summaries[1].exit_theta_max - second.summaries[0].exit_theta_max).abs();
         assert!(d < 1e-8, "{d}");
         assert_eq!(second.summaries[0].index, 1);
+    }
+
+    /// The summaries of `n` GEO orbits of `panel` read at `reads` points per step.
+    fn run_reading(panel: &Panel, n: u64, reads: usize) -> OrbitRun {
+        let o = Orbit::geo_equinox();
+        let eq = equilibrium(panel, Coupling::ProjectedArea, 1.0).unwrap();
+        let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+        let opts = SummaryOptions {
+            window: 600.0,
+            theta_limit: 10.0,
+            stop_at_limit: false,
+            steps_per_period: STEPS_PER_HINGE_PERIOD,
+        };
+        let method = Method::Dopri5(Tolerances::default());
+        let cancel = Cancel::new();
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let mut run = prepare_orbits(
+            panel, &o, model, coupling, &method, 0.0, 0, n, y0, opts, &cancel,
+        )
+        .unwrap();
+        run.observer.reads = reads;
+        let outcome = solve(
+            &mut run.system,
+            &run.method,
+            run.t0,
+            run.y0,
+            run.t1,
+            &mut run.observer,
+        );
+        finish_orbits(run.observer, outcome).unwrap()
+    }
+
+    #[test]
+    fn two_reads_per_step_keep_the_peaks() {
+        // Against 64 reads per step of the same steps, every peak within 0.1 % of the orbit's
+        // amplitude (peaks of θ itself sit on the equilibrium angle), the jitter's peak and RMS
+        // within 0.1 % of themselves. Measured: peaks 1.5e-5 (damped) and 3.1e-4 (undamped,
+        // growing to 0.56 rad), jitter peak 3.0e-4, RMS 4.4e-4; with four reads (before)
+        // 6.0e-5, 1.4e-4 and 1.9e-4. Two reads per step halve the summary's cost.
+        for damping in [3.0, 0.0] {
+            let panel = Panel {
+                damping,
+                ..Panel::paper()
+            };
+            let fine = run_reading(&panel, 2, 64);
+            let coarse = run_reading(&panel, 2, READS_PER_STEP);
+            assert_eq!(fine.stats, coarse.stats);
+            for (f, c) in fine.summaries.iter().zip(&coarse.summaries) {
+                let scale = f.amplitude;
+                // (name, fine, coarse, +1 for a maximum, −1 for a minimum)
+                let peaks = [
+                    ("theta_max", f.theta_max, c.theta_max, 1.0),
+                    ("theta_min", f.theta_min, c.theta_min, -1.0),
+                    ("amplitude", f.amplitude, c.amplitude, 1.0),
+                    (
+                        "entry_theta_min",
+                        f.entry_theta_min,
+                        c.entry_theta_min,
+                        -1.0,
+                    ),
+                    ("exit_theta_max", f.exit_theta_max, c.exit_theta_max, 1.0),
+                    ("entry_peak", f.entry_peak, c.entry_peak, 1.0),
+                    ("exit_peak", f.exit_peak, c.exit_peak, 1.0),
+                ];
+                for (name, want, got, sense) in peaks {
+                    let rel = (got - want).abs() / scale;
+                    assert!(
+                        rel < 1e-3,
+                        "damping {damping} {name}: {got} vs {want} ({rel:e})"
+                    );
+                    // The coarse points are a subset of the fine ones (j/2 = 32j/64 exactly):
+                    // a sparser reading can only miss a peak, never pass it.
+                    assert!(sense * got <= sense * want, "{name}: {got} beyond {want}");
+                }
+                let rel = (c.jitter_peak - f.jitter_peak).abs() / f.jitter_peak;
+                assert!(rel < 1e-3, "damping {damping} jitter_peak: {rel:e}");
+                let rel = (c.jitter_rms - f.jitter_rms).abs() / f.jitter_rms;
+                assert!(rel < 1e-3, "damping {damping} jitter_rms: {rel:e}");
+            }
+        }
     }
 
     #[test]

@@ -191,30 +191,47 @@ impl Coupled {
     /// with sin θ and cos θ computed once and the coefficients taken from [`Rates`].
     #[inline(always)]
     pub fn rhs_at_flux(&self, flux: f64, y: &Vector4<f64>) -> Vector4<f64> {
-        let r = &self.rates;
-        let (tf, tb, th, om) = (y[0], y[1], y[2], y[3]);
         let (sin, cos) = match (self.coupling, self.model) {
             (Coupling::Frozen, HingeModel::Linear) => (0.0, 1.0),
-            _ => sin_cos(th),
+            _ => sin_cos(y[2]),
         };
-        let area = match self.coupling {
-            Coupling::ProjectedArea => cos,
-            Coupling::Frozen => 1.0,
-        };
-        let gradient = tf - tb;
-        let conducted = r.conduction * gradient;
-        let tf4 = (tf * tf) * (tf * tf);
-        let tb4 = (tb * tb) * (tb * tb);
-        let dtf = r.heating * (flux * area) - conducted - r.radiation_front * tf4;
-        let dtb = conducted - r.radiation_back * tb4;
-        // Generalised moment over I_B: M_T − c_d θ̇ − K_el θ.
-        let forced = r.moment * gradient - r.damping * om - r.stiffness * th;
-        let acc = match self.model {
-            HingeModel::Linear => forced,
-            // eq. 20 with 3/(2 m l³) = 1/I_B factored out
-            HingeModel::Nonlinear => (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin),
-        };
+        let r = &self.rates;
+        let c = [
+            r.heating,
+            r.conduction,
+            r.radiation_front,
+            r.radiation_back,
+            r.moment,
+            r.damping,
+            r.stiffness,
+        ];
+        let [dtf, dtb, om, acc] = coupled_rates(
+            self.model,
+            self.coupling,
+            &c,
+            flux,
+            &[y[0], y[1], y[2], y[3]],
+            sin,
+            cos,
+        );
         Vector4::new(dtf, dtb, om, acc)
+    }
+
+    /// The hinge model, the coupling and the folded coefficients (heating, conduction,
+    /// radiation front and back, moment, damping, stiffness), for kernels that evaluate
+    /// [`Coupled::rhs_at_flux`] for several panels at once with the same arithmetic.
+    pub(crate) fn lane_form(&self) -> (HingeModel, Coupling, [f64; 7]) {
+        let r = &self.rates;
+        let c = [
+            r.heating,
+            r.conduction,
+            r.radiation_front,
+            r.radiation_back,
+            r.moment,
+            r.damping,
+            r.stiffness,
+        ];
+        (self.model, self.coupling, c)
     }
 
     /// Illumination factor (s × flux scale) inside the current segment at time t.
@@ -234,6 +251,43 @@ impl OdeSystem<U4> for Coupled {
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
+}
+
+/// The coupled right-hand side (T_f', T_b', θ', θ̇') at state `y` and illumination `flux`, from
+/// the coefficients of [`Rates`] in field order (heating, conduction, radiation front and back,
+/// moment, damping, stiffness) and sin θ, cos θ (0 and 1 when unused). Its arithmetic lives
+/// here once, for [`Coupled::rhs_at_flux`] and for the ensemble's lockstep kernel, which must
+/// give the same bits.
+#[inline(always)]
+pub(crate) fn coupled_rates(
+    model: HingeModel,
+    coupling: Coupling,
+    c: &[f64; 7],
+    flux: f64,
+    y: &[f64; 4],
+    sin: f64,
+    cos: f64,
+) -> [f64; 4] {
+    let [heating, conduction, radiation_front, radiation_back, moment, damping, stiffness] = *c;
+    let [tf, tb, th, om] = *y;
+    let area = match coupling {
+        Coupling::ProjectedArea => cos,
+        Coupling::Frozen => 1.0,
+    };
+    let gradient = tf - tb;
+    let conducted = conduction * gradient;
+    let tf4 = (tf * tf) * (tf * tf);
+    let tb4 = (tb * tb) * (tb * tb);
+    let dtf = heating * (flux * area) - conducted - radiation_front * tf4;
+    let dtb = conducted - radiation_back * tb4;
+    // Generalised moment over I_B: M_T − c_d θ̇ − K_el θ.
+    let forced = moment * gradient - damping * om - stiffness * th;
+    let acc = match model {
+        HingeModel::Linear => forced,
+        // eq. 20 with 3/(2 m l³) = 1/I_B factored out
+        HingeModel::Nonlinear => (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin),
+    };
+    [dtf, dtb, om, acc]
 }
 
 /// A thermal-moment history M(t), N m: constant, or linear between samples (held at the ends).

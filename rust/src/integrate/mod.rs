@@ -8,6 +8,7 @@
 //! callers keep only what they need (samples, per-orbit summaries) and never every step.
 
 pub mod dopri5;
+pub mod lockstep;
 pub mod output;
 pub mod rk4;
 
