@@ -10,6 +10,14 @@ from thermojitter import beam
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
+from thermojitter.distributed import (
+    DistributedFlutterResult,
+    DistributedSolution,
+    distributed_defaults,
+    distributed_flutter,
+    distributed_frequencies,
+    simulate_distributed,
+)
 from thermojitter.errors import InternalError, ParameterError
 from thermojitter.flutter import (
     FlutterResult,
@@ -38,6 +46,8 @@ __all__ = [
     "BeamComparison",
     "CalibrationResult",
     "ConvergenceError",
+    "DistributedFlutterResult",
+    "DistributedSolution",
     "Equilibrium",
     "FlutterResult",
     "FreeFreeBeam",
@@ -59,6 +69,9 @@ __all__ = [
     "calibrate",
     "calibrate_from_csv",
     "compare_with_beam",
+    "distributed_defaults",
+    "distributed_flutter",
+    "distributed_frequencies",
     "hinge_energy",
     "hinge_stiffness",
     "linear_thermal_response",
@@ -66,6 +79,7 @@ __all__ = [
     "natural_frequency",
     "sensitivity",
     "simulate",
+    "simulate_distributed",
     "simulate_hinge",
     "simulate_orbits",
     "simulate_thermal",

@@ -19,6 +19,9 @@ __all__ = [
     "beam_static",
     "check_panels",
     "declination",
+    "distributed_defaults",
+    "distributed_flutter",
+    "distributed_info",
     "derived",
     "eclipses",
     "energy",
@@ -30,6 +33,7 @@ __all__ = [
     "run_orbits",
     "shadow_intervals",
     "simulate",
+    "simulate_distributed",
     "simulate_hinge",
     "simulate_thermal",
     "stability_map",
@@ -78,6 +82,7 @@ def simulate(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float] | None,
+    layers: int = 2,
 ) -> dict[str, Any]: ...
 def simulate_thermal(
     panel: dict[str, float],
@@ -146,6 +151,26 @@ def beam_response(
     solver: dict[str, Any],
     t_eval: _F | None,
     dt_out: float | None,
+) -> dict[str, Any]: ...
+
+# --- distributed panel (rust/src/py/distributed.rs) ---
+
+def distributed_defaults(panel: dict[str, float]) -> dict[str, Any]: ...
+def distributed_info(panel: dict[str, float], settings: dict[str, Any]) -> dict[str, Any]: ...
+def distributed_flutter(
+    panel: dict[str, float], settings: dict[str, Any], flux: float
+) -> dict[str, Any]: ...
+def simulate_distributed(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    settings: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    solver: dict[str, Any],
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: _F | None,
 ) -> dict[str, Any]: ...
 
 # --- orbit options (issue 4)

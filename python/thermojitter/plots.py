@@ -163,12 +163,17 @@ def legend(fig: Any, *, ncols: int | None = None) -> Any:
                 seen[label] = handle
     if not seen:
         return None
-    n = len(seen)
+    if ncols is None:
+        # As many columns as fit the figure's width (about 11 characters per inch at 8 pt).
+        room = 11.0 * fig.get_figwidth()
+        ncols = min(len(seen), 4)
+        while ncols > 1 and max(len(label) + 6 for label in seen) * ncols > room:
+            ncols -= 1
     return fig.legend(
         list(seen.values()),
         list(seen),
         loc="outside lower center",
-        ncols=ncols or min(n, 4),
+        ncols=ncols,
         fontsize=8,
         frameon=False,
     )
@@ -277,13 +282,14 @@ def orbit_summary_figure(out: Path, columns: dict[str, Array], title: str) -> Pa
     fig, (top, bottom) = figure(2, height=5.6)
     days = np.asarray(columns["t_start"]) / 86400.0
     hidden = 0
-    for key, label in (
-        ("amplitude", "max |θ − θ_eq| over the orbit"),
-        ("exit_peak", "peak after shadow exit"),
-        ("entry_peak", "peak after shadow entry"),
+    for key, label, style in (
+        # The amplitude often equals one of the peaks: drawn wide and light beneath them.
+        ("amplitude", "max |θ − θ_eq| over the orbit", {"lw": 2.8, "alpha": 0.45}),
+        ("exit_peak", "peak after shadow exit", {"lw": 0.9}),
+        ("entry_peak", "peak after shadow entry", {"lw": 0.9, "ls": "--"}),
     ):
         values = above_noise(np.degrees(np.asarray(columns[key], dtype=float)))
-        top.semilogy(days, values, lw=0.8, label=label)
+        top.semilogy(days, values, label=label, **style)
     top.set_ylabel("angle [deg]")
     top.set_title(f"{title}: per-orbit summaries")
     top.grid(alpha=0.3, which="both")
@@ -292,16 +298,20 @@ def orbit_summary_figure(out: Path, columns: dict[str, Array], title: str) -> Pa
     hidden = int(np.sum(np.isfinite(raw) & ~np.isfinite(rms)))
     bottom.semilogy(days, rms, lw=0.8, color="C3", label="RMS jitter (θ − M_T/K_el)")
     bottom.set_ylabel("RMS jitter [deg]")
-    note = (
-        f"; {hidden} orbits without eclipse below {NOISE_FLOOR_DEG:g}° (solver resolution) "
-        "not drawn"
-        if hidden
-        else ""
-    )
     bottom.set_title(
-        "RMS over each orbit of θ − M_T/K_el (the oscillation about the static angle)" + note,
+        "RMS over each orbit of θ − M_T/K_el (the oscillation about the static angle)",
         fontsize=9,
     )
+    if hidden:
+        bottom.text(
+            0.01,
+            0.04,
+            f"{hidden} orbits without eclipse: RMS below {NOISE_FLOOR_DEG:g}° "
+            "(solver resolution), not drawn",
+            transform=bottom.transAxes,
+            fontsize=8,
+            color="0.3",
+        )
     bottom.set_xlabel("time from the start [days]")
     bottom.grid(alpha=0.3, which="both")
     legend(fig)
@@ -451,20 +461,33 @@ def _k_label(case: Any) -> str:
 
 
 def beam_time_figure(case: Any, orbit: Any, number: str, path: Path) -> Path:
-    """θ of the hinge model over θ_f of the beam through the eclipse, shadow shaded."""
+    """θ of the hinge model and θ_f of the beam through the eclipse, shadow shaded; below, the
+    first minutes after shadow entry, where the ~8 s jitter of each can be told apart."""
     entry = orbit.shadow_intervals(float(case.t[0]), float(case.t[-1]))[0][0]
-    fig, (ax,) = figure(1, height=4.2)
+    fig, (whole, zoom) = figure(2, height=6.4, sharex=False)
     minutes = (case.t - entry) / 60.0
-    # The beam below, thick and light; the hinge model on top, thin and dark: both visible.
-    ax.plot(
-        minutes, case.theta_f_deg, lw=1.8, color="C1", alpha=0.7, label="beam θ_f (finite elements)"
+    near = (minutes >= -0.5) & (minutes <= 3.0)
+    for ax, keep in ((whole, slice(None)), (zoom, near)):
+        # The beam below, thicker and lighter; the hinge model on top, thin and dark.
+        ax.plot(
+            minutes[keep], case.theta_f_deg[keep], lw=1.8, color="C1", alpha=0.75,
+            label="beam θ_f (finite elements)",
+        )  # fmt: skip
+        ax.plot(
+            minutes[keep], case.theta_deg[keep], lw=0.7, color="C0", zorder=3,
+            label="hinge model θ",
+        )  # fmt: skip
+        ax.set_ylabel("angle [deg]")
+        ax.grid(alpha=0.3)
+    shade_eclipses(whole, orbit, float(case.t[0]), float(case.t[-1]), scale=60.0, offset=entry)
+    shade_eclipses(zoom, orbit, entry - 30.0, entry + 180.0, scale=60.0, offset=entry, labels=False)
+    zoom.set_xlim(-0.5, 3.0)
+    whole.set_xlabel("time from shadow entry [min]")
+    zoom.set_xlabel("time from shadow entry [min] (zoom on the jitter)")
+    whole.set_title(
+        f"{number} — hinge model vs beam, {_k_label(case)}; RMSE {case.rmse_deg:.2f}°",
+        fontsize=10,
     )
-    ax.plot(minutes, case.theta_deg, lw=0.7, color="C0", label="hinge model θ", zorder=3)
-    shade_eclipses(ax, orbit, float(case.t[0]), float(case.t[-1]), scale=60.0, offset=entry)
-    ax.set_xlabel("time from shadow entry [min]")
-    ax.set_ylabel("angle [deg]")
-    ax.set_title(f"{number} — hinge model vs beam, {_k_label(case)}; RMSE {case.rmse_deg:.2f}°")
-    ax.grid(alpha=0.3)
     legend(fig)
     return save(fig, path)
 

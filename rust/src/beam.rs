@@ -17,7 +17,7 @@
 
 use crate::error::{require_finite, require_non_negative, Error, Result};
 use crate::integrate::{solve, Const, Method, OdeSystem, Sampler, Stats};
-use crate::params::Panel;
+use crate::params::{beam_first_angular_frequency, Panel};
 use crate::simulate::Output;
 use crate::system::MomentHistory;
 use nalgebra::{DMatrix, DVector, SVector, SymmetricEigen};
@@ -92,43 +92,20 @@ impl FreeFreeBeam {
 
     /// Assembles a global matrix from the 4×4 element matrix shared by every element.
     fn assemble(&self, element: &[[f64; 4]; 4]) -> DMatrix<f64> {
-        let n = self.dofs();
-        let mut g = DMatrix::zeros(n, n);
-        for e in 0..self.n_elements {
-            let base = 2 * e;
-            for (i, row) in element.iter().enumerate() {
-                for (j, v) in row.iter().enumerate() {
-                    g[(base + i, base + j)] += v;
-                }
-            }
-        }
-        g
+        assemble_uniform(self.n_elements, element)
     }
 
-    /// Global stiffness matrix: element EI/h³ [12 6h −12 6h; 6h 4h² −6h 2h²; …].
+    /// Global stiffness matrix, assembled from [`element_stiffness`].
     pub fn stiffness_matrix(&self) -> DMatrix<f64> {
-        let h = self.element_length();
-        let k = self.flexural_rigidity / (h * h * h);
-        let e = [
-            [12.0, 6.0 * h, -12.0, 6.0 * h],
-            [6.0 * h, 4.0 * h * h, -6.0 * h, 2.0 * h * h],
-            [-12.0, -6.0 * h, 12.0, -6.0 * h],
-            [6.0 * h, 2.0 * h * h, -6.0 * h, 4.0 * h * h],
-        ];
-        self.assemble(&e.map(|r| r.map(|v| v * k)))
+        self.assemble(&element_stiffness(
+            self.flexural_rigidity,
+            self.element_length(),
+        ))
     }
 
-    /// Global consistent mass matrix: element m h/420 [156 22h 54 −13h; 22h 4h² 13h −3h²; …].
+    /// Global consistent mass matrix, assembled from [`element_mass`].
     pub fn mass_matrix(&self) -> DMatrix<f64> {
-        let h = self.element_length();
-        let c = self.mass_per_length * h / 420.0;
-        let e = [
-            [156.0, 22.0 * h, 54.0, -13.0 * h],
-            [22.0 * h, 4.0 * h * h, 13.0 * h, -3.0 * h * h],
-            [54.0, 13.0 * h, 156.0, -22.0 * h],
-            [-13.0 * h, -3.0 * h * h, -22.0 * h, 4.0 * h * h],
-        ];
-        self.assemble(&e.map(|r| r.map(|v| v * c)))
+        self.assemble(&element_mass(self.mass_per_length, self.element_length()))
     }
 
     /// Unit rigid translation (w = 1, w' = 0 at every node).
@@ -153,46 +130,11 @@ impl FreeFreeBeam {
         r
     }
 
-    /// Solves K φ = ω² M φ: Cholesky M = L Lᵀ, eigen-decomposition of L⁻¹ K L⁻ᵀ, φ = L⁻ᵀ z.
+    /// Solves K φ = ω² M φ (see [`generalised_modes`]).
     pub fn modes(&self) -> Result<Modes> {
-        let k = self.stiffness_matrix();
-        let m = self.mass_matrix();
-        let chol = nalgebra::Cholesky::new(m).ok_or_else(|| Error::NoConvergence {
-            what: "beam modes".into(),
-            reason: "the mass matrix is not positive definite".into(),
-        })?;
-        let l = chol.l();
-        let no_solve = || Error::NoConvergence {
-            what: "beam modes".into(),
-            reason: "triangular solve failed".into(),
-        };
-        let x = l.solve_lower_triangular(&k).ok_or_else(no_solve)?; // L⁻¹ K
-        let a = l
-            .solve_lower_triangular(&x.transpose())
-            .ok_or_else(no_solve)?; // L⁻¹ K L⁻ᵀ
-        let a = (&a + a.transpose()) * 0.5;
-        let eig = SymmetricEigen::new(a);
-        let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-        order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-        let n = order.len();
-        let mut eigenvalues = Vec::with_capacity(n);
-        let mut z = DMatrix::zeros(n, n);
-        for (col, &i) in order.iter().enumerate() {
-            eigenvalues.push(eig.eigenvalues[i]);
-            z.set_column(col, &eig.eigenvectors.column(i));
-        }
-        let mut shapes = l.tr_solve_lower_triangular(&z).ok_or_else(no_solve)?;
-        // Sign convention: the deflection at x = 0 is positive (or, if zero, the slope there).
-        for mut c in shapes.column_iter_mut() {
-            let lead = if c[0].abs() > 1e-12 * c.amax() {
-                c[0]
-            } else {
-                c[1]
-            };
-            if lead < 0.0 {
-                c.neg_mut();
-            }
-        }
+        let (eigenvalues, shapes) =
+            generalised_modes(self.stiffness_matrix(), self.mass_matrix(), "beam modes")?;
+        let n = eigenvalues.len();
         // The rigid-body pair must sit far below the first elastic mode.
         if n < 3 || eigenvalues[1].abs() > 1e-6 * eigenvalues[2] {
             return Err(Error::NoConvergence {
@@ -241,6 +183,108 @@ impl FreeFreeBeam {
         require_finite("moment", moment)?;
         Ok(self.end_moment_modes()?.flexibility * moment)
     }
+}
+
+/// Modal damping ratio that makes a beam's first mode decay at the hinge's rate c_d/(2 I_B):
+/// ζ = c_d / (2 I_B ω₁), ω₁ the first free–free frequency of the continuous panel. It equals the
+/// hinge's own c_d / (2 sqrt(K_el I_B)) when K_el follows the frequency criterion.
+pub fn hinge_equivalent_damping_ratio(panel: &Panel) -> f64 {
+    panel.damping / (2.0 * panel.hinge_inertia() * beam_first_angular_frequency(panel))
+}
+
+/// The hinge damping c_d (N m s/rad) equivalent to the modal damping ratio `zeta`: the inverse
+/// of [`hinge_equivalent_damping_ratio`].
+pub fn hinge_equivalent_damping(panel: &Panel, zeta: f64) -> f64 {
+    2.0 * panel.hinge_inertia() * beam_first_angular_frequency(panel) * zeta
+}
+
+/// Global matrix on the 2 (n + 1) nodal degrees of freedom (w_j at 2j, w'_j at 2j + 1) of a
+/// chain of `n_elements` equal elements sharing the 4×4 `element` matrix.
+pub fn assemble_uniform(n_elements: usize, element: &[[f64; 4]; 4]) -> DMatrix<f64> {
+    let n = 2 * (n_elements + 1);
+    let mut g = DMatrix::zeros(n, n);
+    for e in 0..n_elements {
+        let base = 2 * e;
+        for (i, row) in element.iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                g[(base + i, base + j)] += v;
+            }
+        }
+    }
+    g
+}
+
+/// Stiffness matrix of one Hermite cubic element of length `h` and rigidity `ei` (N m²), on
+/// (w₁, w₁', w₂, w₂'): EI/h³ [12 6h −12 6h; 6h 4h² −6h 2h²; −12 −6h 12 −6h; 6h 2h² −6h 4h²].
+pub fn element_stiffness(ei: f64, h: f64) -> [[f64; 4]; 4] {
+    let k = ei / (h * h * h);
+    [
+        [12.0, 6.0 * h, -12.0, 6.0 * h],
+        [6.0 * h, 4.0 * h * h, -6.0 * h, 2.0 * h * h],
+        [-12.0, -6.0 * h, 12.0, -6.0 * h],
+        [6.0 * h, 2.0 * h * h, -6.0 * h, 4.0 * h * h],
+    ]
+    .map(|r| r.map(|v| v * k))
+}
+
+/// Consistent mass matrix of one Hermite cubic element of length `h` and mass per length `m`
+/// (kg/m): m h/420 [156 22h 54 −13h; 22h 4h² 13h −3h²; 54 13h 156 −22h; −13h −3h² −22h 4h²].
+pub fn element_mass(m: f64, h: f64) -> [[f64; 4]; 4] {
+    let c = m * h / 420.0;
+    [
+        [156.0, 22.0 * h, 54.0, -13.0 * h],
+        [22.0 * h, 4.0 * h * h, 13.0 * h, -3.0 * h * h],
+        [54.0, 13.0 * h, 156.0, -22.0 * h],
+        [-13.0 * h, -3.0 * h * h, -22.0 * h, 4.0 * h * h],
+    ]
+    .map(|r| r.map(|v| v * c))
+}
+
+/// Solves K φ = ω² M φ for symmetric K and positive definite M: Cholesky M = L Lᵀ, eigen-
+/// decomposition of L⁻¹ K L⁻ᵀ, φ = L⁻ᵀ z. Returns ω² ascending and the mass-normalised shapes
+/// (φᵀ M φ = 1) as columns in that order, each signed so that its first entry that is not
+/// negligible (deflection at the first node, else the slope there) is positive.
+pub fn generalised_modes(
+    k: DMatrix<f64>,
+    m: DMatrix<f64>,
+    what: &str,
+) -> Result<(Vec<f64>, DMatrix<f64>)> {
+    let chol = nalgebra::Cholesky::new(m).ok_or_else(|| Error::NoConvergence {
+        what: what.into(),
+        reason: "the mass matrix is not positive definite".into(),
+    })?;
+    let l = chol.l();
+    let no_solve = || Error::NoConvergence {
+        what: what.into(),
+        reason: "triangular solve failed".into(),
+    };
+    let x = l.solve_lower_triangular(&k).ok_or_else(no_solve)?; // L⁻¹ K
+    let a = l
+        .solve_lower_triangular(&x.transpose())
+        .ok_or_else(no_solve)?; // L⁻¹ K L⁻ᵀ
+    let a = (&a + a.transpose()) * 0.5;
+    let eig = SymmetricEigen::new(a);
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let n = order.len();
+    let mut eigenvalues = Vec::with_capacity(n);
+    let mut z = DMatrix::zeros(n, n);
+    for (col, &i) in order.iter().enumerate() {
+        eigenvalues.push(eig.eigenvalues[i]);
+        z.set_column(col, &eig.eigenvectors.column(i));
+    }
+    let mut shapes = l.tr_solve_lower_triangular(&z).ok_or_else(no_solve)?;
+    for mut c in shapes.column_iter_mut() {
+        let lead = if c[0].abs() > 1e-12 * c.amax() {
+            c[0]
+        } else {
+            c[1]
+        };
+        if lead < 0.0 {
+            c.neg_mut();
+        }
+    }
+    Ok((eigenvalues, shapes))
 }
 
 /// The elastic modes excited by opposite end moments.

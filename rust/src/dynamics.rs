@@ -1,5 +1,6 @@
 //! Thermal bending moment and the one-degree-of-freedom hinge model (paper Sec. 3, eqs. 20, 28).
 
+use crate::error::{Error, Result};
 use crate::params::Panel;
 
 /// Structural model of the hinge.
@@ -11,10 +12,76 @@ pub enum HingeModel {
     Linear,
 }
 
+/// A structural model of the plate: its states (positions, then velocities), their rates under
+/// the thermal moment, and the projected-area factor its shape imposes on the absorbed flux.
+///
+/// The coupled system ([`crate::system::Coupled`]) puts these states after the temperatures.
+pub trait StructuralModel {
+    /// Number of states.
+    fn size(&self) -> usize;
+
+    /// Name of each state, as results label it ("theta", "theta_dot").
+    fn names(&self) -> Vec<String>;
+
+    /// The inertia the thermal moment is divided by in [`StructuralModel::rates`], kg m² (I_B
+    /// for the hinge): the coupled system folds M_T / inertia into one coefficient.
+    fn inertia(&self) -> f64;
+
+    /// Factor of the absorbed flux for the plate's shape `q` (cos θ for the hinge).
+    fn area_factor(&self, q: &[f64]) -> f64;
+
+    /// Rates of the states under the load `moment / inertia()`, into `out`; returns
+    /// [`StructuralModel::area_factor`] of `q`, so that what both need is computed once.
+    fn rates(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64;
+
+    /// Number of position states (the first ones); the velocities that follow are zero at rest.
+    fn positions(&self) -> usize;
+
+    /// Static balance of the positions under the thermal moment `moment` (N m), in balanced
+    /// units (for the hinge (M_T − K_el θ)/K_el, rad): zero at rest.
+    fn static_residual(&self, moment: f64, positions: &[f64], out: &mut [f64]);
+
+    /// Refuses a rest shape outside the model's range (the hinge beyond 90°).
+    fn check_static(&self, _positions: &[f64]) -> Result<()> {
+        Ok(())
+    }
+}
+
 /// M_T = χ a E I (T_f − T_b) / d, N m.
 #[inline]
 pub fn thermal_moment(panel: &Panel, t_front: f64, t_back: f64) -> f64 {
     panel.moment_per_kelvin() * (t_front - t_back)
+}
+
+/// The generalised moment on the hinge, M − c_d θ̇ − K_el θ, in the unit of its coefficients
+/// (N m, or per I_B when all three are divided by it).
+#[inline(always)]
+pub(crate) fn generalised_moment(
+    moment: f64,
+    damping: f64,
+    stiffness: f64,
+    theta: f64,
+    theta_dot: f64,
+) -> f64 {
+    moment - damping * theta_dot - stiffness * theta
+}
+
+/// θ̈ from the generalised moment over I_B, `forced`: eq. 28, or eq. 20 with 3/(2 m l³) = 1/I_B
+/// factored out. `sin`, `cos` are those of θ (unused by the linear model).
+#[inline(always)]
+pub(crate) fn angular_acceleration(
+    model: HingeModel,
+    forced: f64,
+    theta_dot: f64,
+    sin: f64,
+    cos: f64,
+) -> f64 {
+    match model {
+        HingeModel::Linear => forced,
+        HingeModel::Nonlinear => {
+            (forced - 3.0 * theta_dot * theta_dot * sin * cos) / (1.0 + 3.0 * sin * sin)
+        }
+    }
 }
 
 /// θ̈ of the hinge under the thermal moment `moment`, rad/s².
@@ -26,16 +93,125 @@ pub fn hinge_acceleration(
     theta: f64,
     theta_dot: f64,
 ) -> f64 {
-    let generalised = moment - panel.damping * theta_dot - panel.hinge_stiffness * theta;
-    match model {
-        HingeModel::Linear => generalised / panel.hinge_inertia(),
-        HingeModel::Nonlinear => {
-            // eq. 20 with 3/(2 m l³) = 1/I_B factored out
-            let (s, c) = sin_cos(theta);
-            let forced = generalised / panel.hinge_inertia() - 3.0 * theta_dot * theta_dot * s * c;
-            forced / (1.0 + 3.0 * s * s)
+    let generalised = generalised_moment(
+        moment,
+        panel.damping,
+        panel.hinge_stiffness,
+        theta,
+        theta_dot,
+    );
+    let (s, c) = match model {
+        HingeModel::Linear => (0.0, 1.0),
+        HingeModel::Nonlinear => sin_cos(theta),
+    };
+    angular_acceleration(model, generalised / panel.hinge_inertia(), theta_dot, s, c)
+}
+
+/// The one-degree-of-freedom hinge model (paper Sec. 3): states (θ, θ̇), the projected area
+/// cos θ. Its coefficients are divided by I_B once, here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hinge {
+    model: HingeModel,
+    /// I_B, kg m².
+    inertia: f64,
+    /// c_d / I_B, 1/s.
+    damping: f64,
+    /// K_el / I_B, 1/s².
+    stiffness: f64,
+    /// K_el, N m/rad.
+    hinge_stiffness: f64,
+}
+
+impl Hinge {
+    pub fn new(panel: &Panel, model: HingeModel) -> Self {
+        let inertia = panel.hinge_inertia();
+        Hinge {
+            model,
+            inertia,
+            damping: panel.damping / inertia,
+            stiffness: panel.hinge_stiffness / inertia,
+            hinge_stiffness: panel.hinge_stiffness,
         }
     }
+}
+
+impl Hinge {
+    /// (model, c_d / I_B, K_el / I_B): what [`StructuralModel::rates`] uses of the hinge.
+    pub(crate) fn rate_form(&self) -> (HingeModel, f64, f64) {
+        (self.model, self.damping, self.stiffness)
+    }
+}
+
+impl StructuralModel for Hinge {
+    fn size(&self) -> usize {
+        2
+    }
+    fn names(&self) -> Vec<String> {
+        vec!["theta".into(), "theta_dot".into()]
+    }
+    fn inertia(&self) -> f64 {
+        self.inertia
+    }
+    /// cos θ.
+    #[inline(always)]
+    fn area_factor(&self, q: &[f64]) -> f64 {
+        sin_cos(q[0]).1
+    }
+    #[inline(always)]
+    fn rates(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        let (theta, theta_dot) = (q[0], q[1]);
+        let forced = generalised_moment(load, self.damping, self.stiffness, theta, theta_dot);
+        let (s, c) = sin_cos(theta);
+        out[0] = theta_dot;
+        out[1] = angular_acceleration(self.model, forced, theta_dot, s, c);
+        c
+    }
+    fn positions(&self) -> usize {
+        1
+    }
+    /// M_T − K_el θ = 0, the same for the linear and the non-linear hinge, whose static terms
+    /// coincide.
+    fn static_residual(&self, moment: f64, positions: &[f64], out: &mut [f64]) {
+        out[0] = (moment - self.hinge_stiffness * positions[0]) / self.hinge_stiffness;
+    }
+    fn check_static(&self, positions: &[f64]) -> Result<()> {
+        let theta = positions[0];
+        if theta.abs() >= std::f64::consts::FRAC_PI_2 {
+            return Err(Error::NoConvergence {
+                what: "steady state".into(),
+                reason: format!("hinge angle {theta} rad is beyond 90°: the panel is far too soft"),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// No structure: a plate that does not move (θ = 0), for the thermal models alone.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Rigid;
+
+impl StructuralModel for Rigid {
+    fn size(&self) -> usize {
+        0
+    }
+    fn names(&self) -> Vec<String> {
+        Vec::new()
+    }
+    fn inertia(&self) -> f64 {
+        1.0
+    }
+    #[inline]
+    fn area_factor(&self, _q: &[f64]) -> f64 {
+        1.0
+    }
+    #[inline]
+    fn rates(&self, _load: f64, _q: &[f64], _out: &mut [f64]) -> f64 {
+        1.0
+    }
+    fn positions(&self) -> usize {
+        0
+    }
+    fn static_residual(&self, _moment: f64, _positions: &[f64], _out: &mut [f64]) {}
 }
 
 /// (sin θ, cos θ), the right-hand side's only transcendental functions.

@@ -1,13 +1,18 @@
-//! The sunlit equilibrium of the coupled system: θ̇ = 0 and every rate zero under full Sun.
+//! Steady states under constant sunlight: every temperature's heat flow zero and the structure
+//! at rest under the thermal moment, for any thermal model and structural model, by Newton's
+//! method with a finite-difference Jacobian.
 
-use crate::dynamics::thermal_moment;
+use crate::dynamics::{Hinge, HingeModel, StructuralModel};
 use crate::error::{Error, Result};
+use crate::integrate::State;
 use crate::params::Panel;
 use crate::system::Coupling;
-use crate::thermal::{one_node_equilibrium, two_layer_rates};
-use nalgebra::{Matrix3, Vector3};
+use crate::thermal::{ThermalModel, TwoLayer};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DMatrix, DVector, DefaultAllocator, Dim};
 
-/// The steady state under constant flux factor `flux` (1: full Sun at the nominal constant).
+/// The steady state of the paper's model under constant flux factor `flux` (1: full Sun at the
+/// nominal constant).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Equilibrium {
     pub t_front: f64,
@@ -15,41 +20,80 @@ pub struct Equilibrium {
     pub theta: f64,
 }
 
-/// Residual of the steady equations: two heat balances and the static hinge, M_T − K_el θ = 0
-/// (the same for the linear and the non-linear hinge, whose static terms coincide).
-fn residual(panel: &Panel, coupling: Coupling, flux: f64, x: &Vector3<f64>) -> Vector3<f64> {
-    let (tf, tb, th) = (x[0], x[1], x[2]);
-    let area = match coupling {
-        Coupling::ProjectedArea => th.cos(),
-        Coupling::Frozen => 1.0,
-    };
-    let (df, db) = two_layer_rates(panel, flux * area, tf, tb);
-    let hc = 0.5 * panel.heat_capacity();
-    // Scaled to W/m² and N m so that Newton's test is dimensionally balanced.
-    Vector3::new(
-        df * hc,
-        db * hc,
-        (thermal_moment(panel, tf, tb) - panel.hinge_stiffness * th) / panel.hinge_stiffness,
-    )
+impl Equilibrium {
+    /// The state (T_f, T_b, θ, θ̇ = 0).
+    pub fn state(&self) -> nalgebra::Vector4<f64> {
+        nalgebra::Vector4::new(self.t_front, self.t_back, self.theta, 0.0)
+    }
 }
 
-/// Newton's method on the 3×3 steady system with a finite-difference Jacobian, from the
-/// one-node temperature and the uncoupled angle.
-pub fn equilibrium(panel: &Panel, coupling: Coupling, flux: f64) -> Result<Equilibrium> {
-    panel.validate()?;
+/// Residual of the steady equations at x = (temperatures, positions): the heat flows (W/m²) and
+/// the structure's static balance, each in balanced units so that Newton's test is too.
+fn residual<T, S>(
+    thermal: &T,
+    structure: &S,
+    coupling: Coupling,
+    flux: f64,
+    x: &[f64],
+) -> DVector<f64>
+where
+    T: ThermalModel + ?Sized,
+    S: StructuralModel,
+{
+    let n = thermal.size();
+    let (temps, positions) = x.split_at(n);
+    let area = match coupling {
+        Coupling::ProjectedArea => structure.area_factor(&rest_state(structure, positions)),
+        Coupling::Frozen => 1.0,
+    };
+    let mut r = DVector::zeros(x.len());
+    let (flows, statics) = r.as_mut_slice().split_at_mut(n);
+    // The rates dT/dt (heat flow over capacity), scaled back to W/m² by the capacity.
+    thermal.heat_flows(flux * area, temps, flows);
+    for (i, f) in flows.iter_mut().enumerate() {
+        let capacity = thermal.capacity(i);
+        *f = *f / capacity * capacity;
+    }
+    structure.static_residual(thermal.moment(temps), positions, statics);
+    r
+}
+
+/// The structure's state at rest in `positions` (velocities zero).
+fn rest_state<S: StructuralModel>(structure: &S, positions: &[f64]) -> Vec<f64> {
+    let mut q = vec![0.0; structure.size()];
+    q[..positions.len()].copy_from_slice(positions);
+    q
+}
+
+/// The steady state of `thermal` coupled to `structure` under constant flux factor `flux`:
+/// (temperatures, positions), velocities being zero. Newton from the isothermal plate's
+/// temperature and the unloaded shape, with a forward-difference Jacobian.
+pub fn steady<T, S>(
+    thermal: &T,
+    structure: &S,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<DVector<f64>>
+where
+    T: ThermalModel + ?Sized,
+    S: StructuralModel,
+{
     if !(flux.is_finite() && flux > 0.0) {
         return Err(Error::invalid("flux", flux, "must be finite and > 0"));
     }
-    let t0 = one_node_equilibrium(panel, flux);
-    let mut x = Vector3::new(t0, t0, 0.0);
+    let n = thermal.size();
+    let m = n + structure.positions();
+    let mut x = DVector::zeros(m);
+    thermal.initial_guess(flux, &mut x.as_mut_slice()[..n]);
+    let f_of = |x: &DVector<f64>| residual(thermal, structure, coupling, flux, x.as_slice());
     for _ in 0..100 {
-        let f = residual(panel, coupling, flux, &x);
-        let mut jac = Matrix3::zeros();
-        for j in 0..3 {
+        let f = f_of(&x);
+        let mut jac = DMatrix::zeros(m, m);
+        for j in 0..m {
             let h = 1e-7 * x[j].abs().max(1e-3);
-            let mut xp = x;
+            let mut xp = x.clone();
             xp[j] += h;
-            jac.set_column(j, &((residual(panel, coupling, flux, &xp) - f) / h));
+            jac.set_column(j, &((f_of(&xp) - &f) / h));
         }
         let dx = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
             what: "steady state".into(),
@@ -57,26 +101,15 @@ pub fn equilibrium(panel: &Panel, coupling: Coupling, flux: f64) -> Result<Equil
         })?;
         // Damped update keeps the temperatures positive on wild parameter sets.
         let mut lambda = 1.0;
-        while x[0] + lambda * dx[0] <= 0.0 || x[1] + lambda * dx[1] <= 0.0 {
+        while (0..n).any(|i| x[i] + lambda * dx[i] <= 0.0) {
             lambda *= 0.5;
         }
-        x += dx * lambda;
-        if dx[0].abs() < 1e-12 * x[0] && dx[1].abs() < 1e-12 * x[1] && dx[2].abs() < 1e-14 {
-            let eq = Equilibrium {
-                t_front: x[0],
-                t_back: x[1],
-                theta: x[2],
-            };
-            if eq.theta.abs() >= std::f64::consts::FRAC_PI_2 {
-                return Err(Error::NoConvergence {
-                    what: "steady state".into(),
-                    reason: format!(
-                        "hinge angle {} rad is beyond 90°: the panel is far too soft",
-                        eq.theta
-                    ),
-                });
-            }
-            return Ok(eq);
+        x += &dx * lambda;
+        let temperatures_settled = (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]);
+        let shape_settled = (n..m).all(|i| dx[i].abs() < 1e-14);
+        if temperatures_settled && shape_settled {
+            structure.check_static(&x.as_slice()[n..])?;
+            return Ok(x);
         }
     }
     Err(Error::NoConvergence {
@@ -85,10 +118,46 @@ pub fn equilibrium(panel: &Panel, coupling: Coupling, flux: f64) -> Result<Equil
     })
 }
 
+/// The full state at rest of a system of dimension `dim` from a steady (temperatures,
+/// positions): the velocities zero.
+pub fn rest<D: Dim>(x: &DVector<f64>, dim: D) -> State<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let mut y = State::<D>::zeros_generic(dim, nalgebra::U1);
+    y.as_mut_slice()[..x.len()].copy_from_slice(x.as_slice());
+    y
+}
+
+/// The steady temperatures of a thermal model alone under `flux`, as a start state.
+pub fn thermal_start<T: ThermalModel + ?Sized>(
+    thermal: &T,
+    flux: f64,
+) -> Result<State<nalgebra::Dyn>> {
+    let x = steady(thermal, &crate::dynamics::Rigid, Coupling::Frozen, flux)?;
+    Ok(rest(&x, nalgebra::Dyn(thermal.size())))
+}
+
+/// The paper model's steady state: two layers and the hinge (whose static balance does not
+/// depend on the linear or non-linear form).
+pub fn equilibrium(panel: &Panel, coupling: Coupling, flux: f64) -> Result<Equilibrium> {
+    panel.validate()?;
+    let x = steady(
+        &TwoLayer::new(panel),
+        &Hinge::new(panel, HingeModel::Nonlinear),
+        coupling,
+        flux,
+    )?;
+    Ok(Equilibrium {
+        t_front: x[0],
+        t_back: x[1],
+        theta: x[2],
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::HingeModel;
     use crate::orbit::Orbit;
     use crate::system::Coupled;
 
@@ -105,12 +174,20 @@ mod tests {
             HingeModel::Nonlinear,
             Coupling::ProjectedArea,
         );
-        let rate = sys.rhs_at_flux(
-            1.0,
-            &nalgebra::Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-        );
+        let rate = sys.rhs_at_flux(1.0, &eq.state());
         assert!(rate.amax() < 1e-9, "{rate}");
         let frozen = equilibrium(&p, Coupling::Frozen, 1.0).unwrap();
         assert!(frozen.theta > eq.theta, "cos θ lowers the absorbed flux");
+    }
+
+    #[test]
+    fn thermal_start_is_the_isothermal_closed_form_for_one_node() {
+        let p = Panel::paper();
+        for flux in [1.0, 0.97] {
+            let one = crate::thermal::OneNode::new(&p);
+            let y = thermal_start(&one, flux).unwrap();
+            let exact = one.equilibrium(flux);
+            assert!((y[0] - exact).abs() <= 1e-13 * exact, "{} vs {exact}", y[0]);
+        }
     }
 }

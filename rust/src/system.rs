@@ -1,13 +1,15 @@
-//! The right-hand sides: the thermal models alone, the coupled thermo-structural system, and the
-//! hinge driven by a prescribed moment. Each implements [`OdeSystem`] on a fixed-size state.
+//! The right-hand sides: a thermal model coupled to a structural model (or alone), and the hinge
+//! driven by a prescribed moment. Each implements [`OdeSystem`].
 
-use crate::dynamics::{hinge_acceleration, sin_cos, HingeModel};
-use crate::integrate::OdeSystem;
+use crate::dynamics::{hinge_acceleration, Hinge, HingeModel, Rigid, StructuralModel};
+use crate::error::{Error, Result};
+use crate::integrate::{OdeSystem, State};
 use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
-use crate::thermal::{one_node_rate, two_layer_rates};
-use crate::STEFAN_BOLTZMANN;
-use nalgebra::{SVector, Vector1, Vector2, Vector4, U1, U2, U4};
+use crate::steady::{rest, steady};
+use crate::thermal::{AsWritten, Balance, ThermalModel, TwoLayer};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, DimName, Dyn, SVector, Vector2, Vector4, U1, U2, U4};
 
 /// How the hinge angle feeds back on the heating (paper Sec. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -21,8 +23,8 @@ pub enum Coupling {
 /// Illumination bookkeeping shared by every orbit-driven system: the segment being integrated
 /// decides s, so a step that ends on a shadow boundary sees the segment's own side.
 #[derive(Debug, Clone, Copy)]
-struct Sunlight {
-    orbit: Orbit,
+pub(crate) struct Sunlight {
+    pub(crate) orbit: Orbit,
     segment: (f64, f64),
     /// s over the current segment when it cannot change there: every segment of a cylindrical
     /// shadow, and the full-Sun and umbra segments of a penumbral one (the breakpoints include
@@ -31,7 +33,7 @@ struct Sunlight {
 }
 
 impl Sunlight {
-    fn new(orbit: Orbit) -> Self {
+    pub(crate) fn new(orbit: Orbit) -> Self {
         Sunlight {
             orbit,
             segment: (0.0, 0.0),
@@ -39,7 +41,7 @@ impl Sunlight {
         }
     }
 
-    fn enter(&mut self, a: f64, b: f64) {
+    pub(crate) fn enter(&mut self, a: f64, b: f64) {
         self.segment = (a, b);
         let mid = self.orbit.illumination_on(0.5 * (a + b), a, b);
         let varies = matches!(self.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
@@ -47,7 +49,7 @@ impl Sunlight {
     }
 
     #[inline]
-    fn flux(&self, t: f64) -> f64 {
+    pub(crate) fn flux(&self, t: f64) -> f64 {
         let s = match self.constant_s {
             Some(s) => s,
             None => {
@@ -59,179 +61,154 @@ impl Sunlight {
     }
 }
 
-/// Isothermal plate, state (T).
-#[derive(Debug, Clone, Copy)]
-pub struct OneNode {
-    pub panel: Panel,
-    sun: Sunlight,
-}
-
-impl OneNode {
-    pub fn new(panel: Panel, orbit: Orbit) -> Self {
-        OneNode {
-            panel,
-            sun: Sunlight::new(orbit),
-        }
-    }
-}
-
-impl OdeSystem<U1> for OneNode {
-    #[inline]
-    fn rhs(&self, t: f64, y: &Vector1<f64>) -> Vector1<f64> {
-        Vector1::new(one_node_rate(&self.panel, self.sun.flux(t), y[0]))
-    }
-    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
-        self.sun.orbit.breakpoints(t0, t1)
-    }
-    fn enter_segment(&mut self, a: f64, b: f64) {
-        self.sun.enter(a, b);
-    }
-}
-
-/// Two-layer plate without structure (θ = 0), state (T_f, T_b).
-#[derive(Debug, Clone, Copy)]
-pub struct TwoLayer {
-    pub panel: Panel,
-    sun: Sunlight,
-}
-
-impl TwoLayer {
-    pub fn new(panel: Panel, orbit: Orbit) -> Self {
-        TwoLayer {
-            panel,
-            sun: Sunlight::new(orbit),
-        }
-    }
-}
-
-impl OdeSystem<U2> for TwoLayer {
-    #[inline]
-    fn rhs(&self, t: f64, y: &Vector2<f64>) -> Vector2<f64> {
-        let (df, db) = two_layer_rates(&self.panel, self.sun.flux(t), y[0], y[1]);
-        Vector2::new(df, db)
-    }
-    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
-        self.sun.orbit.breakpoints(t0, t1)
-    }
-    fn enter_segment(&mut self, a: f64, b: f64) {
-        self.sun.enter(a, b);
-    }
-}
-
-/// The coupled thermo-structural system, state (T_f, T_b, θ, θ̇) (paper eqs. 20 and 28).
+/// A thermal model and a structural model coupled through the thermal moment (thermal →
+/// structure) and the projected-area factor (structure → thermal), driven by the orbit's Sun.
 ///
-/// The panel's coefficients are folded into per-second rates once, in [`Coupled::new`]; the
-/// system keeps only those.
+/// State: the thermal model's temperatures, then the structural model's states; `D` is its
+/// dimension, `Const<N>` when N is known at compile time (the paper's model, [`Coupled::new`]:
+/// (T_f, T_b, θ, θ̇)) or `Dyn`. Each model keeps its coefficients folded into per-second rates;
+/// the moment's division by the structure's inertia is folded here, once.
 #[derive(Debug, Clone, Copy)]
-pub struct Coupled {
-    model: HingeModel,
+pub struct Coupled<T = TwoLayer, S = Hinge, D = U4> {
+    thermal: T,
+    structure: S,
     coupling: Coupling,
     sun: Sunlight,
-    rates: Rates,
+    /// M_T per kelvin of the thermal gradient over the structure's inertia.
+    load_per_kelvin: f64,
+    dim: D,
 }
 
-/// The coupled right-hand side's coefficients, each divided by the capacity or inertia it is
-/// divided by in eqs. 2, 20 and 28, so that the hot path holds no division but the inertia factor.
+impl Coupled<TwoLayer, Hinge, U4> {
+    /// The paper's model: two layers (eq. 2) and the hinge (eq. 20 or 28).
+    pub fn new(panel: Panel, orbit: Orbit, model: HingeModel, coupling: Coupling) -> Self {
+        let (thermal, structure) = (TwoLayer::new(&panel), Hinge::new(&panel, model));
+        Self::compose(thermal, structure, orbit, coupling, U4::name())
+            .expect("two temperatures and two hinge states make four")
+    }
+}
+
+/// What a kernel that evaluates [`Coupled::rhs_at_flux`] of the panel model for several panels at
+/// once needs, so that it can do the same arithmetic lane by lane (the ensemble's lockstep lanes).
 #[derive(Debug, Clone, Copy)]
-struct Rates {
-    /// α C / (m c / 2), K/s per unit flux factor.
-    heating: f64,
-    /// K / (m c / 2), 1/s.
-    conduction: f64,
-    /// σ ε_f / (m c / 2) and σ ε_b / (m c / 2), 1/(s K³).
-    radiation_front: f64,
-    radiation_back: f64,
-    /// (χ a E I / d) / I_B, 1/(s² K).
-    moment: f64,
-    /// c_d / I_B, 1/s.
-    damping: f64,
-    /// K_el / I_B, 1/s².
-    stiffness: f64,
+pub(crate) struct LaneForm {
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    /// The two-layer balance per half capacity.
+    pub balance: Balance,
+    /// Thermal moment per kelvin over I_B.
+    pub load_per_kelvin: f64,
+    /// c_d / I_B and K_el / I_B.
+    pub damping: f64,
+    pub stiffness: f64,
 }
 
-impl Rates {
-    fn new(panel: &Panel) -> Self {
-        let half_capacity = 0.5 * panel.heat_capacity();
-        let inertia = panel.hinge_inertia();
-        Rates {
-            heating: panel.absorptivity * panel.solar_constant / half_capacity,
-            conduction: panel.conductance / half_capacity,
-            radiation_front: STEFAN_BOLTZMANN * panel.emissivity_front / half_capacity,
-            radiation_back: STEFAN_BOLTZMANN * panel.emissivity_back / half_capacity,
-            moment: panel.moment_per_kelvin() / inertia,
-            damping: panel.damping / inertia,
-            stiffness: panel.hinge_stiffness / inertia,
+impl Coupled<TwoLayer, Hinge, U4> {
+    pub(crate) fn lane_form(&self) -> LaneForm {
+        let (model, damping, stiffness) = self.structure.rate_form();
+        LaneForm {
+            model,
+            coupling: self.coupling,
+            balance: self.thermal.rate_balance(),
+            load_per_kelvin: self.load_per_kelvin,
+            damping,
+            stiffness,
         }
     }
 }
 
-impl Coupled {
-    pub fn new(panel: Panel, orbit: Orbit, model: HingeModel, coupling: Coupling) -> Self {
-        Coupled {
-            model,
+impl<T: ThermalModel> Coupled<AsWritten<T>, Rigid, Dyn> {
+    /// A thermal model alone, the plate held flat (θ = 0), its rates as written.
+    pub fn thermal_only(thermal: T, orbit: Orbit) -> Self {
+        let n = thermal.size();
+        Self::compose(AsWritten(thermal), Rigid, orbit, Coupling::Frozen, Dyn(n))
+            .expect("the state is the temperatures")
+    }
+}
+
+impl<T: ThermalModel, S: StructuralModel, D: Dim> Coupled<T, S, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// Couples `thermal` and `structure`; `dim` must hold both models' states.
+    pub fn compose(
+        thermal: T,
+        structure: S,
+        orbit: Orbit,
+        coupling: Coupling,
+        dim: D,
+    ) -> Result<Self> {
+        let n = thermal.size() + structure.size();
+        if dim.value() != n {
+            return Err(Error::invalid(
+                "state size",
+                dim.value(),
+                &format!("the models have {n} states"),
+            ));
+        }
+        Ok(Coupled {
+            load_per_kelvin: thermal.moment_per_kelvin() / structure.inertia(),
+            thermal,
+            structure,
             coupling,
             sun: Sunlight::new(orbit),
-            rates: Rates::new(&panel),
-        }
+            dim,
+        })
     }
 
-    /// Projected-area factor of the absorbed flux.
-    #[inline]
-    pub fn area_factor(coupling: Coupling, theta: f64) -> f64 {
-        match coupling {
-            Coupling::ProjectedArea => theta.cos(),
-            Coupling::Frozen => 1.0,
-        }
+    pub fn thermal(&self) -> &T {
+        &self.thermal
+    }
+
+    pub fn structure(&self) -> &S {
+        &self.structure
+    }
+
+    pub fn orbit(&self) -> &Orbit {
+        &self.sun.orbit
+    }
+
+    /// The state's dimension.
+    pub fn dim(&self) -> D {
+        self.dim
+    }
+
+    /// The thermal moment in state `y`, N m.
+    pub fn moment(&self, y: &State<D>) -> f64 {
+        self.thermal.moment(&y.as_slice()[..self.thermal.size()])
+    }
+
+    /// The steady state under constant flux factor `flux`, velocities zero: the default start
+    /// of a run.
+    pub fn steady_state(&self, flux: f64) -> Result<State<D>> {
+        let x = steady(&self.thermal, &self.structure, self.coupling, flux)?;
+        Ok(rest(&x, self.dim))
+    }
+
+    /// Names of the state's components, temperatures first.
+    pub fn names(&self) -> Vec<String> {
+        let mut names = self.thermal.names();
+        names.extend(self.structure.names());
+        names
     }
 
     /// The right-hand side at a given illumination factor (used by the equilibrium solver too).
-    ///
-    /// The same equations as [`two_layer_rates`], [`crate::dynamics::thermal_moment`] and
-    /// [`hinge_acceleration`],
-    /// with sin θ and cos θ computed once and the coefficients taken from [`Rates`].
     #[inline(always)]
-    pub fn rhs_at_flux(&self, flux: f64, y: &Vector4<f64>) -> Vector4<f64> {
-        let (sin, cos) = match (self.coupling, self.model) {
-            (Coupling::Frozen, HingeModel::Linear) => (0.0, 1.0),
-            _ => sin_cos(y[2]),
+    pub fn rhs_at_flux(&self, flux: f64, y: &State<D>) -> State<D> {
+        let mut out = State::<D>::zeros_generic(self.dim, U1);
+        let n = self.thermal.size();
+        let (temps, q) = y.as_slice().split_at(n);
+        let (temp_rates, q_rates) = out.as_mut_slice().split_at_mut(n);
+        let load = self.load_per_kelvin * self.thermal.gradient(temps);
+        let area = match self.coupling {
+            Coupling::ProjectedArea => self.structure.rates(load, q, q_rates),
+            Coupling::Frozen => {
+                self.structure.rates(load, q, q_rates);
+                1.0
+            }
         };
-        let r = &self.rates;
-        let c = [
-            r.heating,
-            r.conduction,
-            r.radiation_front,
-            r.radiation_back,
-            r.moment,
-            r.damping,
-            r.stiffness,
-        ];
-        let [dtf, dtb, om, acc] = coupled_rates(
-            self.model,
-            self.coupling,
-            &c,
-            flux,
-            &[y[0], y[1], y[2], y[3]],
-            sin,
-            cos,
-        );
-        Vector4::new(dtf, dtb, om, acc)
-    }
-
-    /// The hinge model, the coupling and the folded coefficients (heating, conduction,
-    /// radiation front and back, moment, damping, stiffness), for kernels that evaluate
-    /// [`Coupled::rhs_at_flux`] for several panels at once with the same arithmetic.
-    pub(crate) fn lane_form(&self) -> (HingeModel, Coupling, [f64; 7]) {
-        let r = &self.rates;
-        let c = [
-            r.heating,
-            r.conduction,
-            r.radiation_front,
-            r.radiation_back,
-            r.moment,
-            r.damping,
-            r.stiffness,
-        ];
-        (self.model, self.coupling, c)
+        self.thermal.rates(flux * area, temps, temp_rates);
+        out
     }
 
     /// Illumination factor (s × flux scale) inside the current segment at time t.
@@ -240,9 +217,12 @@ impl Coupled {
     }
 }
 
-impl OdeSystem<U4> for Coupled {
+impl<T: ThermalModel, S: StructuralModel, D: Dim> OdeSystem<D> for Coupled<T, S, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
     #[inline(always)]
-    fn rhs(&self, t: f64, y: &Vector4<f64>) -> Vector4<f64> {
+    fn rhs(&self, t: f64, y: &State<D>) -> State<D> {
         self.rhs_at_flux(self.sun.flux(t), y)
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
@@ -251,43 +231,6 @@ impl OdeSystem<U4> for Coupled {
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
-}
-
-/// The coupled right-hand side (T_f', T_b', θ', θ̇') at state `y` and illumination `flux`, from
-/// the coefficients of [`Rates`] in field order (heating, conduction, radiation front and back,
-/// moment, damping, stiffness) and sin θ, cos θ (0 and 1 when unused). Its arithmetic lives
-/// here once, for [`Coupled::rhs_at_flux`] and for the ensemble's lockstep kernel, which must
-/// give the same bits.
-#[inline(always)]
-pub(crate) fn coupled_rates(
-    model: HingeModel,
-    coupling: Coupling,
-    c: &[f64; 7],
-    flux: f64,
-    y: &[f64; 4],
-    sin: f64,
-    cos: f64,
-) -> [f64; 4] {
-    let [heating, conduction, radiation_front, radiation_back, moment, damping, stiffness] = *c;
-    let [tf, tb, th, om] = *y;
-    let area = match coupling {
-        Coupling::ProjectedArea => cos,
-        Coupling::Frozen => 1.0,
-    };
-    let gradient = tf - tb;
-    let conducted = conduction * gradient;
-    let tf4 = (tf * tf) * (tf * tf);
-    let tb4 = (tb * tb) * (tb * tb);
-    let dtf = heating * (flux * area) - conducted - radiation_front * tf4;
-    let dtb = conducted - radiation_back * tb4;
-    // Generalised moment over I_B: M_T − c_d θ̇ − K_el θ.
-    let forced = moment * gradient - damping * om - stiffness * th;
-    let acc = match model {
-        HingeModel::Linear => forced,
-        // eq. 20 with 3/(2 m l³) = 1/I_B factored out
-        HingeModel::Nonlinear => (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin),
-    };
-    [dtf, dtb, om, acc]
 }
 
 /// A thermal-moment history M(t), N m: constant, or linear between samples (held at the ends).
@@ -318,8 +261,7 @@ impl MomentHistory {
     }
 
     /// Checks sample times increasing and values finite.
-    pub fn validate(&self) -> crate::Result<()> {
-        use crate::Error;
+    pub fn validate(&self) -> Result<()> {
         match self {
             MomentHistory::Constant(m) => crate::error::require_finite("moment", *m),
             MomentHistory::Samples { t, moment } => {
@@ -386,6 +328,7 @@ pub fn state(t_front: f64, t_back: f64, theta: f64, theta_dot: f64) -> SVector<f
 mod tests {
     use super::*;
     use crate::dynamics::thermal_moment;
+    use crate::thermal::two_layer_rates;
 
     /// The folded coefficients give the rates of the textbook form of the equations.
     #[test]
@@ -405,7 +348,10 @@ mod tests {
                 for y in &states {
                     for flux in [0.0, 1.0, 0.97] {
                         let got = sys.rhs_at_flux(flux, y);
-                        let area = Coupled::area_factor(coupling, y[2]);
+                        let area = match coupling {
+                            Coupling::ProjectedArea => y[2].cos(),
+                            Coupling::Frozen => 1.0,
+                        };
                         let (dtf, dtb) = two_layer_rates(&panel, flux * area, y[0], y[1]);
                         let m = thermal_moment(&panel, y[0], y[1]);
                         let acc = hinge_acceleration(&panel, model, m, y[2], y[3]);

@@ -21,9 +21,10 @@ use super::dopri5::{
     self, A21, A3, A4, A5, A6, B, B_HAT, C, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY,
 };
 use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
-use crate::dynamics::{sin_cos_kernel, HingeModel};
+use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::error::{Error, Result};
-use crate::system::{coupled_rates, Coupled, Coupling};
+use crate::system::{Coupled, Coupling, LaneForm};
+use crate::thermal::Balance;
 use nalgebra::Vector4;
 use std::f64::consts::FRAC_PI_4;
 
@@ -110,7 +111,8 @@ struct Pack {
     h: V,
     y0: [V; 4],
     k1: [V; 4],
-    /// The folded coefficients of each lane's system (see [`Coupled::lane_form`]).
+    /// Each lane's coefficients: the balance (heating, conduction, radiation front and back),
+    /// then load per kelvin, damping and stiffness (see [`Coupled::lane_form`]).
     coef: [V; 7],
     atol: V,
     rtol: V,
@@ -194,22 +196,28 @@ fn rhs_lanes_of(model: HingeModel, coupling: Coupling, p: &Pack, flux: &V, y: &[
             }
         }
     }
+    // `Coupled::rhs_at_flux` of the two-layer plate on the hinge, lane by lane.
     let mut out = [ZERO; 4];
     for l in 0..LANES {
-        let c = [
-            p.coef[0][l],
-            p.coef[1][l],
-            p.coef[2][l],
-            p.coef[3][l],
-            p.coef[4][l],
-            p.coef[5][l],
-            p.coef[6][l],
-        ];
-        let y = [y[0][l], y[1][l], y[2][l], y[3][l]];
-        let r = coupled_rates(model, coupling, &c, flux[l], &y, sin[l], cos[l]);
-        for i in 0..4 {
-            out[i][l] = r[i];
-        }
+        let balance = Balance {
+            heating: p.coef[0][l],
+            conduction: p.coef[1][l],
+            radiation_front: p.coef[2][l],
+            radiation_back: p.coef[3][l],
+        };
+        let (tf, tb, th, om) = (y[0][l], y[1][l], y[2][l], y[3][l]);
+        let load = p.coef[4][l] * (tf - tb);
+        let forced = generalised_moment(load, p.coef[5][l], p.coef[6][l], th, om);
+        let acc = angular_acceleration(model, forced, om, sin[l], cos[l]);
+        let area = match coupling {
+            Coupling::ProjectedArea => cos[l],
+            Coupling::Frozen => 1.0,
+        };
+        let (front, back) = balance.flows(flux[l] * area, tf, tb);
+        out[0][l] = front;
+        out[1][l] = back;
+        out[2][l] = om;
+        out[3][l] = acc;
     }
     out
 }
@@ -463,7 +471,17 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
 
     /// Loads what stays fixed over the run into lane `l` of `p`.
     fn load(&self, p: &mut Pack, l: usize) {
-        let (_, _, coef) = self.system.lane_form();
+        let f = self.system.lane_form();
+        let b = f.balance;
+        let coef = [
+            b.heating,
+            b.conduction,
+            b.radiation_front,
+            b.radiation_back,
+            f.load_per_kelvin,
+            f.damping,
+            f.stiffness,
+        ];
         for (c, v) in p.coef.iter_mut().zip(coef) {
             c[l] = v;
         }
@@ -555,7 +573,9 @@ where
                     exhausted = true;
                     break;
                 };
-                let (model, coupling, _) = job.system.lane_form();
+                let LaneForm {
+                    model, coupling, ..
+                } = job.system.lane_form();
                 let (m, c) = *form.get_or_insert((model, coupling));
                 if (model, coupling) != (m, c) {
                     let outcome = solve(

@@ -2,11 +2,13 @@
 
 use super::error::invalid;
 use crate::dynamics::HingeModel;
+use crate::integrate::State;
 use crate::integrate::{Method, Tolerances};
 use crate::orbit::Shadow;
 use crate::simulate::Output;
 use crate::{Orbit, Panel};
-use nalgebra::SVector;
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, U1};
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -193,12 +195,17 @@ pub fn output(
     Ok(out)
 }
 
-pub fn state<const N: usize>(v: &[f64]) -> PyResult<SVector<f64, N>> {
-    if v.len() != N {
+/// A start state of dimension `dim` (`U4`, or `Dyn(n)` for a size known at run time).
+pub fn state<D: Dim>(v: &[f64], dim: D) -> PyResult<State<D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let n = dim.value();
+    if v.len() != n {
         return Err(invalid(
             "y0",
             format!("{v:?}"),
-            &format!("must have {N} components, not {}", v.len()),
+            &format!("must have {n} components, not {}", v.len()),
         ));
     }
     if let Some(x) = v.iter().find(|x| !x.is_finite()) {
@@ -208,5 +215,5 @@ pub fn state<const N: usize>(v: &[f64]) -> PyResult<SVector<f64, N>> {
             &format!("component {x} is not finite"),
         ));
     }
-    Ok(SVector::from_column_slice(v))
+    Ok(State::from_column_slice_generic(dim, U1, v))
 }

@@ -5,6 +5,7 @@ use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
 use super::error::shield;
 use crate::summary::{run_orbits_cancellable as run, SummaryOptions};
 use crate::system::Coupling;
+use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -41,7 +42,7 @@ fn run_orbits<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
-        let y = state::<4>(&y0)?;
+        let y = state(&y0, U4)?;
         let options = SummaryOptions {
             window,
             theta_limit,

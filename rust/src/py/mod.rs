@@ -4,6 +4,7 @@
 mod beam;
 mod cancel;
 mod convert;
+mod distributed;
 mod ensemble;
 mod error;
 mod flutter;
@@ -11,15 +12,17 @@ mod longrun;
 mod orbit;
 
 use crate::dynamics::hinge_energy;
-use crate::dynamics::thermal_moment;
+use crate::dynamics::{thermal_moment, Hinge, StructuralModel};
+use crate::integrate::State;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
 use crate::simulate::{run, Trajectory};
 use crate::steady::equilibrium;
-use crate::system::{Coupled, Coupling, DrivenHinge, MomentHistory, OneNode, TwoLayer};
+use crate::system::{Coupled, Coupling, DrivenHinge, MomentHistory};
+use crate::thermal::ThermalModel;
 use convert::{hinge_model, orbit_from, output, panel_from, solver_from, state};
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, SVector};
+use nalgebra::{DefaultAllocator, Dim, Dyn, U2};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -194,9 +197,9 @@ fn energy<'py>(
     })
 }
 
-/// Integrates the coupled thermo-structural system.
+/// Integrates the coupled thermo-structural system: the thermal model with `layers`, the hinge.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, layers=2))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -210,6 +213,7 @@ fn simulate<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
+    layers: u32,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let p = panel_from(panel)?;
@@ -222,33 +226,51 @@ fn simulate<'py>(
         };
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
-        let y_start: SVector<f64, 4> = match y0 {
-            Some(v) => state::<4>(&v)?,
-            None => {
-                let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
-                SVector::<f64, 4>::new(eq.t_front, eq.t_back, eq.theta, 0.0)
-            }
-        };
-        let traj = py.detach(|| {
-            let mut sys = Coupled::new(p, o, hinge, coupling);
-            run(&mut sys, &m, (t0, t1), y_start, &out)
-        })?;
-        let d = run_info(py, &traj)?;
-        let (tf, tb) = (column(&traj, 0), column(&traj, 1));
-        let mt: Vec<f64> = tf
-            .iter()
-            .zip(&tb)
-            .map(|(&f, &b)| thermal_moment(&p, f, b))
-            .collect();
-        let sunlit: Vec<f64> = traj.t.iter().map(|&t| o.illumination(t)).collect();
-        d.set_item(intern!(py, "T_front"), array(py, tf))?;
-        d.set_item(intern!(py, "T_back"), array(py, tb))?;
-        d.set_item(intern!(py, "theta"), array(py, column(&traj, 2)))?;
-        d.set_item(intern!(py, "theta_dot"), array(py, column(&traj, 3)))?;
-        d.set_item(intern!(py, "thermal_moment"), array(py, mt))?;
-        d.set_item(intern!(py, "sunlit"), array(py, sunlit))?;
-        Ok(d)
+        if layers == 2 {
+            // The paper's model, its state size known at compile time.
+            let sys = Coupled::new(p, o, hinge, coupling);
+            return run_coupled(py, sys, &m, (t0, t1), y0, &out);
+        }
+        let thermal = crate::thermal::model(&p, layers)?;
+        let n = thermal.size() + 2;
+        let structure = Hinge::new(&p, hinge);
+        let sys = Coupled::compose(thermal, structure, o, coupling, Dyn(n))?;
+        run_coupled(py, sys, &m, (t0, t1), y0, &out)
     })
+}
+
+/// Runs a coupled system from `y0` (default: its steady state at t0's flux) and returns every
+/// state component under its model's name, the thermal moment and the illumination.
+fn run_coupled<'py, T, S, D>(
+    py: Python<'py>,
+    mut sys: Coupled<T, S, D>,
+    method: &crate::integrate::Method,
+    span: (f64, f64),
+    y0: Option<Vec<f64>>,
+    out: &crate::simulate::Output,
+) -> PyResult<Bound<'py, PyDict>>
+where
+    T: ThermalModel + Send,
+    S: StructuralModel + Send,
+    D: Dim + Send,
+    DefaultAllocator: Allocator<D>,
+    State<D>: Send,
+{
+    let orbit = *sys.orbit();
+    let y_start = match y0 {
+        Some(v) => state(&v, sys.dim())?,
+        None => sys.steady_state(orbit.flux_scale(span.0))?,
+    };
+    let traj = py.detach(|| run(&mut sys, method, span, y_start, out))?;
+    let d = run_info(py, &traj)?;
+    for (i, name) in sys.names().iter().enumerate() {
+        d.set_item(name, array(py, column(&traj, i)))?;
+    }
+    let moment: Vec<f64> = traj.y.iter().map(|y| sys.moment(y)).collect();
+    let sunlit: Vec<f64> = traj.t.iter().map(|&t| orbit.illumination(t)).collect();
+    d.set_item(intern!(py, "thermal_moment"), array(py, moment))?;
+    d.set_item(intern!(py, "sunlit"), array(py, sunlit))?;
+    Ok(d)
 }
 
 /// Integrates a thermal model alone: one node (eq. 1) or two layers (eq. 2, θ = 0).
@@ -272,38 +294,22 @@ fn simulate_thermal<'py>(
         let o = orbit_from(orbit)?;
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
-        match layers {
-            1 => {
-                let y_start = match y0 {
-                    Some(v) => state::<1>(&v)?,
-                    None => SVector::<f64, 1>::new(crate::thermal::one_node_equilibrium(
-                        &p,
-                        o.flux_scale(t0),
-                    )),
-                };
-                let traj =
-                    py.detach(|| run(&mut OneNode::new(p, o), &m, (t0, t1), y_start, &out))?;
-                let d = run_info(py, &traj)?;
-                d.set_item("T", array(py, column(&traj, 0)))?;
-                Ok(d)
-            }
-            2 => {
-                let y_start = match y0 {
-                    Some(v) => state::<2>(&v)?,
-                    None => {
-                        let eq = equilibrium(&p, Coupling::Frozen, o.flux_scale(t0))?;
-                        SVector::<f64, 2>::new(eq.t_front, eq.t_back)
-                    }
-                };
-                let traj =
-                    py.detach(|| run(&mut TwoLayer::new(p, o), &m, (t0, t1), y_start, &out))?;
-                let d = run_info(py, &traj)?;
-                d.set_item("T_front", array(py, column(&traj, 0)))?;
-                d.set_item("T_back", array(py, column(&traj, 1)))?;
-                Ok(d)
-            }
-            other => Err(invalid("layers", other, "must be 1 or 2")),
+        let thermal = crate::thermal::model(&p, layers)?;
+        let names = thermal.names();
+        let dim = Dyn(thermal.size());
+        let y_start = match y0 {
+            Some(v) => state(&v, dim)?,
+            None => crate::steady::thermal_start(&thermal, o.flux_scale(t0))?,
+        };
+        let traj = py.detach(|| {
+            let mut sys = Coupled::thermal_only(thermal, o);
+            run(&mut sys, &m, (t0, t1), y_start, &out)
+        })?;
+        let d = run_info(py, &traj)?;
+        for (i, name) in names.iter().enumerate() {
+            d.set_item(name, array(py, column(&traj, i)))?;
         }
+        Ok(d)
     })
 }
 
@@ -345,7 +351,7 @@ fn simulate_hinge<'py>(
             },
         };
         history.validate()?;
-        let y_start = state::<2>(&y0)?;
+        let y_start = state(&y0, U2)?;
         let traj = py.detach(|| {
             let mut sys = DrivenHinge {
                 panel: p,
@@ -383,6 +389,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     longrun::register(m)?;
     beam::register(m)?;
+    distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;
     cancel::register(m)?;

@@ -1,0 +1,420 @@
+"""The distributed panel: finite elements, each with its own temperatures and its own sunlight.
+
+The hinge model lumps the panel into two rigid halves; the beam comparator loads a free–free beam
+with the hinge model's moment, one way. Here the panel is a chain of Euler–Bernoulli elements,
+two-way coupled: every element carries its own two-layer heat balance, absorbs sunlight at its own
+incidence — the Sun's angle to the element's deformed normal, rigid attitude ``sun_angle`` plus
+the elastic rotation of its chord — and bends under its own thermal moment. The structure is
+reduced to its first ``modes`` elastic modes (the rest quasi-static), so the step size follows the
+physics, not the mesh.
+
+Supports: ``"free-free"`` (the paper's panel, attitude held by the spacecraft; θ_f = asin(2η/L),
+η the tip rise over the centre, as the beam comparator defines it) and ``"cantilever"`` (clamped
+at x = 0 to a rigid bus; θ_f = asin(w(L)/L), the angle of a rigid arm hinged at the root with the
+same tip deflection).
+
+    sol = tj.simulate_distributed(panel, orbit, (t0, t1))
+    sol.theta_f, sol.T_front  # (time,), (time, element)
+    fl = tj.distributed_flutter(panel)
+    fl.growth_rate, fl.critical_damping_ratio, fl.critical_damping
+
+The equations, the mesh and the modal reduction live in the engine (``rust/src/distributed``);
+this module checks types, converts and presents.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from thermojitter import _core
+from thermojitter.errors import flag, real, type_name
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Panel
+from thermojitter.results import _Run
+from thermojitter.simulate import Method, _check_inputs, _solver_args, _span
+
+Array = NDArray[np.float64]
+Support = Literal["free-free", "cantilever"]
+
+
+def distributed_settings(
+    panel: Panel,
+    *,
+    support: Support = "free-free",
+    elements: int | None = None,
+    modes: int | None = None,
+    damping_ratio: float | None = None,
+    sun_angle: float = 0.0,
+    coupled: bool = True,
+) -> dict[str, Any]:
+    """The model settings as the engine takes them; ``None`` picks the engine's default (see
+    :func:`distributed_defaults`). The engine checks the values and names any bad one."""
+    _check_inputs(panel)
+    if not isinstance(support, str):
+        raise TypeError(f"support must be a string, not {type_name(support)}")
+    defaults = _core.distributed_defaults(panel.as_dict())
+    counts = {}
+    for name, value in (("elements", elements), ("modes", modes)):
+        if value is None:
+            value = defaults[name]
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            raise TypeError(f"{name} must be an integer, not {type_name(value)}")
+        counts[name] = int(value)
+    return {
+        "support": support,
+        "elements": counts["elements"],
+        "modes": counts["modes"],
+        "damping_ratio": None if damping_ratio is None else real("damping_ratio", damping_ratio),
+        "sun_angle": real("sun_angle", sun_angle),
+        "coupled": flag("coupled", coupled),
+    }
+
+
+def distributed_defaults(panel: Panel | None = None) -> dict[str, Any]:
+    """The engine's default settings: support, elements, modes, damping_ratio (the
+    hinge-equivalent ζ = c_d/(2 I_B ω₁) of ``panel``, default Table 1) and sun_angle (rad)."""
+    panel = Panel.paper() if panel is None else panel
+    _check_inputs(panel)
+    return dict(_core.distributed_defaults(panel.as_dict()))
+
+
+@dataclass(frozen=True)
+class DistributedSolution(_Run):
+    """The distributed panel at the reported times.
+
+    ``x``: element centres (m), ``x_node``: nodes (m). ``T_front``/``T_back`` (K) and
+    ``thermal_moment`` (N m) have shape (time, element); ``deflection`` (m, positive away from
+    the Sun) and ``slope`` (rad) have shape (time, node); ``theta_f`` (rad) is the
+    hinge-equivalent angle; ``sunlit`` the illuminated fraction s(t).
+    """
+
+    x: Array = field(default_factory=lambda: np.empty(0))
+    x_node: Array = field(default_factory=lambda: np.empty(0))
+    T_front: Array = field(default_factory=lambda: np.empty((0, 0)))
+    T_back: Array = field(default_factory=lambda: np.empty((0, 0)))
+    thermal_moment: Array = field(default_factory=lambda: np.empty((0, 0)))
+    deflection: Array = field(default_factory=lambda: np.empty((0, 0)))
+    slope: Array = field(default_factory=lambda: np.empty((0, 0)))
+    theta_f: Array = field(default_factory=lambda: np.empty(0))
+    sunlit: Array = field(default_factory=lambda: np.empty(0))
+    y_end: Array = field(default_factory=lambda: np.empty(0))
+    support: str = "free-free"
+    frequencies_hz: Array = field(default_factory=lambda: np.empty(0))
+    """The kept elastic modes' frequencies, Hz."""
+    damping_ratio: float = 0.0
+
+    @property
+    def theta_f_deg(self) -> Array:
+        return np.degrees(self.theta_f)
+
+    @property
+    def delta_T(self) -> Array:
+        """T_front − T_back per element, K, shape (time, element)."""
+        return self.T_front - self.T_back
+
+    def _columns(self) -> dict[str, Array]:
+        return {
+            "theta_f": self.theta_f,
+            "tip_deflection": self.deflection[:, -1],
+            "sunlit": self.sunlit,
+        }
+
+    def to_xarray(self) -> Any:
+        """An xarray Dataset: element fields over (time, x), nodal fields over (time, x_node),
+        θ_f and s over time; needs xarray."""
+        try:
+            import xarray as xr
+        except ImportError as exc:  # pragma: no cover
+            raise ImportError(
+                "to_xarray() needs xarray: pip install 'thermojitter[dataframes]'"
+            ) from exc
+        return xr.Dataset(
+            {
+                "T_front": (("time", "x"), self.T_front, {"units": "K"}),
+                "T_back": (("time", "x"), self.T_back, {"units": "K"}),
+                "thermal_moment": (("time", "x"), self.thermal_moment, {"units": "N m"}),
+                "deflection": (("time", "x_node"), self.deflection, {"units": "m"}),
+                "slope": (("time", "x_node"), self.slope, {"units": "rad"}),
+                "theta_f": ("time", self.theta_f, {"units": "rad"}),
+                "sunlit": ("time", self.sunlit),
+            },
+            coords={
+                "time": ("time", self.t, {"units": "s"}),
+                "x": ("x", self.x, {"units": "m", "long_name": "element centre"}),
+                "x_node": ("x_node", self.x_node, {"units": "m", "long_name": "node"}),
+            },
+            attrs={
+                "method": self.method,
+                "support": self.support,
+                **{k: str(v) for k, v in self.settings.items()},
+            },
+        )
+
+
+def simulate_distributed(
+    panel: Panel,
+    orbit: Orbit,
+    t_span: Sequence[float],
+    *,
+    support: Support = "free-free",
+    elements: int | None = None,
+    modes: int | None = None,
+    coupled: bool = True,
+    damping_ratio: float | None = None,
+    sun_angle: float = 0.0,
+    method: Method = "rk45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt: float | None = None,
+    max_step: float = math.inf,
+    max_steps: int = 500_000_000,
+    t_eval: ArrayLike | None = None,
+    dt_out: float | None = None,
+    y0: ArrayLike | None = None,
+) -> DistributedSolution:
+    """Integrates the distributed panel over ``t_span`` (s) on ``orbit``, through its eclipses
+    and penumbrae.
+
+    - ``support``: ``"free-free"`` or ``"cantilever"``; ``sun_angle`` ψ (rad): the Sun's angle to
+      the undeformed front normal (0: Sun-pointing; |ψ| < π/2). With ψ > 0 the Sun lies on the
+      side where thermal bending (away from the Sun) turns the elements further from it.
+    - ``elements``, ``modes``: the mesh and the number of elastic modes integrated (default
+      :func:`distributed_defaults`; the others follow quasi-statically).
+    - ``coupled=False`` freezes every element's absorbing area at cos ψ (one-way coupling).
+    - ``damping_ratio`` ζ of every kept mode; default the hinge-equivalent c_d/(2 I_B ω₁).
+    - Integrator and output as :func:`thermojitter.simulate`; ``y0`` the state
+      (T_front[n], T_back[n], q[k], q̇[k]), default the sunlit equilibrium at the start's flux.
+    """
+    _check_inputs(panel, orbit)
+    t0, t1 = _span(t_span)
+    settings = distributed_settings(
+        panel,
+        support=support,
+        elements=elements,
+        modes=modes,
+        damping_ratio=damping_ratio,
+        sun_angle=sun_angle,
+        coupled=coupled,
+    )
+    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    start = None if y0 is None else np.ascontiguousarray(np.asarray(y0, dtype=float).ravel())
+    raw = _core.simulate_distributed(
+        panel.as_dict(), orbit.as_dict(), settings, t0, t1, y0=start, **args
+    )
+    return DistributedSolution(
+        t=raw["t"],
+        n_steps=int(raw["n_steps"]),
+        n_rejected=int(raw["n_rejected"]),
+        n_rhs=int(raw["n_rhs"]),
+        method=method,
+        settings={
+            **settings,
+            "damping_ratio": float(raw["damping_ratio"]),
+            "rtol": rtol,
+            "atol": atol,
+            "dt": dt,
+        },
+        x=raw["x"],
+        x_node=raw["x_node"],
+        T_front=raw["T_front"],
+        T_back=raw["T_back"],
+        thermal_moment=raw["thermal_moment"],
+        deflection=raw["deflection"],
+        slope=raw["slope"],
+        theta_f=raw["theta_f"],
+        sunlit=raw["sunlit"],
+        y_end=raw["y_end"],
+        support=support,
+        frequencies_hz=raw["frequencies_hz"],
+        damping_ratio=float(raw["damping_ratio"]),
+    )
+
+
+@dataclass(frozen=True)
+class OscillatoryMode:
+    """One oscillatory eigen-pair of the linearised distributed panel: growth rate Re λ (1/s),
+    frequency Im λ/2π (Hz), and the kept structural mode nearest in frequency (0: the first)."""
+
+    growth_rate: float
+    frequency_hz: float
+    structural_mode: int
+
+
+@dataclass(frozen=True)
+class DistributedFlutterResult:
+    """Linear stability of the distributed panel's sunlit equilibrium.
+
+    ``growth_rate`` (1/s) is the largest real part of all eigenvalues; ``oscillatory_modes`` lists
+    each oscillatory pair by ascending frequency. ``critical_damping_ratio`` is the modal ζ (every
+    kept mode) at which the growth rate crosses zero, ``critical_damping`` the same as a hinge
+    damping c_d = 2 I_B ω₁ ζ (N m s/rad), comparable with :func:`thermojitter.flutter`'s.
+    The equilibrium: ``T_front``/``T_back`` per element (K), ``deflection``/``slope`` per node,
+    ``theta_f`` (rad).
+    """
+
+    eigenvalues: NDArray[np.complex128]
+    growth_rate: float
+    oscillatory_modes: tuple[OscillatoryMode, ...]
+    critical_damping_ratio: float
+    critical_damping: float
+    damping_ratio: float
+    theta_f: float
+    x: Array
+    x_node: Array
+    T_front: Array
+    T_back: Array
+    deflection: Array
+    slope: Array
+    support: str
+    elements: int
+    modes: int
+    flux: float
+    sun_angle: float
+
+    @property
+    def stable(self) -> bool:
+        return self.growth_rate < 0.0
+
+    @property
+    def frequency_hz(self) -> float:
+        """Frequency of the least stable oscillatory pair, Hz (0 if none)."""
+        if not self.oscillatory_modes:
+            return 0.0
+        return max(self.oscillatory_modes, key=lambda m: m.growth_rate).frequency_hz
+
+    @property
+    def theta_f_deg(self) -> float:
+        return math.degrees(self.theta_f)
+
+
+def distributed_flutter(
+    panel: Panel,
+    *,
+    support: Support = "free-free",
+    elements: int | None = None,
+    modes: int | None = None,
+    flux: float = 1.0,
+    damping_ratio: float | None = None,
+    sun_angle: float = 0.0,
+) -> DistributedFlutterResult:
+    """Eigen-analysis of the two-way coupled distributed panel linearised at its sunlit
+    equilibrium under ``flux`` (the solar constant's scale: 1 at 1 au, about 1.0343 at
+    perihelion, 0.9674 at aphelion), and its critical damping. Settings as
+    :func:`simulate_distributed`."""
+    settings = distributed_settings(
+        panel,
+        support=support,
+        elements=elements,
+        modes=modes,
+        damping_ratio=damping_ratio,
+        sun_angle=sun_angle,
+        coupled=True,
+    )
+    flux = real("flux", flux)
+    pd = panel.as_dict()
+    raw = _core.distributed_flutter(pd, settings, float(flux))
+    info = _core.distributed_info(pd, settings)
+    return DistributedFlutterResult(
+        eigenvalues=np.array([complex(re, im) for re, im in raw["eigenvalues"]]),
+        growth_rate=float(raw["growth_rate"]),
+        oscillatory_modes=tuple(OscillatoryMode(g, f, int(i)) for g, f, i in raw["modes"]),
+        critical_damping_ratio=float(raw["critical_damping_ratio"]),
+        critical_damping=float(raw["critical_damping"]),
+        damping_ratio=float(raw["damping_ratio"]),
+        theta_f=float(raw["theta_f"]),
+        x=np.asarray(info["x"]),
+        x_node=np.asarray(info["x_node"]),
+        T_front=np.asarray(raw["T_front"]),
+        T_back=np.asarray(raw["T_back"]),
+        deflection=np.asarray(raw["deflection"]),
+        slope=np.asarray(raw["slope"]),
+        support=support,
+        elements=settings["elements"],
+        modes=settings["modes"],
+        flux=float(flux),
+        sun_angle=float(sun_angle),
+    )
+
+
+def distributed_frequencies(
+    panel: Panel,
+    *,
+    support: Support = "free-free",
+    elements: int | None = None,
+    modes: int | None = None,
+) -> Array:
+    """The kept elastic modes' frequencies of the mesh, Hz (the first is the panel's first
+    bending frequency on its support)."""
+    settings = distributed_settings(panel, support=support, elements=elements, modes=modes)
+    return np.asarray(_core.distributed_info(panel.as_dict(), settings)["frequencies_hz"])
+
+
+@dataclass(frozen=True)
+class ConvergenceRow:
+    """One run of a convergence study: its setting, the largest difference of θ_f (rad) from
+    the next finer run and from the finest run, and its cost."""
+
+    elements: int
+    modes: int
+    max_change: float
+    max_error: float
+    n_steps: int
+
+
+def distributed_convergence(
+    panel: Panel,
+    orbit: Orbit,
+    *,
+    vary: Literal["elements", "modes"] = "elements",
+    values: Sequence[int] = (10, 20, 40, 80),
+    support: Support = "free-free",
+    elements: int | None = None,
+    modes: int | None = None,
+    t_span: Sequence[float] | None = None,
+    dt_out: float = 0.5,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+) -> tuple[list[ConvergenceRow], float]:
+    """θ_f through the eclipse as ``vary`` takes ``values`` (ascending), the other setting fixed
+    (default the engine's). Returns the rows and the observed order p from the last three runs,
+    p = log(|Δ₁| / |Δ₂|) / log(r), Δ the largest change between successive runs and r the ratio
+    of successive values (constant). ``t_span`` defaults to the first eclipse with 1200 s of
+    sunlight either side."""
+    from thermojitter.beam import eclipse_window
+
+    values = [int(v) for v in values]
+    if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:], strict=False)):
+        raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")
+    span = eclipse_window(orbit) if t_span is None else _span(t_span)
+    runs = []
+    for v in values:
+        kw: dict[str, Any] = {"elements": elements, "modes": modes, vary: v}
+        runs.append(
+            simulate_distributed(
+                panel, orbit, span, support=support, dt_out=dt_out, rtol=rtol, atol=atol, **kw
+            )
+        )
+    finest = runs[-1].theta_f
+    rows = []
+    for i, run in enumerate(runs):
+        nxt = runs[i + 1].theta_f if i + 1 < len(runs) else run.theta_f
+        rows.append(
+            ConvergenceRow(
+                elements=int(run.settings["elements"]),
+                modes=int(run.settings["modes"]),
+                max_change=float(np.max(np.abs(nxt - run.theta_f))),
+                max_error=float(np.max(np.abs(finest - run.theta_f))),
+                n_steps=run.n_steps,
+            )
+        )
+    d1, d2 = rows[-3].max_change, rows[-2].max_change
+    ratio = values[-1] / values[-2]
+    order = math.log(d1 / d2) / math.log(ratio) if d1 > 0 and d2 > 0 else math.inf
+    return rows, order

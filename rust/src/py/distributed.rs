@@ -1,0 +1,233 @@
+//! Bindings of the distributed panel: its settings, modes, and flutter analysis.
+
+use super::convert::{orbit_from, output, panel_from, solver_from};
+use super::error::{invalid, shield};
+use crate::distributed::{DistributedPanel, Settings, Support};
+use crate::flutter::check_flux;
+use crate::system::Coupling;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::f64::consts::PI;
+
+/// A count setting (`elements`, `modes`) as usize, named in any error.
+fn count(name: &str, value: i64) -> PyResult<usize> {
+    usize::try_from(value).map_err(|_| invalid(name, value, "must be a positive integer"))
+}
+
+/// The model from a panel mapping and a settings mapping {support, elements, modes,
+/// damping_ratio (None: hinge-equivalent), sun_angle, coupled}.
+pub(super) fn model_from(
+    panel: &Bound<'_, PyDict>,
+    settings: &Bound<'_, PyDict>,
+) -> PyResult<DistributedPanel> {
+    let p = panel_from(panel)?;
+    let item = |key: &str| -> PyResult<Bound<'_, PyAny>> {
+        settings
+            .get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("{key} is missing")))
+    };
+    let typed = |key: &str, kind: &str| PyTypeError::new_err(format!("{key} must be {kind}"));
+    let support: String = item("support")?
+        .extract()
+        .map_err(|_| typed("support", "a string"))?;
+    let elements: i64 = item("elements")?
+        .extract()
+        .map_err(|_| typed("elements", "an integer"))?;
+    let modes: i64 = item("modes")?
+        .extract()
+        .map_err(|_| typed("modes", "an integer"))?;
+    let zeta: Option<f64> = item("damping_ratio")?
+        .extract()
+        .map_err(|_| typed("damping_ratio", "a number or None"))?;
+    let sun_angle: f64 = item("sun_angle")?
+        .extract()
+        .map_err(|_| typed("sun_angle", "a number"))?;
+    let coupled: bool = item("coupled")?
+        .extract()
+        .map_err(|_| typed("coupled", "a bool"))?;
+    let defaults = Settings::new(&p);
+    let s = Settings {
+        support: Support::from_name(&support).map_err(PyErr::from)?,
+        elements: count("elements", elements)?,
+        modes: count("modes", modes)?,
+        damping_ratio: zeta.unwrap_or(defaults.damping_ratio),
+        sun_angle,
+        coupling: if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        },
+    };
+    DistributedPanel::new(&p, s).map_err(PyErr::from)
+}
+
+/// What the model is: node and element positions, kept frequencies, the damping ratio in use,
+/// the defaults, and the mesh's first elastic frequency.
+#[pyfunction]
+fn distributed_info<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        let mesh = &m.reduction.mesh;
+        let d = PyDict::new(py);
+        d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
+        d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
+        d.set_item(
+            "frequencies_hz",
+            PyArray1::from_vec(
+                py,
+                m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect(),
+            ),
+        )?;
+        d.set_item("damping_ratio", m.settings.damping_ratio)?;
+        d.set_item("arm", mesh.arm())?;
+        d.set_item("elastic_modes", mesh.elastic_modes())?;
+        Ok(d)
+    })
+}
+
+/// The defaults of the distributed model's settings.
+#[pyfunction]
+fn distributed_defaults(py: Python<'_>, panel: &Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let s = Settings::new(&p);
+        let d = PyDict::new(py);
+        d.set_item("support", s.support.name())?;
+        d.set_item("elements", s.elements)?;
+        d.set_item("modes", s.modes)?;
+        d.set_item("damping_ratio", s.damping_ratio)?;
+        d.set_item("sun_angle", s.sun_angle)?;
+        Ok(d.unbind())
+    })
+}
+
+/// Eigen-analysis of the distributed panel at its sunlit equilibrium under flux factor `flux`.
+#[pyfunction]
+fn distributed_flutter<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    flux: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        check_flux(flux).map_err(PyErr::from)?;
+        let a = py.detach(|| m.flutter(flux)).map_err(PyErr::from)?;
+        let n = m.n();
+        let d = PyDict::new(py);
+        d.set_item(
+            "T_front",
+            PyArray1::from_vec(py, a.equilibrium[..n].to_vec()),
+        )?;
+        d.set_item(
+            "T_back",
+            PyArray1::from_vec(py, a.equilibrium[n..2 * n].to_vec()),
+        )?;
+        let (w, slope) = m.nodal(&a.equilibrium);
+        d.set_item("deflection", PyArray1::from_vec(py, w))?;
+        d.set_item("slope", PyArray1::from_vec(py, slope))?;
+        d.set_item("theta_f", a.theta_f)?;
+        let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
+        d.set_item("eigenvalues", ev)?;
+        d.set_item("growth_rate", a.growth_rate)?;
+        let modes: Vec<(f64, f64, usize)> = a
+            .modes
+            .iter()
+            .map(|o| (o.growth_rate, o.frequency_hz, o.structural_mode))
+            .collect();
+        d.set_item("modes", modes)?;
+        d.set_item("critical_damping_ratio", a.critical_damping_ratio)?;
+        d.set_item("critical_damping", a.critical_damping)?;
+        d.set_item("damping_ratio", m.settings.damping_ratio)?;
+        Ok(d)
+    })
+}
+
+/// Rows of equal length as a 2-D array.
+fn matrix<'py>(
+    py: Python<'py>,
+    rows: &[Vec<f64>],
+    width: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    if rows.is_empty() {
+        return Ok(PyArray2::zeros(py, [0, width], false));
+    }
+    PyArray2::from_vec2(py, rows).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// Integrates the distributed panel on an orbit; fields sampled at the requested times.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, settings, t0, t1, *, solver, t_eval, dt_out, y0))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_distributed<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    t0: f64,
+    t1: f64,
+    solver: &Bound<'py, PyDict>,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    dt_out: Option<f64>,
+    y0: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        let o = orbit_from(orbit)?;
+        let method = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        let start = match y0 {
+            Some(v) => {
+                let v = v.as_array().to_vec();
+                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                    return Err(invalid("y0", x, "every component must be finite"));
+                }
+                Some(v)
+            }
+            None => None,
+        };
+        let r = py
+            .detach(|| crate::distributed::run::simulate(&m, o, &method, (t0, t1), start, &out))
+            .map_err(PyErr::from)?;
+        let mesh = &m.reduction.mesh;
+        let (n, nodes) = (m.n(), m.n() + 1);
+        let d = PyDict::new(py);
+        d.set_item("t", PyArray1::from_vec(py, r.t))?;
+        d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
+        d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
+        d.set_item("T_front", matrix(py, &r.t_front, n)?)?;
+        d.set_item("T_back", matrix(py, &r.t_back, n)?)?;
+        d.set_item("thermal_moment", matrix(py, &r.moment, n)?)?;
+        d.set_item("deflection", matrix(py, &r.deflection, nodes)?)?;
+        d.set_item("slope", matrix(py, &r.slope, nodes)?)?;
+        d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
+        d.set_item("sunlit", PyArray1::from_vec(py, r.sunlit))?;
+        d.set_item("y_end", PyArray1::from_vec(py, r.y_end))?;
+        d.set_item("n_steps", r.stats.n_steps)?;
+        d.set_item("n_rejected", r.stats.n_rejected)?;
+        d.set_item("n_rhs", r.stats.n_rhs)?;
+        d.set_item(
+            "frequencies_hz",
+            PyArray1::from_vec(
+                py,
+                m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect(),
+            ),
+        )?;
+        d.set_item("damping_ratio", m.settings.damping_ratio)?;
+        Ok(d)
+    })
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_flutter, m)?)?;
+    Ok(())
+}
