@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 
+import machine  # benches/machine.py
 import thermojitter as tj
 
 
@@ -28,6 +29,7 @@ def main() -> None:
     parser.add_argument("--damping", type=float, default=None, help="override c_d, N m s/rad")
     parser.add_argument("--checkpoint", default=None)
     args = parser.parse_args()
+    print(machine.describe())
 
     panel = tj.Panel.paper()
     if args.damping is not None:

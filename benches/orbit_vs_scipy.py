@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 
+import machine  # benches/machine.py
 import thermojitter as tj
 from thermojitter import reference as ref
 
@@ -33,6 +34,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="runs of thermojitter (median)")
     parser.add_argument("--repeat-scipy", type=int, default=1, help="runs of scipy (median)")
     args = parser.parse_args()
+    print(machine.describe())
 
     panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
     span = (0.0, orbit.period)

@@ -216,4 +216,7 @@ class EnsemblePool:
         threshold: float | None,
         stop_at_threshold: bool,
         cancel: CancelToken | None = None,
+        lockstep: bool = True,
     ) -> dict[str, Any]: ...
+
+def cpu_info() -> dict[str, Any]: ...

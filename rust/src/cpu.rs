@@ -78,11 +78,11 @@ pub fn describe() -> String {
         }
     };
     format!(
-        "CPU: {} | has: {} | build: {} (baseline {}) | ensemble kernel: {}",
+        "CPU: {} | has: {} | build: {} {} | ensemble kernel: {} (chosen at run time)",
         model_name(),
         list(detected()),
-        list(compiled()),
         std::env::consts::ARCH,
+        list(compiled()),
         crate::integrate::lockstep::Kernel::detect().name(),
     )
 }

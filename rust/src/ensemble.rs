@@ -307,9 +307,9 @@ pub enum Path {
     Scalar,
 }
 
-/// Samples given to one lockstep group: a few lanes' worth, so that lanes freed early (a sample
-/// stopped at its threshold) take the next sample, and enough groups for every thread.
-const GROUP: usize = 2 * LANES;
+/// Samples given to one lockstep group: one per lane. Samples of a batch take about the same
+/// number of steps, so the lanes of a group end together; a group of one runs alone.
+const GROUP: usize = LANES;
 
 /// [`run_batch`] along `path`.
 pub fn run_batch_on(
@@ -420,7 +420,7 @@ mod tests {
 
     #[test]
     fn lockstep_rows_equal_scalar_rows() {
-        // Eleven samples: a group of eight with refills and one of three; one invalid panel, one
+        // Eleven samples: groups of four, four and three; one invalid panel, some
         // that stop at their threshold early.
         let mut ps: Vec<Panel> = (0..11)
             .map(|k| Panel {

@@ -48,6 +48,15 @@ impl Sunlight {
         self.constant_s = if varies { None } else { Some(mid) };
     }
 
+    /// The flux over the current segment when it is the same at every time of it (s constant
+    /// there and the Sun at 1 au): what [`Sunlight::flux`] returns at any t of the segment.
+    pub(crate) fn constant_flux(&self) -> Option<f64> {
+        match self.constant_s {
+            Some(s) if !self.orbit.eccentric_sun => Some(s * self.orbit.flux_scale(self.segment.0)),
+            _ => None,
+        }
+    }
+
     #[inline]
     pub(crate) fn flux(&self, t: f64) -> f64 {
         let s = match self.constant_s {
@@ -104,6 +113,11 @@ pub(crate) struct LaneForm {
 }
 
 impl Coupled<TwoLayer, Hinge, U4> {
+    /// [`Sunlight::constant_flux`] of the current segment.
+    pub(crate) fn constant_flux(&self) -> Option<f64> {
+        self.sun.constant_flux()
+    }
+
     pub(crate) fn lane_form(&self) -> LaneForm {
         let (model, damping, stiffness) = self.structure.rate_form();
         LaneForm {

@@ -51,7 +51,7 @@ pub const B_HAT: [f64; 7] = [
     1.0 / 40.0,
 ];
 /// Dense-output coefficients (Hairer, Nørsett & Wanner, dopri5).
-const DENSE: [f64; 7] = [
+pub(crate) const DENSE: [f64; 7] = [
     -12715105075.0 / 11282082432.0,
     0.0,
     87487479700.0 / 32700410799.0,

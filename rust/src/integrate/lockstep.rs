@@ -18,7 +18,7 @@
 //! ([`Kernel::detect`]). Both give the same bits.
 
 use super::dopri5::{
-    self, A21, A3, A4, A5, A6, B, B_HAT, C, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY,
+    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY,
 };
 use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
 use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
@@ -123,8 +123,10 @@ struct Pack {
 /// The lanes' results of one trial step.
 struct Trial {
     y_new: [V; 4],
-    /// k2..k7.
-    k: [[V; 4]; 6],
+    /// The continuous extension's coefficients r2..r5 (r1 is y0).
+    dense: [[V; 4]; 4],
+    /// k7 = f(t + h, y_new), the next step's k1.
+    k7: [V; 4],
     /// The error norm squared (mean square of the weighted error).
     mean_square: V,
 }
@@ -315,9 +317,31 @@ fn step_lanes(model: HingeModel, coupling: Coupling, p: &Pack) -> Trial {
         let b = e[1][l] * e[1][l] + e[3][l] * e[3][l];
         mean_square[l] = (a + b) / 4.0;
     }
+    // `dopri5::dense_coefficients`, computed for every lane (most trials are accepted and the
+    // summary reads every step).
+    let mut dense = [[ZERO; 4]; 4];
+    for i in 0..4 {
+        for l in 0..LANES {
+            let diff = y_new[i][l] - y0[i][l];
+            let bspl = k1[i][l] * h[l] - diff;
+            let r4 = diff - k7[i][l] * h[l] - bspl;
+            let r5 = (k1[i][l] * DENSE[0]
+                + k3[i][l] * DENSE[2]
+                + k4[i][l] * DENSE[3]
+                + k5[i][l] * DENSE[4]
+                + k6[i][l] * DENSE[5]
+                + k7[i][l] * DENSE[6])
+                * h[l];
+            dense[0][i][l] = diff;
+            dense[1][i][l] = bspl;
+            dense[2][i][l] = r4;
+            dense[3][i][l] = r5;
+        }
+    }
     Trial {
         y_new,
-        k: [k2, k3, k4, k5, k6, k7],
+        dense,
+        k7,
         mean_square,
     }
 }
@@ -342,6 +366,8 @@ struct Lane<O> {
     stats: Stats,
     y: Vector4<f64>,
     k1: Vector4<f64>,
+    /// The illumination when it is the same over the whole segment.
+    constant_flux: Option<f64>,
 }
 
 /// How a run left its lane.
@@ -395,6 +421,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             },
             y: y0,
             k1: y0,
+            constant_flux: None,
         };
         if lane.enter_segment() {
             Ok(lane)
@@ -414,6 +441,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
                 continue;
             }
             self.system.enter_segment(a, b);
+            self.constant_flux = self.system.constant_flux();
             self.t = a;
             self.b = b;
             self.k1 = self.system.rhs(a, &self.y);
@@ -462,10 +490,16 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             p.y0[i][l] = self.y[i];
             p.k1[i][l] = self.k1[i];
         }
-        for (j, c) in C[1..5].iter().enumerate() {
-            p.flux[j][l] = self.system.flux_at(t + c * h);
+        if let Some(flux) = self.constant_flux {
+            for f in &mut p.flux {
+                f[l] = flux;
+            }
+        } else {
+            for (j, c) in C[1..5].iter().enumerate() {
+                p.flux[j][l] = self.system.flux_at(t + c * h);
+            }
+            p.flux[4][l] = self.system.flux_at(t_new);
         }
-        p.flux[4][l] = self.system.flux_at(t_new);
         Ok(())
     }
 
@@ -510,14 +544,13 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             self.stats.n_steps += 1;
             let y0 = self.y;
             let y_new = lane(&trial.y_new);
-            let [_, k3, k4, k5, k6, k7] = &trial.k;
-            let k7 = lane(k7);
-            let slopes = [self.k1, lane(k3), lane(k4), lane(k5), lane(k6), k7];
+            let [r2, r3, r4, r5] = &trial.dense;
+            let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
             self.y = y_new;
-            let dense = DenseStep::dopri5(t, t_new, y0, y_new, slopes);
+            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r);
             self.t = t_new;
             self.stats.t_end = t_new;
-            self.k1 = k7;
+            self.k1 = lane(&trial.k7);
             self.h_abs = (h * factor).min(self.tol.max_step);
             self.rejected = false;
             if self.observer.on_step(&dense).is_break() {
@@ -660,11 +693,20 @@ mod tests {
             period: 5828.5,
             ..Orbit::geo_equinox()
         };
+        jobs_on(orbit, panels, model, coupling)
+    }
+
+    fn jobs_on(
+        orbit: Orbit,
+        panels: &[Panel],
+        model: HingeModel,
+        coupling: Coupling,
+    ) -> Vec<Job<Tagged>> {
         panels
             .iter()
             .enumerate()
             .map(|(k, p)| {
-                let eq = equilibrium(p, coupling, 1.0).unwrap();
+                let eq = equilibrium(p, coupling, orbit.flux_scale(0.0)).unwrap();
                 Job {
                     system: Coupled::new(*p, orbit, model, coupling),
                     tol: Tolerances {
@@ -747,6 +789,19 @@ mod tests {
                     assert_eq!(g, w, "{model:?} {coupling:?} {kernel:?}: run {k}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn lanes_equal_single_runs_through_a_penumbra() {
+        // The Sun's distance and the penumbra make the illumination vary within segments.
+        let orbit = Orbit::geo_year(273.0);
+        assert!(orbit.eclipses(0.0, orbit.period).len() == 1);
+        let ps = panels(5);
+        let (m, c) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let want = alone(jobs_on(orbit, &ps, m, c));
+        for kernel in [Kernel::Portable, Kernel::detect()] {
+            assert_eq!(in_lockstep(kernel, jobs_on(orbit, &ps, m, c)), want);
         }
     }
 
