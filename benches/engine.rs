@@ -36,6 +36,18 @@ fn median_ns(batches: usize, per_batch: u64, mut f: impl FnMut()) -> f64 {
     times[batches / 2]
 }
 
+/// CPU time of this process so far, ns: the sum over its threads of the time on a CPU as the
+/// Linux scheduler counts it (/proc/self/task/*/schedstat); None elsewhere. Less sensitive than
+/// wall time to other work sharing the machine.
+fn process_cpu_ns() -> Option<u64> {
+    let mut total = 0;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(total)
+}
+
 fn main() {
     let filter: Vec<String> = std::env::args()
         .skip(1)
@@ -155,16 +167,26 @@ fn main() {
             stop_at_threshold: false,
         };
         let one = pool(1).expect("pool");
+        // CPU time where the OS reports it (the machine may be shared), else wall time.
+        let clock = if process_cpu_ns().is_some() {
+            "CPU"
+        } else {
+            "wall"
+        };
         let mut per_sample = [Vec::new(), Vec::new()];
         for _ in 0..3 {
             for (i, (key, _, path)) in paths.iter().enumerate() {
                 if !wanted(key) {
                     continue;
                 }
-                let start = Instant::now();
+                let (start, cpu) = (Instant::now(), process_cpu_ns());
                 let rows = run_batch_on(&one, &panels, &settings, &Cancel::new(), *path);
                 black_box(rows.expect("batch"));
-                per_sample[i].push(start.elapsed().as_secs_f64() / panels.len() as f64);
+                let seconds = match (cpu, process_cpu_ns()) {
+                    (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
+                    _ => start.elapsed().as_secs_f64(),
+                };
+                per_sample[i].push(seconds / panels.len() as f64);
             }
         }
         let median = |v: &mut Vec<f64>| {
@@ -175,7 +197,7 @@ fn main() {
         let lanes = median(&mut per_sample[1]);
         if let Some(s) = scalar {
             println!(
-                "ensemble sample, {}    {:8.2} ms/sample",
+                "ensemble sample, {}    {:8.2} ms/sample ({clock} time)",
                 paths[0].1,
                 1e3 * s
             );
@@ -183,7 +205,7 @@ fn main() {
         if let Some(l) = lanes {
             let ratio = scalar.map_or(String::new(), |s| format!(" ({:.2}x)", s / l));
             println!(
-                "ensemble sample, {}    {:8.2} ms/sample{ratio}",
+                "ensemble sample, {}    {:8.2} ms/sample ({clock} time){ratio}",
                 paths[1].1,
                 1e3 * l
             );
