@@ -11,9 +11,9 @@ import resource
 import sys
 import time
 
+import machine  # benches/machine.py
 import numpy as np
 
-import machine  # benches/machine.py
 import thermojitter as tj
 
 

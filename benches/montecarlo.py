@@ -12,11 +12,11 @@ machine anyway (the header prints the load average).
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from typing import Any
 
 import machine  # benches/machine.py
+
 import thermojitter as tj
 import thermojitter.montecarlo as mc
 

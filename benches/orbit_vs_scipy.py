@@ -11,9 +11,9 @@ import argparse
 import statistics
 import time
 
+import machine  # benches/machine.py
 import numpy as np
 
-import machine  # benches/machine.py
 import thermojitter as tj
 from thermojitter import reference as ref
 

@@ -47,10 +47,10 @@ from typing import Any
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+import machine  # noqa: E402  (benches/machine.py)
 import numpy as np  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
-import machine  # noqa: E402  (benches/machine.py)
 import thermojitter as tj  # noqa: E402
 from thermojitter import reference as ref  # noqa: E402
 

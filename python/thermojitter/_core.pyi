@@ -18,6 +18,7 @@ __all__ = [
     "beam_response",
     "beam_static",
     "check_panels",
+    "cpu_info",
     "declination",
     "distributed_defaults",
     "distributed_flutter",

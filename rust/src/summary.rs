@@ -21,6 +21,10 @@ use std::ops::ControlFlow;
 /// Points read per step: the midpoint and the end.
 const READS_PER_STEP: usize = 2;
 
+/// Angles below which a missed peak does not matter, rad (a nanoradian: jitter is measured in
+/// microradians and more).
+const NEGLIGIBLE_ANGLE: f64 = 1e-9;
+
 /// Points read in a step that may hold an extreme (a multiple of [`READS_PER_STEP`], so that its
 /// points include the coarse ones).
 const DETAILED_READS: usize = 8;
@@ -123,8 +127,8 @@ pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> M
 
 struct Collector {
     panel: Panel,
-    /// The panel's thermal moment per kelvin, computed once (it holds a division).
-    moment_per_kelvin: f64,
+    /// M_T/K_el per kelvin of T_f − T_b (M_T as in `dynamics::thermal_moment`), computed once.
+    static_per_kelvin: f64,
     orbit: Orbit,
     coupling: Coupling,
     options: SummaryOptions,
@@ -166,49 +170,52 @@ impl Collector {
     /// θ − M_T/K_el, the dynamic part of the deflection.
     #[inline]
     fn dynamic(&self, y: &Vector4<f64>) -> f64 {
-        // M_T as in `dynamics::thermal_moment`.
-        y[2] - self.moment_per_kelvin * (y[0] - y[1]) / self.panel.hinge_stiffness
+        y[2] - self.static_per_kelvin * (y[0] - y[1])
     }
 
     /// Whether a step could change an extreme of the current orbit or crosses into an eclipse
-    /// window, the next orbit or the limit, judged from its start, midpoint and end: a value
-    /// between two of them passes the larger by at most the largest |θ̇| times their spacing (a
-    /// bound where θ turns, as |θ̇| grows away from the turning point); the quasi-static part
-    /// M_T/K_el moves slowly and its change between the points is added to the margin.
+    /// window, the next orbit or the limit, judged from its start, midpoint and end (with a
+    /// margin for what may lie between them). A margin below [`NEGLIGIBLE_ANGLE`] never asks for
+    /// detail.
+    #[inline]
     fn may_hold_an_extreme(&self, step: &DenseStep<U4>, y_mid: &Vector4<f64>) -> bool {
         let s = &self.current;
         let (t0, t1) = (step.t0, step.t1);
         let w = self.options.window;
         // NaN eclipse times compare false: no window.
-        let in_window = |start: f64| t1 >= start && t0 <= start + w;
-        if t1 > s.t_end || in_window(s.t_entry) || in_window(s.t_exit) {
+        if t1 > s.t_end
+            || (t1 >= s.t_entry && t0 <= s.t_entry + w)
+            || (t1 >= s.t_exit && t0 <= s.t_exit + w)
+        {
             return true;
         }
-        let points = [&step.y0, y_mid, &step.y1];
-        let rate = points.iter().fold(0.0_f64, |m, y| m.max(y[3].abs()));
-        let margin = rate * 0.5 * (t1 - t0);
-        let (mut hi, mut lo, mut dev, mut dynamic) = (f64::MIN, f64::MAX, 0.0_f64, 0.0_f64);
-        let mut drift = 0.0_f64;
-        let mut last_static: Option<f64> = None;
-        for y in points {
-            let th = y[2];
-            hi = hi.max(th);
-            lo = lo.min(th);
-            dev = dev.max((th - s.theta_eq).abs());
-            let d = self.dynamic(y);
-            dynamic = dynamic.max(d.abs());
-            let quasi_static = th - d;
-            if let Some(q) = last_static {
-                drift = drift.max((quasi_static - q).abs());
-            }
-            last_static = Some(quasi_static);
+        let (a, b, c) = (&step.y0, y_mid, &step.y1);
+        // Points `half` apart: where θ turns between two of them, it passes the larger by about
+        // |Δθ̇| half / 8 (exactly so for a sinusoid sampled finely); four times that is the margin.
+        let half = 0.5 * (t1 - t0);
+        let margin = (b[3] - a[3]).abs().max((c[3] - b[3]).abs()) * (0.5 * half);
+        let k = self.static_per_kelvin;
+        let (qa, qb, qc) = (k * (a[0] - a[1]), k * (b[0] - b[1]), k * (c[0] - c[1]));
+        // The quasi-static part bends slowly: twice its second difference bounds its share.
+        let bend = 2.0 * (qa - 2.0 * qb + qc).abs();
+        if margin + bend <= NEGLIGIBLE_ANGLE {
+            // Nothing between the points can pass them by more than a negligible angle (the
+            // hinge at rest: on a plateau every point may equal the extreme).
+            return false;
         }
+        let hi = a[2].max(b[2]).max(c[2]);
+        let lo = a[2].min(b[2]).min(c[2]);
+        let dev = (hi - s.theta_eq).abs().max((lo - s.theta_eq).abs());
+        let dynamic = (a[2] - qa)
+            .abs()
+            .max((b[2] - qb).abs())
+            .max((c[2] - qc).abs());
         let limit_near = self.crossing.is_none() && hi.max(-lo) + margin > self.options.theta_limit;
-        // Any comparison with NaN (a state gone non-finite) refines too.
+        // Any comparison with NaN (a state gone non-finite) asks for detail too.
         !(hi + margin <= s.theta_max
             && lo - margin >= s.theta_min
             && dev + margin <= s.amplitude
-            && dynamic + margin + drift <= s.jitter_peak)
+            && dynamic + margin + bend <= s.jitter_peak)
             || limit_near
     }
 
@@ -437,7 +444,7 @@ pub(crate) fn prepare_orbits<'c>(
     }
     let mut collector = Collector {
         panel: *panel,
-        moment_per_kelvin: panel.moment_per_kelvin(),
+        static_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
         orbit: *orbit,
         coupling,
         options,

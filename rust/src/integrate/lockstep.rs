@@ -231,7 +231,7 @@ fn stage<const M: usize>(y0: &[V; 4], h: &V, terms: [(&[V; 4], f64); M]) -> [V; 
     for (k, a) in terms {
         for i in 0..4 {
             for l in 0..LANES {
-                out[i][l] = out[i][l] + k[i][l] * (a * h[l]);
+                out[i][l] += k[i][l] * (a * h[l]);
             }
         }
     }
@@ -600,8 +600,8 @@ where
     let mut exhausted = false;
     loop {
         // Give every idle lane the next job.
-        for l in 0..LANES {
-            while lanes[l].is_none() && !exhausted {
+        for (l, slot) in lanes.iter_mut().enumerate() {
+            while slot.is_none() && !exhausted {
                 let Some(mut job) = next() else {
                     exhausted = true;
                     break;
@@ -625,7 +625,7 @@ where
                 match Lane::start(job) {
                     Ok(lane) => {
                         lane.load(&mut pack, l);
-                        lanes[l] = Some(lane);
+                        *slot = Some(lane);
                     }
                     Err((observer, outcome)) => done(observer, outcome),
                 }
@@ -734,12 +734,14 @@ mod tests {
             .collect()
     }
 
-    type Runs = Vec<(Vec<u64>, Vec<u64>, Stats)>;
+    /// A run's samples and end state by their bits, with its counters.
+    type Run = (Vec<u64>, Vec<u64>, Stats);
+    type Runs = Vec<Run>;
 
     /// Each job's samples and end state by their bits, with its counters, in job order.
     fn in_lockstep(kernel: Kernel, jobs: Vec<Job<Tagged>>) -> Runs {
         let n = jobs.len();
-        let mut out: Vec<Option<(Vec<u64>, Vec<u64>, Stats)>> = vec![None; n];
+        let mut out: Vec<Option<Run>> = vec![None; n];
         let mut queue = jobs.into_iter();
         solve_lockstep(
             kernel,
@@ -752,7 +754,7 @@ mod tests {
         out.into_iter().map(Option::unwrap).collect()
     }
 
-    fn bits(s: &Sampler<U4>, y: &Vector4<f64>, stats: Stats) -> (Vec<u64>, Vec<u64>, Stats) {
+    fn bits(s: &Sampler<U4>, y: &Vector4<f64>, stats: Stats) -> Run {
         let samples = s.y.iter().flat_map(|v| v.iter()).map(|x| x.to_bits());
         let end = y.iter().map(|x| x.to_bits()).collect();
         (samples.collect(), end, stats)
