@@ -182,6 +182,12 @@ def test_beam_command_writes_figures_and_summary(tmp_path: object) -> None:
     with open(f"{out}/beam_report.md") as fh:
         report = fh.read()
     assert "0.93°" in report and "about 12%" in report
+    # The distributed-panel section: its numbers, table rows and figure.
+    assert "## Hinge model vs coupled distributed panel" in report
+    dist = summary["distributed"]
+    assert [r["where"] for r in dist["critical_damping"]] == ["1 au", "perihelion", "aphelion"]
+    with open(dist["figure"], "rb") as fh:
+        assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
 
 
 def test_default_damping_matches_the_hinge_decay_rate() -> None:

@@ -41,6 +41,7 @@ FIGURES = [
     "fig22b_theta_frequency.png",
     "fig23_fft_deflection.png",
     "fig24_fft_frequency.png",
+    "fig_hinge_vs_distributed.png",
 ]
 
 

@@ -124,6 +124,8 @@ def test_bad_support_and_types() -> None:
         tj.distributed_flutter(PAPER, elements=4.0)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="coupled"):
         tj.simulate_distributed(PAPER, GEO, (0.0, 1.0), coupled=1)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="layers"):
+        tj.distributed_flutter(PAPER, elements=4, layers=7)
     with pytest.raises(ValueError, match="y0"):
         tj.simulate_distributed(PAPER, GEO, (0.0, 1.0), elements=4, y0=np.ones(3))
 
@@ -149,3 +151,20 @@ def test_eclipse_response_converges_with_the_mesh() -> None:
     )
     assert rows[0].max_change > rows[1].max_change > 0.0
     assert order > 2.5
+
+
+def test_report_tables_are_consistent() -> None:
+    from thermojitter.distributed_report import cantilever_table, critical_damping_table
+
+    rows = critical_damping_table(PAPER)
+    by = {r["where"]: r for r in rows}
+    # More sunlight, a larger gradient and a stronger pump: c_d* grows with the flux, in every
+    # model, and the flux scale is the orbit model's 1/r² at perihelion and aphelion.
+    assert by["perihelion"]["flux"] == pytest.approx(1 / (1 - 0.0167) ** 2, rel=1e-4)
+    assert by["aphelion"]["flux"] == pytest.approx(1 / (1 + 0.0167) ** 2, rel=1e-4)
+    for key in ("hinge_deflection", "hinge_frequency", "distributed"):
+        assert by["aphelion"][key] < by["1 au"][key] < by["perihelion"][key]
+    zeta = tj.distributed_defaults(PAPER)["damping_ratio"]
+    for r in cantilever_table(PAPER, (-30.0, 0.0, 30.0)):
+        assert r["stable"] == (r["critical_damping_ratio"] < zeta)
+        assert r["stable"] == (r["growth_rate"] < 0.0)

@@ -6,7 +6,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
-from thermojitter import beam
+from thermojitter import beam, materials
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
@@ -27,6 +27,7 @@ from thermojitter.flutter import (
     linear_thermal_response,
     stability_map,
 )
+from thermojitter.laminate import Laminate, Layer
 from thermojitter.longrun import OrbitSummaries, simulate_orbits
 from thermojitter.montecarlo import SensitivityResult, monte_carlo, sensitivity, sweep
 from thermojitter.orbit import Orbit
@@ -53,6 +54,8 @@ __all__ = [
     "FreeFreeBeam",
     "HingeSolution",
     "IntegrationError",
+    "Laminate",
+    "Layer",
     "InternalError",
     "LinearThermalResponse",
     "Orbit",
@@ -75,6 +78,7 @@ __all__ = [
     "hinge_energy",
     "hinge_stiffness",
     "linear_thermal_response",
+    "materials",
     "monte_carlo",
     "natural_frequency",
     "sensitivity",

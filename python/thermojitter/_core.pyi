@@ -12,36 +12,48 @@ __all__ = [
     "ConvergenceError",
     "EnsemblePool",
     "IntegrationError",
+    "LAYER_FIELDS",
     "PANEL_FIELDS",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
     "beam_static",
     "check_panels",
+    "conduction_grid",
     "cpu_info",
     "declination",
+    "derived",
     "distributed_defaults",
     "distributed_flutter",
     "distributed_info",
-    "derived",
     "eclipses",
     "energy",
+    "equivalent_panel",
     "flutter",
     "flux_scale",
+    "hinge_equivalent_damping_ratio",
     "illumination",
+    "laminate_properties",
+    "layered_flutter",
+    "layered_steady_state",
+    "materials",
     "moment",
     "orbit_breakpoints",
     "run_orbits",
+    "run_orbits_hybrid",
     "shadow_intervals",
     "simulate",
     "simulate_distributed",
     "simulate_hinge",
+    "simulate_layers",
     "simulate_thermal",
     "stability_map",
     "steady_state",
     "stiffness",
     "synodic_period",
     "umbra_intervals",
+    "validate_laminate",
+    "validate_layer",
     "validate_orbit",
     "validate_panel",
 ]
@@ -133,6 +145,26 @@ def run_orbits(
     stop_at_limit: bool,
     steps_per_period: float,
     cancel: CancelToken | None = None,
+    layup: dict[str, Any] | None = None,
+    nodes: int | None = None,
+) -> dict[str, Any]: ...
+def run_orbits_hybrid(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    model: str,
+    coupled: bool,
+    solver: dict[str, Any],
+    t_start: float,
+    first_index: int,
+    n_orbits: int,
+    y0: list[float],
+    window: float,
+    theta_limit: float,
+    stop_at_limit: bool,
+    steps_per_period: float,
+    hybrid: dict[str, float],
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---
@@ -157,6 +189,7 @@ def beam_response(
 # --- distributed panel (rust/src/py/distributed.rs) ---
 
 def distributed_defaults(panel: dict[str, float]) -> dict[str, Any]: ...
+def hinge_equivalent_damping_ratio(panel: dict[str, float]) -> float: ...
 def distributed_info(panel: dict[str, float], settings: dict[str, Any]) -> dict[str, Any]: ...
 def distributed_flutter(
     panel: dict[str, float], settings: dict[str, Any], flux: float
@@ -216,8 +249,53 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
+        validity_limit: float = 0.3490658503988659,
+        hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
         lockstep: bool = True,
     ) -> dict[str, Any]: ...
+
+# --- laminates and the N-node model -------------------------------------------------------------
+LAYER_FIELDS: list[str]
+
+def validate_layer(layer: dict[str, Any]) -> None: ...
+def validate_laminate(laminate: dict[str, Any]) -> None: ...
+def laminate_properties(laminate: dict[str, Any]) -> dict[str, float]: ...
+def equivalent_panel(laminate: dict[str, Any], panel: dict[str, float]) -> dict[str, float]: ...
+def materials() -> list[dict[str, Any]]: ...
+def conduction_grid(
+    panel: dict[str, float], layup: dict[str, Any] | None, nodes: int
+) -> dict[str, Any]: ...
+def layered_steady_state(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    coupled: bool = True,
+    flux: float = 1.0,
+) -> dict[str, Any]: ...
+def layered_flutter(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    model: str,
+    coupled: bool,
+    flux: float,
+    with_critical: bool = True,
+) -> dict[str, Any]: ...
+def simulate_layers(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    orbit: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    model: str,
+    coupled: bool,
+    solver: dict[str, Any],
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: list[float] | None,
+) -> dict[str, Any]: ...
 
 def cpu_info() -> dict[str, Any]: ...

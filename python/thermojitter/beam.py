@@ -30,7 +30,7 @@ from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
-from thermojitter.simulate import Method, Model, _check_inputs, _solver_args, _span, simulate
+from thermojitter.simulate import Method, Model, check_inputs, simulate, solver_args, time_span
 
 Array = NDArray[np.float64]
 Criterion = Literal["deflection", "deflection_small_angle", "frequency"]
@@ -46,8 +46,8 @@ def default_damping_ratio(panel: Panel) -> float:
     at the hinge's rate c_d/(2 I_B), whatever K_el the hinge uses, and ζ equals the hinge's own
     c_d / (2 sqrt(K_el I_B)) when K_el follows the frequency criterion. Every mode gets this ζ.
     """
-    omega1 = 2.0 * math.pi * beam_frequency(panel)
-    return panel.damping / (2.0 * panel.hinge_inertia * omega1)
+    check_inputs(panel)
+    return float(_core.hinge_equivalent_damping_ratio(panel.as_dict()))
 
 
 @dataclass(frozen=True)
@@ -71,7 +71,7 @@ class FreeFreeBeam:
     (even, so that the centre is a node; 2 to 1000)."""
 
     def __init__(self, panel: Panel, n_elements: int = 100) -> None:
-        _check_inputs(panel)
+        check_inputs(panel)
         if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)):
             raise TypeError(f"n_elements must be an int, not {type(n_elements).__name__}")
         self.panel = panel
@@ -147,11 +147,11 @@ class FreeFreeBeam:
             raise ValueError(
                 f"times/moments hold {ts.size}/{ms.size} values: need two or more, equal lengths"
             )
-        t0, t1 = (float(ts[0]), float(ts[-1])) if t_span is None else _span(t_span)
+        t0, t1 = (float(ts[0]), float(ts[-1])) if t_span is None else time_span(t_span)
         if t_eval is None and dt_out is None:
             t_eval = ts[(ts >= t0) & (ts <= t1)]
         zeta = default_damping_ratio(self.panel) if damping_ratio is None else damping_ratio
-        args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+        args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
         raw = _core.beam_response(
             self.panel.as_dict(),
             self.n_elements,
@@ -295,14 +295,14 @@ def compare_with_beam(
     ``rmse_deg`` is the RMS of θ − θ_f over the window; the dominant frequencies come from the
     FFT of each signal above ``f_min`` (Hz).
     """
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     hinge_panel = panel
     if criterion is not None:
         hinge_panel = panel.replace(hinge_stiffness=hinge_stiffness(panel, criterion))
     if scale_moment:
         chi = hinge_panel.hinge_stiffness / _flexural_stiffness(panel)
         hinge_panel = hinge_panel.replace(moment_scale=chi)
-    span = eclipse_window(orbit) if t_span is None else _span(t_span)
+    span = eclipse_window(orbit) if t_span is None else time_span(t_span)
     if not (math.isfinite(dt_out) and dt_out > 0):
         raise ValueError(f"dt_out = {dt_out!r} is invalid: must be finite and > 0")
     if span[1] - span[0] < 16 * dt_out:
@@ -534,13 +534,26 @@ def beam_report_markdown(result: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_beam_comparison(out: str | Path, n_elements: int = 100, calibrate: bool = True) -> int:
+def write_beam_comparison(
+    out: str | Path, n_elements: int = 100, calibrate: bool = True, distributed: bool = True
+) -> int:
     """The paper's beam comparison (Figs. 22–24) for Table 1, written to ``out`` with
-    ``beam_summary.json`` and ``beam_report.md``; prints one line per case."""
+    ``beam_summary.json`` and ``beam_report.md``; prints one line per case. With
+    ``distributed``, also the section "Hinge model vs coupled distributed panel"
+    (:mod:`thermojitter.distributed_report`)."""
     result = beam_comparison_figures(out_dir=out, n_elements=n_elements, calibrate=calibrate)
+    report = beam_report_markdown(result)
+    if distributed:
+        from thermojitter.distributed_report import (
+            hinge_vs_distributed,
+            hinge_vs_distributed_markdown,
+        )
+
+        result["distributed"] = hinge_vs_distributed(out_dir=out)
+        report += "\n" + hinge_vs_distributed_markdown(result["distributed"])
     path = Path(out) / "beam_summary.json"
     path.write_text(json.dumps(result, indent=2))
-    (Path(out) / "beam_report.md").write_text(beam_report_markdown(result))
+    (Path(out) / "beam_report.md").write_text(report)
     for name, case in result["cases"].items():
         print(
             f"{name:17s} K_el = {case['hinge_stiffness']:8.1f} N m/rad  chi = "
@@ -548,5 +561,13 @@ def write_beam_comparison(out: str | Path, n_elements: int = 100, calibrate: boo
             f"f_hinge = {case['hinge_frequency_hz']:.4f} Hz  "
             f"mismatch = {100 * case['frequency_mismatch']:+.1f}%"
         )
+    if distributed:
+        for name, case in result["distributed"]["cases"].items():
+            print(f"distributed vs hinge ({name}): RMSE θ − θ_f = {case['rmse_deg']:.3f} deg")
+        for row in result["distributed"]["critical_damping"]:
+            print(
+                f"c_d* at {row['where']:10s}: hinge {row['hinge_deflection']:.3f} (deflection), "
+                f"{row['hinge_frequency']:.3f} (frequency); distributed {row['distributed']:.3f}"
+            )
     print(f"beam f_n = {result['beam']['natural_frequencies_hz'][0]:.4f} Hz; wrote {path}")
     return 0

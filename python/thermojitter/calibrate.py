@@ -25,7 +25,7 @@ from scipy.optimize import least_squares
 
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.simulate import Model, _check_inputs, simulate
+from thermojitter.simulate import Model, check_inputs, simulate
 
 Array = NDArray[np.float64]
 
@@ -115,7 +115,7 @@ def calibrate(
     ts, th = _series(t, theta)
     base = Panel.paper() if panel is None else panel
     orb = Orbit.geo_equinox() if orbit is None else orbit
-    _check_inputs(base, orb)
+    check_inputs(base, orb)
     names = list(fit)
     if not names or len(set(names)) != len(names) or any(n not in FITTABLE for n in names):
         raise ValueError(f"fit = {fit!r} is invalid: a non-empty set of {', '.join(FITTABLE)}")

@@ -37,11 +37,18 @@ from thermojitter import _core
 from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.results import _Run
-from thermojitter.simulate import Method, _check_inputs, _solver_args, _span
+from thermojitter.results import Run
+from thermojitter.simulate import Method, check_inputs, solver_args, time_span
 
 Array = NDArray[np.float64]
 Support = Literal["free-free", "cantilever"]
+
+
+def _count(name: str, value: Any) -> int:
+    """An integer setting (its range is the engine's to check)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, not {type_name(value)}")
+    return int(value)
 
 
 def distributed_settings(
@@ -53,10 +60,11 @@ def distributed_settings(
     damping_ratio: float | None = None,
     sun_angle: float = 0.0,
     coupled: bool = True,
+    layers: int = 2,
 ) -> dict[str, Any]:
     """The model settings as the engine takes them; ``None`` picks the engine's default (see
     :func:`distributed_defaults`). The engine checks the values and names any bad one."""
-    _check_inputs(panel)
+    check_inputs(panel)
     if not isinstance(support, str):
         raise TypeError(f"support must be a string, not {type_name(support)}")
     defaults = _core.distributed_defaults(panel.as_dict())
@@ -64,9 +72,7 @@ def distributed_settings(
     for name, value in (("elements", elements), ("modes", modes)):
         if value is None:
             value = defaults[name]
-        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-            raise TypeError(f"{name} must be an integer, not {type_name(value)}")
-        counts[name] = int(value)
+        counts[name] = _count(name, value)
     return {
         "support": support,
         "elements": counts["elements"],
@@ -74,6 +80,7 @@ def distributed_settings(
         "damping_ratio": None if damping_ratio is None else real("damping_ratio", damping_ratio),
         "sun_angle": real("sun_angle", sun_angle),
         "coupled": flag("coupled", coupled),
+        "layers": _count("layers", layers),
     }
 
 
@@ -81,24 +88,24 @@ def distributed_defaults(panel: Panel | None = None) -> dict[str, Any]:
     """The engine's default settings: support, elements, modes, damping_ratio (the
     hinge-equivalent ζ = c_d/(2 I_B ω₁) of ``panel``, default Table 1) and sun_angle (rad)."""
     panel = Panel.paper() if panel is None else panel
-    _check_inputs(panel)
+    check_inputs(panel)
     return dict(_core.distributed_defaults(panel.as_dict()))
 
 
 @dataclass(frozen=True)
-class DistributedSolution(_Run):
+class DistributedSolution(Run):
     """The distributed panel at the reported times.
 
-    ``x``: element centres (m), ``x_node``: nodes (m). ``T_front``/``T_back`` (K) and
-    ``thermal_moment`` (N m) have shape (time, element); ``deflection`` (m, positive away from
-    the Sun) and ``slope`` (rad) have shape (time, node); ``theta_f`` (rad) is the
-    hinge-equivalent angle; ``sunlit`` the illuminated fraction s(t).
+    ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
+    elements' thermal model ("T_front", "T_back" for two layers; also attributes) to a (time,
+    element) array in K; ``thermal_moment`` (N m) has shape (time, element); ``deflection`` (m,
+    positive away from the Sun) and ``slope`` (rad) have shape (time, node); ``theta_f`` (rad) is
+    the hinge-equivalent angle; ``sunlit`` the illuminated fraction s(t).
     """
 
     x: Array = field(default_factory=lambda: np.empty(0))
     x_node: Array = field(default_factory=lambda: np.empty(0))
-    T_front: Array = field(default_factory=lambda: np.empty((0, 0)))
-    T_back: Array = field(default_factory=lambda: np.empty((0, 0)))
+    temperatures: dict[str, Array] = field(default_factory=dict)
     thermal_moment: Array = field(default_factory=lambda: np.empty((0, 0)))
     deflection: Array = field(default_factory=lambda: np.empty((0, 0)))
     slope: Array = field(default_factory=lambda: np.empty((0, 0)))
@@ -113,6 +120,16 @@ class DistributedSolution(_Run):
     @property
     def theta_f_deg(self) -> Array:
         return np.degrees(self.theta_f)
+
+    @property
+    def T_front(self) -> Array:
+        """Front-face temperature per element, K, shape (time, element)."""
+        return self.temperatures["T_front"]
+
+    @property
+    def T_back(self) -> Array:
+        """Back-face temperature per element, K, shape (time, element)."""
+        return self.temperatures["T_back"]
 
     @property
     def delta_T(self) -> Array:
@@ -137,8 +154,10 @@ class DistributedSolution(_Run):
             ) from exc
         return xr.Dataset(
             {
-                "T_front": (("time", "x"), self.T_front, {"units": "K"}),
-                "T_back": (("time", "x"), self.T_back, {"units": "K"}),
+                **{
+                    name: (("time", "x"), values, {"units": "K"})
+                    for name, values in self.temperatures.items()
+                },
                 "thermal_moment": (("time", "x"), self.thermal_moment, {"units": "N m"}),
                 "deflection": (("time", "x_node"), self.deflection, {"units": "m"}),
                 "slope": (("time", "x_node"), self.slope, {"units": "rad"}),
@@ -169,6 +188,7 @@ def simulate_distributed(
     coupled: bool = True,
     damping_ratio: float | None = None,
     sun_angle: float = 0.0,
+    layers: int = 2,
     method: Method = "rk45",
     rtol: float = 1e-8,
     atol: float = 1e-10,
@@ -189,11 +209,13 @@ def simulate_distributed(
       :func:`distributed_defaults`; the others follow quasi-statically).
     - ``coupled=False`` freezes every element's absorbing area at cos ψ (one-way coupling).
     - ``damping_ratio`` ζ of every kept mode; default the hinge-equivalent c_d/(2 I_B ω₁).
-    - Integrator and output as :func:`thermojitter.simulate`; ``y0`` the state
-      (T_front[n], T_back[n], q[k], q̇[k]), default the sunlit equilibrium at the start's flux.
+    - ``layers``: every element's through-thickness thermal model (2: the paper's eq. 2).
+    - Integrator and output as :func:`thermojitter.simulate`; ``y0`` the state (the
+      temperatures of element 0, of element 1, ..., then q[k] and q̇[k]), default the sunlit
+      equilibrium at the start's flux.
     """
-    _check_inputs(panel, orbit)
-    t0, t1 = _span(t_span)
+    check_inputs(panel, orbit)
+    t0, t1 = time_span(t_span)
     settings = distributed_settings(
         panel,
         support=support,
@@ -202,8 +224,9 @@ def simulate_distributed(
         damping_ratio=damping_ratio,
         sun_angle=sun_angle,
         coupled=coupled,
+        layers=layers,
     )
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     start = None if y0 is None else np.ascontiguousarray(np.asarray(y0, dtype=float).ravel())
     raw = _core.simulate_distributed(
         panel.as_dict(), orbit.as_dict(), settings, t0, t1, y0=start, **args
@@ -223,8 +246,7 @@ def simulate_distributed(
         },
         x=raw["x"],
         x_node=raw["x_node"],
-        T_front=raw["T_front"],
-        T_back=raw["T_back"],
+        temperatures=dict(raw["temperatures"]),
         thermal_moment=raw["thermal_moment"],
         deflection=raw["deflection"],
         slope=raw["slope"],
@@ -255,8 +277,8 @@ class DistributedFlutterResult:
     each oscillatory pair by ascending frequency. ``critical_damping_ratio`` is the modal ζ (every
     kept mode) at which the growth rate crosses zero, ``critical_damping`` the same as a hinge
     damping c_d = 2 I_B ω₁ ζ (N m s/rad), comparable with :func:`thermojitter.flutter`'s.
-    The equilibrium: ``T_front``/``T_back`` per element (K), ``deflection``/``slope`` per node,
-    ``theta_f`` (rad).
+    The equilibrium: ``temperatures`` by name per element (K; ``T_front``/``T_back``),
+    ``deflection``/``slope`` per node, ``theta_f`` (rad).
     """
 
     eigenvalues: NDArray[np.complex128]
@@ -268,8 +290,7 @@ class DistributedFlutterResult:
     theta_f: float
     x: Array
     x_node: Array
-    T_front: Array
-    T_back: Array
+    temperatures: dict[str, Array]
     deflection: Array
     slope: Array
     support: str
@@ -293,6 +314,14 @@ class DistributedFlutterResult:
     def theta_f_deg(self) -> float:
         return math.degrees(self.theta_f)
 
+    @property
+    def T_front(self) -> Array:
+        return self.temperatures["T_front"]
+
+    @property
+    def T_back(self) -> Array:
+        return self.temperatures["T_back"]
+
 
 def distributed_flutter(
     panel: Panel,
@@ -303,6 +332,7 @@ def distributed_flutter(
     flux: float = 1.0,
     damping_ratio: float | None = None,
     sun_angle: float = 0.0,
+    layers: int = 2,
 ) -> DistributedFlutterResult:
     """Eigen-analysis of the two-way coupled distributed panel linearised at its sunlit
     equilibrium under ``flux`` (the solar constant's scale: 1 at 1 au, about 1.0343 at
@@ -316,6 +346,7 @@ def distributed_flutter(
         damping_ratio=damping_ratio,
         sun_angle=sun_angle,
         coupled=True,
+        layers=layers,
     )
     flux = real("flux", flux)
     pd = panel.as_dict()
@@ -331,8 +362,7 @@ def distributed_flutter(
         theta_f=float(raw["theta_f"]),
         x=np.asarray(info["x"]),
         x_node=np.asarray(info["x_node"]),
-        T_front=np.asarray(raw["T_front"]),
-        T_back=np.asarray(raw["T_back"]),
+        temperatures={k: np.asarray(v) for k, v in raw["temperatures"].items()},
         deflection=np.asarray(raw["deflection"]),
         slope=np.asarray(raw["slope"]),
         support=support,
@@ -392,7 +422,7 @@ def distributed_convergence(
     values = [int(v) for v in values]
     if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:], strict=False)):
         raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")
-    span = eclipse_window(orbit) if t_span is None else _span(t_span)
+    span = eclipse_window(orbit) if t_span is None else time_span(t_span)
     runs = []
     for v in values:
         kw: dict[str, Any] = {"elements": elements, "modes": modes, vary: v}

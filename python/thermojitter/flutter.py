@@ -56,6 +56,7 @@ def flutter(
     flux: float | None = None,
     orbit: Orbit | None = None,
     t: float = 0.0,
+    layers: int | None = None,
 ) -> FlutterResult:
     """Linear stability of the sunlit equilibrium of ``panel``.
 
@@ -64,6 +65,9 @@ def flutter(
     on it. Or give ``orbit`` and a time ``t`` (s) instead: the flux is then
     ``orbit.flux_scale(t)``, e.g. ``flutter(panel, orbit=Orbit.geo_year("2026-07-05"))`` near
     aphelion.
+
+    ``layers=N`` analyses the N-node through-thickness model on the panel's layup (or one
+    homogeneous layer for a plain panel); ``jacobian`` is then over (node temperatures…, θ, θ̇).
     """
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
@@ -75,6 +79,8 @@ def flutter(
         flux = float(orbit.flux_scale(float(t))[0])
     elif flux is None:
         flux = 1.0
+    if layers is not None:
+        return _layered_flutter(panel, model, bool(coupled), float(flux), layers)
     raw = _core.flutter(panel.as_dict(), model, bool(coupled), float(flux))
     tf, tb, th = raw["equilibrium"]
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
@@ -88,6 +94,33 @@ def flutter(
         model=model,
         coupled=bool(coupled),
         flux=float(flux),
+    )
+
+
+def _layered_flutter(
+    panel: Panel, model: str, coupled: bool, flux: float, layers: int
+) -> FlutterResult:
+    """The N-node model's flutter analysis: the Jacobian over (node temperatures…, θ, θ̇)."""
+    from thermojitter.simulate import check_layers, layup_dict
+
+    nodes = check_layers(layers)
+    raw = _core.layered_flutter(panel.as_dict(), layup_dict(panel), nodes, model, coupled, flux)
+    temps = raw["temperatures"]
+    return FlutterResult(
+        equilibrium=Equilibrium(
+            T_front=float(temps[0]),
+            T_back=float(temps[-1]),
+            theta=float(raw["theta"]),
+            thermal_moment=float(raw["thermal_moment"]),
+        ),
+        jacobian=np.asarray(raw["jacobian"]),
+        eigenvalues=np.array([complex(re, im) for re, im in raw["eigenvalues"]]),
+        growth_rate=float(raw["growth_rate"]),
+        frequency_hz=float(raw["frequency_hz"]),
+        critical_damping=float(raw["critical_damping"]),
+        model=model,
+        coupled=coupled,
+        flux=flux,
     )
 
 

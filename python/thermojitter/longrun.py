@@ -24,7 +24,13 @@ from thermojitter import _core
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import Interruptible, progress_bar, report_interrupted
-from thermojitter.simulate import _check_inputs, solver_settings, steady_state
+from thermojitter.simulate import (
+    check_inputs,
+    check_layers,
+    layup_dict,
+    solver_settings,
+    steady_state,
+)
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -33,8 +39,14 @@ SUMMARY_FIELDS = (
 )  # fmt: skip
 """Columns of the per-orbit summaries (angles rad, times s; NaN where an orbit has no eclipse)."""
 
+HYBRID_COUNTERS = (
+    "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
+)  # fmt: skip
+"""How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
+integrator of the non-linear model and the hinge-resolved fallback."""
+
 DEFAULT_THETA_LIMIT = math.radians(20.0)
-"""|θ| beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
+"""abs(θ) beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
 meant for modest angles)."""
 
 
@@ -44,10 +56,10 @@ class OrbitSummaries:
 
     Columns (one value per orbit): ``index``, ``t_start``, ``t_end``, ``theta_eq`` (sunlit
     equilibrium at that orbit's flux), ``theta_max``, ``theta_min``, ``amplitude``
-    (max |θ − θ_eq|), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
+    (max abs(θ − θ_eq)), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
     the quasi-static deflection), ``t_entry``/``t_exit`` (umbra), ``entry_theta_min`` and
     ``exit_theta_max`` (in the window after entry and exit), ``entry_peak``/``exit_peak``
-    (max |θ − θ_eq| in those windows).
+    (max abs(θ − θ_eq) in those windows).
     """
 
     columns: dict[str, NDArray[Any]]
@@ -56,10 +68,23 @@ class OrbitSummaries:
     n_steps: int = 0
     n_rhs: int = 0
     limit_crossing: tuple[float, int, float] | None = None
-    """(t s, orbit index, θ rad) where |θ| first passed theta_limit, or None."""
+    """(t s, orbit index, θ rad) where abs(θ) first passed theta_limit, or None."""
     interrupted: bool = False
     """True when Ctrl-C ended the run early; the columns hold the finished orbits."""
     settings: dict[str, Any] = field(default_factory=dict)
+    propagation: dict[str, float] = field(default_factory=dict)
+    """Hybrid runs: simulated time (s) by linear arcs (``t_linear``), by the non-linear model
+    (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
+    full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``)."""
+
+    @property
+    def nonlinear_fraction(self) -> float:
+        """Share of the simulated time integrated with the full non-linear model (1: not hybrid)."""
+        p = self.propagation
+        if not p:
+            return 1.0
+        total = p["t_linear"] + p["t_exponential"] + p["t_fallback"]
+        return (p["t_exponential"] + p["t_fallback"]) / total if total > 0 else 0.0
 
     def __getattr__(self, name: str) -> NDArray[Any]:
         columns = self.__dict__.get("columns", {})
@@ -80,7 +105,7 @@ class OrbitSummaries:
         return pd.DataFrame(self.columns).set_index("index")
 
 
-def _fingerprint(settings: dict[str, Any]) -> str:
+def settings_fingerprint(settings: dict[str, Any]) -> str:
     return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
 
 
@@ -99,7 +124,7 @@ def _save_checkpoint(
 ) -> None:
     """Writes atomically: a killed writer leaves the previous checkpoint intact."""
     payload = {
-        "fingerprint": _fingerprint(settings),
+        "fingerprint": settings_fingerprint(settings),
         "settings": settings,
         "next_index": next_index,
         "y": y,
@@ -118,11 +143,11 @@ def _save_checkpoint(
     os.replace(tmp, path)
 
 
-def _flatten(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+def flatten_settings(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
     for key, value in settings.items():
         if isinstance(value, dict):
-            flat.update(_flatten(value, f"{prefix}{key}."))
+            flat.update(flatten_settings(value, f"{prefix}{key}."))
         else:
             flat[prefix + key] = value
     return flat
@@ -133,8 +158,8 @@ def _load_checkpoint(path: Path, settings: dict[str, Any]) -> dict[str, Any] | N
         return None
     with open(path) as fh:
         payload: dict[str, Any] = json.load(fh)
-    if payload.get("fingerprint") != _fingerprint(settings):
-        old, new = _flatten(payload.get("settings", {})), _flatten(settings)
+    if payload.get("fingerprint") != settings_fingerprint(settings):
+        old, new = flatten_settings(payload.get("settings", {})), flatten_settings(settings)
         changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         raise ValueError(
             f"checkpoint {path} was written for other settings (differs in: "
@@ -151,11 +176,11 @@ def simulate_orbits(
     t_start: float = 0.0,
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
-    method: Literal["rk45", "rk4"] = "rk45",
+    method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
     rtol: float = 1e-8,
     atol: float = 1e-10,
     dt: float | None = None,
-    y0: tuple[float, float, float, float] | None = None,
+    y0: tuple[float, ...] | None = None,
     window: float = 600.0,
     theta_limit: float = DEFAULT_THETA_LIMIT,
     on_limit: Literal["stop", "flag"] = "stop",
@@ -166,12 +191,14 @@ def simulate_orbits(
     max_steps: int = 500_000_000,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
+    hybrid: dict[str, float] | None = None,
+    layers: int | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
     Memory grows with the number of orbits, not of steps (a 10-year GEO run keeps ~3650 rows).
 
-    - ``theta_limit`` (rad): the hinge model's range of validity; when |θ| passes it the run
+    - ``theta_limit`` (rad): the hinge model's range of validity; when abs(θ) passes it the run
       stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.
@@ -180,13 +207,24 @@ def simulate_orbits(
       (polled between chunks, for callers that handle SIGINT and report it themselves), silently.
     - ``progress``: a tqdm bar on stderr with the remaining time (in Jupyter a widget; also when
       stderr is not a terminal); ``None``: only when stderr is a terminal; ``False``: none.
+    - ``method``: ``"hybrid"`` (default) propagates the sunlit arcs exactly in the linearised
+      system's modal form and integrates only the shadow crossings and their thermal recovery
+      with the full non-linear model (an exponential integrator), falling back on the
+      hinge-resolved rk45 where the oscillation is too large for either; the per-orbit
+      summaries agree with rk45's within 2 % and it is hundreds of times faster on GEO.
+      ``result.propagation`` says how the simulated time was split. ``"rk45"``/``"rk4"``
+      integrate everything (rk45 resolves the hinge period, see ``steps_per_period``).
+      ``hybrid``: optional engine settings (``rtol``, ``atol_temperature``, ``atol_angle``,
+      ``max_step``, ``linear_tolerance``, ``linear_amplitude``, ``resolved_amplitude``).
     - ``steps_per_period``: rk45's step is capped at T_n/steps_per_period, T_n the hinge's natural
       period (0: error control alone). Without the cap the step grows, once the oscillation is
       small against ``atol``, to where the method's own dissipation exceeds a weak flutter's
       growth rate, and flutter near the critical damping goes unseen. With 40 the measured growth
       is within 1 % of the eigen-analysis; it costs about twice the steps of error control alone.
+    - ``layers=N``: the N-node through-thickness model on the panel's layup (see
+      :func:`thermojitter.simulate`); ``y0`` and ``y_end`` are then (node temperatures…, θ, θ̇).
     """
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
         raise ValueError(f"n_orbits = {n_orbits!r} is invalid: must be an integer >= 1")
     if (
@@ -213,11 +251,21 @@ def simulate_orbits(
         raise ValueError(
             f"steps_per_period = {steps_per_period!r} is invalid: must be a finite number >= 0"
         )
+    nodes = None if layers is None else check_layers(layers)
+    if nodes is not None and method == "hybrid":
+        # The hybrid propagator covers the two-layer model; layered panels are integrated in full.
+        method = "rk45"
     if y0 is None:
         # The sunlit equilibrium at the solar flux of the start date.
         flux = float(orbit.flux_scale(float(t_start))[0])
-        eq = steady_state(panel, coupled=coupled, flux=flux)
-        y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
+        if nodes is None:
+            eq = steady_state(panel, coupled=coupled, flux=flux)
+            y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
+        else:
+            raw_eq = _core.layered_steady_state(
+                panel.as_dict(), layup_dict(panel), nodes, bool(coupled), flux
+            )
+            y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_dict(),
@@ -235,20 +283,33 @@ def simulate_orbits(
         "orbits_per_call": orbits_per_call,
         "steps_per_period": float(steps_per_period),
     }
+    if nodes is not None:
+        settings["layers"] = nodes
+        settings["layup"] = layup_dict(panel)
+    hybrid_settings = {k: float(v) for k, v in (hybrid or {}).items()}
+    if method == "hybrid":
+        settings["hybrid"] = hybrid_settings
     core_args: dict[str, Any] = {
         "model": model,
         "coupled": bool(coupled),
-        "solver": solver_settings(method, rtol, atol, dt, math.inf, max_steps),
+        "solver": solver_settings(
+            "rk45" if method == "hybrid" else method, rtol, atol, dt, math.inf, max_steps
+        ),
         "window": float(window),
         "theta_limit": float(theta_limit),
         "stop_at_limit": on_limit == "stop",
         "steps_per_period": float(steps_per_period),
     }
+    if nodes is not None:
+        core_args["layup"] = layup_dict(panel)
+        core_args["nodes"] = nodes
 
     columns = _empty_columns()
     y = [float(v) for v in y0]
     next_index = 0
-    counters = {"n_steps": 0, "n_rhs": 0}
+    counters: dict[str, Any] = {"n_steps": 0, "n_rhs": 0}
+    if method == "hybrid":
+        counters.update({name: 0 for name in HYBRID_COUNTERS})
     crossing: tuple[float, int, float] | None = None
     path = Path(checkpoint) if checkpoint is not None else None
     if path is not None:
@@ -269,8 +330,10 @@ def simulate_orbits(
             # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same places.
             count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
             t0 = float(t_start) + next_index * orbit.period
+            run = _core.run_orbits_hybrid if method == "hybrid" else _core.run_orbits
+            extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
             raw = engine.call(
-                _core.run_orbits,
+                run,
                 panel.as_dict(),
                 orbit.as_dict(),
                 t_start=t0,
@@ -278,12 +341,15 @@ def simulate_orbits(
                 n_orbits=count,
                 y0=y,
                 **core_args,
+                **extra,
             )
             for name in SUMMARY_FIELDS:
                 columns[name].extend(np.asarray(raw[name]).tolist())
             y = list(raw["y_end"])
             counters["n_steps"] += int(raw["n_steps"])
             counters["n_rhs"] += int(raw["n_rhs"])
+            for name in HYBRID_COUNTERS if method == "hybrid" else ():
+                counters[name] += raw[name]
             if crossing is None and raw["crossing"] is not None:
                 crossing = tuple(raw["crossing"])  # type: ignore[assignment]
             if raw["stopped"]:
@@ -327,6 +393,7 @@ def simulate_orbits(
         t_end=float(columns["t_end"][-1]) if columns["t_end"] else float(t_start),
         n_steps=counters["n_steps"],
         n_rhs=counters["n_rhs"],
+        propagation={k: counters[k] for k in HYBRID_COUNTERS if k in counters},
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,

@@ -34,29 +34,36 @@ from scipy.stats import qmc
 
 from thermojitter import _core
 from thermojitter.errors import ParameterError
-from thermojitter.longrun import _fingerprint, _flatten
+from thermojitter.longrun import DEFAULT_THETA_LIMIT, flatten_settings, settings_fingerprint
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import progress_bar, report_interrupted
-from thermojitter.simulate import _check_inputs, solver_settings
+from thermojitter.simulate import check_inputs, solver_settings
 
 Sampler = Literal["random", "lhs", "sobol"]
 
 METRICS = (
     "theta_eq", "growth_rate", "frequency_hz", "stable", "critical_damping", "theta_abs_max",
     "amplitude", "entry_peak", "exit_peak", "jitter_rms", "jitter_peak", "t_threshold",
-    "t_reached", "n_steps", "error",
+    "orbit_threshold", "orbit_limit", "amplitude_slope", "t_nonlinear", "t_reached", "n_steps",
+    "error",
 )  # fmt: skip
 """Columns of the metrics, after the sampled parameters (angles rad, times s, rates 1/s):
 
 - ``theta_eq``: sunlit equilibrium angle at full Sun;
 - ``growth_rate``, ``frequency_hz``, ``stable``: linear stability of that equilibrium
   (``tj.flutter``); ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
-- ``theta_abs_max``: max |θ| over the horizon; ``amplitude``: max |θ − θ_eq|;
-- ``entry_peak``/``exit_peak``: max |θ − θ_eq| within ``window`` s after a shadow entry / exit;
+- ``theta_abs_max``: max abs(θ) over the horizon; ``amplitude``: max abs(θ − θ_eq);
+- ``entry_peak``/``exit_peak``: max abs(θ − θ_eq) within ``window`` s after a shadow entry / exit;
 - ``jitter_rms``/``jitter_peak``: of θ − M_T/K_el (the oscillation about the quasi-static
   deflection) over the horizon;
-- ``t_threshold``: first time |θ| passed ``threshold`` (NaN: never, or no threshold);
+- ``t_threshold``/``orbit_threshold``: first time (s) and orbit at which abs(θ) passed
+  ``threshold`` (NaN: never, or no threshold);
+- ``orbit_limit``: first orbit whose abs(θ) passed the validity limit (20°; NaN: none);
+- ``amplitude_slope``: growth (> 0) or decay of the per-orbit amplitude over the run, the
+  least-squares slope of ln(amplitude) against the orbit index, 1/orbit;
+- ``t_nonlinear``: simulated time integrated with the full non-linear model, s (the whole run
+  unless ``method="hybrid"``);
 - ``t_reached``: where the integration ended (the horizon, unless stopped at the threshold);
 - ``n_steps``: accepted integrator steps; ``error``: why a sample failed (None when it did not;
   its numbers are then NaN).
@@ -290,16 +297,30 @@ def _options(
         raise ValueError(f"threshold = {threshold!r} is invalid: must be a finite angle > 0 (rad)")
     if not (isinstance(window, (int, float)) and math.isfinite(window) and window > 0):
         raise ValueError(f"window = {window!r} is invalid: must be finite and > 0 (s)")
+    hybrid = method == "hybrid"
     return {
         "orbit": orbit.as_dict(),
         "model": str(model),
         "coupled": bool(coupled),
-        "solver": solver_settings(str(method), rtol, atol, dt, math.inf, max_steps),
+        # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
+        "solver": solver_settings(
+            "rk45" if hybrid else str(method), rtol, atol, dt, math.inf, max_steps
+        ),
         "n_orbits": int(horizon),
         "window": float(window),
         "threshold": None if threshold is None else float(threshold),
         "stop_at_threshold": bool(stop_at_threshold),
+        "validity_limit": DEFAULT_THETA_LIMIT,
+        "hybrid": {} if hybrid else None,
     }
+
+
+def _default_method(method: str | None, orbit: Orbit, horizon: Any) -> str:
+    """``None``: the hybrid propagator over a month or more, the hinge-resolved rk45 below."""
+    if method is not None:
+        return method
+    long = isinstance(horizon, (int, np.integer)) and horizon * orbit.period >= 30 * 86400.0
+    return "hybrid" if long else "rk45"
 
 
 # Rows come from the engine's lockstep lanes (several samples per core at once); False runs one
@@ -380,7 +401,7 @@ def _dask_client(backend: Any) -> tuple[Any, bool]:
             "backend='dask' needs dask.distributed: pip install 'thermojitter[dask]'"
         ) from exc
     if backend == "dask":
-        return Client(LocalCluster()), True
+        return Client(LocalCluster(dashboard_address=":0")), True  # any free port
     if isinstance(backend, str):
         return Client(backend), True
     raise ValueError(
@@ -452,11 +473,11 @@ def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_si
     """Creates or checks the manifest; returns the chunk size the directory was started with."""
     directory.mkdir(parents=True, exist_ok=True)
     manifest = directory / "manifest.json"
-    fingerprint = _fingerprint(settings)
+    fingerprint = settings_fingerprint(settings)
     if manifest.exists():
         saved = json.loads(manifest.read_text())
         if saved.get("fingerprint") != fingerprint:
-            old, new = _flatten(saved.get("settings", {})), _flatten(settings)
+            old, new = flatten_settings(saved.get("settings", {})), flatten_settings(settings)
             changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
             raise ValueError(
                 f"checkpoint {directory} was written for other settings (differs in: "
@@ -677,7 +698,7 @@ def monte_carlo(
     progress: bool = True,
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
-    method: Literal["rk45", "rk4"] = "rk45",
+    method: Literal["rk45", "rk4", "hybrid"] | None = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     dt: float | None = None,
@@ -698,7 +719,10 @@ def monte_carlo(
       (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
       ``frame.attrs["seed"]``; required with ``checkpoint``).
     - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
-    - ``threshold`` (rad): time the first |θ| above it (``t_threshold``); with
+    - ``method``: ``"hybrid"`` (exact linear arcs in sunlight, the non-linear model through the
+      shadows; see ``simulate_orbits``), ``"rk45"`` (hinge-resolved) or ``"rk4"``; None: hybrid
+      for horizons of a month or more, rk45 below.
+    - ``threshold`` (rad): time the first abs(θ) above it (``t_threshold``); with
       ``stop_at_threshold`` a sample stops there.
     - ``threads``: rayon threads on this machine (default: one per core). ``backend``: None (this
       machine), ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``;
@@ -710,14 +734,15 @@ def monte_carlo(
 
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     vary = _check_vary(vary)
     n = _check_n(n)
     seed = _check_seed(seed, checkpoint)
     if sampler not in ("random", "lhs", "sobol"):
         raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
     options = _options(
-        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        orbit, horizon, model, coupled, _default_method(method, orbit, horizon), rtol, atol, dt,
+        window, threshold,
         stop_at_threshold, max_steps,
     )  # fmt: skip
     u = _unit_design(sampler, n, len(vary), seed)
@@ -754,7 +779,7 @@ def sweep(
     progress: bool = True,
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
-    method: Literal["rk45", "rk4"] = "rk45",
+    method: Literal["rk45", "rk4", "hybrid"] | None = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     dt: float | None = None,
@@ -764,7 +789,7 @@ def sweep(
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
     arguments are the same."""
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     if not isinstance(grid, Mapping) or not grid:
         raise ValueError("grid must be a non-empty mapping of panel parameter names to values")
     _check_names(list(grid), "grid")
@@ -775,7 +800,8 @@ def sweep(
             raise ValueError(f"grid[{name!r}] = {vals!r} is invalid: must be finite numbers")
         axes.append(arr.tolist())
     options = _options(
-        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        orbit, horizon, model, coupled, _default_method(method, orbit, horizon), rtol, atol, dt,
+        window, threshold,
         stop_at_threshold, max_steps,
     )  # fmt: skip
     names = list(grid)
@@ -825,7 +851,7 @@ def sensitivity(
     progress: bool = True,
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
-    method: Literal["rk45", "rk4"] = "rk45",
+    method: Literal["rk45", "rk4", "hybrid"] | None = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     dt: float | None = None,
@@ -849,14 +875,15 @@ def sensitivity(
         ) from exc
     import pandas as pd
 
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     vary = _check_vary(vary)
     n = _check_n(n, 2)
     seed = _check_seed(seed, None)
     if metric not in _FLOAT_METRICS and metric != "stable":
         raise ValueError(f"metric = {metric!r} is invalid: choose from {', '.join(_FLOAT_METRICS)}")
     options = _options(
-        orbit, horizon, model, coupled, method, rtol, atol, dt, window, threshold,
+        orbit, horizon, model, coupled, _default_method(method, orbit, horizon), rtol, atol, dt,
+        window, threshold,
         stop_at_threshold, max_steps,
     )  # fmt: skip
     names = list(vary)

@@ -5,9 +5,12 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, fields
 from functools import cached_property
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from thermojitter import _core
+
+if TYPE_CHECKING:
+    from thermojitter.laminate import Laminate
 
 PANEL_UNITS = {
     "emissivity_front": "-",
@@ -30,6 +33,18 @@ PANEL_UNITS = {
 """SI unit of each Panel field, for axis labels and tables."""
 
 StiffnessCriterion = Literal["deflection", "deflection_small_angle", "frequency"]
+
+LAYUP_FIELDS = (
+    "specific_heat",
+    "mass_per_length",
+    "expansion_coeff",
+    "youngs_modulus",
+    "thickness",
+    "width",
+    "conductance",
+    "bending_inertia",
+)
+"""The fields of a panel made by :meth:`Panel.from_laminate` that its layup decides."""
 
 
 @dataclass(frozen=True)
@@ -104,11 +119,76 @@ class Panel:
         return tuple(f.name for f in fields(Panel))
 
     def replace(self, **changes: float) -> Panel:
-        """A validated copy with some parameters changed."""
+        """A validated copy with some parameters changed.
+
+        A panel made by :meth:`from_laminate` keeps its layup; the fields the layup decides
+        (:data:`LAYUP_FIELDS`) cannot be changed on it (change the laminate instead)."""
         unknown = sorted(set(changes) - set(self.field_names()))
         if unknown:
             raise ValueError(f"unknown panel parameter(s): {', '.join(unknown)}")
-        return dataclasses.replace(self, **changes)
+        if self.layup is not None:
+            fixed = sorted(set(changes) & set(LAYUP_FIELDS))
+            if fixed:
+                raise ValueError(
+                    f"{', '.join(fixed)} of a laminate panel follow from its layup: change the "
+                    "Laminate and call Panel.from_laminate again"
+                )
+        copy = dataclasses.replace(self, **changes)
+        object.__setattr__(copy, "_layup", self.layup)
+        return copy
+
+    @classmethod
+    def from_laminate(
+        cls,
+        laminate: Laminate,
+        *,
+        length: float = 50.0,
+        width: float = 1.0,
+        hinge_stiffness: float | None = None,
+        criterion: StiffnessCriterion = "deflection_small_angle",
+        damping: float = 3.0,
+        solar_constant: float = 1361.0,
+        moment_scale: float = 1.0,
+    ) -> Panel:
+        """The panel of a laminate, carrying its layup (``panel.layup``).
+
+        The engine derives, by classical lamination theory: the mass per area Σρh (times the
+        width) and the specific heat that gives the heat capacity Σρch; E = Σ E h / d and
+        I = w D / E, D the bending stiffness about the neutral axis (the modulus-weighted
+        centroid); the two-layer conductance K = 1/Σ(h/k) between the two faces; and the
+        expansion coefficient that gives a linear profile's thermal moment in a E I ΔT / d.
+        The existing models run on these fields; ``layers=N`` runs the N-node model on the
+        layup itself. ``hinge_stiffness`` defaults to K_el by ``criterion``.
+        """
+        from thermojitter.laminate import Laminate
+
+        if not isinstance(laminate, Laminate):
+            raise TypeError(
+                f"laminate must be a thermojitter.Laminate, not {type(laminate).__name__}"
+            )
+        base = cls(
+            length=length,
+            width=width,
+            damping=damping,
+            solar_constant=solar_constant,
+            moment_scale=moment_scale,
+            hinge_stiffness=1.0 if hinge_stiffness is None else hinge_stiffness,
+        )
+        fields_ = dict(_core.equivalent_panel(laminate.as_dict(), base.as_dict()))
+        panel = cls(**fields_)
+        if hinge_stiffness is None:
+            from thermojitter import panel as this_module
+
+            k_el = this_module.hinge_stiffness(panel, criterion)
+            panel = cls(**{**fields_, "hinge_stiffness": k_el})
+        object.__setattr__(panel, "_layup", laminate)
+        return panel
+
+    @property
+    def layup(self) -> Laminate | None:
+        """The laminate this panel was made from (:meth:`from_laminate`), or None for a plain
+        panel (one homogeneous layer to the N-node model)."""
+        return self.__dict__.get("_layup")
 
     @cached_property
     def _values(self) -> dict[str, float]:

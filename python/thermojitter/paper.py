@@ -826,6 +826,40 @@ def beam_section(ctx: PaperContext) -> SectionResult:
     return res
 
 
+def distributed_section(ctx: PaperContext) -> SectionResult:
+    """Beyond the paper (its Sec. 5): the hinge model against the two-way coupled distributed
+    panel."""
+    from thermojitter.distributed_report import (
+        FIGURE,
+        hinge_vs_distributed,
+        hinge_vs_distributed_markdown,
+    )
+
+    result = hinge_vs_distributed(ctx.panel, ctx.orbit, ctx.out)
+    ctx.tick(FIGURE)
+    d, f = result["cases"]["deflection"], result["cases"]["frequency"]
+    nominal = result["critical_damping"][0]
+    res = SectionResult(figures=[FIGURE])
+    res.summary = {"distributed": result}
+    res.rows = [
+        (
+            "RMSE θ − θ_f (coupled distributed panel), deflection K_el",
+            "–",
+            f"{d['rmse_deg']:.3f}°",
+            "–",
+        ),
+        ("RMSE θ − θ_f (coupled distributed panel), 5.21 EI/L", "–", f"{f['rmse_deg']:.3f}°", "–"),
+        (
+            "c_d* at 1 au: hinge (frequency K_el) / distributed panel",
+            "–",
+            f"{nominal['hinge_frequency']:.3f} / {nominal['distributed']:.3f} N m s/rad",
+            "–",
+        ),
+    ]
+    res.text = hinge_vs_distributed_markdown(result).split("\n", 2)[2]
+    return res
+
+
 SECTIONS: list[Section] = [
     Section("thermal", "Thermal models (Figs. 2–6)", 5, thermal_section),
     Section("kinematics", "Hinge kinematics (Fig. 12)", 1, kinematics_section),
@@ -833,6 +867,7 @@ SECTIONS: list[Section] = [
     Section("flutter", "Thermal flutter without damping (Figs. 17–18)", 2, flutter_section),
     Section("linearity", "Linear vs non-linear hinge (Figs. 19–20)", 2, linearity_section),
     Section("beam", "Hinge model against a finite-element beam (Figs. 22–24)", 4, beam_section),
+    Section("distributed", "Hinge model vs coupled distributed panel", 1, distributed_section),
 ]
 """The sections of ``thermojitter paper``, in report order."""
 

@@ -516,8 +516,8 @@ def beam_spectrum_figure(case: Any, number: str, path: Path) -> Path:
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("amplitude [deg]")
     ax.set_title(
-        f"{number} — spectrum of θ, {_k_label(case)}: peak {case.hinge_frequency:.4f} Hz "
-        f"({100 * case.frequency_mismatch:+.1f}% vs f_n)",
+        f"{number} — spectra of θ and θ_f, {_k_label(case)}\n"
+        f"θ peaks at {case.hinge_frequency:.4f} Hz, {100 * case.frequency_mismatch:+.2f}% from f_n",
         fontsize=10,
     )
     ax.grid(alpha=0.3, which="both")

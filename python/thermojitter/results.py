@@ -76,6 +76,11 @@ class _Run:
         )
 
 
+Run = _Run
+"""The counters and exports every run result shares (the base of the result classes of other
+modules, such as :class:`thermojitter.distributed.DistributedSolution`)."""
+
+
 @dataclass(frozen=True)
 class Solution(_Run):
     """The coupled thermo-structural solution at the reported times.
@@ -91,6 +96,19 @@ class Solution(_Run):
     thermal_moment: Array = field(default_factory=lambda: np.empty(0))
     sunlit: Array = field(default_factory=lambda: np.empty(0))
     y_end: Array = field(default_factory=lambda: np.empty(0))
+    T_nodes: Array | None = None
+    """With ``layers=N``: the temperature of every node (time × node), K."""
+    depth: Array | None = None
+    """With ``layers=N``: each node's depth below the front face, m."""
+
+    def to_xarray(self) -> Any:
+        """An xarray Dataset over t (s); with ``layers=N`` also ``T_nodes`` over (t, node),
+        with the node depth (m) as a coordinate."""
+        ds = super().to_xarray()
+        if self.T_nodes is not None and self.depth is not None:
+            ds = ds.assign_coords(depth=("node", np.asarray(self.depth)))
+            ds["T_nodes"] = (("t", "node"), np.asarray(self.T_nodes))
+        return ds
 
     @property
     def y(self) -> Array:

@@ -27,7 +27,7 @@ def _check_type(name: str, value: Any, kind: type | tuple[type, ...]) -> None:
         )
 
 
-def _span(t_span: Sequence[float]) -> tuple[float, float]:
+def time_span(t_span: Sequence[float]) -> tuple[float, float]:
     try:
         t0, t1 = (float(v) for v in t_span)
     except (TypeError, ValueError) as exc:
@@ -44,7 +44,7 @@ def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
     return arr
 
 
-def _solver_args(
+def solver_args(
     method: str,
     rtol: float,
     atol: float,
@@ -82,11 +82,29 @@ def solver_settings(
     }
 
 
-def _check_inputs(panel: Panel, orbit: Orbit | None = None) -> None:
+def check_inputs(panel: Panel, orbit: Orbit | None = None) -> None:
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
     if orbit is not None and not isinstance(orbit, Orbit):
         raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
+
+
+def check_layers(layers: Any) -> int:
+    """``layers`` as a node count (an int >= 2; the engine checks it against the layup)."""
+    if isinstance(layers, bool) or not isinstance(layers, (int, np.integer)):
+        raise TypeError(
+            f"layers must be an int (nodes through the thickness), not {type(layers).__name__}"
+        )
+    if layers < 2:
+        raise ValueError(
+            f"layers = {layers!r} is invalid: must be >= 2 (nodes through the thickness)"
+        )
+    return int(layers)
+
+
+def layup_dict(panel: Panel) -> dict[str, Any] | None:
+    """The panel's layup as the engine takes it (None: one homogeneous layer)."""
+    return None if panel.layup is None else panel.layup.as_dict()
 
 
 def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:
@@ -95,7 +113,7 @@ def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Eq
     ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
     (1: nominal; e.g. 1.033 at perihelion).
     """
-    _check_inputs(panel)
+    check_inputs(panel)
     pd = panel.as_dict()
     tf, tb, th = _core.steady_state(pd, bool(coupled), float(flux))
     moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
@@ -118,6 +136,7 @@ def simulate(
     y0: Sequence[float] | None = None,
     max_step: float = float("inf"),
     max_steps: int = 500_000_000,
+    layers: int | None = None,
 ) -> Solution:
     """Integrates the coupled thermo-structural model over ``t_span`` (s).
 
@@ -136,12 +155,51 @@ def simulate(
     growth studies pass ``max_step`` ≈ T_n/40 (T_n = 1/natural_frequency), or use
     :func:`thermojitter.simulate_orbits`, which does so by default.
 
+    ``layers=N`` runs the N-node through-thickness model (nodes on both faces, on every layer
+    interface and inside the layers) on the panel's layup (:meth:`Panel.from_laminate`), or on
+    one homogeneous layer for a plain panel, where ``layers=2`` is the two-layer model itself.
+    The solution then carries ``T_nodes`` (time × node, K) and ``depth`` (m below the front
+    face); ``y0`` is (node temperatures…, θ, θ̇).
+
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
     """
-    _check_inputs(panel, orbit)
-    t0, t1 = _span(t_span)
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    check_inputs(panel, orbit)
+    t0, t1 = time_span(t_span)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    settings = {"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled}
+    if layers is not None:
+        nodes = check_layers(layers)
+        raw = _core.simulate_layers(
+            panel.as_dict(),
+            layup_dict(panel),
+            nodes,
+            orbit.as_dict(),
+            t0,
+            t1,
+            model=model,
+            coupled=bool(coupled),
+            y0=None if y0 is None else [float(v) for v in y0],
+            **args,
+        )
+        temps = np.asarray(raw["T_nodes"])
+        return Solution(
+            t=raw["t"],
+            n_steps=raw["n_steps"],
+            n_rejected=raw["n_rejected"],
+            n_rhs=raw["n_rhs"],
+            method=method,
+            settings={**settings, "layers": nodes},
+            T_front=temps[:, 0],
+            T_back=temps[:, -1],
+            theta=raw["theta"],
+            theta_dot=raw["theta_dot"],
+            thermal_moment=raw["thermal_moment"],
+            sunlit=raw["sunlit"],
+            y_end=raw["y_end"],
+            T_nodes=temps,
+            depth=raw["depth"],
+        )
     raw = _core.simulate(
         panel.as_dict(),
         orbit.as_dict(),
@@ -158,7 +216,7 @@ def simulate(
         n_rejected=raw["n_rejected"],
         n_rhs=raw["n_rhs"],
         method=method,
-        settings={"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled},
+        settings=settings,
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         theta=raw["theta"],
@@ -187,11 +245,11 @@ def simulate_thermal(
 ) -> ThermalSolution:
     """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
     (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
-    _check_inputs(panel, orbit)
+    check_inputs(panel, orbit)
     if layers not in (1, 2) or isinstance(layers, bool):
         raise ValueError(f"layers = {layers!r} is invalid: must be 1 or 2")
-    t0, t1 = _span(t_span)
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    t0, t1 = time_span(t_span)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     raw = _core.simulate_thermal(
         panel.as_dict(),
         orbit.as_dict(),
@@ -234,9 +292,9 @@ def simulate_hinge(
     """The hinge alone under a prescribed thermal moment (N m): a constant, or samples
     ``moment`` at times ``moment_t`` (linear in between, held beyond the ends).
     ``y0`` = (θ rad, θ̇ rad/s)."""
-    _check_inputs(panel)
-    t0, t1 = _span(t_span)
-    args = _solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    check_inputs(panel)
+    t0, t1 = time_span(t_span)
+    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     m = np.ascontiguousarray(np.atleast_1d(np.asarray(moment, dtype=float)).ravel())
     mt = None if moment_t is None else _times(moment_t)
     raw = _core.simulate_hinge(
@@ -270,7 +328,7 @@ def hinge_energy(
 ) -> np.ndarray:
     """Energy of the hinge in a constant moment field (kinetic + spring − M θ), J.
     Conserved when c_d = 0."""
-    _check_inputs(panel)
+    check_inputs(panel)
     th = np.ascontiguousarray(np.atleast_1d(np.asarray(theta, dtype=float)))
     om = np.ascontiguousarray(np.atleast_1d(np.asarray(theta_dot, dtype=float)))
     return np.asarray(_core.energy(panel.as_dict(), model, th, om, float(moment)))

@@ -9,13 +9,15 @@ use crate::cancel::Cancel;
 use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
 use crate::flutter::{analyse, critical_damping};
+use crate::hybrid::{run_orbits_hybrid, HybridSettings};
 use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LANES};
-use crate::integrate::{solve, DenseStep, Method, Observer};
+use crate::integrate::{DenseStep, Method, Observer};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::summary::{
-    finish_orbits, prepare_orbits, OrbitRun, PreparedOrbits, SummaryObserver, SummaryOptions,
+    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, SummaryObserver,
+    SummaryOptions, TwoLayerView,
 };
 use crate::system::Coupling;
 use nalgebra::{Vector4, U4};
@@ -40,6 +42,12 @@ pub struct EnsembleSettings {
     /// Stop a sample at the first crossing of the threshold (its metrics then cover the run so
     /// far).
     pub stop_at_threshold: bool,
+    /// |θ| beyond which the hinge model is not trusted, rad: the first orbit that passes it is
+    /// reported.
+    pub validity_limit: f64,
+    /// Propagate with the hybrid propagator (`method` is then its fallback) instead of the
+    /// hinge-resolved integration.
+    pub hybrid: Option<HybridSettings>,
 }
 
 impl EnsembleSettings {
@@ -52,6 +60,10 @@ impl EnsembleSettings {
         }
         if let Some(th) = self.threshold {
             require_positive("threshold", th)?;
+        }
+        require_positive("validity_limit", self.validity_limit)?;
+        if let Some(h) = &self.hybrid {
+            h.validate()?;
         }
         Ok(())
     }
@@ -77,8 +89,16 @@ pub struct SampleMetrics {
     /// RMS and peak of θ − M_T/K_el over the horizon.
     pub jitter_rms: f64,
     pub jitter_peak: f64,
-    /// First time |θ| passed the threshold (NaN: never, or no threshold).
+    /// First time |θ| passed the threshold (NaN: never, or no threshold), and its orbit.
     pub t_threshold: f64,
+    pub orbit_threshold: f64,
+    /// First orbit whose |θ| passed the validity limit (NaN: none).
+    pub orbit_limit: f64,
+    /// Growth (> 0) or decay of the per-orbit amplitude over the run: the least-squares slope of
+    /// ln(amplitude) against the orbit index, 1/orbit (NaN with fewer than two orbits).
+    pub amplitude_slope: f64,
+    /// Simulated time integrated with the full non-linear model, s (the whole run unless hybrid).
+    pub t_nonlinear: f64,
     /// Time the integration reached (the horizon unless stopped at the threshold).
     pub t_reached: f64,
     pub n_steps: u64,
@@ -100,6 +120,10 @@ impl SampleMetrics {
             jitter_rms: f64::NAN,
             jitter_peak: f64::NAN,
             t_threshold: f64::NAN,
+            orbit_threshold: f64::NAN,
+            orbit_limit: f64::NAN,
+            amplitude_slope: f64::NAN,
+            t_nonlinear: f64::NAN,
             t_reached: f64::NAN,
             n_steps: 0,
             error: Some(err.to_string()),
@@ -138,6 +162,33 @@ fn reduce(run: &OrbitRun) -> (f64, f64, f64, f64, f64, f64) {
     (theta_abs_max, amplitude, entry, exit, rms, jitter_peak)
 }
 
+/// First orbit whose largest |θ| passed `limit`, as a float (NaN: none).
+fn first_orbit_beyond(run: &OrbitRun, limit: f64) -> f64 {
+    run.summaries
+        .iter()
+        .find(|o| o.theta_max.abs().max(o.theta_min.abs()) > limit)
+        .map_or(f64::NAN, |o| o.index as f64)
+}
+
+/// Least-squares slope of ln(amplitude) against the orbit index (orbits with amplitude > 0).
+fn log_slope(run: &OrbitRun) -> f64 {
+    let points: Vec<(f64, f64)> = run
+        .summaries
+        .iter()
+        .filter(|o| o.amplitude > 0.0)
+        .map(|o| (o.index as f64, o.amplitude.ln()))
+        .collect();
+    let n = points.len() as f64;
+    if points.len() < 2 {
+        return f64::NAN;
+    }
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+    sxy / sxx
+}
+
 /// One sample: the flutter analysis and the summarised run of `panel` (stops with
 /// `Error::Cancelled` within one step of `cancel` being cancelled).
 pub fn run_sample(
@@ -145,16 +196,26 @@ pub fn run_sample(
     settings: &EnsembleSettings,
     cancel: &Cancel,
 ) -> Result<SampleMetrics> {
-    let (head, mut run) = prepare_sample(panel, settings, cancel)?;
-    let outcome = solve(
-        &mut run.system,
-        &run.method,
-        run.t0,
-        run.y0,
-        run.t1,
-        &mut run.observer,
-    );
-    Ok(finish_sample(&head, &finish_orbits(run.observer, outcome)?))
+    let (head, y0, options) = sample_head(panel, settings, cancel)?;
+    let s = settings;
+    let (run, t_nonlinear) = match &s.hybrid {
+        None => {
+            let run = run_orbits_cancellable(
+                panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
+                cancel,
+            )?;
+            let t = run.stats.t_end;
+            (run, t)
+        }
+        Some(h) => {
+            let out = run_orbits_hybrid(
+                panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
+                h, cancel,
+            )?;
+            (out.run, out.t_exponential + out.t_fallback)
+        }
+    };
+    Ok(sample_metrics(&head, settings, &run, t_nonlinear))
 }
 
 /// What a sample knows before its run: the flutter analysis of its equilibrium.
@@ -165,12 +226,12 @@ struct SampleHead {
     critical_damping: f64,
 }
 
-/// The flutter analysis of a sample and its run, set up.
-fn prepare_sample<'c>(
+/// The flutter analysis of a sample, its initial state and its summary options.
+fn sample_head(
     panel: &Panel,
     settings: &EnsembleSettings,
-    cancel: &'c Cancel,
-) -> Result<(SampleHead, PreparedOrbits<'c>)> {
+    cancel: &Cancel,
+) -> Result<(SampleHead, Vector4<f64>, SummaryOptions)> {
     cancel.check()?;
     panel.validate()?;
     let s = settings;
@@ -185,20 +246,22 @@ fn prepare_sample<'c>(
         stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
         steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
     };
-    let run = prepare_orbits(
-        panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options, cancel,
-    )?;
     let head = SampleHead {
         theta_eq: flutter.equilibrium.theta,
         growth_rate: flutter.growth_rate,
         frequency_hz: flutter.frequency_hz,
         critical_damping: critical,
     };
-    Ok((head, run))
+    Ok((head, y0, options))
 }
 
 /// A sample's metrics from its head and its run.
-fn finish_sample(head: &SampleHead, run: &OrbitRun) -> SampleMetrics {
+fn sample_metrics(
+    head: &SampleHead,
+    settings: &EnsembleSettings,
+    run: &OrbitRun,
+    t_nonlinear: f64,
+) -> SampleMetrics {
     let (theta_abs_max, amplitude, entry_peak, exit_peak, jitter_rms, jitter_peak) = reduce(run);
     SampleMetrics {
         theta_eq: head.theta_eq,
@@ -212,6 +275,10 @@ fn finish_sample(head: &SampleHead, run: &OrbitRun) -> SampleMetrics {
         jitter_rms,
         jitter_peak,
         t_threshold: run.crossing.map_or(f64::NAN, |c| c.t),
+        orbit_threshold: run.crossing.map_or(f64::NAN, |c| c.orbit as f64),
+        orbit_limit: first_orbit_beyond(run, settings.validity_limit),
+        amplitude_slope: log_slope(run),
+        t_nonlinear,
         t_reached: run.stats.t_end,
         n_steps: run.stats.n_steps,
         error: None,
@@ -222,7 +289,7 @@ fn finish_sample(head: &SampleHead, run: &OrbitRun) -> SampleMetrics {
 struct LaneSample<'c> {
     index: usize,
     head: SampleHead,
-    observer: SummaryObserver<'c>,
+    observer: SummaryObserver<'c, TwoLayerView>,
 }
 
 impl Observer<U4> for LaneSample<'_> {
@@ -232,15 +299,23 @@ impl Observer<U4> for LaneSample<'_> {
     }
 }
 
-/// Runs `panels` on this thread, [`LANES`] at a time in lockstep; results in input order, each
-/// the same, bit for bit, as [`run_sample`]'s.
+/// Runs `panels` (hinge-resolved Dormand–Prince samples) on this thread, [`LANES`] at a time in
+/// lockstep; results in input order, each the same, bit for bit, as [`run_sample`]'s.
 fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> Vec<SampleMetrics> {
     // Rows are written by `next` (a sample that fails before its run) and by `done`.
     let out = RefCell::new(vec![None; panels.len()]);
     let mut queue = panels.iter().enumerate();
+    let s = settings;
     let next = || {
         for (index, panel) in queue.by_ref() {
-            match prepare_sample(panel, settings, cancel) {
+            let prepared = sample_head(panel, s, cancel).and_then(|(head, y0, options)| {
+                let run = prepare_orbits(
+                    panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0,
+                    options, cancel,
+                )?;
+                Ok((head, run))
+            });
+            match prepared {
                 Ok((head, run)) => {
                     let Method::Dopri5(tol) = run.method else {
                         unreachable!("only Dormand–Prince batches run in lockstep")
@@ -265,7 +340,7 @@ fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> 
     };
     let done = |sample: LaneSample<'_>, outcome| {
         let row = finish_orbits(sample.observer, outcome)
-            .map(|run| finish_sample(&sample.head, &run))
+            .map(|run| sample_metrics(&sample.head, s, &run, run.stats.t_end))
             .unwrap_or_else(SampleMetrics::failed);
         out.borrow_mut()[sample.index] = Some(row);
     };
@@ -300,8 +375,8 @@ pub fn run_batch(
 /// How a batch's samples are integrated; both give the same rows, bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Path {
-    /// [`LANES`] samples at a time per thread, in SIMD lanes (Dormand–Prince batches; others
-    /// run one at a time).
+    /// [`LANES`] samples at a time per thread, in SIMD lanes (hinge-resolved Dormand–Prince
+    /// batches; others run one at a time).
     Lockstep,
     /// One sample at a time per thread.
     Scalar,
@@ -320,11 +395,12 @@ pub fn run_batch_on(
     path: Path,
 ) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
-    let lockstep = path == Path::Lockstep && matches!(settings.method, Method::Dopri5(_));
+    let lockstep = path == Path::Lockstep
+        && settings.hybrid.is_none()
+        && matches!(settings.method, Method::Dopri5(_));
     let scalar = |p: &Panel| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed);
     let out = pool.install(|| {
         if lockstep {
-            // A group of one sample gains nothing from the lanes: it runs alone.
             let groups: Vec<Vec<SampleMetrics>> = panels
                 .par_chunks(GROUP)
                 .with_max_len(1)
@@ -366,6 +442,8 @@ mod tests {
             window: 600.0,
             threshold: Some(0.2),
             stop_at_threshold: false,
+            validity_limit: 0.35,
+            hybrid: None,
         }
     }
 
@@ -396,6 +474,10 @@ mod tests {
                     m.jitter_rms,
                     m.jitter_peak,
                     m.t_threshold,
+                    m.orbit_threshold,
+                    m.orbit_limit,
+                    m.amplitude_slope,
+                    m.t_nonlinear,
                     m.t_reached,
                 ];
                 let mut b: Vec<u64> = v.iter().map(|x| x.to_bits()).collect();
@@ -491,6 +573,48 @@ mod tests {
         assert_eq!(m.theta_abs_max, o.theta_max.abs().max(o.theta_min.abs()));
         assert!((m.jitter_rms - o.jitter_rms).abs() <= 1e-15 * o.jitter_rms);
         assert_eq!(m.theta_eq, eq.theta);
+    }
+
+    #[test]
+    fn hybrid_samples_do_not_depend_on_threads_and_equal_their_single_run() {
+        let s = EnsembleSettings {
+            orbit: Orbit::geo_year(70.0),
+            n_orbits: 3,
+            hybrid: Some(HybridSettings::default()),
+            threshold: None,
+            ..settings()
+        };
+        let one = run_batch(&pool(1).unwrap(), &panels(), &s, &Cancel::new()).unwrap();
+        let two = run_batch(&pool(2).unwrap(), &panels(), &s, &Cancel::new()).unwrap();
+        assert_eq!(bits(&one), bits(&two));
+        let p = Panel::paper();
+        let m = run_sample(&p, &s, &Cancel::new()).unwrap();
+        let eq = equilibrium(&p, s.coupling, s.orbit.flux_scale(0.0)).unwrap();
+        let single = run_orbits_hybrid(
+            &p,
+            &s.orbit,
+            s.model,
+            s.coupling,
+            &s.method,
+            0.0,
+            0,
+            3,
+            Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+            SummaryOptions {
+                window: s.window,
+                theta_limit: f64::MAX,
+                stop_at_limit: false,
+                steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
+            },
+            &HybridSettings::default(),
+            &Cancel::new(),
+        )
+        .unwrap();
+        let amp = single.run.summaries.iter().map(|o| o.amplitude);
+        assert_eq!(m.amplitude, amp.fold(f64::NAN, f64::max));
+        assert_eq!(m.t_nonlinear, single.t_exponential + single.t_fallback);
+        assert!(m.t_nonlinear > 0.0 && m.t_nonlinear < 0.2 * m.t_reached);
+        assert!(m.amplitude_slope.is_finite());
     }
 
     #[test]

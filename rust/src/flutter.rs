@@ -5,13 +5,16 @@
 //! the heating; the temperature gradient answers with a lag, and that lag can feed energy into the
 //! oscillation (the paper's "thermal pumping"). Linear stability of the equilibrium decides it.
 
-use crate::dynamics::HingeModel;
+use crate::dynamics::{HingeModel, StructuralModel};
 use crate::error::{require_non_negative, Error, Result};
+use crate::integrate::State;
 use crate::params::Panel;
 use crate::steady::{equilibrium, Equilibrium};
-use crate::system::Coupling;
+use crate::system::{Coupled, Coupling};
+use crate::thermal::ThermalModel;
 use crate::STEFAN_BOLTZMANN;
-use nalgebra::{Complex, Matrix4, Vector4};
+use nalgebra::allocator::Allocator;
+use nalgebra::{Complex, DMatrix, DVector, DefaultAllocator, Dim, Matrix4, U1};
 
 /// Linear stability of the sunlit equilibrium.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,57 +93,146 @@ pub fn analyse(
 ) -> Result<FlutterAnalysis> {
     let eq = equilibrium(panel, coupling, flux)?;
     let jac = jacobian(panel, model, coupling, flux, &eq);
-    // Balance the scales (kelvin rows against radian rows) before the eigen-solve;
-    // a diagonal similarity leaves the eigenvalues unchanged.
-    let scale = Vector4::new(
+    // Kelvin rows against radian rows: θ scaled by the temperature, θ̇ by ω_n too.
+    let scale = [
         1.0,
         1.0,
         1.0 / eq.t_front.max(1.0),
         panel.natural_angular_frequency() / eq.t_front.max(1.0),
-    );
-    let balanced = Matrix4::from_fn(|i, j| jac[(i, j)] * scale[j] / scale[i]);
-    let ev = balanced.complex_eigenvalues();
-    if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
-        return Err(Error::NoConvergence {
-            what: "eigenvalues".into(),
-            reason: "non-finite result".into(),
-        });
-    }
-    let mut eigenvalues = [ev[0], ev[1], ev[2], ev[3]];
-    eigenvalues.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
-    let growth_rate = eigenvalues[0].re;
-    let omega = eigenvalues.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
+    ];
+    let spectrum = Spectrum::of(&DMatrix::from_column_slice(4, 4, jac.as_slice()), &scale)?;
     Ok(FlutterAnalysis {
         equilibrium: eq,
         jacobian: jac,
-        eigenvalues,
-        growth_rate,
-        frequency_hz: omega / (2.0 * std::f64::consts::PI),
+        eigenvalues: [
+            spectrum.eigenvalues[0],
+            spectrum.eigenvalues[1],
+            spectrum.eigenvalues[2],
+            spectrum.eigenvalues[3],
+        ],
+        growth_rate: spectrum.growth_rate,
+        frequency_hz: spectrum.frequency_hz,
     })
 }
 
-/// The damping c_d (N m s/rad) at which the growth rate crosses zero, by bracketing and bisection.
-/// Returns 0 when the panel is stable even without damping.
-pub fn critical_damping(
-    panel: &Panel,
-    model: HingeModel,
-    coupling: Coupling,
+/// Eigenvalues of a linearised system, with its growth rate and oscillation frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spectrum {
+    /// 1/s, sorted by decreasing real part (then imaginary part).
+    pub eigenvalues: Vec<Complex<f64>>,
+    /// Largest real part, 1/s: positive means the equilibrium is unstable.
+    pub growth_rate: f64,
+    /// Largest |Im λ| / 2π, Hz (0 when nothing oscillates).
+    pub frequency_hz: f64,
+}
+
+impl Spectrum {
+    /// The spectrum of `jac` after the diagonal similarity D⁻¹ J D, D = diag(`scale`), which
+    /// leaves the eigenvalues unchanged and evens out the units of the state's components
+    /// (kelvin against radians) before the eigen-solve.
+    pub fn of(jac: &DMatrix<f64>, scale: &[f64]) -> Result<Spectrum> {
+        let n = jac.nrows();
+        if jac.ncols() != n || scale.len() != n {
+            return Err(Error::invalid(
+                "jacobian",
+                format!("{}x{}", n, jac.ncols()),
+                &format!("must be square and match the {} scales", scale.len()),
+            ));
+        }
+        let balanced = DMatrix::from_fn(n, n, |i, j| jac[(i, j)] * scale[j] / scale[i]);
+        let ev = balanced.complex_eigenvalues();
+        if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+            return Err(Error::NoConvergence {
+                what: "eigenvalues".into(),
+                reason: "non-finite result".into(),
+            });
+        }
+        let mut eigenvalues: Vec<Complex<f64>> = ev.iter().copied().collect();
+        eigenvalues.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
+        let growth_rate = eigenvalues[0].re;
+        let omega = eigenvalues.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
+        Ok(Spectrum {
+            eigenvalues,
+            growth_rate,
+            frequency_hz: omega / (2.0 * std::f64::consts::PI),
+        })
+    }
+}
+
+/// ∂f/∂y of `f` at `y` by central differences, step ε^(1/3) · max(|y_j|, `floor[j]`) in
+/// component j (`floor`: a magnitude typical of the component where it passes through zero).
+pub fn finite_difference_jacobian(
+    f: impl Fn(&DVector<f64>) -> DVector<f64>,
+    y: &DVector<f64>,
+    floor: &[f64],
+) -> DMatrix<f64> {
+    let n = y.len();
+    let mut jac = DMatrix::zeros(n, n);
+    for j in 0..n {
+        let h = f64::EPSILON.cbrt() * y[j].abs().max(floor[j]);
+        let (mut plus, mut minus) = (y.clone(), y.clone());
+        plus[j] += h;
+        minus[j] -= h;
+        // The step actually taken, so that rounding of y ± h does not bias the quotient.
+        let step = plus[j] - minus[j];
+        jac.set_column(j, &((f(&plus) - f(&minus)) / step));
+    }
+    jac
+}
+
+/// Linear stability of any coupled system at its steady state under flux factor `flux`: its
+/// right-hand side differentiated by [`finite_difference_jacobian`], then [`Spectrum::of`]
+/// with each component scaled by its magnitude at the equilibrium. Returns the equilibrium and
+/// the spectrum.
+pub fn analyse_system<T, S, D>(
+    system: &Coupled<T, S, D>,
     flux: f64,
-) -> Result<f64> {
-    let growth = |cd: f64| -> Result<f64> {
-        let p = Panel {
-            damping: cd,
-            ..*panel
-        };
-        Ok(analyse(&p, model, coupling, flux)?.growth_rate)
+) -> Result<(State<D>, DMatrix<f64>, Spectrum)>
+where
+    T: ThermalModel,
+    S: StructuralModel,
+    D: Dim,
+    DefaultAllocator: Allocator<D>,
+{
+    check_flux(flux)?;
+    let eq = system.steady_state(flux)?;
+    let y = DVector::from_column_slice(eq.as_slice());
+    let dim = system.dim();
+    let f = |x: &DVector<f64>| {
+        let state = State::<D>::from_column_slice_generic(dim, U1, x.as_slice());
+        DVector::from_column_slice(system.rhs_at_flux(flux, &state).as_slice())
     };
+    // Temperatures and shapes through zero: a kelvin, a milliradian (or its modal equivalent).
+    let n_thermal = system.thermal().size();
+    let floor: Vec<f64> = (0..y.len())
+        .map(|i| if i < n_thermal { 1.0 } else { 1e-3 })
+        .collect();
+    let jac = finite_difference_jacobian(f, &y, &floor);
+    let scale: Vec<f64> = (0..y.len())
+        .map(|i| {
+            if i < n_thermal {
+                1.0
+            } else {
+                1.0 / y.amax().max(1.0)
+            }
+        })
+        .collect();
+    let spectrum = Spectrum::of(&jac, &scale)?;
+    Ok((eq, jac, spectrum))
+}
+
+/// The value of a stabilising parameter (a damping, a damping ratio) at which `growth` crosses
+/// zero, by bracketing from `start` (doubling) and bisection to `rel_tol`. Returns 0 when the
+/// system is stable without it.
+pub fn critical_value(
+    mut growth: impl FnMut(f64) -> Result<f64>,
+    start: f64,
+    rel_tol: f64,
+) -> Result<f64> {
     if growth(0.0)? < 0.0 {
         return Ok(0.0);
     }
-    // The equilibrium does not depend on c_d; only the hinge row of the Jacobian does.
-    let mut hi = panel
-        .damping
-        .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
+    let mut hi = start;
     let mut n = 0;
     while growth(hi)? >= 0.0 {
         hi *= 2.0;
@@ -160,11 +252,33 @@ pub fn critical_damping(
         } else {
             hi = mid;
         }
-        if hi - lo <= 1e-12 * hi {
+        if hi - lo <= rel_tol * hi {
             break;
         }
     }
     Ok(0.5 * (lo + hi))
+}
+
+/// The damping c_d (N m s/rad) at which the growth rate crosses zero, by bracketing and bisection.
+/// Returns 0 when the panel is stable even without damping.
+pub fn critical_damping(
+    panel: &Panel,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<f64> {
+    let growth = |cd: f64| -> Result<f64> {
+        let p = Panel {
+            damping: cd,
+            ..*panel
+        };
+        Ok(analyse(&p, model, coupling, flux)?.growth_rate)
+    };
+    // The equilibrium does not depend on c_d; only the hinge row of the Jacobian does.
+    let start = panel
+        .damping
+        .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
+    critical_value(growth, start, 1e-12)
 }
 
 /// Checks a flux factor argument.
@@ -194,7 +308,7 @@ mod tests {
                 let eq = equilibrium(&p, coupling, 1.0).unwrap();
                 let jac = jacobian(&p, model, coupling, 1.0, &eq);
                 let sys = Coupled::new(p, Orbit::geo_equinox(), model, coupling);
-                let y = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+                let y = eq.state();
                 for j in 0..4 {
                     let h = 1e-6 * y[j].abs().max(1e-3);
                     let mut yp = y;
@@ -264,5 +378,58 @@ mod tests {
         )
         .unwrap();
         assert!(above.stable() && !below.stable());
+    }
+
+    #[test]
+    fn any_system_by_finite_differences_matches_the_analytic_analysis() {
+        let orbit = Orbit::geo_equinox();
+        for damping in [0.0, 3.0] {
+            let p = Panel {
+                damping,
+                ..Panel::paper()
+            };
+            for model in [HingeModel::Nonlinear, HingeModel::Linear] {
+                let exact = analyse(&p, model, Coupling::ProjectedArea, 1.0).unwrap();
+                let sys = Coupled::new(p, orbit, model, Coupling::ProjectedArea);
+                let (eq, jac, spectrum) = analyse_system(&sys, 1.0).unwrap();
+                assert_eq!(eq, exact.equilibrium.state());
+                for i in 0..4 {
+                    for j in 0..4 {
+                        let tol = 1e-7 * exact.jacobian.column(j).amax();
+                        assert!(
+                            (jac[(i, j)] - exact.jacobian[(i, j)]).abs() <= tol,
+                            "({i},{j})"
+                        );
+                    }
+                }
+                // Rounding in the differences moves the eigenvalues by ~1e-10 of their size.
+                let size = exact
+                    .eigenvalues
+                    .iter()
+                    .map(|z| z.norm())
+                    .fold(0.0, f64::max);
+                let err = (spectrum.growth_rate - exact.growth_rate).abs();
+                assert!(err < 1e-8 * size, "{model:?} c_d {damping}: {err}");
+                assert!((spectrum.frequency_hz / exact.frequency_hz - 1.0).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn critical_damping_of_any_system_by_its_growth_rate() {
+        let p = Panel::paper();
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let growth = |cd: f64| {
+            let sys = Coupled::new(
+                Panel { damping: cd, ..p },
+                Orbit::geo_equinox(),
+                model,
+                coupling,
+            );
+            Ok(analyse_system(&sys, 1.0)?.2.growth_rate)
+        };
+        let generic = critical_value(growth, 1.0, 1e-10).unwrap();
+        let exact = critical_damping(&p, model, coupling, 1.0).unwrap();
+        assert!((generic / exact - 1.0).abs() < 1e-5, "{generic} vs {exact}");
     }
 }

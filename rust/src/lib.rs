@@ -7,13 +7,17 @@
 
 pub mod beam;
 pub mod cancel;
+pub mod conduction;
 pub mod cpu;
 pub mod distributed;
 pub mod dynamics;
 pub mod ensemble;
 pub mod error;
 pub mod flutter;
+pub mod hybrid;
 pub mod integrate;
+pub mod laminate;
+pub mod layered;
 pub mod orbit;
 pub mod params;
 pub mod simulate;

@@ -1,33 +1,47 @@
 //! Per-orbit summaries of long runs: memory grows with the number of orbits, not of steps.
 //!
-//! Each accepted step is read at its midpoint (from the dense output) and at its end, and at
-//! eight points where it may hold an extreme of the orbit (judged from θ̇ at those points) or
-//! overlaps an eclipse window: the step is capped at a fortieth of the hinge period, so the peaks
-//! are read at 320 points per period, the rest at 80. Against 64 points in every step the peaks
-//! stay within 1e-5 of the amplitude (`two_reads_per_step_keep_the_peaks` below measures it) at
-//! about half the cost of the four points per step read before.
+//! Each accepted step is read at four evenly spaced points of its dense output, fine enough to
+//! catch the peaks of an oscillation that needs tens of steps per period.
 
 use crate::cancel::Cancel;
-use crate::dynamics::HingeModel;
+use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::Result;
-use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
+use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, State, Stats};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
-use nalgebra::{Vector4, U4};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, Vector4};
 use std::ops::ControlFlow;
 
-/// Points read per step: the midpoint and the end.
-const READS_PER_STEP: usize = 2;
+/// How the summaries read a model's state: the hinge angle and the quasi-static angle
+/// M_T/K_el at (t, y), and the sunlit equilibrium angle under a flux factor.
+pub trait SummaryView {
+    fn theta_eq(&self, flux: f64) -> Result<f64>;
+    /// (θ, M_T/K_el) at time t in state y.
+    fn angles(&self, t: f64, y: &[f64]) -> (f64, f64);
+}
 
-/// Angles below which a missed peak does not matter, rad (a nanoradian: jitter is measured in
-/// microradians and more).
-const NEGLIGIBLE_ANGLE: f64 = 1e-9;
+/// The two-layer system's view: state (T_f, T_b, θ, θ̇).
+pub(crate) struct TwoLayerView {
+    pub(crate) panel: Panel,
+    pub(crate) coupling: Coupling,
+}
 
-/// Points read in a step that may hold an extreme (a multiple of [`READS_PER_STEP`], so that its
-/// points include the coarse ones).
-const DETAILED_READS: usize = 8;
+impl SummaryView for TwoLayerView {
+    fn theta_eq(&self, flux: f64) -> Result<f64> {
+        Ok(equilibrium(&self.panel, self.coupling, flux)?.theta)
+    }
+    #[inline]
+    fn angles(&self, _t: f64, y: &[f64]) -> (f64, f64) {
+        let quasi_static = thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+        (y[2], quasi_static)
+    }
+}
+
+/// Points read per step (the step end and three interior points).
+const READS_PER_STEP: usize = 4;
 
 /// What one orbit did. Angles in rad, times in s; NaN where an orbit has no eclipse.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -125,29 +139,57 @@ pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> M
     }
 }
 
-struct Collector {
-    panel: Panel,
-    /// M_T/K_el per kelvin of T_f − T_b (M_T as in `dynamics::thermal_moment`), computed once.
-    static_per_kelvin: f64,
-    orbit: Orbit,
-    coupling: Coupling,
-    options: SummaryOptions,
-    first_index: u64,
-    t_start: f64,
-    done: Vec<OrbitSummary>,
-    current: OrbitSummary,
-    sq_sum: f64,
-    duration: f64,
-    crossing: Option<LimitCrossing>,
+/// Builds the per-orbit summaries from what the propagator reports: points of the solution
+/// (the integrators' dense output) or bands [θ_lo, θ_hi] that hold it (the hybrid propagator's
+/// oscillation envelopes and exactly propagated arcs).
+pub(crate) struct Collector<V> {
+    pub(crate) view: V,
+    pub(crate) orbit: Orbit,
+    pub(crate) options: SummaryOptions,
+    pub(crate) first_index: u64,
+    pub(crate) t_start: f64,
+    pub(crate) done: Vec<OrbitSummary>,
+    pub(crate) current: OrbitSummary,
+    pub(crate) sq_sum: f64,
+    pub(crate) duration: f64,
+    pub(crate) crossing: Option<LimitCrossing>,
 }
 
-impl Collector {
+impl<V: SummaryView> Collector<V> {
+    /// A collector whose first orbit `first_index` starts at `t_start` with hinge angle θ0.
+    pub(crate) fn new(
+        view: V,
+        orbit: &Orbit,
+        options: SummaryOptions,
+        t_start: f64,
+        first_index: u64,
+        n_orbits: u64,
+        theta0: f64,
+    ) -> Result<Self> {
+        let mut collector = Collector {
+            view,
+            orbit: *orbit,
+            options,
+            first_index,
+            t_start,
+            done: Vec::with_capacity(n_orbits as usize),
+            current: OrbitSummary::new(first_index, 0.0, 0.0, 0.0, None),
+            sq_sum: 0.0,
+            duration: 0.0,
+            crossing: None,
+        };
+        collector.current = collector.open(first_index)?;
+        collector.current.theta_max = theta0;
+        collector.current.theta_min = theta0;
+        Ok(collector)
+    }
+
     fn open(&mut self, index: u64) -> Result<OrbitSummary> {
         let t0 = self.t_start + (index - self.first_index) as f64 * self.orbit.period;
         let t1 = t0 + self.orbit.period;
         let flux = self.orbit.flux_scale(0.5 * (t0 + t1));
         let theta_eq = if flux > 0.0 {
-            equilibrium(&self.panel, self.coupling, flux)?.theta
+            self.view.theta_eq(flux)?
         } else {
             0.0
         };
@@ -155,7 +197,7 @@ impl Collector {
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
     }
 
-    fn close(&mut self) {
+    pub(crate) fn close(&mut self) {
         let mut s = self.current;
         s.jitter_rms = if self.duration > 0.0 {
             (self.sq_sum / self.duration).sqrt()
@@ -167,158 +209,166 @@ impl Collector {
         self.duration = 0.0;
     }
 
-    /// θ − M_T/K_el, the dynamic part of the deflection.
-    #[inline]
-    fn dynamic(&self, y: &Vector4<f64>) -> f64 {
-        y[2] - self.static_per_kelvin * (y[0] - y[1])
+    /// One point of the solution, standing for the interval dt before it.
+    pub(crate) fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
+        let (th, quasi_static) = self.view.angles(t, y);
+        let dynamic = th - quasi_static;
+        self.record(t, th, th, dynamic.abs(), dynamic * dynamic * dt, dt)
     }
 
-    /// Whether a step could change an extreme of the current orbit or crosses into an eclipse
-    /// window, the next orbit or the limit, judged from its start, midpoint and end (with a
-    /// margin for what may lie between them). A margin below [`NEGLIGIBLE_ANGLE`] never asks for
-    /// detail.
-    #[inline]
-    fn may_hold_an_extreme(&self, step: &DenseStep<U4>, y_mid: &Vector4<f64>) -> bool {
-        let s = &self.current;
-        let (t0, t1) = (step.t0, step.t1);
-        let w = self.options.window;
-        // NaN eclipse times compare false: no window.
-        if t1 > s.t_end
-            || (t1 >= s.t_entry && t0 <= s.t_entry + w)
-            || (t1 >= s.t_exit && t0 <= s.t_exit + w)
-        {
-            return true;
-        }
-        let (a, b, c) = (&step.y0, y_mid, &step.y1);
-        // Points `half` apart: where θ turns between two of them, it passes the larger by about
-        // |Δθ̇| half / 8 (exactly so for a sinusoid sampled finely); four times that is the margin.
-        let half = 0.5 * (t1 - t0);
-        let margin = (b[3] - a[3]).abs().max((c[3] - b[3]).abs()) * (0.5 * half);
-        let k = self.static_per_kelvin;
-        let (qa, qb, qc) = (k * (a[0] - a[1]), k * (b[0] - b[1]), k * (c[0] - c[1]));
-        // The quasi-static part bends slowly: twice its second difference bounds its share.
-        let bend = 2.0 * (qa - 2.0 * qb + qc).abs();
-        if margin + bend <= NEGLIGIBLE_ANGLE {
-            // Nothing between the points can pass them by more than a negligible angle (the
-            // hinge at rest: on a plateau every point may equal the extreme).
-            return false;
-        }
-        let hi = a[2].max(b[2]).max(c[2]);
-        let lo = a[2].min(b[2]).min(c[2]);
-        let dev = (hi - s.theta_eq).abs().max((lo - s.theta_eq).abs());
-        let dynamic = (a[2] - qa)
-            .abs()
-            .max((b[2] - qb).abs())
-            .max((c[2] - qc).abs());
-        let limit_near = self.crossing.is_none() && hi.max(-lo) + margin > self.options.theta_limit;
-        // Any comparison with NaN (a state gone non-finite) asks for detail too.
-        !(hi + margin <= s.theta_max
-            && lo - margin >= s.theta_min
-            && dev + margin <= s.amplitude
-            && dynamic + margin + bend <= s.jitter_peak)
-            || limit_near
-    }
-
-    fn read(&mut self, t: f64, y: &Vector4<f64>, dt: f64) -> Result<()> {
+    /// Moves on to the orbit that holds t (closing the finished ones).
+    pub(crate) fn advance(&mut self, t: f64) -> Result<()> {
         while t > self.current.t_end {
             self.close();
             let next = self.current.index + 1;
             self.current = self.open(next)?;
         }
-        let th = y[2];
-        let dynamic = self.dynamic(y);
+        Ok(())
+    }
+
+    /// A span (t_a, t_b] inside one orbit whose θ extremes over any sub-interval `extremes` gives,
+    /// with the dynamic part's largest magnitude and ∫(dynamic)² over the span. The caller keeps
+    /// |θ| below the limit over the span.
+    pub(crate) fn record_span(
+        &mut self,
+        t_a: f64,
+        t_b: f64,
+        extremes: &dyn Fn(f64, f64) -> (f64, f64),
+        dynamic_abs: f64,
+        sq: f64,
+    ) -> Result<()> {
+        // The orbit that holds the span's middle (its ends may round onto a neighbour's edge).
+        self.advance(0.5 * (t_a + t_b))?;
+        let (lo, hi) = extremes(t_a, t_b);
         let s = &mut self.current;
-        s.theta_max = s.theta_max.max(th);
-        s.theta_min = s.theta_min.min(th);
-        let dev = (th - s.theta_eq).abs();
+        s.theta_max = s.theta_max.max(hi);
+        s.theta_min = s.theta_min.min(lo);
+        let eq = s.theta_eq;
+        let dev = |lo: f64, hi: f64| (hi - eq).abs().max((lo - eq).abs());
+        s.amplitude = s.amplitude.max(dev(lo, hi));
+        s.jitter_peak = s.jitter_peak.max(dynamic_abs);
+        self.sq_sum += sq;
+        self.duration += t_b - t_a;
+        let w = self.options.window;
+        let (entry, exit) = (s.t_entry, s.t_exit);
+        for (start, is_entry) in [(entry, true), (exit, false)] {
+            let (a, b) = (t_a.max(start), t_b.min(start + w));
+            if start.is_nan() || a > b {
+                continue; // no window, or no overlap
+            }
+            let (l, h) = extremes(a, b);
+            let d = dev(l, h);
+            let s = &mut self.current;
+            if is_entry {
+                s.entry_theta_min = nan_min(s.entry_theta_min, l);
+                s.entry_peak = nan_max(s.entry_peak, d);
+            } else {
+                s.exit_theta_max = nan_max(s.exit_theta_max, h);
+                s.exit_peak = nan_max(s.exit_peak, d);
+            }
+        }
+        Ok(())
+    }
+
+    /// θ lies in [th_lo, th_hi] at t; the dynamic part's magnitude is at most `dynamic_abs`
+    /// there, and ∫(dynamic)² over the interval dt before t is `sq`.
+    pub(crate) fn record(
+        &mut self,
+        t: f64,
+        th_lo: f64,
+        th_hi: f64,
+        dynamic_abs: f64,
+        sq: f64,
+        dt: f64,
+    ) -> Result<()> {
+        self.advance(t)?;
+        let s = &mut self.current;
+        s.theta_max = s.theta_max.max(th_hi);
+        s.theta_min = s.theta_min.min(th_lo);
+        let dev = (th_hi - s.theta_eq).abs().max((th_lo - s.theta_eq).abs());
         s.amplitude = s.amplitude.max(dev);
-        s.jitter_peak = s.jitter_peak.max(dynamic.abs());
-        self.sq_sum += dynamic * dynamic * dt;
+        s.jitter_peak = s.jitter_peak.max(dynamic_abs);
+        self.sq_sum += sq;
         self.duration += dt;
         let w = self.options.window;
         if t >= s.t_entry && t <= s.t_entry + w {
-            s.entry_theta_min = if s.entry_theta_min.is_nan() {
-                th
-            } else {
-                s.entry_theta_min.min(th)
-            };
-            s.entry_peak = if s.entry_peak.is_nan() {
-                dev
-            } else {
-                s.entry_peak.max(dev)
-            };
+            s.entry_theta_min = nan_min(s.entry_theta_min, th_lo);
+            s.entry_peak = nan_max(s.entry_peak, dev);
         }
         if t >= s.t_exit && t <= s.t_exit + w {
-            s.exit_theta_max = if s.exit_theta_max.is_nan() {
-                th
-            } else {
-                s.exit_theta_max.max(th)
-            };
-            s.exit_peak = if s.exit_peak.is_nan() {
-                dev
-            } else {
-                s.exit_peak.max(dev)
-            };
+            s.exit_theta_max = nan_max(s.exit_theta_max, th_hi);
+            s.exit_peak = nan_max(s.exit_peak, dev);
         }
-        if self.crossing.is_none() && th.abs() > self.options.theta_limit {
-            self.crossing = Some(LimitCrossing {
-                t,
-                orbit: s.index,
-                theta: th,
-            });
+        if self.crossing.is_none() {
+            let limit = self.options.theta_limit;
+            let theta = if th_hi > limit {
+                Some(th_hi)
+            } else if th_lo < -limit {
+                Some(th_lo)
+            } else {
+                None
+            };
+            if let Some(theta) = theta {
+                self.crossing = Some(LimitCrossing {
+                    t,
+                    orbit: s.index,
+                    theta,
+                });
+            }
         }
         Ok(())
     }
 }
 
-/// The observer of a summarised run (see [`prepare_orbits`]).
-pub(crate) struct SummaryObserver<'c> {
-    collector: Collector,
-    error: Option<crate::Error>,
-    cancel: &'c Cancel,
-    /// Points read in a step: [`READS_PER_STEP`], or [`DETAILED_READS`] in a step that may hold
-    /// an extreme; with `detail` false, always `reads` (the fine reference of the tests).
-    reads: usize,
-    detail: bool,
-}
-
-impl SummaryObserver<'_> {
-    /// Reads `reads` evenly spaced points of the step, the last its end.
-    fn read_step(&mut self, step: &DenseStep<U4>, reads: usize) -> Result<()> {
-        let h = (step.t1 - step.t0) / reads as f64;
-        for j in 1..reads {
-            let t = step.t0 + j as f64 * h;
-            self.collector.read(t, &step.eval(t), h)?;
-        }
-        self.collector.read(step.t1, &step.y1, h)
+/// min(acc, v), where NaN in `acc` means "nothing yet".
+fn nan_min(acc: f64, v: f64) -> f64 {
+    if acc.is_nan() {
+        v
+    } else {
+        acc.min(v)
     }
 }
 
-impl Observer<U4> for SummaryObserver<'_> {
-    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+/// max(acc, v), where NaN in `acc` means "nothing yet".
+fn nan_max(acc: f64, v: f64) -> f64 {
+    if acc.is_nan() {
+        v
+    } else {
+        acc.max(v)
+    }
+}
+
+pub(crate) struct SummaryObserver<'c, V> {
+    pub(crate) collector: Collector<V>,
+    pub(crate) error: Option<crate::Error>,
+    pub(crate) cancel: &'c Cancel,
+}
+
+impl<D: Dim, V: SummaryView> Observer<D> for SummaryObserver<'_, V>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()> {
         if let Err(e) = self.cancel.check() {
             self.error = Some(e);
             return ControlFlow::Break(());
         }
-        let read = if !self.detail {
-            self.read_step(step, self.reads)
-        } else {
-            // The midpoint, then either the two points or, where the step may hold an extreme,
-            // a finer reading (which includes them).
-            let h = 0.5 * (step.t1 - step.t0);
-            let t_mid = step.t0 + h;
-            let y_mid = step.eval(t_mid);
-            if self.collector.may_hold_an_extreme(step, &y_mid) {
-                self.read_step(step, DETAILED_READS)
+        let h = (step.t1 - step.t0) / READS_PER_STEP as f64;
+        for j in 1..=READS_PER_STEP {
+            let t = if j == READS_PER_STEP {
+                step.t1
             } else {
-                self.collector
-                    .read(t_mid, &y_mid, h)
-                    .and_then(|()| self.collector.read(step.t1, &step.y1, h))
+                step.t0 + j as f64 * h
+            };
+            let read = if j == READS_PER_STEP {
+                self.collector.read(t, step.y1.as_slice(), h)
+            } else {
+                self.collector.read(t, step.eval(t).as_slice(), h)
+            };
+            if let Err(e) = read {
+                self.error = Some(e);
+                return ControlFlow::Break(());
             }
-        };
-        if let Err(e) = read {
-            self.error = Some(e);
-            return ControlFlow::Break(());
         }
         if self.collector.options.stop_at_limit && self.collector.crossing.is_some() {
             return ControlFlow::Break(());
@@ -383,43 +433,48 @@ pub fn run_orbits_cancellable(
     options: SummaryOptions,
     cancel: &Cancel,
 ) -> Result<OrbitRun> {
-    let mut run = prepare_orbits(
+    let mut system = Coupled::new(*panel, *orbit, model, coupling);
+    let view = TwoLayerView {
+        panel: *panel,
+        coupling,
+    };
+    let run = run_summarised(
+        &mut system,
+        view,
         panel,
         orbit,
-        model,
-        coupling,
         method,
         t_start,
         first_index,
         n_orbits,
         y0,
+        2,
         options,
         cancel,
     )?;
-    let outcome = solve(
-        &mut run.system,
-        &run.method,
-        run.t0,
-        run.y0,
-        run.t1,
-        &mut run.observer,
-    );
-    finish_orbits(run.observer, outcome)
+    Ok(OrbitRun {
+        summaries: run.summaries,
+        stats: run.stats,
+        y_end: run.y_end,
+        crossing: run.crossing,
+    })
 }
 
-/// A summarised run set up but not yet integrated: integrate `system` with `method` from
-/// (`t0`, `y0`) to `t1` into `observer` (with [`solve`], or in lockstep with other runs), then
-/// hand the outcome to [`finish_orbits`].
+/// A summarised run of any model: the summaries, the counters and the end state.
+/// A summarised run of the two-layer panel set up but not yet integrated: integrate `system` with
+/// `method` from (`t0`, `y0`) to `t1` into `observer` (with [`solve`], or in lockstep with
+/// other runs), then hand the outcome to [`finish_orbits`]. The same checks and observer as
+/// [`run_orbits_cancellable`].
 pub(crate) struct PreparedOrbits<'c> {
     pub system: Coupled,
     pub method: Method,
     pub t0: f64,
     pub t1: f64,
     pub y0: Vector4<f64>,
-    pub observer: SummaryObserver<'c>,
+    pub observer: SummaryObserver<'c, TwoLayerView>,
 }
 
-/// Checks the settings and sets up a summarised run (see [`run_orbits_cancellable`]).
+/// Sets up what [`run_orbits_cancellable`] integrates.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare_orbits<'c>(
     panel: &Panel,
@@ -442,24 +497,11 @@ pub(crate) fn prepare_orbits<'c>(
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
-    let mut collector = Collector {
+    let view = TwoLayerView {
         panel: *panel,
-        static_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
-        orbit: *orbit,
         coupling,
-        options,
-        first_index,
-        t_start,
-        done: Vec::with_capacity(n_orbits as usize),
-        current: OrbitSummary::new(first_index, 0.0, 0.0, 0.0, None),
-        sq_sum: 0.0,
-        duration: 0.0,
-        crossing: None,
     };
-    collector.current = collector.open(first_index)?;
-    let y0_theta = y0[2];
-    collector.current.theta_max = y0_theta;
-    collector.current.theta_min = y0_theta;
+    let collector = Collector::new(view, orbit, options, t_start, first_index, n_orbits, y0[2])?;
     Ok(PreparedOrbits {
         system: Coupled::new(*panel, *orbit, model, coupling),
         method,
@@ -470,15 +512,14 @@ pub(crate) fn prepare_orbits<'c>(
             collector,
             error: None,
             cancel,
-            reads: READS_PER_STEP,
-            detail: true,
         },
     })
 }
 
-/// The summaries of a prepared run from the outcome of its integration.
+/// The summaries of a prepared run from the outcome of its integration (as
+/// [`run_orbits_cancellable`] returns them).
 pub(crate) fn finish_orbits(
-    observer: SummaryObserver<'_>,
+    observer: SummaryObserver<'_, TwoLayerView>,
     outcome: Result<(Stats, Vector4<f64>)>,
 ) -> Result<OrbitRun> {
     let (stats, y_end) = outcome?;
@@ -488,6 +529,75 @@ pub(crate) fn finish_orbits(
     let mut c = observer.collector;
     c.close();
     Ok(OrbitRun {
+        summaries: c.done,
+        stats,
+        y_end,
+        crossing: c.crossing,
+    })
+}
+
+#[derive(Debug, Clone)]
+pub struct Summarised<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    pub summaries: Vec<OrbitSummary>,
+    pub stats: Stats,
+    pub y_end: State<D>,
+    pub crossing: Option<LimitCrossing>,
+}
+
+/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` (whose
+/// component `theta_index` is θ) and summarises each orbit through `view`; the step is capped
+/// by `panel`'s hinge period as [`SummaryOptions::steps_per_period`] asks.
+#[allow(clippy::too_many_arguments)]
+pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
+    system: &mut S,
+    view: V,
+    panel: &Panel,
+    orbit: &Orbit,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: State<D>,
+    theta_index: usize,
+    options: SummaryOptions,
+    cancel: &Cancel,
+) -> Result<Summarised<D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    cancel.check()?;
+    crate::error::require_positive("window", options.window)?;
+    crate::error::require_positive("theta_limit", options.theta_limit)?;
+    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    let method = &resolve_hinge(method, panel, options.steps_per_period);
+    if n_orbits == 0 {
+        return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
+    }
+    let collector = Collector::new(
+        view,
+        orbit,
+        options,
+        t_start,
+        first_index,
+        n_orbits,
+        y0[theta_index],
+    )?;
+    let mut observer = SummaryObserver {
+        collector,
+        error: None,
+        cancel,
+    };
+    let t_end = t_start + n_orbits as f64 * orbit.period;
+    let (stats, y_end) = solve(system, method, t_start, y0, t_end, &mut observer)?;
+    if let Some(e) = observer.error {
+        return Err(e);
+    }
+    let mut c = observer.collector;
+    c.close();
+    Ok(Summarised {
         summaries: c.done,
         stats,
         y_end,
@@ -563,89 +673,6 @@ mod tests {
         let d = (whole.summaries[1].exit_theta_max - second.summaries[0].exit_theta_max).abs();
         assert!(d < 1e-8, "{d}");
         assert_eq!(second.summaries[0].index, 1);
-    }
-
-    /// The summaries of `n` GEO orbits of `panel` read at `reads` points per step.
-    fn run_reading(panel: &Panel, n: u64, reads: usize, detail: bool) -> OrbitRun {
-        let o = Orbit::geo_equinox();
-        let eq = equilibrium(panel, Coupling::ProjectedArea, 1.0).unwrap();
-        let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-        let opts = SummaryOptions {
-            window: 600.0,
-            theta_limit: 10.0,
-            stop_at_limit: false,
-            steps_per_period: STEPS_PER_HINGE_PERIOD,
-        };
-        let method = Method::Dopri5(Tolerances::default());
-        let cancel = Cancel::new();
-        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
-        let mut run = prepare_orbits(
-            panel, &o, model, coupling, &method, 0.0, 0, n, y0, opts, &cancel,
-        )
-        .unwrap();
-        run.observer.reads = reads;
-        run.observer.detail = detail;
-        let outcome = solve(
-            &mut run.system,
-            &run.method,
-            run.t0,
-            run.y0,
-            run.t1,
-            &mut run.observer,
-        );
-        finish_orbits(run.observer, outcome).unwrap()
-    }
-
-    #[test]
-    fn two_reads_per_step_keep_the_peaks() {
-        // Against 64 reads per step of the same steps: every peak within 1e-4 of the orbit's
-        // amplitude (peaks of θ itself sit on the equilibrium angle), the jitter's peak within
-        // 1e-4 and its RMS within 0.1 % of themselves. Measured: peaks 5e-7 (damped) and 7e-6
-        // (undamped, growing to 0.56 rad), jitter peak 8e-6, RMS 1.3e-4 and 4.9e-4, with 1.5 %
-        // and 8 % of the steps read in detail. Four reads in every step (before): peaks 6e-5,
-        // jitter peak 1.4e-4, RMS 1.9e-4.
-        for damping in [3.0, 0.0] {
-            let panel = Panel {
-                damping,
-                ..Panel::paper()
-            };
-            let fine = run_reading(&panel, 2, 64, false);
-            let coarse = run_reading(&panel, 2, READS_PER_STEP, true);
-            assert_eq!(fine.stats, coarse.stats);
-            for (f, c) in fine.summaries.iter().zip(&coarse.summaries) {
-                let scale = f.amplitude;
-                // (name, fine, coarse, +1 for a maximum, −1 for a minimum)
-                let peaks = [
-                    ("theta_max", f.theta_max, c.theta_max, 1.0),
-                    ("theta_min", f.theta_min, c.theta_min, -1.0),
-                    ("amplitude", f.amplitude, c.amplitude, 1.0),
-                    (
-                        "entry_theta_min",
-                        f.entry_theta_min,
-                        c.entry_theta_min,
-                        -1.0,
-                    ),
-                    ("exit_theta_max", f.exit_theta_max, c.exit_theta_max, 1.0),
-                    ("entry_peak", f.entry_peak, c.entry_peak, 1.0),
-                    ("exit_peak", f.exit_peak, c.exit_peak, 1.0),
-                ];
-                for (name, want, got, sense) in peaks {
-                    let rel = (got - want).abs() / scale;
-                    assert!(
-                        rel < 1e-3,
-                        "damping {damping} {name}: {got} vs {want} ({rel:e})"
-                    );
-                    // The points read are a subset of the fine ones (j/2 = 32j/64 and
-                    // j/8 = 8j/64 exactly):
-                    // a sparser reading can only miss a peak, never pass it.
-                    assert!(sense * got <= sense * want, "{name}: {got} beyond {want}");
-                }
-                let rel = (c.jitter_peak - f.jitter_peak).abs() / f.jitter_peak;
-                assert!(rel < 1e-4, "damping {damping} jitter_peak: {rel:e}");
-                let rel = (c.jitter_rms - f.jitter_rms).abs() / f.jitter_rms;
-                assert!(rel < 1e-3, "damping {damping} jitter_rms: {rel:e}");
-            }
-        }
     }
 
     #[test]

@@ -384,4 +384,39 @@ mod tests {
             }
         }
     }
+
+    /// The same models behind a run-time size and dynamic dispatch give the same bits.
+    #[test]
+    fn a_run_time_sized_system_reproduces_the_paper_model() {
+        use crate::integrate::{Method, Tolerances};
+        use crate::simulate::{run, Output};
+        let p = Panel::paper();
+        let o = Orbit::geo_year(273.0);
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let mut fixed = Coupled::new(p, o, model, coupling);
+        let thermal = crate::thermal::model(&p, 2).unwrap();
+        let mut dynamic =
+            Coupled::compose(thermal, Hinge::new(&p, model), o, coupling, Dyn(4)).unwrap();
+        let flux = o.flux_scale(40_000.0);
+        let y0 = fixed.steady_state(flux).unwrap();
+        let y0_dyn = dynamic.steady_state(flux).unwrap();
+        assert_eq!(y0.as_slice(), y0_dyn.as_slice());
+        let method = Method::Dopri5(Tolerances::default());
+        let out = Output::Every(60.0);
+        let span = (40_000.0, 50_000.0);
+        let a = run(&mut fixed, &method, span, y0, &out).unwrap();
+        let b = run(&mut dynamic, &method, span, y0_dyn, &out).unwrap();
+        assert_eq!(a.stats, b.stats);
+        for (x, y) in a.y.iter().zip(&b.y) {
+            assert_eq!(x.as_slice(), y.as_slice());
+        }
+        assert!(Coupled::compose(
+            TwoLayer::new(&p),
+            Hinge::new(&p, model),
+            o,
+            coupling,
+            Dyn(5)
+        )
+        .is_err());
+    }
 }

@@ -15,8 +15,10 @@ def add_parser(sub: Any) -> None:
         description=(
             "Drive a free-free finite-element beam with the hinge run's thermal moment through "
             "an eclipse and compare its equivalent angle with the hinge model's, for K_el by the "
-            "deflection and the frequency criteria (paper Figs. 22-24). Writes the figures, "
-            "beam_summary.json and beam_report.md into --out."
+            "deflection and the frequency criteria (paper Figs. 22-24); then compare the hinge "
+            "model with the two-way coupled distributed panel (theta vs theta_f, critical "
+            "damping at 1 au, perihelion and aphelion, the cantilever's stability). Writes the "
+            "figures, beam_summary.json and beam_report.md into --out."
         ),
         epilog="Example: thermojitter beam --out out/beam",
     )
@@ -33,10 +35,17 @@ def add_parser(sub: Any) -> None:
         action="store_true",
         help="skip fitting the hinge parameters to the beam run",
     )
+    beam.add_argument(
+        "--no-distributed",
+        action="store_true",
+        help="skip the comparison with the coupled distributed panel",
+    )
     beam.set_defaults(handler=run, stop_flag=False)
 
 
 def run(args: argparse.Namespace) -> int:
     from thermojitter.beam import write_beam_comparison
 
-    return write_beam_comparison(out_dir(args.out), args.elements, not args.no_calibrate)
+    return write_beam_comparison(
+        out_dir(args.out), args.elements, not args.no_calibrate, not args.no_distributed
+    )

@@ -41,6 +41,8 @@ DEFAULT_X = "damping:0:5:51"
 DEFAULT_Y = "conductance:5:60:56"
 ModelName = Literal["nonlinear", "linear"]
 MODELS: tuple[ModelName, ...] = ("nonlinear", "linear")
+FLUTTER_KEYS = ("model", "coupled", "flux", "x", "y")
+"""Keys of the [flutter] table."""
 
 
 def parse_axis(text: str, which: str) -> tuple[str, np.ndarray]:
@@ -119,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
         except ScenarioError as e:
             raise UserError(str(e)) from None
         panel, orbit, options = scenario.panel, scenario.orbit, scenario.extra["flutter"]
-        unknown = set(options) - {"model", "coupled", "flux", "x", "y"}
+        unknown = set(options) - set(FLUTTER_KEYS)
         if unknown:
             raise UserError(f"{path}: flutter.{sorted(unknown)[0]}: unknown key")
         source = str(path)

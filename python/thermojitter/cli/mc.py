@@ -31,7 +31,9 @@ from thermojitter.cli.common import Interrupted, out_dir
 from thermojitter.montecarlo import monte_carlo
 from thermojitter.scenario import ScenarioError, load_scenario
 
-_RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window")
+SETTING_KEYS = ("n", "seed", "sampler", "truncate")
+"""Keys of [montecarlo] that set the design."""
+RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window")
 
 
 def read_scenario(path: str | Path) -> dict[str, Any]:
@@ -42,7 +44,7 @@ def read_scenario(path: str | Path) -> dict[str, Any]:
     if not vary:
         raise ScenarioError(path, "vary", "a [vary] table is required (parameter = [dist, ...])")
     settings = dict(scenario.extra["montecarlo"])
-    allowed = {"n", "seed", "sampler", "truncate", *_RUN_KEYS}
+    allowed = {*SETTING_KEYS, *RUN_KEYS}
     extra = sorted(set(settings) - allowed)
     if extra:
         raise ScenarioError(path, f"montecarlo.{extra[0]}", "unknown key")
@@ -91,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     scenario = read_scenario(args.scenario)
     s = scenario["settings"]
     out = out_dir(args.out)
-    run = {k: s[k] for k in _RUN_KEYS if k in s}
+    run = {k: s[k] for k in RUN_KEYS if k in s}
     for key in ("horizon", "threshold"):
         if getattr(args, key) is not None:
             run[key] = getattr(args, key)

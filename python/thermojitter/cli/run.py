@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import textwrap
 import time
 from pathlib import Path
 from typing import Any
@@ -24,21 +25,40 @@ MAX_ORBITS = 100_000
 
 COLUMNS = ("T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit")
 
-SCENARIO_KEYS = """\
-[panel]       any Panel field (SI units; Table 1 for the rest): length, width, thickness,
-              mass_per_length, specific_heat, absorptivity, emissivity_front, emissivity_back,
-              conductance, youngs_modulus, bending_inertia, hinge_stiffness, damping,
-              moment_scale, solar_constant, ... (python -c "import thermojitter as tj;
-              print(tj.Panel.paper())" lists them with their values)
-[orbit]       preset = "geo_equinox" | "geo_year" | "leo" | "sunlit"; start_date = "YYYY-MM-DD"
-              (geo_year); altitude (leo, m); and/or any Orbit field: radius, earth_radius,
-              period, phase0, shadow ("none" | "cylindrical" | "penumbra"), season,
-              eccentric_sun, ...
-[simulation]  t_start (s); the span: t_end (s) or orbits or years; model = "nonlinear" |
-              "linear"; coupled = true; method = "rk45" | "rk4"; rtol, atol; dt (rk4 step, s);
-              dt_out (output interval, s); keep = "samples" | "orbits" (one summary row per
-              orbit, resumable); theta_limit_deg and on_limit = "stop" | "flag" (keep = "orbits")
-[output]      format = "csv" | "parquet"; plots = true | false"""
+
+def scenario_keys_help() -> str:
+    """Every key of the four tables of a scenario, for ``run --help`` (the names come from the
+    code, so none is missing)."""
+    from dataclasses import fields
+
+    from thermojitter import _core
+    from thermojitter.orbit import Orbit
+    from thermojitter.scenario import SimulationSettings
+
+    def table(name: str, keys: list[str], note: str) -> str:
+        body = textwrap.fill(", ".join(keys) + "; " + note, width=86, break_on_hyphens=False)
+        return f"[{name}]\n" + textwrap.indent(body, "  ")
+
+    return "\n".join(
+        [
+            table("panel", list(_core.PANEL_FIELDS), "SI units, Table 1 for the rest"),
+            table(
+                "orbit",
+                ["preset", "start_date", "altitude", *(f.name for f in fields(Orbit))],
+                'preset = "geo_equinox" | "geo_year" (start_date = YYYY-MM-DD) | "leo" '
+                '(altitude, m) | "sunlit"; shadow = "none" | "cylindrical" | "penumbra"',
+            ),
+            table(
+                "simulation",
+                [f.name for f in fields(SimulationSettings)],
+                "the span is one of t_end (s), orbits, years; model = nonlinear | linear; "
+                "method = rk45 | rk4 (dt = step, s); dt_out = output interval, s; keep = "
+                '"samples" | "orbits" (one summary row per orbit, resumable, with '
+                'theta_limit_deg and on_limit = "stop" | "flag")',
+            ),
+            table("output", ["format", "plots"], 'format = "csv" | "parquet"; plots = true'),
+        ]
+    )
 
 
 def _chunks(t0: float, t1: float, period: float) -> list[tuple[float, float]]:
@@ -299,8 +319,8 @@ def add_parser(sub: Any) -> None:
             'and plots (temperatures.png, theta.png) into --out; with keep = "orbits", one '
             "summary row per orbit (orbits.csv, orbits.png), resumable from checkpoint.json."
         ),
-        epilog="Scenario keys (every table optional):\n"
-        + SCENARIO_KEYS
+        epilog="Scenario keys (every table and key optional):\n"
+        + scenario_keys_help()
         + "\n\nExample: thermojitter run examples/paper.toml --out out/run",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -1,18 +1,21 @@
 //! The distributed panel: a finite-element Euler–Bernoulli panel whose every element carries its
-//! own two-layer thermal state, absorbs sunlight at its own incidence and bends under its own
-//! thermal moment — the continuous counterpart of the hinge model, two-way coupled the same way.
+//! own through-thickness thermal state, absorbs sunlight at its own incidence and bends under its
+//! own thermal moment — the continuous counterpart of the hinge model, two-way coupled the same
+//! way.
 //!
-//! Element e (chord slope ρ_e = (w_{e+1} − w_e)/h, see [`structure`]) has the heat balance of
-//! eq. 2 with the absorbed flux factor s(t) · (flux scale) · cos(ψ + atan ρ_e): ψ is the Sun's
+//! Element e (chord slope ρ_e = (w_{e+1} − w_e)/h, see [`structure`]) has the heat balance of its
+//! thermal model ([`crate::thermal::ThermalModel`], two layers by default: eq. 2) with the
+//! absorbed flux factor s(t) · (flux scale) · cos(ψ + atan ρ_e): ψ is the Sun's
 //! angle to the undeformed front normal (the rigid attitude; 0 for the Sun-pointing panel) and
 //! atan ρ_e the elastic rotation of the element's chord, so the Sun sees each element at its own
-//! angle. Its thermal moment M_e = a E I (T_f − T_b)/d (the physical rigidity: the hinge model's χ
-//! is a calibration of the hinge, not of the panel) loads the structure as consistent nodal loads.
+//! angle. Its thermal moment M_e (a E I (T_f − T_b)/d for two layers, with the physical rigidity:
+//! the hinge model's χ is a calibration of the hinge, not of the panel) loads the structure as
+//! consistent nodal loads.
 //! With the coupling frozen the factor is cos ψ for every element.
 //!
 //! The structure is reduced to its first k elastic modes q (state), the others quasi-static:
-//! w = Φ q + R M. The state is y = (T_f[0..n], T_b[0..n], q[0..k], q̇[0..k]) and the modal
-//! equations are q̈ᵢ + 2ζωᵢ q̇ᵢ + ωᵢ² qᵢ = Σ_e Gᵢₑ M_e.
+//! w = Φ q + R M. The state is y = (temperatures of element 0, of element 1, ..., q[0..k],
+//! q̇[0..k]) and the modal equations are q̈ᵢ + 2ζωᵢ q̇ᵢ + ωᵢ² qᵢ = Σ_e Gᵢₑ M_e.
 //!
 //! Not modelled: conduction along the panel (as in the paper's model; the incidence varies by a
 //! few degrees along it) and the rigid-body attitude dynamics of a free panel, whose attitude the
@@ -21,13 +24,10 @@
 pub mod run;
 pub mod structure;
 
-use crate::dynamics::thermal_moment;
 use crate::error::{require_finite, require_non_negative, Error, Result};
 use crate::params::Panel;
-use crate::steady::equilibrium;
 use crate::system::Coupling;
-use crate::thermal::two_layer_rates;
-use crate::STEFAN_BOLTZMANN;
+use crate::thermal::{self, ThermalModel};
 use nalgebra::{Complex, DMatrix, DVector};
 use std::f64::consts::{FRAC_PI_2, PI};
 pub use structure::{Mesh, Reduction, Support, CANTILEVER_BETA1_L, MAX_ELEMENTS};
@@ -48,6 +48,8 @@ pub struct Settings {
     /// ψ, the Sun's angle to the undeformed front normal, rad, |ψ| < π/2.
     pub sun_angle: f64,
     pub coupling: Coupling,
+    /// Layers of every element's through-thickness model ([`thermal::model`]).
+    pub layers: u32,
 }
 
 impl Settings {
@@ -61,6 +63,7 @@ impl Settings {
             damping_ratio: crate::beam::hinge_equivalent_damping_ratio(panel),
             sun_angle: 0.0,
             coupling: Coupling::ProjectedArea,
+            layers: 2,
         }
     }
 
@@ -78,31 +81,51 @@ impl Settings {
     }
 }
 
-/// The coupled distributed model: panel, settings and the modal reduction.
-#[derive(Debug, Clone)]
+/// The coupled distributed model: panel, settings, each element's thermal model and the modal
+/// reduction.
 pub struct DistributedPanel {
     pub panel: Panel,
     pub settings: Settings,
     pub reduction: Reduction,
-    /// The panel with χ = 1: the physical thermal moment.
-    physical: Panel,
+    /// The through-thickness model every element carries (registered in [`thermal::model`]),
+    /// built with χ = 1: the panel's physical thermal moment.
+    thermal: Box<dyn ThermalModel + Send + Sync>,
+}
+
+impl std::fmt::Debug for DistributedPanel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DistributedPanel")
+            .field("settings", &self.settings)
+            .field("temperatures", &self.thermal.names())
+            .finish()
+    }
+}
+
+impl Clone for DistributedPanel {
+    fn clone(&self) -> Self {
+        DistributedPanel::new(&self.panel, self.settings)
+            .expect("settings that built a model build it again")
+    }
 }
 
 /// Absorbed-area factor of an element: cos(ψ + atan ρ), zero once the Sun is behind the front.
+/// Written as (cos ψ − ρ sin ψ)/√(1 + ρ²), one square root instead of an arctangent and a
+/// cosine on the hot path; `sun` is (sin ψ, cos ψ).
 #[inline]
-fn incidence(sun_angle: f64, slope: f64) -> f64 {
-    (sun_angle + slope.atan()).cos().max(0.0)
+fn incidence(sun: (f64, f64), slope: f64) -> f64 {
+    let (s, c) = sun;
+    ((c - slope * s) / (1.0 + slope * slope).sqrt()).max(0.0)
 }
 
-/// d incidence / d ρ.
+/// d incidence / d ρ = −(sin ψ + ρ cos ψ)/(1 + ρ²)^{3/2} (zero where the factor is clamped).
 #[inline]
-fn incidence_slope(sun_angle: f64, slope: f64) -> f64 {
-    let a = sun_angle + slope.atan();
-    if a.cos() <= 0.0 {
-        0.0
-    } else {
-        -a.sin() / (1.0 + slope * slope)
+fn incidence_slope(sun: (f64, f64), slope: f64) -> f64 {
+    let (s, c) = sun;
+    if c - slope * s <= 0.0 {
+        return 0.0;
     }
+    let r2 = 1.0 + slope * slope;
+    -(s + slope * c) / (r2 * r2.sqrt())
 }
 
 impl DistributedPanel {
@@ -110,14 +133,15 @@ impl DistributedPanel {
         settings.validate()?;
         let mesh = Mesh::new(panel, settings.support, settings.elements)?;
         let reduction = Reduction::new(mesh, settings.modes)?;
+        let physical = Panel {
+            moment_scale: 1.0,
+            ..*panel
+        };
         Ok(DistributedPanel {
             panel: *panel,
             settings,
             reduction,
-            physical: Panel {
-                moment_scale: 1.0,
-                ..*panel
-            },
+            thermal: thermal::model(&physical, settings.layers)?,
         })
     }
 
@@ -131,64 +155,95 @@ impl DistributedPanel {
         self.settings.modes
     }
 
-    /// State size 2n + 2k.
+    /// Temperatures per element.
+    pub fn layers(&self) -> usize {
+        self.thermal.size()
+    }
+
+    /// Names of an element's temperatures ("T_front", "T_back", ...).
+    pub fn temperature_names(&self) -> Vec<String> {
+        self.thermal.names()
+    }
+
+    /// Number of temperatures, n × layers: the modal coordinates start there.
+    fn temps(&self) -> usize {
+        self.n() * self.layers()
+    }
+
+    /// State size n × layers + 2k.
     pub fn state_size(&self) -> usize {
-        2 * (self.n() + self.k())
+        self.temps() + 2 * self.k()
     }
 
-    /// Thermal moment of one element, N m.
-    #[inline]
-    pub fn element_moment(&self, t_front: f64, t_back: f64) -> f64 {
-        thermal_moment(&self.physical, t_front, t_back)
+    /// Element e's temperatures in the state.
+    fn element<'a>(&self, y: &'a [f64], e: usize) -> &'a [f64] {
+        let s = self.layers();
+        &y[e * s..(e + 1) * s]
     }
 
-    /// Element moments from the state.
+    /// Modal coordinates q of the state.
+    fn modal<'a>(&self, y: &'a [f64]) -> &'a [f64] {
+        &y[self.temps()..self.temps() + self.k()]
+    }
+
+    /// Element moments from the state, N m.
     pub fn moments(&self, y: &[f64]) -> Vec<f64> {
-        let n = self.n();
-        (0..n)
-            .map(|e| self.element_moment(y[e], y[n + e]))
+        (0..self.n())
+            .map(|e| self.thermal.moment(self.element(y, e)))
             .collect()
     }
 
     /// Per-element chord slopes ρ = D Φ q + D R M.
-    fn slopes(&self, q: &[f64], moments: &[f64]) -> DVector<f64> {
+    fn slopes(&self, q: &[f64], moments: &[f64]) -> Vec<f64> {
         let r = &self.reduction;
-        let mut rho = &r.slope_residual * DVector::from_column_slice(moments);
-        rho.gemv(1.0, &r.slope_modal, &DVector::from_column_slice(q), 1.0);
+        let n = self.n();
+        let mut rho = vec![0.0; n];
+        // Column by column (the matrices are column-major): each pass is a contiguous axpy.
+        let columns = r
+            .slope_residual
+            .as_slice()
+            .chunks_exact(n)
+            .zip(moments)
+            .chain(r.slope_modal.as_slice().chunks_exact(n).zip(q));
+        for (col, x) in columns {
+            for (out, a) in rho.iter_mut().zip(col) {
+                *out += a * x;
+            }
+        }
         rho
     }
 
     /// Absorbed-area factor of each element for chord slopes `rho`.
     fn areas(&self, rho: &[f64]) -> Vec<f64> {
-        let psi = self.settings.sun_angle;
+        let sun = self.settings.sun_angle.sin_cos();
         match self.settings.coupling {
-            Coupling::ProjectedArea => rho.iter().map(|r| incidence(psi, *r)).collect(),
-            Coupling::Frozen => vec![psi.cos(); rho.len()],
+            Coupling::ProjectedArea => rho.iter().map(|r| incidence(sun, *r)).collect(),
+            Coupling::Frozen => vec![sun.1; rho.len()],
         }
     }
 
     /// The right-hand side under illumination factor `flux` (s × flux scale).
     pub fn rhs_at_flux(&self, flux: f64, y: &[f64], dy: &mut [f64]) {
-        let (n, k) = (self.n(), self.k());
+        let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
         let r = &self.reduction;
         let moments = self.moments(y);
-        let q = &y[2 * n..2 * n + k];
-        let v = &y[2 * n + k..];
+        let q = self.modal(y);
+        let v = &y[nt + k..];
         let areas = match self.settings.coupling {
-            Coupling::ProjectedArea => self.areas(self.slopes(q, &moments).as_slice()),
+            Coupling::ProjectedArea => self.areas(&self.slopes(q, &moments)),
             Coupling::Frozen => self.areas(&vec![0.0; n]),
         };
-        for e in 0..n {
-            let (df, db) = two_layer_rates(&self.panel, flux * areas[e], y[e], y[n + e]);
-            dy[e] = df;
-            dy[n + e] = db;
+        for (e, area) in areas.iter().enumerate() {
+            let temps = self.element(y, e);
+            self.thermal
+                .rates(flux * area, temps, &mut dy[e * s..(e + 1) * s]);
         }
-        let force = &r.force * DVector::from_column_slice(&moments);
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
             let w = r.omega[i];
-            dy[2 * n + i] = v[i];
-            dy[2 * n + k + i] = force[i] - 2.0 * zeta * w * v[i] - w * w * q[i];
+            let force: f64 = (0..n).map(|e| r.force[(i, e)] * moments[e]).sum();
+            dy[nt + i] = v[i];
+            dy[nt + k + i] = force - 2.0 * zeta * w * v[i] - w * w * q[i];
         }
     }
 
@@ -207,66 +262,108 @@ impl DistributedPanel {
             .collect()
     }
 
-    /// The full state at rest in static equilibrium with the given temperatures.
-    pub fn static_state(&self, t_front: &[f64], t_back: &[f64]) -> Vec<f64> {
-        let moments: Vec<f64> = t_front
-            .iter()
-            .zip(t_back)
-            .map(|(f, b)| self.element_moment(*f, *b))
-            .collect();
-        let mut y = Vec::with_capacity(self.state_size());
-        y.extend_from_slice(t_front);
-        y.extend_from_slice(t_back);
-        y.extend(self.static_modal(&moments));
-        y.extend(std::iter::repeat_n(0.0, self.k()));
+    /// The full state at rest in static equilibrium with the given temperatures (element-major:
+    /// element 0's temperatures, then element 1's, ...).
+    pub fn static_state(&self, temps: &[f64]) -> Vec<f64> {
+        let mut y = temps.to_vec();
+        y.extend(std::iter::repeat_n(0.0, 2 * self.k()));
+        let moments = self.moments(&y);
+        let q = self.static_modal(&moments);
+        y[self.temps()..self.temps() + self.k()].copy_from_slice(&q);
         y
+    }
+
+    /// The temperatures of every element, one row per name in [`Self::temperature_names`].
+    pub fn temperature_rows(&self, y: &[f64]) -> Vec<Vec<f64>> {
+        let s = self.layers();
+        (0..s)
+            .map(|i| (0..self.n()).map(|e| y[e * s + i]).collect())
+            .collect()
     }
 
     /// θ_f of a state, rad.
     pub fn theta_f(&self, y: &[f64], t: f64) -> Result<f64> {
-        let n = self.n();
-        let moments = self.moments(y);
-        let rise = self.reduction.rise(&y[2 * n..2 * n + self.k()], &moments);
+        let rise = self.reduction.rise(self.modal(y), &self.moments(y));
         self.reduction.theta_f(rise, t)
     }
 
     /// Nodal deflections and slopes of a state.
     pub fn nodal(&self, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let n = self.n();
-        let w = self
-            .reduction
-            .deflection(&y[2 * n..2 * n + self.k()], &self.moments(y));
+        let w = self.reduction.deflection(self.modal(y), &self.moments(y));
         self.reduction.nodal(&w)
     }
 
-    /// Sunlit equilibrium under illumination factor `flux`: Newton on the 2n heat balances with
-    /// the structure in its static shape (exact whatever the number of kept modes).
+    /// ∂(heat flows or rates)/∂(temperatures) of one element (s × s, row-major) and
+    /// ∂/∂flux (s), by central differences of the thermal model at flux factor `flux` —
+    /// whatever the model, the steady state and the Jacobian need only its `heat_flows` or
+    /// `rates`. The flux enters linearly, and the step in each temperature is small enough
+    /// (1e-4 K) for the T⁴ terms to be exact to about 1e-10.
+    fn element_partials(
+        &self,
+        flux: f64,
+        temps: &[f64],
+        per_capacity: bool,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let s = temps.len();
+        let eval = |f: f64, t: &[f64], out: &mut [f64]| {
+            if per_capacity {
+                self.thermal.rates(f, t, out)
+            } else {
+                self.thermal.heat_flows(f, t, out)
+            }
+        };
+        let (mut plus, mut minus) = (vec![0.0; s], vec![0.0; s]);
+        let mut d_temps = vec![0.0; s * s];
+        let mut t = temps.to_vec();
+        for j in 0..s {
+            let h = 1e-4;
+            t[j] = temps[j] + h;
+            eval(flux, &t, &mut plus);
+            t[j] = temps[j] - h;
+            eval(flux, &t, &mut minus);
+            t[j] = temps[j];
+            for i in 0..s {
+                d_temps[i * s + j] = (plus[i] - minus[i]) / (2.0 * h);
+            }
+        }
+        eval(1.0, temps, &mut plus);
+        eval(0.0, temps, &mut minus);
+        let d_flux = plus.iter().zip(&minus).map(|(a, b)| a - b).collect();
+        (d_temps, d_flux)
+    }
+
+    /// ∂M/∂T of an element's temperatures, N m/K (M is linear in them).
+    fn moment_partials(&self) -> Vec<f64> {
+        let s = self.layers();
+        let zero = vec![0.0; s];
+        let m0 = self.thermal.moment(&zero);
+        (0..s)
+            .map(|j| {
+                let mut unit = zero.clone();
+                unit[j] = 1.0;
+                self.thermal.moment(&unit) - m0
+            })
+            .collect()
+    }
+
+    /// Sunlit equilibrium under illumination factor `flux`: Newton on the heat balances of every
+    /// element with the structure in its static shape (exact whatever the number of kept modes).
     pub fn equilibrium(&self, flux: f64) -> Result<Vec<f64>> {
         if !(flux.is_finite() && flux > 0.0) {
             return Err(Error::invalid("flux", flux, "must be finite and > 0"));
         }
-        let n = self.n();
-        let p = &self.panel;
-        let psi = self.settings.sun_angle;
+        let (n, s, nt) = (self.n(), self.layers(), self.temps());
+        let sun = self.settings.sun_angle.sin_cos();
         let coupled = self.settings.coupling == Coupling::ProjectedArea;
-        let hc = 0.5 * p.heat_capacity();
-        let mu = self.element_moment(1.0, 0.0);
-        let absorbed = p.absorptivity * p.solar_constant * flux;
-        // Start from the uniform panel at the rigid incidence (the frozen hinge's temperatures).
-        let start = equilibrium(p, Coupling::Frozen, flux * psi.cos())?;
-        let mut x = DVector::from_fn(
-            2 * n,
-            |i, _| {
-                if i < n {
-                    start.t_front
-                } else {
-                    start.t_back
-                }
-            },
-        );
+        let dm = self.moment_partials();
+        // Start from the uniform panel at the rigid incidence.
+        let mut guess = vec![0.0; s];
+        self.thermal.initial_guess(flux * sun.1, &mut guess);
+        let mut x = DVector::from_fn(nt, |i, _| guess[i % s]);
         let fs = &self.reduction.slope_static;
+        let mut flows = vec![0.0; s];
         for _ in 0..100 {
-            let moments: Vec<f64> = (0..n).map(|e| mu * (x[e] - x[n + e])).collect();
+            let moments = self.moments(x.as_slice());
             let rho: Vec<f64> = if coupled {
                 (0..n)
                     .map(|e| (0..n).map(|j| fs[(e, j)] * moments[j]).sum())
@@ -275,24 +372,27 @@ impl DistributedPanel {
                 vec![0.0; n]
             };
             let areas = self.areas(&rho);
-            let mut f = DVector::zeros(2 * n);
-            let mut jac = DMatrix::zeros(2 * n, 2 * n);
+            let mut f = DVector::zeros(nt);
+            let mut jac = DMatrix::zeros(nt, nt);
             for e in 0..n {
-                let (tf, tb) = (x[e], x[n + e]);
-                let (df, db) = two_layer_rates(p, flux * areas[e], tf, tb);
+                let temps = self.element(x.as_slice(), e);
                 // Residuals in W/m².
-                f[e] = df * hc;
-                f[n + e] = db * hc;
-                let (jff, jfb, jbf, jbb) = layer_partials(p, tf, tb);
-                jac[(e, e)] += jff;
-                jac[(e, n + e)] += jfb;
-                jac[(n + e, e)] += jbf;
-                jac[(n + e, n + e)] += jbb;
+                self.thermal.heat_flows(flux * areas[e], temps, &mut flows);
+                f.rows_mut(e * s, s).copy_from_slice(&flows);
+                let (d_temps, d_flux) = self.element_partials(flux * areas[e], temps, false);
+                for i in 0..s {
+                    for j in 0..s {
+                        jac[(e * s + i, e * s + j)] += d_temps[i * s + j];
+                    }
+                }
                 if coupled {
-                    let g = absorbed * incidence_slope(psi, rho[e]) * mu;
-                    for j in 0..n {
-                        jac[(e, j)] += g * fs[(e, j)];
-                        jac[(e, n + j)] -= g * fs[(e, j)];
+                    let g = flux * incidence_slope(sun, rho[e]);
+                    for i in 0..s {
+                        for m in 0..n {
+                            for (j, dmj) in dm.iter().enumerate() {
+                                jac[(e * s + i, m * s + j)] += d_flux[i] * g * fs[(e, m)] * dmj;
+                            }
+                        }
                     }
                 }
             }
@@ -301,21 +401,16 @@ impl DistributedPanel {
                 reason: "singular Jacobian".into(),
             })?;
             let mut lambda = 1.0;
-            while (0..2 * n).any(|i| x[i] + lambda * dx[i] <= 0.0) {
+            while (0..nt).any(|i| x[i] + lambda * dx[i] <= 0.0) {
                 lambda *= 0.5;
             }
             x += &dx * lambda;
-            if (0..2 * n).all(|i| dx[i].abs() < 1e-12 * x[i]) {
-                let y = self.static_state(&x.as_slice()[..n], &x.as_slice()[n..]);
-                let rise = self
-                    .reduction
-                    .rise(&y[2 * n..2 * n + self.k()], &self.moments(&y));
-                self.reduction
-                    .theta_f(rise, 0.0)
-                    .map_err(|_| Error::NoConvergence {
-                        what: "distributed steady state".into(),
-                        reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
-                    })?;
+            if (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]) {
+                let y = self.static_state(x.as_slice());
+                self.theta_f(&y, 0.0).map_err(|_| Error::NoConvergence {
+                    what: "distributed steady state".into(),
+                    reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
+                })?;
                 return Ok(y);
             }
         }
@@ -327,57 +422,53 @@ impl DistributedPanel {
 
     /// ∂f/∂y of the right-hand side at state `y` under illumination factor `flux`.
     pub fn jacobian(&self, flux: f64, y: &[f64]) -> DMatrix<f64> {
-        let (n, k) = (self.n(), self.k());
-        let p = &self.panel;
+        let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
         let r = &self.reduction;
-        let hc = 0.5 * p.heat_capacity();
-        let mu = self.element_moment(1.0, 0.0);
-        let psi = self.settings.sun_angle;
+        let sun = self.settings.sun_angle.sin_cos();
+        let dm = self.moment_partials();
         let moments = self.moments(y);
-        let q = &y[2 * n..2 * n + k];
-        let mut j = DMatrix::zeros(2 * n + 2 * k, 2 * n + 2 * k);
+        let q = self.modal(y);
         let rho = self.slopes(q, &moments);
-        let absorbed = p.absorptivity * p.solar_constant * flux;
+        let areas = self.areas(&rho);
+        let mut j = DMatrix::zeros(nt + 2 * k, nt + 2 * k);
         for e in 0..n {
-            let (jff, jfb, jbf, jbb) = layer_partials(p, y[e], y[n + e]);
-            j[(e, e)] += jff / hc;
-            j[(e, n + e)] += jfb / hc;
-            j[(n + e, e)] += jbf / hc;
-            j[(n + e, n + e)] += jbb / hc;
+            let (d_temps, d_flux) =
+                self.element_partials(flux * areas[e], self.element(y, e), true);
+            for a in 0..s {
+                for b in 0..s {
+                    j[(e * s + a, e * s + b)] += d_temps[a * s + b];
+                }
+            }
             if self.settings.coupling == Coupling::ProjectedArea {
                 // Heating through the chord slope, which moves with every moment and mode.
-                let g = absorbed * incidence_slope(psi, rho[e]) / hc;
-                for m in 0..n {
-                    j[(e, m)] += g * r.slope_residual[(e, m)] * mu;
-                    j[(e, n + m)] -= g * r.slope_residual[(e, m)] * mu;
-                }
-                for i in 0..k {
-                    j[(e, 2 * n + i)] += g * r.slope_modal[(e, i)];
+                let g = flux * incidence_slope(sun, rho[e]);
+                for a in 0..s {
+                    let ga = g * d_flux[a];
+                    for m in 0..n {
+                        for (b, dmb) in dm.iter().enumerate() {
+                            j[(e * s + a, m * s + b)] += ga * r.slope_residual[(e, m)] * dmb;
+                        }
+                    }
+                    for i in 0..k {
+                        j[(e * s + a, nt + i)] += ga * r.slope_modal[(e, i)];
+                    }
                 }
             }
         }
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
             let w = r.omega[i];
-            j[(2 * n + i, 2 * n + k + i)] = 1.0;
+            j[(nt + i, nt + k + i)] = 1.0;
             for e in 0..n {
-                j[(2 * n + k + i, e)] = r.force[(i, e)] * mu;
-                j[(2 * n + k + i, n + e)] = -r.force[(i, e)] * mu;
+                for (b, dmb) in dm.iter().enumerate() {
+                    j[(nt + k + i, e * s + b)] = r.force[(i, e)] * dmb;
+                }
             }
-            j[(2 * n + k + i, 2 * n + i)] = -w * w;
-            j[(2 * n + k + i, 2 * n + k + i)] = -2.0 * zeta * w;
+            j[(nt + k + i, nt + i)] = -w * w;
+            j[(nt + k + i, nt + k + i)] = -2.0 * zeta * w;
         }
         j
     }
-}
-
-/// Partial derivatives of the two heat balances of eq. 2 (W/m² per K) with respect to (T_f, T_b)
-/// at fixed absorbed flux: (∂f/∂T_f, ∂f/∂T_b, ∂b/∂T_f, ∂b/∂T_b).
-fn layer_partials(p: &Panel, tf: f64, tb: f64) -> (f64, f64, f64, f64) {
-    let k = p.conductance;
-    let rf = 4.0 * STEFAN_BOLTZMANN * p.emissivity_front * tf * tf * tf;
-    let rb = 4.0 * STEFAN_BOLTZMANN * p.emissivity_back * tb * tb * tb;
-    (-k - rf, k, k, -k - rb)
 }
 
 /// One oscillatory eigen-pair of the linearised distributed system.
@@ -460,18 +551,23 @@ fn eigenvalues(j: &DMatrix<f64>) -> Result<Vec<Complex<f64>>> {
 }
 
 impl DistributedPanel {
-    /// Eigen-analysis at the equilibrium `y_eq` under `flux`, with the modal damping ratio `zeta`.
-    fn spectrum(&self, flux: f64, y_eq: &[f64], zeta: f64) -> Result<Vec<Complex<f64>>> {
-        let mut model = self.clone();
-        model.settings.damping_ratio = zeta;
-        eigenvalues(&model.jacobian(flux, y_eq))
+    /// Eigenvalues of the Jacobian `base` with the modal damping ratio set to `zeta` (only the
+    /// q̇ diagonal depends on it; the equilibrium does not).
+    fn spectrum(&self, base: &DMatrix<f64>, zeta: f64) -> Result<Vec<Complex<f64>>> {
+        let (k, nt) = (self.k(), self.temps());
+        let mut j = base.clone();
+        for (i, w) in self.reduction.omega.iter().enumerate() {
+            j[(nt + k + i, nt + k + i)] = -2.0 * zeta * w;
+        }
+        eigenvalues(&j)
     }
 
     /// Linear stability of the sunlit equilibrium under illumination factor `flux` (1: full Sun
     /// at 1 au), with the critical damping ratio found by bisection.
     pub fn flutter(&self, flux: f64) -> Result<DistributedFlutter> {
         let y = self.equilibrium(flux)?;
-        let ev = self.spectrum(flux, &y, self.settings.damping_ratio)?;
+        let base = self.jacobian(flux, &y);
+        let ev = self.spectrum(&base, self.settings.damping_ratio)?;
         let omega = &self.reduction.omega;
         // The n thermal eigenvalues are real and nearly equal (one per element); rounding can
         // split such a cluster into pairs with Im λ around 1e-5 rad/s. A structural pair sits
@@ -492,7 +588,7 @@ impl DistributedPanel {
             })
             .collect();
         modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        let growth = |zeta: f64| -> Result<f64> { Ok(self.spectrum(flux, &y, zeta)?[0].re) };
+        let growth = |zeta: f64| -> Result<f64> { Ok(self.spectrum(&base, zeta)?[0].re) };
         let zeta_star = if growth(0.0)? < 0.0 {
             0.0
         } else {

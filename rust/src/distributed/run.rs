@@ -45,9 +45,10 @@ impl OdeSystem<Dyn> for DistributedSystem {
 #[derive(Debug, Clone)]
 pub struct DistributedRun {
     pub t: Vec<f64>,
-    /// T_f and T_b per element, K.
-    pub t_front: Vec<Vec<f64>>,
-    pub t_back: Vec<Vec<f64>>,
+    /// Names of an element's temperatures ("T_front", "T_back" for two layers).
+    pub names: Vec<String>,
+    /// Per sample, per name, the temperature of every element, K.
+    pub temperatures: Vec<Vec<Vec<f64>>>,
     /// Thermal moment per element, N m.
     pub moment: Vec<Vec<f64>>,
     /// Deflection (m) and slope per node.
@@ -81,8 +82,9 @@ pub fn simulate(
                     "y0",
                     format!("{} components", v.len()),
                     &format!(
-                        "must hold {} (T_front and T_back of {} elements, q and q̇ of {} modes)",
+                        "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
                         model.state_size(),
+                        model.layers(),
                         model.n(),
                         model.k()
                     ),
@@ -100,11 +102,10 @@ pub fn simulate(
         DVector::from_vec(start),
         output,
     )?;
-    let n = model.n();
     let mut out = DistributedRun {
         t: traj.t.clone(),
-        t_front: Vec::with_capacity(traj.t.len()),
-        t_back: Vec::with_capacity(traj.t.len()),
+        names: model.temperature_names(),
+        temperatures: Vec::with_capacity(traj.t.len()),
         moment: Vec::with_capacity(traj.t.len()),
         deflection: Vec::with_capacity(traj.t.len()),
         slope: Vec::with_capacity(traj.t.len()),
@@ -115,8 +116,7 @@ pub fn simulate(
     };
     for (t, y) in traj.t.iter().zip(&traj.y) {
         let y = y.as_slice();
-        out.t_front.push(y[..n].to_vec());
-        out.t_back.push(y[n..2 * n].to_vec());
+        out.temperatures.push(model.temperature_rows(y));
         out.moment.push(model.moments(y));
         let (w, s) = model.nodal(y);
         out.deflection.push(w);

@@ -17,7 +17,7 @@ use pyo3::types::{PyBool, PyDict, PyString};
 
 /// A float entry of a mapping, named in any error. The key may be an interned Python string, so
 /// that the lookup neither builds nor hashes a new string.
-fn float_item<'py, K>(d: &Bound<'py, PyDict>, key: K) -> PyResult<f64>
+pub(super) fn float_item<'py, K>(d: &Bound<'py, PyDict>, key: K) -> PyResult<f64>
 where
     K: IntoPyObject<'py> + std::fmt::Display + Copy,
 {

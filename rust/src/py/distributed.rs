@@ -47,8 +47,14 @@ pub(super) fn model_from(
     let coupled: bool = item("coupled")?
         .extract()
         .map_err(|_| typed("coupled", "a bool"))?;
+    let layers: i64 = item("layers")?
+        .extract()
+        .map_err(|_| typed("layers", "an integer"))?;
+    let layers = u32::try_from(layers)
+        .map_err(|_| invalid("layers", layers, "must be a positive integer"))?;
     let defaults = Settings::new(&p);
     let s = Settings {
+        layers,
         support: Support::from_name(&support).map_err(PyErr::from)?,
         elements: count("elements", elements)?,
         modes: count("modes", modes)?,
@@ -91,6 +97,17 @@ fn distributed_info<'py>(
     })
 }
 
+/// ζ = c_d/(2 I_B ω₁): the modal damping ratio equivalent to the panel's hinge damping (the beam
+/// comparator's and the distributed panel's default).
+#[pyfunction]
+fn hinge_equivalent_damping_ratio(panel: &Bound<'_, PyDict>) -> PyResult<f64> {
+    shield(|| {
+        Ok(crate::beam::hinge_equivalent_damping_ratio(&panel_from(
+            panel,
+        )?))
+    })
+}
+
 /// The defaults of the distributed model's settings.
 #[pyfunction]
 fn distributed_defaults(py: Python<'_>, panel: &Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
@@ -119,16 +136,16 @@ fn distributed_flutter<'py>(
         let m = model_from(panel, settings)?;
         check_flux(flux).map_err(PyErr::from)?;
         let a = py.detach(|| m.flutter(flux)).map_err(PyErr::from)?;
-        let n = m.n();
         let d = PyDict::new(py);
-        d.set_item(
-            "T_front",
-            PyArray1::from_vec(py, a.equilibrium[..n].to_vec()),
-        )?;
-        d.set_item(
-            "T_back",
-            PyArray1::from_vec(py, a.equilibrium[n..2 * n].to_vec()),
-        )?;
+        let temps = PyDict::new(py);
+        for (name, row) in m
+            .temperature_names()
+            .iter()
+            .zip(m.temperature_rows(&a.equilibrium))
+        {
+            temps.set_item(name, PyArray1::from_vec(py, row))?;
+        }
+        d.set_item("temperatures", temps)?;
         let (w, slope) = m.nodal(&a.equilibrium);
         d.set_item("deflection", PyArray1::from_vec(py, w))?;
         d.set_item("slope", PyArray1::from_vec(py, slope))?;
@@ -201,8 +218,13 @@ fn simulate_distributed<'py>(
         d.set_item("t", PyArray1::from_vec(py, r.t))?;
         d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
         d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
-        d.set_item("T_front", matrix(py, &r.t_front, n)?)?;
-        d.set_item("T_back", matrix(py, &r.t_back, n)?)?;
+        // One (time × element) array per temperature name.
+        let temps = PyDict::new(py);
+        for (i, name) in r.names.iter().enumerate() {
+            let rows: Vec<Vec<f64>> = r.temperatures.iter().map(|s| s[i].clone()).collect();
+            temps.set_item(name, matrix(py, &rows, n)?)?;
+        }
+        d.set_item("temperatures", temps)?;
         d.set_item("thermal_moment", matrix(py, &r.moment, n)?)?;
         d.set_item("deflection", matrix(py, &r.deflection, nodes)?)?;
         d.set_item("slope", matrix(py, &r.slope, nodes)?)?;
@@ -227,6 +249,7 @@ fn simulate_distributed<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
+    m.add_function(wrap_pyfunction!(hinge_equivalent_damping_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_flutter, m)?)?;
     Ok(())

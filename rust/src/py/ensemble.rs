@@ -4,6 +4,7 @@ use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
+use super::longrun::hybrid_from;
 use crate::ensemble::{pool, run_batch_on, EnsembleSettings, Path, SampleMetrics};
 use crate::system::Coupling;
 use crate::Panel;
@@ -85,7 +86,7 @@ impl EnsemblePool {
 
     /// Runs one sample per row of `panels`; returns the metrics as columns. `lockstep`: several
     /// samples per thread in SIMD lanes (the same rows, bit for bit, as one at a time).
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, cancel=None, lockstep=true))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=0.3490658503988659, hybrid=None, cancel=None, lockstep=true))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -99,6 +100,8 @@ impl EnsemblePool {
         window: f64,
         threshold: Option<f64>,
         stop_at_threshold: bool,
+        validity_limit: f64,
+        hybrid: Option<&Bound<'py, PyDict>>,
         cancel: Option<&Bound<'py, CancelToken>>,
         lockstep: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
@@ -123,6 +126,8 @@ impl EnsemblePool {
                 window,
                 threshold,
                 stop_at_threshold,
+                validity_limit,
+                hybrid: hybrid.map(hybrid_from).transpose()?,
             };
             let pool = &self.pool;
             let out = py.detach(|| run_batch_on(pool, &ps, &settings, &cancel, path))?;
@@ -140,6 +145,10 @@ impl EnsemblePool {
                 ("jitter_rms", col(|m| m.jitter_rms)),
                 ("jitter_peak", col(|m| m.jitter_peak)),
                 ("t_threshold", col(|m| m.t_threshold)),
+                ("orbit_threshold", col(|m| m.orbit_threshold)),
+                ("orbit_limit", col(|m| m.orbit_limit)),
+                ("amplitude_slope", col(|m| m.amplitude_slope)),
+                ("t_nonlinear", col(|m| m.t_nonlinear)),
                 ("t_reached", col(|m| m.t_reached)),
             ] {
                 d.set_item(name, PyArray1::from_vec(py, values))?;

@@ -8,6 +8,7 @@ mod distributed;
 mod ensemble;
 mod error;
 mod flutter;
+mod laminate;
 mod longrun;
 mod orbit;
 
@@ -393,5 +394,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     orbit::register(m)?;
     ensemble::register(m)?;
     cancel::register(m)?;
+    laminate::register(m)?;
     Ok(())
 }

@@ -1,0 +1,64 @@
+"""A small library of materials for laminate layers (room-temperature values).
+
+Each material's values and their source live once, in the engine; this module exposes them.
+``Material.layer(thickness)`` makes a :class:`thermojitter.Layer`. The materials and the source of
+every value:
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from thermojitter import _core
+from thermojitter.laminate import Layer
+
+
+@dataclass(frozen=True)
+class Material:
+    """A material of the library: the properties of a layer but its thickness (SI), and
+    ``source``, where every value comes from."""
+
+    key: str
+    name: str
+    conductivity: float
+    density: float
+    specific_heat: float
+    youngs_modulus: float
+    expansion_coeff: float
+    source: str
+
+    def layer(self, thickness: float, name: str | None = None) -> Layer:
+        """A layer of this material, ``thickness`` m thick (named after the material by
+        default)."""
+        return Layer(
+            thickness=thickness,
+            conductivity=self.conductivity,
+            density=self.density,
+            specific_heat=self.specific_heat,
+            youngs_modulus=self.youngs_modulus,
+            expansion_coeff=self.expansion_coeff,
+            name=self.key if name is None else name,
+        )
+
+
+LIBRARY: dict[str, Material] = {m["key"]: Material(**m) for m in _core.materials()}
+"""Every material by key."""
+
+ALUMINIUM_6061 = LIBRARY["aluminium_6061"]
+TITANIUM_6AL4V = LIBRARY["titanium_6al4v"]
+CFRP_M55J_QI = LIBRARY["cfrp_m55j_qi"]
+ALUMINIUM_HONEYCOMB = LIBRARY["aluminium_honeycomb"]
+KAPTON = LIBRARY["kapton"]
+
+
+def get(key: str) -> Material:
+    """A material by key (``ValueError`` listing the keys if unknown)."""
+    try:
+        return LIBRARY[key]
+    except KeyError:
+        raise ValueError(f"material {key!r} is not in the library ({', '.join(LIBRARY)})") from None
+
+
+__doc__ = (__doc__ or "") + "".join(
+    f"\n- ``{m.key.upper()}``, {m.name}: {m.source}\n" for m in LIBRARY.values()
+)

@@ -1,0 +1,162 @@
+//! The exponential Rosenbrock method exprb32 (Hochbruck, Ostermann & Schweitzer 2009) with error
+//! control, for the stretches that need the non-linear model: shadow crossings and the thermal
+//! recovery after them.
+//!
+//! Each step linearises the coupled system about the current state, u' = J u + v t + g(t, u), and
+//! propagates the linear part exactly through φ-functions of hJ. The lightly damped hinge is part of
+//! J, so its oscillation is carried without numerical dissipation and the step is set by the slow
+//! non-linear remainder (T⁴ radiation, the cos θ projected area, the penumbra's s(t)), not by the
+//! hinge period:
+//!
+//! ```text
+//! U  = u + h φ1(hJ) f(t, u) + h² φ2(hJ) v
+//! D  = g(t + h, U) − g(t, u)
+//! u⁺ = U + 2h φ3(hJ) D          (third order; U is the embedded second-order solution)
+//! ```
+
+use super::expm::{phi12, phi3};
+use super::jacobian::Linearisation;
+use crate::error::{Error, Result};
+use crate::system::Coupled;
+use nalgebra::Vector4;
+
+/// Error-control settings of the exponential stretches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExpTolerances {
+    pub rtol: f64,
+    /// Absolute tolerances of (T_f, T_b) in K and of (θ, θ̇) in rad and rad/s.
+    pub atol_temperature: f64,
+    pub atol_angle: f64,
+    pub max_step: f64,
+}
+
+/// One accepted step: both ends and the slopes there (for Hermite interpolation).
+#[derive(Debug, Clone, Copy)]
+pub struct ExpStep {
+    pub t0: f64,
+    pub t1: f64,
+    pub y0: Vector4<f64>,
+    pub y1: Vector4<f64>,
+    pub f0: Vector4<f64>,
+    pub f1: Vector4<f64>,
+}
+
+/// ∂f/∂t through the illumination (s(t) in a penumbra, the Sun's distance) inside the segment
+/// [a, b], by a one-sided difference that stays inside it.
+fn time_derivative(
+    system: &Coupled,
+    lin: &Linearisation,
+    t: f64,
+    y: &Vector4<f64>,
+    a: f64,
+    b: f64,
+) -> Vector4<f64> {
+    let delta = 1e-2_f64.min(0.5 * (b - a));
+    let dflux = if t + delta <= b {
+        (system.flux_at(t + delta) - system.flux_at(t)) / delta
+    } else {
+        (system.flux_at(t) - system.flux_at((t - delta).max(a))) / delta
+    };
+    lin.flux_sensitivity(y) * dflux
+}
+
+/// Integrates the segment [a, b] (no breakpoint inside; the system has entered it) from (t, y),
+/// t in [a, b), calling `on_step` after every accepted step; stops early when it returns true.
+/// `h` carries the step size from segment to segment. Returns the number of (accepted,
+/// rejected) steps.
+#[allow(clippy::too_many_arguments)]
+pub fn segment(
+    system: &Coupled,
+    lin: &Linearisation,
+    a: f64,
+    b: f64,
+    t: &mut f64,
+    y: &mut Vector4<f64>,
+    h: &mut f64,
+    tol: &ExpTolerances,
+    mut on_step: impl FnMut(&ExpStep) -> Result<bool>,
+) -> Result<(u64, u64, bool)> {
+    let (mut accepted, mut rejected) = (0u64, 0u64);
+    let mut f0 = system.rhs_at_flux(system.flux_at(*t), y);
+    while *t < b {
+        let t0 = *t;
+        let y0 = *y;
+        let flux = system.flux_at(t0);
+        let jac = lin.jacobian(flux, &y0);
+        let v = time_derivative(system, lin, t0, &y0, a, b);
+        let mut rejected_here = false;
+        loop {
+            let step = h.min(tol.max_step).min(b - t0);
+            let t1 = if t0 + step >= b { b } else { t0 + step };
+            let hs = t1 - t0;
+            if hs.is_nan() || hs <= 1e-9 * t0.abs().max(1.0) {
+                return Err(Error::Integration {
+                    t: t0,
+                    reason: format!(
+                        "the exponential integrator's step fell to {hs:e} s (state {:?})",
+                        y0.as_slice()
+                    ),
+                });
+            }
+            let a_mat = jac * hs;
+            let du = phi12(&a_mat, &(f0 * hs), &(v * (hs * hs)));
+            let u_mid = y0 + du;
+            let f_mid = system.rhs_at_flux(system.flux_at(t1), &u_mid);
+            // g(t1, U) − g(t0, u) with g(t, u) = f(t, u) − J u − v t.
+            let d = f_mid - f0 - jac * du - v * hs;
+            let corr = phi3(&a_mat, &(d * (2.0 * hs)));
+            let y1 = u_mid + corr;
+            let mut acc = 0.0;
+            for i in 0..4 {
+                let atol = if i < 2 {
+                    tol.atol_temperature
+                } else {
+                    tol.atol_angle
+                };
+                let r = corr[i] / (atol + tol.rtol * y0[i].abs().max(y1[i].abs()));
+                acc += r * r;
+            }
+            let err = (acc / 4.0).sqrt();
+            if err <= 1.0 {
+                let mut factor = if err == 0.0 {
+                    5.0
+                } else {
+                    (0.9 * err.powf(-1.0 / 3.0)).min(5.0)
+                };
+                if rejected_here {
+                    factor = factor.min(1.0);
+                }
+                // A step cut short by the segment's end does not shrink the next one.
+                if t1 < b || hs >= *h {
+                    *h = hs * factor;
+                }
+                let f1 = system.rhs_at_flux(system.flux_at(t1), &y1);
+                accepted += 1;
+                *t = t1;
+                *y = y1;
+                let stop = on_step(&ExpStep {
+                    t0,
+                    t1,
+                    y0,
+                    y1,
+                    f0,
+                    f1,
+                })?;
+                f0 = f1;
+                if stop {
+                    return Ok((accepted, rejected, true));
+                }
+                break;
+            }
+            rejected += 1;
+            rejected_here = true;
+            *h = hs
+                * if err.is_finite() {
+                    (0.9 * err.powf(-1.0 / 3.0)).max(0.2)
+                } else {
+                    0.2
+                };
+        }
+    }
+    Ok((accepted, rejected, false))
+}

@@ -1,0 +1,811 @@
+//! The hybrid long-run propagator: the same per-orbit summaries as the hinge-resolved integration
+//! of [`crate::summary::run_orbits`], at a small fraction of the cost.
+//!
+//! Three regimes, chosen as the run goes:
+//!
+//! - **Linear arcs** (sunlit, near the equilibrium): the linearised system about the sunlit
+//!   equilibrium, with the Sun's slow distance drift as a forcing, propagated exactly in modal form
+//!   ([`linear`]), one arc per orbit at most; the summaries over the arc come from the closed form.
+//!   No numerical dissipation, so weak flutter grows at exactly the eigenvalue's rate.
+//! - **Exponential stretches** (shadow crossings and the thermal recovery after them): the full
+//!   non-linear model, integrated by the exponential Rosenbrock method [`exprb`], whose step is set
+//!   by the slow thermal non-linearity rather than the hinge period.
+//! - **Full integration** (the fallback): Dormand–Prince with the step capped at T_n/40, as
+//!   [`crate::summary::run_orbits`], for an orbit at a time, where the oscillation is too large for
+//!   the linearisation or the modal decomposition is ill-conditioned.
+//!
+//! The switch back to linear arcs is guarded by a measured criterion: the non-linear remainder
+//! r = f(y) − A (y − y_eq), expressed as the static angle error it would cause (|A⁻¹|_θ·|r|), must
+//! be below `linear_tolerance`, the oscillation below `linear_amplitude`, the plate in full Sun and
+//! past the last shadow exit by the summary window.
+
+pub mod expm;
+pub mod exprb;
+pub mod jacobian;
+pub mod linear;
+
+use crate::cancel::Cancel;
+use crate::dynamics::{thermal_moment, HingeModel};
+use crate::error::{require_positive, Error, Result};
+use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
+use crate::orbit::{Eclipse, Orbit};
+use crate::params::Panel;
+use crate::steady::equilibrium;
+use crate::summary::{
+    resolve_hinge, Collector, OrbitRun, SummaryObserver, SummaryOptions, TwoLayerView,
+    STEPS_PER_HINGE_PERIOD,
+};
+use crate::system::{Coupled, Coupling};
+use exprb::{ExpStep, ExpTolerances};
+use jacobian::Linearisation;
+use linear::Arc;
+use nalgebra::{Vector4, U4};
+use std::ops::ControlFlow;
+
+/// Settings of the hybrid propagator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HybridSettings {
+    /// Error control of the exponential stretches.
+    pub tolerances: ExpTolerances,
+    /// Largest non-linear remainder, as a static angle error (rad), at which the state is handed
+    /// back to linear propagation.
+    pub linear_tolerance: f64,
+    /// Largest oscillation amplitude |θ − θ_eq| (rad) propagated linearly; larger oscillations
+    /// are integrated in full.
+    pub linear_amplitude: f64,
+    /// Largest hinge oscillation (about the quasi-static deflection, rad) left to the exponential
+    /// integrator, whose summaries take it through its envelope; a larger one (the ringing after
+    /// the flux jump of a cylindrical shadow) is integrated in full until the state is linear.
+    pub resolved_amplitude: f64,
+}
+
+impl Default for HybridSettings {
+    fn default() -> Self {
+        HybridSettings {
+            tolerances: ExpTolerances {
+                rtol: 1e-4,
+                atol_temperature: 1e-2,
+                atol_angle: 1e-7,
+                max_step: 300.0,
+            },
+            linear_tolerance: 1e-7,
+            linear_amplitude: 0.01,
+            resolved_amplitude: 1e-4,
+        }
+    }
+}
+
+impl HybridSettings {
+    pub fn validate(&self) -> Result<()> {
+        require_positive("hybrid.rtol", self.tolerances.rtol)?;
+        require_positive("hybrid.atol_temperature", self.tolerances.atol_temperature)?;
+        require_positive("hybrid.atol_angle", self.tolerances.atol_angle)?;
+        require_positive("hybrid.max_step", self.tolerances.max_step)?;
+        require_positive("hybrid.linear_tolerance", self.linear_tolerance)?;
+        require_positive("hybrid.linear_amplitude", self.linear_amplitude)?;
+        require_positive("hybrid.resolved_amplitude", self.resolved_amplitude)
+    }
+}
+
+/// A hybrid run: the summaries and how the simulated time was split between the regimes.
+#[derive(Debug, Clone)]
+pub struct HybridRun {
+    pub run: OrbitRun,
+    /// Simulated time propagated by linear arcs, by the exponential integrator (full non-linear
+    /// model) and by the hinge-resolved fallback (full non-linear model), s.
+    pub t_linear: f64,
+    pub t_exponential: f64,
+    pub t_fallback: f64,
+    pub n_arcs: u64,
+    pub n_exp_steps: u64,
+    pub n_fallback_steps: u64,
+}
+
+/// What the state at a sunlit time allows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Regime {
+    Linear,
+    NonLinear,
+    Large,
+}
+
+struct Driver<'a> {
+    panel: Panel,
+    orbit: Orbit,
+    settings: &'a HybridSettings,
+    fallback: Method,
+    system: Coupled,
+    obs: SummaryObserver<'a, TwoLayerView>,
+    t_start: f64,
+    t_end: f64,
+    t: f64,
+    y: Vector4<f64>,
+    h_exp: f64,
+    stats: Stats,
+    out: HybridRun,
+    /// Static θ per kelvin of gradient, rad/K.
+    theta_per_kelvin: f64,
+    judge: Judge,
+    /// Units of the state for the modal decomposition.
+    scale: Vector4<f64>,
+}
+
+/// Integrates orbits `first_index .. first_index + n_orbits` from (t_start, y0) with the hybrid
+/// propagator and summarises each orbit; `method` is the full integration used as the fallback.
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits_hybrid(
+    panel: &Panel,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vector4<f64>,
+    options: SummaryOptions,
+    settings: &HybridSettings,
+    cancel: &Cancel,
+) -> Result<HybridRun> {
+    cancel.check()?;
+    require_positive("window", options.window)?;
+    require_positive("theta_limit", options.theta_limit)?;
+    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    settings.validate()?;
+    panel.validate()?;
+    orbit.validate()?;
+    method.validate()?;
+    if n_orbits == 0 {
+        return Err(Error::invalid("n_orbits", 0, "must be >= 1"));
+    }
+    crate::error::require_finite("t_start", t_start)?;
+    if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            "y0",
+            y0[i],
+            "every component must be finite",
+        ));
+    }
+    let steps = if options.steps_per_period > 0.0 {
+        options.steps_per_period
+    } else {
+        STEPS_PER_HINGE_PERIOD
+    };
+    let view = TwoLayerView {
+        panel: *panel,
+        coupling,
+    };
+    let collector = Collector::new(view, orbit, options, t_start, first_index, n_orbits, y0[2])?;
+    let t_end = t_start + n_orbits as f64 * orbit.period;
+    let t_ref = equilibrium(panel, coupling, orbit.flux_scale(t_start))
+        .map(|e| e.t_front)
+        .unwrap_or(300.0);
+    let wn = panel.natural_angular_frequency();
+    let mut d = Driver {
+        panel: *panel,
+        orbit: *orbit,
+        settings,
+        fallback: resolve_hinge(method, panel, steps),
+        system: Coupled::new(*panel, *orbit, model, coupling),
+        obs: SummaryObserver {
+            collector,
+            error: None,
+            cancel,
+        },
+        t_start,
+        t_end,
+        t: t_start,
+        y: y0,
+        h_exp: 1.0,
+        stats: Stats {
+            t_end: t_start,
+            ..Stats::default()
+        },
+        out: HybridRun {
+            run: OrbitRun {
+                summaries: Vec::new(),
+                stats: Stats::default(),
+                y_end: y0,
+                crossing: None,
+            },
+            t_linear: 0.0,
+            t_exponential: 0.0,
+            t_fallback: 0.0,
+            n_arcs: 0,
+            n_exp_steps: 0,
+            n_fallback_steps: 0,
+        },
+        theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
+        judge: Judge {
+            panel: *panel,
+            orbit: *orbit,
+            model,
+            coupling,
+            settings: *settings,
+            system: Coupled::new(*panel, *orbit, model, coupling),
+            lin: Linearisation::new(panel, model, coupling),
+            theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
+        },
+        scale: Vector4::new(1.0, 1.0, 1.0 / t_ref, wn / t_ref),
+    };
+    d.run()?;
+    let Driver {
+        mut obs,
+        mut out,
+        mut stats,
+        t,
+        y,
+        ..
+    } = d;
+    obs.collector.close();
+    stats.t_end = t;
+    stats.stopped = t < t_end && obs.collector.crossing.is_some();
+    out.run = OrbitRun {
+        summaries: obs.collector.done,
+        stats,
+        y_end: y,
+        crossing: obs.collector.crossing,
+    };
+    Ok(out)
+}
+
+/// The tests that decide the regime: everything they need, copied out of the driver so that the
+/// fallback's observer can use them too.
+#[derive(Clone, Copy)]
+struct Judge {
+    panel: Panel,
+    orbit: Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    settings: HybridSettings,
+    system: Coupled,
+    lin: Linearisation,
+    theta_per_kelvin: f64,
+}
+
+impl Judge {
+    /// The sunlit equilibrium and Jacobian at the flux of time t.
+    fn reference(&self, flux: f64) -> Result<(Vector4<f64>, nalgebra::Matrix4<f64>)> {
+        let eq = equilibrium(&self.panel, self.coupling, flux)?;
+        let y_ref = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+        Ok((y_ref, self.lin.jacobian(flux, &y_ref)))
+    }
+
+    /// Amplitude of the hinge oscillation about the quasi-static deflection M_T/K_el, from the
+    /// dynamic part and its rate.
+    fn oscillation(&self, y: &Vector4<f64>, f: &Vector4<f64>) -> f64 {
+        let d = y[2] - self.theta_per_kelvin * (y[0] - y[1]);
+        let d_rate = y[3] - self.theta_per_kelvin * (f[0] - f[1]);
+        let s = y[2].sin();
+        let inertia = match self.model {
+            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
+            HingeModel::Linear => 1.0,
+        };
+        let w2 = self.panel.hinge_stiffness / (self.panel.hinge_inertia() * inertia);
+        (d * d + d_rate * d_rate / w2).sqrt()
+    }
+
+    /// May the state at sunlit time t be propagated linearly?
+    fn regime(&self, t: f64, y: &Vector4<f64>) -> Result<Regime> {
+        if self.orbit.illumination(t) < 1.0 {
+            return Ok(Regime::NonLinear);
+        }
+        let flux = self.orbit.flux_scale(t);
+        let f = self.system.rhs_at_flux(flux, y);
+        let (y_ref, a) = self.reference(flux)?;
+        let dev = y - y_ref;
+        let amplitude = (dev[2] * dev[2]
+            + dev[3] * dev[3] / self.panel.natural_angular_frequency().powi(2))
+        .sqrt();
+        if amplitude.max(self.oscillation(y, &f)) > self.settings.linear_amplitude {
+            return Ok(Regime::Large);
+        }
+        let r = f - a * dev;
+        let Some(inv) = a.try_inverse() else {
+            return Ok(Regime::NonLinear);
+        };
+        let static_error: f64 = (0..4).map(|i| (inv[(2, i)] * r[i]).abs()).sum();
+        Ok(if static_error <= self.settings.linear_tolerance {
+            Regime::Linear
+        } else {
+            Regime::NonLinear
+        })
+    }
+}
+
+/// Watches the hinge-resolved fallback and ends it once the state may go back to linear arcs
+/// (checked every `CHECK_EVERY` s of simulated time, in full Sun past the last shadow's window).
+struct FallbackObserver<'a, 'c> {
+    inner: &'a mut SummaryObserver<'c, TwoLayerView>,
+    judge: Judge,
+    eclipses: &'a [Eclipse],
+    window: f64,
+    next_check: f64,
+    released: bool,
+    error: Option<Error>,
+}
+
+const CHECK_EVERY: f64 = 60.0;
+
+impl Observer<U4> for FallbackObserver<'_, '_> {
+    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+        self.inner.on_step(step)?;
+        let t1 = step.t1;
+        if t1 < self.next_check {
+            return ControlFlow::Continue(());
+        }
+        self.next_check = t1 + CHECK_EVERY;
+        let shadow = self
+            .eclipses
+            .iter()
+            .any(|e| e.outer.0 <= t1 && t1 < e.outer.1);
+        let release = self
+            .eclipses
+            .iter()
+            .filter(|e| e.outer.0 <= t1)
+            .map(|e| e.outer.1 + self.window)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if shadow || t1 < release {
+            return ControlFlow::Continue(());
+        }
+        match self.judge.regime(t1, &step.y1) {
+            Ok(Regime::Linear) => {
+                self.released = true;
+                ControlFlow::Break(())
+            }
+            Ok(_) => ControlFlow::Continue(()),
+            Err(e) => {
+                self.error = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    }
+}
+
+impl Driver<'_> {
+    fn stopped(&self) -> bool {
+        self.obs.collector.options.stop_at_limit && self.obs.collector.crossing.is_some()
+    }
+
+    /// End of the orbit that holds (t, t + dt].
+    fn orbit_end(&self, t: f64) -> f64 {
+        let p = self.orbit.period;
+        let k = ((t - self.t_start) / p).floor();
+        // The summaries' own orbit edges: start + k·p, end = that + p.
+        let mut end = self.t_start + k * p + p;
+        if end - t <= 1e-9 * p {
+            end += p;
+        }
+        end.min(self.t_end)
+    }
+
+    fn run(&mut self) -> Result<()> {
+        let mut fallback = false;
+        while self.t < self.t_end && !self.stopped() {
+            self.obs.cancel.check()?;
+            let horizon = (self.t + self.orbit.period).min(self.t_end);
+            let eclipses = self.orbit.eclipses(self.t, horizon);
+            if fallback {
+                self.full(horizon, &eclipses)?;
+                fallback = false;
+                continue;
+            }
+            let in_shadow = eclipses
+                .iter()
+                .any(|e| e.outer.0 <= self.t && self.t < e.outer.1);
+            if !in_shadow {
+                match self.judge.regime(self.t, &self.y)? {
+                    Regime::Linear => {
+                        let next_contact = eclipses
+                            .iter()
+                            .map(|e| e.outer.0)
+                            .filter(|&c| c > self.t)
+                            .fold(f64::INFINITY, f64::min);
+                        let end = next_contact.min(self.orbit_end(self.t));
+                        fallback = self.linear(end)?.is_some();
+                        continue;
+                    }
+                    Regime::Large => {
+                        fallback = true;
+                        continue;
+                    }
+                    Regime::NonLinear => {}
+                }
+            }
+            fallback = self.exponential(horizon, &eclipses)?;
+        }
+        Ok(())
+    }
+
+    /// A linear arc from t to `end` (same orbit, full Sun). Returns Some(()) when the arc had to
+    /// stop early for the fallback (oscillation too large, decomposition ill-conditioned).
+    fn linear(&mut self, end: f64) -> Result<Option<()>> {
+        let t0 = self.t;
+        let flux0 = self.orbit.flux_scale(t0);
+        let flux1 = self.orbit.flux_scale(end);
+        let (y_ref, a) = self.judge.reference(flux0)?;
+        let b = self.judge.lin.flux_sensitivity(&y_ref) * ((flux1 - flux0) / (end - t0));
+        let Ok(arc) = Arc::new(&a, &b, &y_ref, &self.y, end - t0, &self.scale) else {
+            return Ok(Some(()));
+        };
+        let theta = arc.signal(&Vector4::new(0.0, 0.0, 1.0, 0.0));
+        let k = self.theta_per_kelvin;
+        let dynamic = arc.signal(&Vector4::new(-k, k, 1.0, 0.0));
+        let limit = self.settings.linear_amplitude;
+        let mut length = end - t0;
+        let mut early = false;
+        if theta.envelope_max(0.0, length) > limit {
+            // Propagate only while the oscillation stays small (its envelope is monotonic).
+            let (mut lo, mut hi) = (0.0, length);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if theta.envelope_max(0.0, mid) > limit {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            length = lo;
+            early = true;
+        }
+        let (lo, hi) = theta.extremes(0.0, length);
+        let theta_limit = self.obs.collector.options.theta_limit;
+        if hi > theta_limit || lo < -theta_limit {
+            // Leave the crossing of the validity limit to the full integration.
+            return Ok(Some(()));
+        }
+        if length > 0.0 {
+            let (dlo, dhi) = dynamic.extremes(0.0, length);
+            let sq = dynamic.integral_sq(length);
+            let extremes = |a: f64, b: f64| theta.extremes(a - t0, b - t0);
+            self.obs.collector.record_span(
+                t0,
+                t0 + length,
+                &extremes,
+                dlo.abs().max(dhi.abs()),
+                sq,
+            )?;
+            self.y = arc.state(length);
+            self.t = if early { t0 + length } else { end };
+            self.out.t_linear += length;
+            self.out.n_arcs += 1;
+        }
+        Ok(early.then_some(()))
+    }
+
+    /// The hinge-resolved full integration from t to `end`, or until the state may go back to
+    /// linear arcs.
+    fn full(&mut self, end: f64, eclipses: &[Eclipse]) -> Result<()> {
+        let window = self.judge_window();
+        let mut watch = FallbackObserver {
+            inner: &mut self.obs,
+            judge: self.judge,
+            eclipses,
+            window,
+            next_check: self.t + CHECK_EVERY,
+            released: false,
+            error: None,
+        };
+        let (stats, y) = solve(
+            &mut self.system,
+            &self.fallback,
+            self.t,
+            self.y,
+            end,
+            &mut watch,
+        )?;
+        if let Some(e) = watch.error.take() {
+            return Err(e);
+        }
+        if let Some(e) = self.obs.error.take() {
+            return Err(e);
+        }
+        self.out.t_fallback += stats.t_end - self.t;
+        self.out.n_fallback_steps += stats.n_steps;
+        self.stats.n_steps += stats.n_steps;
+        self.stats.n_rejected += stats.n_rejected;
+        self.stats.n_rhs += stats.n_rhs;
+        self.t = if stats.stopped { stats.t_end } else { end };
+        self.y = y;
+        Ok(())
+    }
+
+    fn judge_window(&self) -> f64 {
+        self.obs.collector.options.window
+    }
+
+    /// The non-linear model by the exponential integrator from t, until the state may go back to
+    /// linear arcs, or `horizon`. Returns true when the oscillation grew too large for it (the
+    /// caller falls back to the full integration).
+    fn exponential(&mut self, horizon: f64, eclipses: &[Eclipse]) -> Result<bool> {
+        let start = self.t;
+        let mut cuts = vec![self.t];
+        cuts.extend(self.orbit.breakpoints(self.t, horizon));
+        cuts.push(horizon);
+        let window = self.obs.collector.options.window;
+        let period = 2.0 * std::f64::consts::PI / self.panel.natural_angular_frequency();
+        let mut large = false;
+        let mut done = false;
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if b <= a || done {
+                continue;
+            }
+            self.system.enter_segment(a, b);
+            let system = self.system;
+            let lin = self.judge.lin;
+            let settings = self.settings;
+            let mut t = self.t;
+            let mut y = self.y;
+            let mut h = self.h_exp;
+            let mut failure: Option<Error> = None;
+            let this = &mut *self;
+            let (acc, rej, stop) = exprb::segment(
+                &system,
+                &lin,
+                a,
+                b,
+                &mut t,
+                &mut y,
+                &mut h,
+                &settings.tolerances,
+                |st: &ExpStep| -> Result<bool> {
+                    this.obs.cancel.check()?;
+                    this.read_step(st, period)?;
+                    if this.stopped() {
+                        return Ok(true);
+                    }
+                    let t1 = st.t1;
+                    let shadow = eclipses.iter().any(|e| e.outer.0 <= t1 && t1 < e.outer.1);
+                    let release = eclipses
+                        .iter()
+                        .filter(|e| e.outer.0 <= t1)
+                        .map(|e| e.outer.1 + window)
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    // The exponential integrator's summaries read a small oscillation through
+                    // its envelope; a larger one is resolved by the full integration.
+                    if this.judge.oscillation(&st.y1, &st.f1) > settings.resolved_amplitude {
+                        large = true;
+                        return Ok(true);
+                    }
+                    if !shadow && t1 >= release && t1 < b {
+                        match this.judge.regime(t1, &st.y1) {
+                            Ok(Regime::Linear) => return Ok(true),
+                            Ok(_) => {}
+                            Err(e) => failure = Some(e),
+                        }
+                    }
+                    Ok(failure.is_some())
+                },
+            )
+            .or_else(|e| match e {
+                // A step that cannot be made small enough: let the full integration take over.
+                Error::Integration { .. } => {
+                    large = true;
+                    Ok((0, 0, true))
+                }
+                other => Err(other),
+            })?;
+            if let Some(e) = failure {
+                return Err(e);
+            }
+            self.t = t;
+            self.y = y;
+            self.h_exp = h;
+            self.out.n_exp_steps += acc;
+            self.stats.n_steps += acc;
+            self.stats.n_rejected += rej;
+            self.stats.n_rhs += 3 * (acc + rej);
+            done = stop;
+        }
+        self.out.t_exponential += self.t - start;
+        Ok(large)
+    }
+
+    /// Feeds one exponential step to the summaries: four points of its Hermite interpolant when
+    /// the step resolves the hinge period, else bands θ_qs ± a (the quasi-static deflection and the
+    /// oscillation's amplitude, interpolated between the step's ends).
+    fn read_step(&mut self, st: &ExpStep, period: f64) -> Result<()> {
+        let dense = DenseStep::<U4>::hermite(st.t0, st.t1, st.y0, st.y1, st.f0, st.f1);
+        let h = (st.t1 - st.t0) / 4.0;
+        let resolved = st.t1 - st.t0 <= period / 8.0;
+        let (a0, a1) = (
+            self.judge.oscillation(&st.y0, &st.f0),
+            self.judge.oscillation(&st.y1, &st.f1),
+        );
+        for j in 1..=4 {
+            let t = if j == 4 { st.t1 } else { st.t0 + j as f64 * h };
+            let y = if j == 4 { st.y1 } else { dense.eval(t) };
+            if resolved {
+                self.obs.collector.read(t, y.as_slice(), h)?;
+            } else {
+                let frac = j as f64 / 4.0;
+                let amp = a0 + (a1 - a0) * frac;
+                let quasi_static =
+                    thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+                self.obs.collector.record(
+                    t,
+                    quasi_static - amp,
+                    quasi_static + amp,
+                    amp,
+                    0.5 * amp * amp * h,
+                    h,
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flutter::{analyse, critical_damping};
+    use crate::integrate::Tolerances;
+    use crate::orbit::Shadow;
+    use crate::summary::{run_orbits, OrbitSummary};
+
+    fn options() -> SummaryOptions {
+        SummaryOptions {
+            window: 600.0,
+            theta_limit: 0.35,
+            stop_at_limit: true,
+            steps_per_period: STEPS_PER_HINGE_PERIOD,
+        }
+    }
+
+    fn start(panel: &Panel, orbit: &Orbit, kick: f64) -> Vector4<f64> {
+        let eq = equilibrium(panel, Coupling::ProjectedArea, orbit.flux_scale(0.0)).unwrap();
+        Vector4::new(eq.t_front, eq.t_back, eq.theta + kick, 0.0)
+    }
+
+    fn hybrid(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> HybridRun {
+        run_orbits_hybrid(
+            panel,
+            orbit,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            &Method::Dopri5(Tolerances::default()),
+            0.0,
+            0,
+            n,
+            y0,
+            options(),
+            &HybridSettings::default(),
+            &Cancel::new(),
+        )
+        .unwrap()
+    }
+
+    /// Within 2 %, or 1e-6 rad where the full run's value is below 5e-5 rad (NaN matches NaN).
+    fn close(name: &str, k: usize, full: f64, hyb: f64) {
+        if full.is_nan() {
+            assert!(
+                hyb.is_nan(),
+                "{name}[{k}]: {hyb} where the full run has none"
+            );
+            return;
+        }
+        let ok = if full.abs() < 5e-5 {
+            (hyb - full).abs() <= 1e-6
+        } else {
+            (hyb / full - 1.0).abs() <= 0.02
+        };
+        assert!(ok, "{name}[{k}]: hybrid {hyb:e} vs full {full:e}");
+    }
+
+    fn compare(full: &[OrbitSummary], hyb: &[OrbitSummary]) {
+        assert_eq!(full.len(), hyb.len());
+        for (k, (f, h)) in full.iter().zip(hyb).enumerate() {
+            close("amplitude", k, f.amplitude, h.amplitude);
+            close("exit_peak", k, f.exit_peak, h.exit_peak);
+            close("entry_peak", k, f.entry_peak, h.entry_peak);
+            close("jitter_rms", k, f.jitter_rms, h.jitter_rms);
+            close("theta_max", k, f.theta_max, h.theta_max);
+            close("theta_min", k, f.theta_min, h.theta_min);
+        }
+    }
+
+    #[test]
+    fn penumbra_eclipses_match_the_hinge_resolved_run() {
+        // Three orbits of the spring eclipse season: penumbra, eccentric Sun, moving declination.
+        let panel = Panel::paper();
+        let orbit = Orbit::geo_year(70.0);
+        let y0 = start(&panel, &orbit, 0.0);
+        let full = run_orbits(
+            &panel,
+            &orbit,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            &Method::Dopri5(Tolerances::default()),
+            0.0,
+            0,
+            3,
+            y0,
+            options(),
+        )
+        .unwrap();
+        let hyb = hybrid(&panel, &orbit, 3, y0);
+        compare(&full.summaries, &hyb.run.summaries);
+        assert!(hyb.t_linear > 2.0 * orbit.period, "{}", hyb.t_linear);
+        assert!(hyb.t_exponential > 0.0 && hyb.t_fallback == 0.0);
+        assert!(hyb.run.stats.n_steps * 50 < full.stats.n_steps);
+        let total = hyb.t_linear + hyb.t_exponential + hyb.t_fallback;
+        assert!((total - 3.0 * orbit.period).abs() < 1e-6 * total);
+    }
+
+    #[test]
+    fn weak_flutter_in_permanent_sunlight_grows_at_the_eigenvalue() {
+        let base = Panel {
+            solar_constant: 1361.0 * 1.034,
+            ..Panel::paper()
+        };
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let crit = critical_damping(&base, model, coupling, 1.0).unwrap();
+        let orbit = Orbit {
+            shadow: Shadow::None,
+            ..Orbit::geo_equinox()
+        };
+        for damping in [crit - 0.1, crit + 0.1] {
+            let panel = Panel { damping, ..base };
+            let predicted = analyse(&panel, model, coupling, 1.0).unwrap().growth_rate;
+            let run = hybrid(&panel, &orbit, 4, start(&panel, &orbit, 1e-6));
+            let s = &run.run.summaries;
+            let measured = (s[3].amplitude / s[1].amplitude).ln() / (2.0 * orbit.period);
+            assert!(
+                (measured / predicted - 1.0).abs() < 0.01,
+                "c_d {damping}: {measured:e} vs {predicted:e}"
+            );
+            assert_eq!(run.t_linear, 4.0 * orbit.period);
+        }
+    }
+
+    #[test]
+    fn a_flux_jump_rings_in_the_full_integration_and_matches_it() {
+        let panel = Panel::paper();
+        let orbit = Orbit::geo_equinox();
+        let y0 = start(&panel, &orbit, 0.0);
+        let full = run_orbits(
+            &panel,
+            &orbit,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            &Method::Dopri5(Tolerances::default()),
+            0.0,
+            0,
+            2,
+            y0,
+            options(),
+        )
+        .unwrap();
+        let hyb = hybrid(&panel, &orbit, 2, y0);
+        compare(&full.summaries, &hyb.run.summaries);
+        assert!(hyb.t_fallback > 0.0 && hyb.t_linear > orbit.period);
+    }
+
+    #[test]
+    fn the_validity_limit_stops_a_fluttering_panel_like_the_full_run() {
+        let panel = Panel {
+            damping: 0.0,
+            ..Panel::paper()
+        };
+        let orbit = Orbit::geo_equinox();
+        let run = hybrid(&panel, &orbit, 20, start(&panel, &orbit, 0.0));
+        let c = run
+            .run
+            .crossing
+            .expect("an undamped panel must leave the limit");
+        assert!(c.theta.abs() > 0.35 && run.run.stats.stopped);
+        assert_eq!(run.run.summaries.last().unwrap().index, c.orbit);
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        let s = HybridSettings {
+            linear_tolerance: -1.0,
+            ..HybridSettings::default()
+        };
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.starts_with("hybrid.linear_tolerance"), "{e}");
+    }
+}

@@ -1,0 +1,1275 @@
+//! The N-node laminate coupled to the hinge: state (thermal coordinates…, θ, θ̇).
+//!
+//! The thermal coordinates are either the node temperatures (when every conduction mode is slow
+//! enough for explicit steps the size of the hinge's) or the amplitudes of the slow conduction
+//! modes, with the fast modes quasi-static.
+//!
+//! Why modes: the conduction operator is linear and constant, so its modes decouple; only the
+//! face nodes see the non-linear radiation and the cos θ heating. A mode k with rate λ_k driven
+//! at the hinge's angular frequency ω lags it by atan(ω/λ_k); when λ_k ≫ ω the lag is small and
+//! the mode follows its forcing, q_k = φ_kᵀ b / (C_tot λ_k) (b: the heat entering at the faces),
+//! so it can leave the state. That removes exactly the fast modes that would force explicit steps
+//! of microseconds, keeps the slow ones (where the physics of the lag is) exact, and is exact in
+//! every steady state. The fast modes change the face temperatures, which change the radiation,
+//! so the two face temperatures are found by Newton's method at every evaluation (two unknowns;
+//! it converges in two or three iterations because the fast modes' face compliance is tiny
+//! against radiation). Measured against the full nodal model in docs/laminates.md.
+
+use crate::conduction::{Conduction, Modes};
+use crate::dynamics::{sin_cos, HingeModel};
+use crate::error::{Error, Result};
+use crate::integrate::{Dyn, OdeSystem, State};
+use crate::orbit::Orbit;
+use crate::params::Panel;
+use crate::system::{Coupling, Sunlight};
+use nalgebra::allocator::Allocator;
+use nalgebra::{Const, DMatrix, DVector, DefaultAllocator, Dim, SVector};
+
+/// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
+/// the hinge's angular frequency), and quasi-static above. See docs/laminates.md for the
+/// measurement behind the value.
+pub const FAST_MODE_FACTOR: f64 = 20.0;
+
+/// The thermal coordinates of the state.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Thermal {
+    /// Node temperatures, front to back.
+    Nodal(Box<NodalRates>),
+    /// Amplitudes of the slow modes, the fast ones quasi-static.
+    Modal(Box<Reduced>),
+}
+
+/// The nodal model's coefficients, each divided by the capacity or inertia it is divided by, in
+/// the order of operations of the two-layer system ([`crate::system::Coupled`]), so that two
+/// nodes on a plain panel give its right-hand side to the bit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodalRates {
+    /// α C / C₀, K/s per unit flux factor.
+    heating: f64,
+    /// σ ε_f / C₀ and σ ε_b / C_{N−1}, 1/(s K³).
+    radiation_front: f64,
+    radiation_back: f64,
+    /// G_e / C_e and G_e / C_{e+1}: element e seen from its first and second node, 1/s.
+    down: Vec<f64>,
+    up: Vec<f64>,
+    /// μ_i / I_B and Σ μ_i / I_B, 1/(s² K).
+    moment: Vec<f64>,
+    moment_total: f64,
+    reference_temperature: f64,
+}
+
+impl NodalRates {
+    fn new(c: &Conduction, inertia: f64) -> Self {
+        let n = c.nodes();
+        NodalRates {
+            heating: c.absorbed / c.capacity[0],
+            radiation_front: c.radiation_front / c.capacity[0],
+            radiation_back: c.radiation_back / c.capacity[n - 1],
+            down: (0..n - 1)
+                .map(|e| c.conductance[e] / c.capacity[e])
+                .collect(),
+            up: (0..n - 1)
+                .map(|e| c.conductance[e] / c.capacity[e + 1])
+                .collect(),
+            moment: c.moment_weight.iter().map(|m| m / inertia).collect(),
+            moment_total: c.moment_total / inertia,
+            reference_temperature: c.reference_temperature,
+        }
+    }
+
+    /// Node rates into `dy[..n]`; returns M_T / I_B.
+    #[inline]
+    fn rates(&self, flux: f64, t: &[f64], dy: &mut [f64]) -> f64 {
+        let n = t.len();
+        let last = n - 1;
+        let (t0, tl) = (t[0], t[last]);
+        let f4 = (t0 * t0) * (t0 * t0);
+        let b4 = (tl * tl) * (tl * tl);
+        dy[0] = self.heating * flux - self.down[0] * (t0 - t[1]);
+        for i in 1..last {
+            dy[i] = self.up[i - 1] * (t[i - 1] - t[i]) - self.down[i] * (t[i] - t[i + 1]);
+        }
+        dy[0] -= self.radiation_front * f4;
+        dy[last] = self.up[last - 1] * (t[last - 1] - tl) - self.radiation_back * b4;
+        let mut moment = 0.0;
+        for (mu, x) in self.moment.iter().zip(t) {
+            moment += mu * (x - t0);
+        }
+        moment + self.moment_total * (t0 - self.reference_temperature)
+    }
+}
+
+/// The slow-mode model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reduced {
+    /// λ_k of the kept modes, 1/s.
+    pub rates: Vec<f64>,
+    /// φ_k at the front and back nodes, divided by C_tot (the forcing of each kept mode).
+    front: Vec<f64>,
+    back: Vec<f64>,
+    /// φ_k at the front and back nodes (the face temperatures of each kept mode).
+    front_shape: Vec<f64>,
+    back_shape: Vec<f64>,
+    /// μᵀ φ_k: the moment of each kept mode, N m/K.
+    moment: Vec<f64>,
+    /// Face temperatures of the quasi-static fast modes per unit face input,
+    /// F = Σ_fast φ_face φ_faceᵀ / (C_tot λ_k), K m²/W.
+    compliance: [[f64; 2]; 2],
+    /// Moment of the fast modes per unit face input, Σ_fast (μᵀφ_k) φ_face / (C_tot λ_k).
+    fast_moment: [f64; 2],
+    /// Indices of the kept modes in `modes`.
+    kept: Vec<usize>,
+    /// The full modal basis (for initial states and node temperatures).
+    pub modes: Modes,
+}
+
+/// The coupled N-node system's coefficients (no orbit: the flux factor is an argument).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layered {
+    pub conduction: Conduction,
+    pub thermal: Thermal,
+    model: HingeModel,
+    coupling: Coupling,
+    /// 1/I_B, c_d/I_B, K_el/I_B.
+    inverse_inertia: f64,
+    damping: f64,
+    stiffness: f64,
+}
+
+impl Layered {
+    /// The system of `conduction` on `panel`'s hinge. `fast_factor` sets which conduction modes
+    /// are quasi-static (λ_k > fast_factor ω_n); `f64::INFINITY` keeps every node.
+    pub fn new(
+        panel: &Panel,
+        conduction: Conduction,
+        model: HingeModel,
+        coupling: Coupling,
+        fast_factor: f64,
+    ) -> Result<Self> {
+        panel.validate()?;
+        if fast_factor.is_nan() || fast_factor <= 0.0 {
+            return Err(Error::invalid("fast_factor", fast_factor, "must be > 0"));
+        }
+        let inertia = panel.hinge_inertia();
+        let cut = fast_factor * panel.natural_angular_frequency();
+        let modes = conduction.modes();
+        let thermal = if modes.rates.iter().all(|&l| l <= cut) {
+            Thermal::Nodal(Box::new(NodalRates::new(&conduction, inertia)))
+        } else {
+            Thermal::Modal(Box::new(Reduced::new(&conduction, modes, cut)))
+        };
+        Ok(Layered {
+            conduction,
+            thermal,
+            model,
+            coupling,
+            inverse_inertia: 1.0 / inertia,
+            damping: panel.damping / inertia,
+            stiffness: panel.hinge_stiffness / inertia,
+        })
+    }
+
+    /// Number of thermal coordinates in the state.
+    pub fn thermal_size(&self) -> usize {
+        match &self.thermal {
+            Thermal::Nodal(_) => self.conduction.nodes(),
+            Thermal::Modal(r) => r.rates.len(),
+        }
+    }
+
+    /// State size: thermal coordinates + θ + θ̇.
+    pub fn size(&self) -> usize {
+        self.thermal_size() + 2
+    }
+
+    #[inline]
+    fn sin_cos(&self, theta: f64) -> (f64, f64) {
+        match (self.coupling, self.model) {
+            (Coupling::Frozen, HingeModel::Linear) => (0.0, 1.0),
+            _ => sin_cos(theta),
+        }
+    }
+
+    /// dy/dt at illumination factor `flux` (written into `dy`).
+    #[inline]
+    pub fn rhs_at_flux(&self, flux: f64, y: &[f64], dy: &mut [f64]) {
+        let m = self.thermal_size();
+        let (th, om) = (y[m], y[m + 1]);
+        let (sin, cos) = self.sin_cos(th);
+        let area = match self.coupling {
+            Coupling::ProjectedArea => cos,
+            Coupling::Frozen => 1.0,
+        };
+        // M_T / I_B.
+        let moment_rate = match &self.thermal {
+            Thermal::Nodal(r) => r.rates(flux * area, &y[..m], dy),
+            Thermal::Modal(r) => {
+                r.rates_and_moment(&self.conduction, flux * area, &y[..m], dy)
+                    * self.inverse_inertia
+            }
+        };
+        let forced = moment_rate - self.damping * om - self.stiffness * th;
+        dy[m] = om;
+        dy[m + 1] = match self.model {
+            HingeModel::Linear => forced,
+            HingeModel::Nonlinear => (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin),
+        };
+    }
+
+    /// M_T of a state at illumination factor `flux` (before the projected area), N m.
+    pub fn moment_of(&self, flux: f64, y: &[f64]) -> f64 {
+        let m = self.thermal_size();
+        match &self.thermal {
+            Thermal::Nodal(_) => self.conduction.moment(&y[..m]),
+            Thermal::Modal(r) => {
+                let area = match self.coupling {
+                    Coupling::ProjectedArea => y[m].cos(),
+                    Coupling::Frozen => 1.0,
+                };
+                r.moment(&self.conduction, flux * area, &y[..m])
+            }
+        }
+    }
+
+    /// Node temperatures of a state at illumination factor `flux` (front first).
+    pub fn node_temperatures(&self, flux: f64, y: &[f64]) -> Vec<f64> {
+        let m = self.thermal_size();
+        match &self.thermal {
+            Thermal::Nodal(_) => y[..m].to_vec(),
+            Thermal::Modal(r) => {
+                let area = match self.coupling {
+                    Coupling::ProjectedArea => y[m].cos(),
+                    Coupling::Frozen => 1.0,
+                };
+                r.node_temperatures(&self.conduction, flux * area, &y[..m])
+            }
+        }
+    }
+
+    /// The state of node temperatures `t` and hinge (θ, θ̇) in this system's coordinates (the
+    /// fast modes of `t` are dropped: they follow from the rest).
+    pub fn state_from_nodes(&self, t: &[f64], theta: f64, theta_dot: f64) -> Vec<f64> {
+        let mut y = match &self.thermal {
+            Thermal::Nodal(_) => t.to_vec(),
+            Thermal::Modal(r) => r.project(&self.conduction, t),
+        };
+        y.push(theta);
+        y.push(theta_dot);
+        y
+    }
+}
+
+impl Reduced {
+    fn new(conduction: &Conduction, modes: Modes, cut: f64) -> Self {
+        let n = conduction.nodes();
+        let total = modes.total_capacity;
+        let mu = &conduction.moment_weight;
+        let mut r = Reduced {
+            rates: Vec::new(),
+            front: Vec::new(),
+            back: Vec::new(),
+            front_shape: Vec::new(),
+            back_shape: Vec::new(),
+            moment: Vec::new(),
+            compliance: [[0.0; 2]; 2],
+            fast_moment: [0.0; 2],
+            kept: Vec::new(),
+            modes: modes.clone(),
+        };
+        for (k, &lambda) in modes.rates.iter().enumerate() {
+            let phi = modes.shapes.column(k);
+            let face = [phi[0], phi[n - 1]];
+            let mode_moment: f64 = (0..n).map(|i| mu[i] * phi[i]).sum();
+            // The uniform mode (λ = 0) is always slow.
+            if k == 0 || lambda <= cut {
+                r.kept.push(k);
+                r.rates.push(lambda);
+                r.front.push(face[0] / total);
+                r.back.push(face[1] / total);
+                r.front_shape.push(face[0]);
+                r.back_shape.push(face[1]);
+                r.moment.push(mode_moment);
+            } else {
+                let w = 1.0 / (total * lambda);
+                for i in 0..2 {
+                    for j in 0..2 {
+                        r.compliance[i][j] += face[i] * face[j] * w;
+                    }
+                    r.fast_moment[i] += mode_moment * face[i] * w;
+                }
+            }
+        }
+        r
+    }
+
+    /// Face temperatures u = u_slow + F b(u) and face inputs b, by Newton's method.
+    #[inline]
+    fn faces(&self, c: &Conduction, flux: f64, amp: &[f64]) -> ([f64; 2], (f64, f64)) {
+        let mut slow = [0.0, 0.0];
+        for ((a, f), b) in amp.iter().zip(&self.front_shape).zip(&self.back_shape) {
+            slow[0] += f * a;
+            slow[1] += b * a;
+        }
+        let f = &self.compliance;
+        let mut b = c.face_inputs(flux, slow[0], slow[1]);
+        let mut u = [
+            slow[0] + f[0][0] * b.0 + f[0][1] * b.1,
+            slow[1] + f[1][0] * b.0 + f[1][1] * b.1,
+        ];
+        for _ in 0..20 {
+            b = c.face_inputs(flux, u[0], u[1]);
+            // g(u) = u − slow − F b(u); ∂b/∂u = −diag(d).
+            let g = [
+                u[0] - slow[0] - (f[0][0] * b.0 + f[0][1] * b.1),
+                u[1] - slow[1] - (f[1][0] * b.0 + f[1][1] * b.1),
+            ];
+            let d = [
+                4.0 * c.radiation_front * u[0] * u[0] * u[0],
+                4.0 * c.radiation_back * u[1] * u[1] * u[1],
+            ];
+            let j = [
+                [1.0 + f[0][0] * d[0], f[0][1] * d[1]],
+                [f[1][0] * d[0], 1.0 + f[1][1] * d[1]],
+            ];
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            let du = [
+                (j[1][1] * g[0] - j[0][1] * g[1]) / det,
+                (j[0][0] * g[1] - j[1][0] * g[0]) / det,
+            ];
+            u[0] -= du[0];
+            u[1] -= du[1];
+            if du[0].abs() <= 1e-14 * u[0].abs() && du[1].abs() <= 1e-14 * u[1].abs() {
+                break;
+            }
+        }
+        (u, c.face_inputs(flux, u[0], u[1]))
+    }
+
+    /// Rates of the kept modes (into dy[..m]) and the thermal moment.
+    #[inline]
+    fn rates_and_moment(&self, c: &Conduction, flux: f64, amp: &[f64], dy: &mut [f64]) -> f64 {
+        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let mut moment = self.fast_moment[0] * b0 + self.fast_moment[1] * b1 - c.moment_offset;
+        for k in 0..amp.len() {
+            dy[k] = -self.rates[k] * amp[k] + self.front[k] * b0 + self.back[k] * b1;
+            moment += self.moment[k] * amp[k];
+        }
+        moment
+    }
+
+    fn moment(&self, c: &Conduction, flux: f64, amp: &[f64]) -> f64 {
+        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let mut moment = self.fast_moment[0] * b0 + self.fast_moment[1] * b1 - c.moment_offset;
+        for (m, a) in self.moment.iter().zip(amp) {
+            moment += m * a;
+        }
+        moment
+    }
+
+    fn node_temperatures(&self, c: &Conduction, flux: f64, amp: &[f64]) -> Vec<f64> {
+        let n = c.nodes();
+        let (_, (b0, b1)) = self.faces(c, flux, amp);
+        let total = self.modes.total_capacity;
+        let mut t = vec![0.0; n];
+        for (k, &lambda) in self.modes.rates.iter().enumerate() {
+            let phi = self.modes.shapes.column(k);
+            let q = match self.kept.iter().position(|&j| j == k) {
+                Some(p) => amp[p],
+                None => (phi[0] * b0 + phi[n - 1] * b1) / (total * lambda),
+            };
+            for i in 0..n {
+                t[i] += phi[i] * q;
+            }
+        }
+        t
+    }
+
+    /// Amplitudes of the kept modes of a nodal profile: q_k = φ_kᵀ C T / C_tot.
+    fn project(&self, c: &Conduction, t: &[f64]) -> Vec<f64> {
+        let total = self.modes.total_capacity;
+        self.kept
+            .iter()
+            .map(|&k| {
+                let phi = self.modes.shapes.column(k);
+                (0..c.nodes())
+                    .map(|i| phi[i] * c.capacity[i] * t[i])
+                    .sum::<f64>()
+                    / total
+            })
+            .collect()
+    }
+}
+
+/// The N-node system in orbit: the illumination of the current segment drives it.
+#[derive(Debug, Clone)]
+pub struct LayeredOrbit {
+    pub system: Layered,
+    sun: Sunlight,
+}
+
+impl LayeredOrbit {
+    pub fn new(system: Layered, orbit: Orbit) -> Self {
+        LayeredOrbit {
+            system,
+            sun: Sunlight::new(orbit),
+        }
+    }
+}
+
+impl OdeSystem<Dyn> for LayeredOrbit {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State<Dyn>) -> State<Dyn> {
+        let mut dy = DVector::zeros(y.len());
+        self.system
+            .rhs_at_flux(self.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        dy
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.sun.orbit.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.sun.enter(a, b);
+    }
+}
+
+/// The N-node system on a state whose size S is known at compile time: the integrator's
+/// vectors then live on the stack, with no allocation per evaluation (the run-time size `Dyn`
+/// allocates every intermediate vector, which costs more than the physics of a small state).
+struct Fixed<const S: usize>(LayeredOrbit);
+
+impl<const S: usize> OdeSystem<Const<S>> for Fixed<S> {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State<Const<S>>) -> State<Const<S>> {
+        let mut dy = SVector::<f64, S>::zeros();
+        self.0
+            .system
+            .rhs_at_flux(self.0.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        dy
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.0.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.0.enter_segment(a, b);
+    }
+}
+
+/// A state vector of dimension `D` from its components.
+fn state_of<D: Dim>(v: &[f64]) -> State<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    State::<D>::from_column_slice_generic(D::from_usize(v.len()), Const::<1>, v)
+}
+
+/// Calls `$run(system, state)` with the N-node system `$orb` on a compile-time state size when
+/// its size is one of the common ones (slow-mode models keep a few modes; nodal models have a
+/// few nodes), else on the run-time size.
+macro_rules! on_fastest_state {
+    ($orb:expr, $size:expr, $run:ident ( $($arg:expr),* )) => {
+        match $size {
+            3 => $run(&mut Fixed::<3>($orb), $($arg),*),
+            4 => $run(&mut Fixed::<4>($orb), $($arg),*),
+            5 => $run(&mut Fixed::<5>($orb), $($arg),*),
+            6 => $run(&mut Fixed::<6>($orb), $($arg),*),
+            7 => $run(&mut Fixed::<7>($orb), $($arg),*),
+            8 => $run(&mut Fixed::<8>($orb), $($arg),*),
+            9 => $run(&mut Fixed::<9>($orb), $($arg),*),
+            10 => $run(&mut Fixed::<10>($orb), $($arg),*),
+            11 => $run(&mut Fixed::<11>($orb), $($arg),*),
+            12 => $run(&mut Fixed::<12>($orb), $($arg),*),
+            13 => $run(&mut Fixed::<13>($orb), $($arg),*),
+            14 => $run(&mut Fixed::<14>($orb), $($arg),*),
+            16 => $run(&mut Fixed::<16>($orb), $($arg),*),
+            18 => $run(&mut Fixed::<18>($orb), $($arg),*),
+            22 => $run(&mut Fixed::<22>($orb), $($arg),*),
+            _ => { let mut dynamic = $orb; $run(&mut dynamic, $($arg),*) }
+        }
+    };
+}
+
+/// A sampled run of the N-node system, with the temperature of every node.
+#[derive(Debug, Clone)]
+pub struct LayeredRun {
+    pub t: Vec<f64>,
+    /// Node temperatures at each sample (sample-major: t.len() × nodes).
+    pub temperatures: Vec<f64>,
+    pub theta: Vec<f64>,
+    pub theta_dot: Vec<f64>,
+    pub moment: Vec<f64>,
+    pub stats: crate::integrate::Stats,
+    /// The end state as node temperatures, θ, θ̇ (a run can resume from it).
+    pub y_end: Vec<f64>,
+}
+
+/// Integrates the N-node system over `t_span` from `y0` (node temperatures, θ, θ̇; default the
+/// sunlit equilibrium at the start's solar flux) and samples it as `output` asks.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate(
+    panel: &Panel,
+    conduction: Conduction,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &crate::integrate::Method,
+    t_span: (f64, f64),
+    y0: Option<&[f64]>,
+    output: &crate::simulate::Output,
+) -> Result<LayeredRun> {
+    let n = conduction.nodes();
+    let start: Vec<f64> = match y0 {
+        Some(v) => {
+            if v.len() != n + 2 {
+                return Err(Error::invalid(
+                    "y0",
+                    format!("{} components", v.len()),
+                    &format!(
+                        "must hold the {n} node temperatures, θ and θ̇ ({} values)",
+                        n + 2
+                    ),
+                ));
+            }
+            if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                return Err(Error::invalid("y0", x, "every component must be finite"));
+            }
+            v.to_vec()
+        }
+        None => {
+            let eq = equilibrium(panel, &conduction, coupling, orbit.flux_scale(t_span.0))?;
+            let mut v = eq.temperatures;
+            v.push(eq.theta);
+            v.push(0.0);
+            v
+        }
+    };
+    let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
+    let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
+    let size = y_start.len();
+    let orb = LayeredOrbit::new(system.clone(), *orbit);
+    let (t, y, stats, y_end) =
+        on_fastest_state!(orb, size, sample_run(method, t_span, &y_start, output))?;
+    let m = system.thermal_size();
+    let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
+    let mut run = LayeredRun {
+        theta: y.iter().map(|v| v[m]).collect(),
+        theta_dot: y.iter().map(|v| v[m + 1]).collect(),
+        temperatures: Vec::with_capacity(t.len() * n),
+        moment: Vec::with_capacity(t.len()),
+        t,
+        stats,
+        y_end: Vec::new(),
+    };
+    for (t, y) in run.t.iter().zip(&y) {
+        let temps = system.node_temperatures(area_free(*t), y);
+        run.moment.push(system.conduction.moment(&temps));
+        run.temperatures.extend(temps);
+    }
+    let mut end = system.node_temperatures(area_free(stats.t_end), &y_end);
+    end.push(y_end[m]);
+    end.push(y_end[m + 1]);
+    run.y_end = end;
+    Ok(run)
+}
+
+/// Samples of one run of `system`: times, states, counters and the end state.
+type Samples = (Vec<f64>, Vec<Vec<f64>>, crate::integrate::Stats, Vec<f64>);
+
+fn sample_run<D: Dim, S: OdeSystem<D>>(
+    system: &mut S,
+    method: &crate::integrate::Method,
+    t_span: (f64, f64),
+    y0: &[f64],
+    output: &crate::simulate::Output,
+) -> Result<Samples>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let traj = crate::simulate::run(system, method, t_span, state_of::<D>(y0), output)?;
+    let y = traj.y.iter().map(|v| v.as_slice().to_vec()).collect();
+    Ok((traj.t, y, traj.stats, traj.y_end.as_slice().to_vec()))
+}
+
+/// The summaries' view of the N-node system.
+struct LayeredView {
+    system: Layered,
+    panel: Panel,
+    orbit: Orbit,
+    coupling: Coupling,
+}
+
+impl crate::summary::SummaryView for LayeredView {
+    fn theta_eq(&self, flux: f64) -> Result<f64> {
+        Ok(equilibrium(&self.panel, &self.system.conduction, self.coupling, flux)?.theta)
+    }
+    fn angles(&self, t: f64, y: &[f64]) -> (f64, f64) {
+        let flux = self.orbit.illumination(t) * self.orbit.flux_scale(t);
+        let theta = y[self.system.thermal_size()];
+        (
+            theta,
+            self.system.moment_of(flux, y) / self.panel.hinge_stiffness,
+        )
+    }
+}
+
+/// Per-orbit summaries of the N-node system (as [`crate::summary::run_orbits`]), from `y0` =
+/// (node temperatures, θ, θ̇); the end state is returned in the same form.
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits(
+    panel: &Panel,
+    conduction: Conduction,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &crate::integrate::Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: &[f64],
+    options: crate::summary::SummaryOptions,
+    cancel: &crate::cancel::Cancel,
+) -> Result<LayeredSummaries> {
+    let n = conduction.nodes();
+    check_start(y0, n)?;
+    let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
+    let m = system.thermal_size();
+    let start = system.state_from_nodes(&y0[..n], y0[n], y0[n + 1]);
+    let view = LayeredView {
+        system: system.clone(),
+        panel: *panel,
+        orbit: *orbit,
+        coupling,
+    };
+    let orb = LayeredOrbit::new(system.clone(), *orbit);
+    let size = start.len();
+    let args = (
+        view,
+        panel,
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        options,
+        cancel,
+    );
+    let mut run = on_fastest_state!(orb, size, summarised_run(&start, m, args))?;
+    let t_end = run.stats.t_end;
+    let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);
+    let mut end = system.node_temperatures(flux, &run.y_end);
+    end.push(run.y_end[m]);
+    end.push(run.y_end[m + 1]);
+    run.y_end = end;
+    Ok(run)
+}
+
+/// The summarised run's settings, passed through the size dispatch.
+type SummaryArgs<'a> = (
+    LayeredView,
+    &'a Panel,
+    &'a Orbit,
+    &'a crate::integrate::Method,
+    f64,
+    u64,
+    u64,
+    crate::summary::SummaryOptions,
+    &'a crate::cancel::Cancel,
+);
+
+/// Per-orbit summaries of the N-node system, the end state as a plain vector.
+pub struct LayeredSummaries {
+    pub summaries: Vec<crate::summary::OrbitSummary>,
+    pub stats: crate::integrate::Stats,
+    /// Node temperatures, θ, θ̇.
+    pub y_end: Vec<f64>,
+    pub crossing: Option<crate::summary::LimitCrossing>,
+}
+
+fn summarised_run<D: Dim, S: OdeSystem<D>>(
+    system: &mut S,
+    y0: &[f64],
+    theta_index: usize,
+    args: SummaryArgs<'_>,
+) -> Result<LayeredSummaries>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel) = args;
+    let run = crate::summary::run_summarised(
+        system,
+        view,
+        panel,
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        state_of::<D>(y0),
+        theta_index,
+        options,
+        cancel,
+    )?;
+    Ok(LayeredSummaries {
+        summaries: run.summaries,
+        stats: run.stats,
+        y_end: run.y_end.as_slice().to_vec(),
+        crossing: run.crossing,
+    })
+}
+
+/// Checks a start state of node temperatures, θ and θ̇.
+fn check_start(v: &[f64], n: usize) -> Result<()> {
+    if v.len() != n + 2 {
+        return Err(Error::invalid(
+            "y0",
+            format!("{} components", v.len()),
+            &format!(
+                "must hold the {n} node temperatures, θ and θ̇ ({} values)",
+                n + 2
+            ),
+        ));
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(Error::invalid("y0", x, "every component must be finite"));
+    }
+    Ok(())
+}
+
+/// The steady state of the coupled N-node system under a constant illumination factor: node
+/// temperatures (front first) and θ, with θ̇ = 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayeredEquilibrium {
+    pub temperatures: Vec<f64>,
+    pub theta: f64,
+    pub moment: f64,
+}
+
+/// Newton's method on the N heat balances and the static hinge (M_T = K_el θ), with the
+/// analytic Jacobian, from the uncoupled steady profile.
+pub fn equilibrium(
+    panel: &Panel,
+    c: &Conduction,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<LayeredEquilibrium> {
+    let n = c.nodes();
+    if c.two_layer {
+        // Two nodes on a plain panel are eq. 2: the same steady state to the bit, so that a run
+        // from it is the two-layer run.
+        let eq = crate::steady::equilibrium(panel, coupling, flux)?;
+        let temperatures = vec![eq.t_front, eq.t_back];
+        return Ok(LayeredEquilibrium {
+            moment: c.moment(&temperatures),
+            temperatures,
+            theta: eq.theta,
+        });
+    }
+    let profile = c.steady_profile(flux)?;
+    let k_el = panel.hinge_stiffness;
+    let mut x = DVector::zeros(n + 1);
+    for i in 0..n {
+        x[i] = profile[i];
+    }
+    x[n] = c.moment(&profile) / k_el;
+    let k = c.conduction_matrix();
+    for _ in 0..100 {
+        let th = x[n];
+        let (area, d_area) = match coupling {
+            Coupling::ProjectedArea => (th.cos(), -th.sin()),
+            Coupling::Frozen => (1.0, 0.0),
+        };
+        let t: Vec<f64> = x.rows(0, n).iter().copied().collect();
+        let (qf, qb) = c.face_inputs(flux * area, t[0], t[n - 1]);
+        let mut f = DVector::zeros(n + 1);
+        let kt = &k * x.rows(0, n);
+        for i in 0..n {
+            f[i] = -kt[i];
+        }
+        f[0] += qf;
+        f[n - 1] += qb;
+        f[n] = (c.moment(&t) - k_el * th) / k_el;
+        let mut jac = DMatrix::zeros(n + 1, n + 1);
+        jac.view_mut((0, 0), (n, n)).copy_from(&(-&k));
+        jac[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3);
+        jac[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3);
+        jac[(0, n)] = c.absorbed * flux * d_area;
+        for i in 0..n {
+            jac[(n, i)] = c.moment_weight[i] / k_el;
+        }
+        jac[(n, n)] = -1.0;
+        let dx = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
+            what: "steady state".into(),
+            reason: "singular Jacobian".into(),
+        })?;
+        let mut lambda = 1.0;
+        while (0..n).any(|i| x[i] + lambda * dx[i] <= 0.0) {
+            lambda *= 0.5;
+        }
+        x += &dx * lambda;
+        let small_t = (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]);
+        if small_t && dx[n].abs() < 1e-14 {
+            if x[n].abs() >= std::f64::consts::FRAC_PI_2 {
+                return Err(Error::NoConvergence {
+                    what: "steady state".into(),
+                    reason: format!(
+                        "hinge angle {} rad is beyond 90°: the panel is far too soft",
+                        x[n]
+                    ),
+                });
+            }
+            let temperatures: Vec<f64> = x.rows(0, n).iter().copied().collect();
+            let moment = c.moment(&temperatures);
+            return Ok(LayeredEquilibrium {
+                temperatures,
+                theta: x[n],
+                moment,
+            });
+        }
+    }
+    Err(Error::NoConvergence {
+        what: "steady state".into(),
+        reason: "Newton did not converge in 100 iterations".into(),
+    })
+}
+
+/// The analytic Jacobian of the nodal system (N node temperatures, θ, θ̇) at a steady state.
+pub fn jacobian(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+    eq: &LayeredEquilibrium,
+) -> DMatrix<f64> {
+    let n = c.nodes();
+    let t = &eq.temperatures;
+    let mut j = DMatrix::zeros(n + 2, n + 2);
+    let k = c.conduction_matrix();
+    for r in 0..n {
+        for col in 0..n {
+            j[(r, col)] = -k[(r, col)] / c.capacity[r];
+        }
+    }
+    j[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3) / c.capacity[0];
+    j[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3) / c.capacity[n - 1];
+    let s = eq.theta.sin();
+    if coupling == Coupling::ProjectedArea {
+        j[(0, n)] = -c.absorbed * flux * s / c.capacity[0];
+    }
+    j[(n, n + 1)] = 1.0;
+    // The static residual is zero at the equilibrium, so the derivative of the non-linear
+    // inertia factor drops out (as in the two-layer Jacobian).
+    let inertia = panel.hinge_inertia()
+        * match model {
+            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
+            HingeModel::Linear => 1.0,
+        };
+    for col in 0..n {
+        j[(n + 1, col)] = c.moment_weight[col] / inertia;
+    }
+    j[(n + 1, n)] = -panel.hinge_stiffness / inertia;
+    j[(n + 1, n + 1)] = -panel.damping / inertia;
+    j
+}
+
+/// Linear stability of the N-node system's sunlit equilibrium (the full nodal Jacobian: an
+/// eigen-analysis has no step to protect from fast modes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayeredFlutter {
+    pub equilibrium: LayeredEquilibrium,
+    /// ∂f/∂y at the equilibrium, state (node temperatures, θ, θ̇).
+    pub jacobian: DMatrix<f64>,
+    /// Its eigenvalues, 1/s, by decreasing real part.
+    pub eigenvalues: Vec<nalgebra::Complex<f64>>,
+    /// Largest real part of the eigenvalues, 1/s.
+    pub growth_rate: f64,
+    /// Frequency of the fastest oscillatory pair, Hz.
+    pub frequency_hz: f64,
+}
+
+pub fn analyse(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<LayeredFlutter> {
+    let eq = equilibrium(panel, c, coupling, flux)?;
+    let (growth_rate, frequency_hz, eigenvalues) = growth(panel, c, model, coupling, flux, &eq)?;
+    Ok(LayeredFlutter {
+        jacobian: jacobian(panel, c, model, coupling, flux, &eq),
+        equilibrium: eq,
+        eigenvalues,
+        growth_rate,
+        frequency_hz,
+    })
+}
+
+/// (growth rate, frequency, eigenvalues by decreasing real part) of the Jacobian at `eq`.
+fn growth(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+    eq: &LayeredEquilibrium,
+) -> Result<(f64, f64, Vec<nalgebra::Complex<f64>>)> {
+    let n = c.nodes();
+    let jac = jacobian(panel, c, model, coupling, flux, eq);
+    // Balance kelvin rows against radian rows (a diagonal similarity keeps the eigenvalues).
+    let tmax = eq.temperatures.iter().fold(1.0_f64, |a, &b| a.max(b));
+    let mut scale = vec![1.0; n + 2];
+    scale[n] = 1.0 / tmax;
+    scale[n + 1] = panel.natural_angular_frequency() / tmax;
+    let balanced = DMatrix::from_fn(n + 2, n + 2, |i, j| jac[(i, j)] * scale[j] / scale[i]);
+    let ev = balanced.complex_eigenvalues();
+    if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+        return Err(Error::NoConvergence {
+            what: "eigenvalues".into(),
+            reason: "non-finite result".into(),
+        });
+    }
+    let mut ev: Vec<_> = ev.iter().copied().collect();
+    ev.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
+    let omega = ev.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
+    Ok((ev[0].re, omega / (2.0 * std::f64::consts::PI), ev))
+}
+
+/// The damping c_d (N m s/rad) at which the growth rate crosses zero (bisection); 0 when the
+/// panel is stable without damping.
+pub fn critical_damping(
+    panel: &Panel,
+    c: &Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+    flux: f64,
+) -> Result<f64> {
+    // The equilibrium does not depend on c_d.
+    let eq = equilibrium(panel, c, coupling, flux)?;
+    let rate = |cd: f64| -> Result<f64> {
+        let p = Panel {
+            damping: cd,
+            ..*panel
+        };
+        Ok(growth(&p, c, model, coupling, flux, &eq)?.0)
+    };
+    if rate(0.0)? < 0.0 {
+        return Ok(0.0);
+    }
+    let mut hi = panel
+        .damping
+        .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
+    let mut tries = 0;
+    while rate(hi)? >= 0.0 {
+        hi *= 2.0;
+        tries += 1;
+        if tries > 200 {
+            return Err(Error::NoConvergence {
+                what: "critical damping".into(),
+                reason: "no stabilising damping found".into(),
+            });
+        }
+    }
+    let mut lo = 0.0;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if rate(mid)? >= 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-12 * hi {
+            break;
+        }
+    }
+    Ok(0.5 * (lo + hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::laminate::{Laminate, MATERIALS};
+    use crate::system::Coupled;
+    use crate::Orbit;
+
+    /// A CFRP/honeycomb solar-array substrate with Kapton on the Sun side.
+    pub(crate) fn wing_layup() -> Laminate {
+        Laminate {
+            layers: vec![
+                MATERIALS[4].layer(50e-6),
+                MATERIALS[2].layer(0.3e-3),
+                MATERIALS[3].layer(20e-3),
+                MATERIALS[2].layer(0.3e-3),
+            ],
+            emissivity_front: 0.8,
+            emissivity_back: 0.8,
+            absorptivity: 0.9,
+            reference_temperature: 293.15,
+        }
+    }
+
+    #[test]
+    fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
+        let p = Panel {
+            damping: 2.0,
+            ..Panel::paper()
+        };
+        for model in [HingeModel::Nonlinear, HingeModel::Linear] {
+            for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+                let c = Conduction::homogeneous(&p, 2).unwrap();
+                let sys = Layered::new(&p, c, model, coupling, FAST_MODE_FACTOR).unwrap();
+                assert!(matches!(sys.thermal, Thermal::Nodal(_)));
+                let two = Coupled::new(p, Orbit::geo_equinox(), model, coupling);
+                for y in [[380.0, 368.0, 0.085, 0.0], [250.0, 262.0, -0.3, 0.02]] {
+                    let mut dy = [0.0; 4];
+                    sys.rhs_at_flux(0.97, &y, &mut dy);
+                    let want = two.rhs_at_flux(0.97, &nalgebra::Vector4::from(y));
+                    for i in 0..4 {
+                        assert!((dy[i] - want[i]).abs() <= 1e-13 * want[i].abs().max(1e-3));
+                    }
+                }
+                let eq = equilibrium(&p, &sys.conduction, coupling, 1.0).unwrap();
+                let two_eq = crate::steady::equilibrium(&p, coupling, 1.0).unwrap();
+                assert!((eq.theta / two_eq.theta - 1.0).abs() < 1e-10);
+                assert!((eq.temperatures[0] / two_eq.t_front - 1.0).abs() < 1e-12);
+                let a = analyse(&p, &sys.conduction, model, coupling, 1.0).unwrap();
+                let b = crate::flutter::analyse(&p, model, coupling, 1.0).unwrap();
+                assert!(
+                    (a.growth_rate - b.growth_rate).abs() < 1e-9 * b.growth_rate.abs().max(1e-6)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let p = Panel {
+            damping: 0.5,
+            ..Panel::paper()
+        };
+        let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
+        let sys = Layered::new(
+            &p,
+            c.clone(),
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            f64::INFINITY,
+        )
+        .unwrap();
+        let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+        let jac = jacobian(
+            &p,
+            &c,
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            1.0,
+            &eq,
+        );
+        let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+        let n = y.len();
+        let mut f0 = vec![0.0; n];
+        sys.rhs_at_flux(1.0, &y, &mut f0);
+        assert!(f0.iter().all(|v| v.abs() < 1e-9), "equilibrium: {f0:?}");
+        for j in 0..n {
+            let h = if j < n - 2 { 1e-6 * y[j] } else { 1e-5 };
+            let (mut yp, mut ym) = (y.clone(), y.clone());
+            yp[j] += h;
+            ym[j] -= h;
+            let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+            sys.rhs_at_flux(1.0, &yp, &mut fp);
+            sys.rhs_at_flux(1.0, &ym, &mut fm);
+            let scale = (0..n).map(|i| jac[(i, j)].abs()).fold(1e-12, f64::max);
+            for i in 0..n {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                assert!(
+                    (fd - jac[(i, j)]).abs() < 1e-6 * scale,
+                    "({i},{j}) {fd} vs {}",
+                    jac[(i, j)]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn quasi_static_fast_modes_are_exact_in_steady_state() {
+        // An aluminium boom wall: every non-uniform conduction mode is fast.
+        let lam = Laminate {
+            layers: vec![MATERIALS[0].layer(1e-3)],
+            ..wing_layup()
+        };
+        let p = lam.equivalent_panel(&Panel::paper()).unwrap();
+        for layup in [lam, wing_layup()] {
+            let c = Conduction::new(&p, &layup, 20).unwrap();
+            let sys = Layered::new(
+                &p,
+                c.clone(),
+                HingeModel::Nonlinear,
+                Coupling::ProjectedArea,
+                FAST_MODE_FACTOR,
+            )
+            .unwrap();
+            assert!(matches!(sys.thermal, Thermal::Modal(_)));
+            let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+            let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+            let mut dy = vec![0.0; y.len()];
+            sys.rhs_at_flux(1.0, &y, &mut dy);
+            let m = sys.conduction.moment(&sys.node_temperatures(1.0, &y));
+            // The moment is a sum of large terms that nearly cancel (M_T = Σ μ_i T_i − Σ μ_i T_ref):
+            // compare against their size.
+            let size: f64 = c
+                .moment_weight
+                .iter()
+                .zip(&eq.temperatures)
+                .map(|(m, t)| (m * t).abs())
+                .sum();
+            assert!((m - eq.moment).abs() < 1e-13 * size, "{m} vs {}", eq.moment);
+            let t = sys.node_temperatures(1.0, &y);
+            for (a, b) in t.iter().zip(&eq.temperatures) {
+                assert!((a / b - 1.0).abs() < 1e-12);
+            }
+            for (i, v) in dy.iter().enumerate() {
+                assert!(v.abs() < 1e-9 * (1.0 + y[i].abs()), "{i}: {v}");
+            }
+        }
+    }
+
+    /// The example wing (CFRP/honeycomb, 20 m) and boom (1 mm aluminium, 2 m) as panels.
+    pub(crate) fn examples() -> Vec<(&'static str, Panel, Laminate)> {
+        let boom = Laminate {
+            layers: vec![MATERIALS[0].layer(1e-3)],
+            emissivity_front: 0.8,
+            emissivity_back: 0.8,
+            absorptivity: 0.4,
+            reference_temperature: 293.15,
+        };
+        let mut out = Vec::new();
+        for (name, lam, length) in [("wing", wing_layup(), 20.0), ("boom", boom, 2.0)] {
+            let base = Panel {
+                length,
+                damping: 0.0,
+                ..Panel::paper()
+            };
+            let mut p = lam.equivalent_panel(&base).unwrap();
+            p.hinge_stiffness = crate::params::hinge_stiffness(
+                &p,
+                crate::params::StiffnessCriterion::DeflectionSmallAngle,
+                0.0,
+            )
+            .unwrap();
+            out.push((name, p, lam));
+        }
+        out
+    }
+
+    /// Measurement behind FAST_MODE_FACTOR: one eclipse exit of the example wing and boom with
+    /// 20 nodes, for several cuts; prints the jitter after exit, the steps and the critical
+    /// damping of the reduced model. `cargo test --release -- --ignored fast_mode --nocapture`
+    #[test]
+    #[ignore]
+    fn fast_mode_factor_measurement() {
+        use crate::integrate::{Method, Tolerances};
+        use crate::simulate::{run, Output};
+        let orbit = Orbit::geo_equinox();
+        let (entry, exit) = orbit.shadow_intervals(0.0, orbit.period)[0];
+        for (name, p, lam) in examples() {
+            let p = Panel { damping: 0.0, ..p };
+            let c = Conduction::new(&p, &lam, 20).unwrap();
+            let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+            let full =
+                analyse(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0).unwrap();
+            let cd = critical_damping(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0)
+                .unwrap();
+            let wn = p.natural_angular_frequency();
+            let rates = c.modes().rates;
+            println!(
+                "{name}: omega_n {wn:.3} rad/s, theta_eq {:.3e} rad, conduction rates {:.3e}..{:.3e} 1/s, full-model growth(c_d=0) {:.4e} 1/s, c_d* {cd:.5e}",
+                eq.theta, rates[1], rates[19], full.growth_rate
+            );
+            let t0 = entry - 600.0;
+            let t1 = exit + 1200.0;
+            let tn = 2.0 * std::f64::consts::PI / wn;
+            for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 200.0, 1000.0] {
+                let sys = Layered::new(
+                    &p,
+                    c.clone(),
+                    HingeModel::Nonlinear,
+                    Coupling::ProjectedArea,
+                    factor,
+                )
+                .unwrap();
+                let kept = sys.thermal_size();
+                let y0 = DVector::from_vec(sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0));
+                let mut orb = LayeredOrbit::new(sys, orbit);
+                let method = Method::Dopri5(Tolerances {
+                    rtol: 1e-8,
+                    atol: 1e-10,
+                    max_step: tn / 40.0,
+                    max_steps: 50_000_000,
+                });
+                let start = std::time::Instant::now();
+                let traj = run(&mut orb, &method, (t0, t1), y0, &Output::Every(0.05)).unwrap();
+                let secs = start.elapsed().as_secs_f64();
+                let m = kept;
+                let peak = traj
+                    .t
+                    .iter()
+                    .zip(&traj.y)
+                    .filter(|(t, _)| **t > exit)
+                    .map(|(_, y)| (y[m] - eq.theta).abs())
+                    .fold(0.0, f64::max);
+                println!("  factor {factor:>6}: kept {kept:>2} modes, steps {:>9}, {secs:.2} s, exit peak |theta - theta_eq| {peak:.6e}", traj.stats.n_steps);
+            }
+        }
+    }
+
+    #[test]
+    fn two_nodes_reproduce_the_two_layer_orbit_to_1e10() {
+        use crate::integrate::{Method, Tolerances};
+        use crate::simulate::{run, Output};
+        // The nodal right-hand side on two nodes does eq. 2's arithmetic in eq. 2's order, so
+        // the runs take the same steps; anything but rounding-level agreement would show here
+        // (a near-undamped hinge amplifies any difference in the step sequence to ~1e-6).
+        let p = Panel::paper();
+        let o = Orbit::geo_equinox();
+        let method = Method::Dopri5(Tolerances::default());
+        let out = Output::Every(30.0);
+        let span = (0.0, o.period);
+        let c = Conduction::homogeneous(&p, 2).unwrap();
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        // Both from the same start (the equilibria agree to 1e-10 on their own, tested above).
+        let eq = crate::steady::equilibrium(&p, coupling, 1.0).unwrap();
+        let y0 = nalgebra::Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+        let start = [eq.t_front, eq.t_back, eq.theta, 0.0];
+        let lay = simulate(
+            &p,
+            c,
+            &o,
+            model,
+            coupling,
+            &method,
+            span,
+            Some(&start),
+            &out,
+        )
+        .unwrap();
+        let two = run(
+            &mut Coupled::new(p, o, model, coupling),
+            &method,
+            span,
+            y0,
+            &out,
+        )
+        .unwrap();
+        assert_eq!(lay.t.len(), two.t.len());
+        let theta_scale = two.column(2).iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        let mut worst: f64 = 0.0;
+        for (k, y) in two.y.iter().enumerate() {
+            worst = worst
+                .max((lay.temperatures[2 * k] / y[0] - 1.0).abs())
+                .max((lay.temperatures[2 * k + 1] / y[1] - 1.0).abs())
+                .max((lay.theta[k] - y[2]).abs() / theta_scale);
+        }
+        println!("two nodes vs two layers over one GEO orbit: worst relative difference {worst:e}; steps {} vs {}", lay.stats.n_steps, two.stats.n_steps);
+
+        assert!(worst < 1e-10, "{worst}");
+    }
+}

@@ -1,0 +1,143 @@
+"""The hybrid long-run propagator against the hinge-resolved integration it replaces.
+
+Accuracy gate (every orbit, each metric): within 2 %, or 1e-6 rad where the full run's value is
+below 5e-5 rad. The long cases (a whole spring eclipse season, a flutter that grows for five
+months) take minutes with the full integration; they run when THERMOJITTER_SLOW=1 is set and are
+reported by benches/longrun.py.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import thermojitter as tj
+from conftest import PAPER
+
+METRICS = ("amplitude", "exit_peak", "entry_peak", "jitter_rms", "theta_max", "theta_min")
+slow = pytest.mark.skipif(
+    not os.environ.get("THERMOJITTER_SLOW"), reason="minutes of full integration"
+)
+
+
+def assert_gate(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries) -> None:
+    assert len(full) == len(hybrid)
+    for name in METRICS:
+        a, b = full.columns[name], hybrid.columns[name]
+        np.testing.assert_array_equal(np.isnan(a), np.isnan(b), err_msg=name)
+        defined = ~np.isnan(a)
+        small = np.abs(a) < 5e-5
+        err = np.abs(b - a)
+        bad = defined & np.where(small, err > 1e-6, err > 0.02 * np.abs(a))
+        assert not bad.any(), f"{name}: orbits {np.flatnonzero(bad)}: {a[bad]} vs {b[bad]}"
+
+
+def both(orbit: tj.Orbit, n: int, panel: tj.Panel = PAPER) -> tuple[tj.OrbitSummaries, ...]:
+    full = tj.simulate_orbits(panel, orbit, n, method="rk45", orbits_per_call=n)
+    hybrid = tj.simulate_orbits(panel, orbit, n, method="hybrid", orbits_per_call=n)
+    return full, hybrid
+
+
+def test_spring_eclipses_in_the_penumbra() -> None:
+    """Eight orbits in mid-March (penumbra, eccentric Sun): the CI-sized part of case (a)."""
+    full, hybrid = both(tj.Orbit.geo_year("2026-03-08"), 8)
+    assert_gate(full, hybrid)
+    p = hybrid.propagation
+    assert p["t_fallback"] == 0.0 and p["t_linear"] > 0.9 * 8 * tj.Orbit.geo_year().period
+    assert 0.0 < hybrid.nonlinear_fraction < 0.1
+    assert hybrid.n_steps * 50 < full.n_steps
+
+
+@slow
+def test_whole_spring_eclipse_season() -> None:
+    """Case (a): 64 orbits from 20 February, through the whole spring season."""
+    full, hybrid = both(tj.Orbit.geo_year("2026-02-20"), 64)
+    assert np.isfinite(full.t_entry).sum() > 40
+    assert_gate(full, hybrid)
+
+
+def test_cylindrical_shadow_at_equinox() -> None:
+    """Case (b): the paper's orbit; the flux jump rings the hinge, which the fallback resolves."""
+    full, hybrid = both(tj.Orbit.geo_equinox(), 10)
+    assert_gate(full, hybrid)
+    assert hybrid.propagation["t_fallback"] > 0.0
+
+
+def test_low_orbit_eclipse_every_orbit() -> None:
+    """Case (c): the state never settles between eclipses, so little is left to linear arcs."""
+    full, hybrid = both(tj.Orbit.leo(), 100)
+    assert_gate(full, hybrid)
+
+
+@pytest.mark.parametrize("offset", [-0.1, 0.1])
+def test_weak_flutter_grows_at_the_eigenvalue_without_a_step_cap(offset: float) -> None:
+    base = PAPER.replace(solar_constant=1361.0 * 1.034)
+    panel = base.replace(damping=tj.flutter(base).critical_damping + offset)
+    predicted = tj.flutter(panel).growth_rate
+    sunlit = tj.Orbit.sunlit()
+    eq = tj.steady_state(panel)
+    y0 = (eq.T_front, eq.T_back, eq.theta + 1e-6, 0.0)
+    runs = tj.simulate_orbits(panel, sunlit, 4, y0=y0, method="hybrid")
+    measured = math.log(runs.amplitude[3] / runs.amplitude[1]) / (2 * sunlit.period)
+    assert measured == pytest.approx(predicted, rel=0.01)
+
+
+@slow
+def test_summer_stable_panel_passes_the_limit_with_the_full_run() -> None:
+    """c_d = 2.20 from 1 July: rings down in autumn, flutters toward perihelion."""
+    panel = PAPER.replace(damping=2.20)
+    full, hybrid = both(tj.Orbit.geo_year("2026-07-01"), 366, panel)
+    assert full.limit_crossing is not None and hybrid.limit_crossing is not None
+    assert abs(hybrid.limit_crossing[1] - full.limit_crossing[1]) <= 1
+
+
+def _child(path: Path, n: int) -> str:
+    return textwrap.dedent(f"""
+        import json, thermojitter as tj
+        r = tj.simulate_orbits(tj.Panel.paper(), tj.Orbit.geo_year("2026-03-01"), {n},
+                               method="hybrid", checkpoint={str(path)!r}, checkpoint_every=0.0,
+                               orbits_per_call=1, progress=False)
+        print(json.dumps({{"done": len(r)}}))
+    """)
+
+
+def test_killed_hybrid_run_resumes_to_identical_summaries(tmp_path: Path) -> None:
+    n = 400
+    path = tmp_path / "run.ckpt"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _child(path, n)], text=True, stdout=subprocess.PIPE
+    )
+    while proc.poll() is None:
+        try:
+            if json.loads(path.read_text())["next_index"] >= 5:
+                break
+        except (FileNotFoundError, json.JSONDecodeError, KeyError):
+            pass
+    proc.kill()
+    proc.wait()
+    done = json.loads(path.read_text())["next_index"]
+    assert 0 < done < n, "the child finished before it could be killed"
+    orbit = tj.Orbit.geo_year("2026-03-01")
+    kw = {"method": "hybrid", "orbits_per_call": 1, "progress": False}
+    resumed = tj.simulate_orbits(PAPER, orbit, n, checkpoint=path, **kw)  # type: ignore[arg-type]
+    straight = tj.simulate_orbits(PAPER, orbit, n, **kw)  # type: ignore[arg-type]
+    for name, column in straight.columns.items():
+        np.testing.assert_array_equal(resumed.columns[name], column, err_msg=name)
+    assert resumed.propagation == straight.propagation
+
+
+def test_bad_hybrid_settings_are_named() -> None:
+    with pytest.raises(ValueError, match="linear_tolerance"):
+        tj.simulate_orbits(
+            PAPER, tj.Orbit.sunlit(), 1, method="hybrid", hybrid={"linear_tolerance": -1.0}
+        )
+    with pytest.raises(ValueError, match="warp"):
+        tj.simulate_orbits(PAPER, tj.Orbit.sunlit(), 1, method="hybrid", hybrid={"warp": 9.0})

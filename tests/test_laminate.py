@@ -1,0 +1,148 @@
+"""Laminate layups and the N-node through-thickness model, through the public API.
+
+The physics is checked against independent truth in the engine's own tests (the exact steady
+profile, Carslaw & Jaeger's series, a E I ΔT/d, Timoshenko's bimetal); here: the contract of the
+Python names, and that ``layers=2`` on a plain panel is the two-layer model.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import thermojitter as tj
+from thermojitter import materials as mat
+
+GEO = tj.Orbit.geo_equinox()
+
+
+def wing() -> tj.Laminate:
+    return tj.Laminate(
+        [
+            mat.KAPTON.layer(50e-6),
+            mat.CFRP_M55J_QI.layer(0.3e-3),
+            mat.ALUMINIUM_HONEYCOMB.layer(20e-3),
+            mat.CFRP_M55J_QI.layer(0.3e-3),
+        ],
+        emissivity_front=0.8,
+        emissivity_back=0.8,
+        absorptivity=0.9,
+    )
+
+
+def test_layer_errors_name_the_layer_and_field() -> None:
+    with pytest.raises(ValueError, match="layer 'core': density"):
+        tj.Layer(20e-3, 2.5, -50.0, 880.0, 0.0, 2.4e-5, name="core")
+    with pytest.raises(TypeError, match="layer 'skin': thickness"):
+        tj.Layer("thin", 1.0, 1600.0, 800.0, 1e11, 0.0, name="skin")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="emissivity_back"):
+        tj.Laminate([mat.KAPTON.layer(1e-4)], 0.8, 1.5, 0.5)
+    with pytest.raises(TypeError, match=r"layers\[1\]"):
+        tj.Laminate([mat.KAPTON.layer(1e-4), "glue"], 0.8, 0.8, 0.5)  # type: ignore[list-item]
+    # A core alone carries no bending stress: not a panel.
+    with pytest.raises(ValueError, match="youngs_modulus"):
+        tj.Laminate([mat.ALUMINIUM_HONEYCOMB.layer(0.02)], 0.8, 0.8, 0.5)
+
+
+def test_every_material_names_its_source() -> None:
+    assert len(mat.LIBRARY) >= 5
+    for m in mat.LIBRARY.values():
+        assert len(m.source) > 40, m.key
+        assert m.key.upper() in (mat.__doc__ or "")
+        assert m.layer(1e-3).name == m.key
+    with pytest.raises(ValueError, match="not in the library"):
+        mat.get("unobtainium")
+
+
+def test_lamination_theory_of_a_sandwich() -> None:
+    # Thin equal faces on a core without modulus: D = E t (c + t)²/2 + 2 E t³/12 (parallel axes).
+    face, core = mat.CFRP_M55J_QI, mat.ALUMINIUM_HONEYCOMB
+    t, c = 0.3e-3, 20e-3
+    lam = tj.Laminate([face.layer(t), core.layer(c), face.layer(t)], 0.8, 0.8, 0.9)
+    e = face.youngs_modulus
+    assert lam.bending_stiffness == pytest.approx(
+        e * t * (c + t) ** 2 / 2 + e * t**3 / 6, rel=1e-12
+    )
+    assert lam.neutral_axis == pytest.approx(c / 2 + t, rel=1e-12)
+    rho_h = 2 * face.density * t + core.density * c
+    assert lam.mass_per_area == pytest.approx(rho_h, rel=1e-12)
+    assert lam.thermal_resistance == pytest.approx(
+        2 * t / face.conductivity + c / core.conductivity
+    )
+
+
+def test_from_laminate_gives_the_layup_its_panel() -> None:
+    lam = wing()
+    p = tj.Panel.from_laminate(lam, length=20.0)
+    assert p.layup is lam
+    assert p.youngs_modulus * p.bending_inertia == pytest.approx(lam.bending_stiffness, rel=1e-12)
+    assert p.mass_per_length * p.specific_heat == pytest.approx(lam.heat_capacity, rel=1e-12)
+    assert p.conductance == pytest.approx(1.0 / lam.thermal_resistance, rel=1e-12)
+    assert p.hinge_stiffness == pytest.approx(4 * lam.bending_stiffness / 20.0, rel=1e-12)
+    # Fields the layup decides cannot drift from it; the others can, and the layup stays.
+    with pytest.raises(ValueError, match="conductance"):
+        p.replace(conductance=10.0)
+    assert p.replace(damping=0.5).layup is lam
+    assert tj.Panel.paper().layup is None
+
+
+def test_two_layers_on_a_plain_panel_are_the_two_layer_model() -> None:
+    p = tj.Panel.paper()
+    a = tj.simulate(p, GEO, (0.0, GEO.period), dt_out=60.0)
+    b = tj.simulate(p, GEO, (0.0, GEO.period), dt_out=60.0, layers=2)
+    for name in ("T_front", "T_back", "theta", "theta_dot", "thermal_moment"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert np.max(np.abs(x - y)) <= 1e-10 * np.max(np.abs(x)), name
+    assert b.T_nodes is not None and b.T_nodes.shape == (a.t.size, 2)
+    fa, fb = tj.flutter(p.replace(damping=0.0)), tj.flutter(p.replace(damping=0.0), layers=2)
+    assert fb.critical_damping == pytest.approx(fa.critical_damping, rel=1e-10)
+    assert fb.growth_rate == pytest.approx(fa.growth_rate, rel=1e-10)
+    sa = tj.simulate_orbits(p, GEO, 1, progress=False, method="rk45")
+    sb = tj.simulate_orbits(p, GEO, 1, progress=False, layers=2)
+    assert np.array_equal(sa.exit_peak, sb.exit_peak)
+
+
+def test_node_temperatures_over_time_and_depth() -> None:
+    xr = pytest.importorskip("xarray")
+    p = tj.Panel.from_laminate(wing(), length=20.0)
+    t0 = GEO.shadow_intervals(0.0, GEO.period)[0][1] - 100.0
+    sol = tj.simulate(p, GEO, (t0, t0 + 400.0), layers=20, dt_out=5.0)
+    assert sol.T_nodes is not None and sol.depth is not None
+    assert sol.T_nodes.shape == (sol.t.size, 20)
+    assert sol.depth[0] == 0.0 and sol.depth[-1] == pytest.approx(wing().thickness)
+    # Sunrise warms the front face first.
+    after = sol.t > t0 + 100.0
+    assert np.all(np.diff(sol.T_nodes[after, 0]) > 0.0)
+    assert np.all(sol.T_front == sol.T_nodes[:, 0]) and np.all(sol.T_back == sol.T_nodes[:, -1])
+    ds = sol.to_xarray()
+    assert isinstance(ds, xr.Dataset)
+    assert ds["T_nodes"].dims == ("t", "node") and ds["depth"].size == 20
+    # Restart from the end state: same continuation.
+    again = tj.simulate(p, GEO, (t0 + 400.0, t0 + 500.0), layers=20, y0=sol.y_end, dt_out=50.0)
+    assert again.T_nodes is not None and again.T_nodes[0] == pytest.approx(
+        sol.T_nodes[-1], rel=1e-12
+    )
+
+
+def test_layers_is_checked() -> None:
+    p = tj.Panel.from_laminate(wing(), length=20.0)
+    with pytest.raises(ValueError, match="layers"):
+        tj.simulate(p, GEO, (0.0, 10.0), layers=3)  # fewer nodes than the layup needs
+    with pytest.raises(ValueError, match="layers"):
+        tj.flutter(p, layers=1)
+    with pytest.raises(TypeError, match="layers"):
+        tj.simulate(p, GEO, (0.0, 10.0), layers=True)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="y0"):
+        tj.simulate(p, GEO, (0.0, 10.0), layers=8, y0=[300.0] * 4)
+
+
+def test_the_laminate_bends_with_a_uniform_temperature_like_a_bimetal() -> None:
+    # Kapton on one side only: the sunlit equilibrium angle of the N-node model includes the
+    # moment of the mean temperature above T_ref, which the two-layer equivalent leaves out.
+    p = tj.Panel.from_laminate(wing(), length=20.0)
+    eq2 = tj.flutter(p).equilibrium
+    eqn = tj.flutter(p, layers=20).equilibrium
+    assert eqn.thermal_moment > eq2.thermal_moment > 0.0
+    assert math.isclose(eqn.theta, eqn.thermal_moment / p.hinge_stiffness, rel_tol=1e-3)
