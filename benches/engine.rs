@@ -165,6 +165,8 @@ fn main() {
             window: 600.0,
             threshold: None,
             stop_at_threshold: false,
+            validity_limit: 0.35,
+            hybrid: None,
         };
         let one = pool(1).expect("pool");
         // CPU time where the OS reports it (the machine may be shared), else wall time.
