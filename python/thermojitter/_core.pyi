@@ -8,12 +8,23 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "leo_orbit",
+    "eclipse_duration",
+    "SIDEREAL_DAY",
+    "PERIHELION_DAY",
+    "MU_EARTH",
+    "GEO_RADIUS",
+    "GEO_EQUINOX_ORBIT",
+    "EQUINOX_DAY",
+    "EARTH_RADIUS",
+    "CASE_A_PANEL",
     "CancelToken",
     "ConvergenceError",
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
     "PANEL_FIELDS",
+    "PAPER_PANEL",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -34,6 +45,8 @@ __all__ = [
     "hinge_equivalent_damping_ratio",
     "illumination",
     "laminate_properties",
+    "linear_delta_t",
+    "linear_thermal",
     "layered_flutter",
     "layered_steady_state",
     "materials",
@@ -59,6 +72,15 @@ __all__ = [
 ]
 
 PANEL_FIELDS: list[str]
+PAPER_PANEL: dict[str, float]
+GEO_RADIUS: float
+EARTH_RADIUS: float
+SIDEREAL_DAY: float
+MU_EARTH: float
+EQUINOX_DAY: float
+PERIHELION_DAY: float
+GEO_EQUINOX_ORBIT: dict[str, Any]
+CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
 
 class IntegrationError(RuntimeError): ...
@@ -215,9 +237,18 @@ def umbra_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[f
 def orbit_breakpoints(orbit: dict[str, Any], t0: float, t1: float) -> list[float]: ...
 def flux_scale(orbit: dict[str, Any], t: _F) -> _F: ...
 def declination(orbit: dict[str, Any], t: _F) -> _F: ...
+def eclipse_duration(orbit: dict[str, Any]) -> float: ...
+def leo_orbit(altitude: float) -> dict[str, Any]: ...
 def synodic_period(orbit: dict[str, Any]) -> float: ...
 
 # --- stability map (issue 4)
+def linear_thermal(
+    panel: dict[str, float],
+    flux: float = 1.0,
+    omega: float | None = None,
+    t_star: float | None = None,
+) -> dict[str, Any]: ...
+def linear_delta_t(fields: dict[str, float], t: _F, phi: float, delta_t0: float | None) -> _F: ...
 def stability_map(
     panel: dict[str, float],
     x_name: str,

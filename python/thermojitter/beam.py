@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 from thermojitter.orbit import Orbit
-from thermojitter.panel import Panel, beam_frequency, hinge_stiffness
+from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
 from thermojitter.simulate import Method, Model, check_inputs, simulate, solver_args, time_span
@@ -249,11 +249,6 @@ class BeamComparison:
         }
 
 
-def _flexural_stiffness(panel: Panel) -> float:
-    """4EI/L, the small-angle deflection-criterion K_el, N m/rad."""
-    return 4.0 * panel.youngs_modulus * panel.bending_inertia / panel.length
-
-
 def eclipse_window(orbit: Orbit, margin: float = DEFAULT_MARGIN) -> tuple[float, float]:
     """The first eclipse of the orbit with ``margin`` seconds of sunlight on each side, s."""
     intervals = orbit.shadow_intervals(0.0, orbit.period)
@@ -300,7 +295,7 @@ def compare_with_beam(
     if criterion is not None:
         hinge_panel = panel.replace(hinge_stiffness=hinge_stiffness(panel, criterion))
     if scale_moment:
-        chi = hinge_panel.hinge_stiffness / _flexural_stiffness(panel)
+        chi = _core.derived(hinge_panel.as_dict())["matching_moment_scale"]
         hinge_panel = hinge_panel.replace(moment_scale=chi)
     span = eclipse_window(orbit) if t_span is None else time_span(t_span)
     if not (math.isfinite(dt_out) and dt_out > 0):
@@ -312,14 +307,14 @@ def compare_with_beam(
     sol = simulate(
         hinge_panel, orbit, span, model=model, coupled=coupled, t_eval=samples, rtol=rtol, atol=atol
     )
-    physical = np.asarray(sol.thermal_moment) / hinge_panel.moment_scale
-    beam = FreeFreeBeam(panel.replace(moment_scale=1.0), n_elements)
+    beam_panel = panel.replace(moment_scale=1.0)
+    physical = _core.moment(beam_panel.as_dict(), sol.T_front, sol.T_back)
+    beam = FreeFreeBeam(beam_panel, n_elements)
     zeta = default_damping_ratio(panel) if damping_ratio is None else damping_ratio
     resp = beam.response(sol.t, physical, damping_ratio=zeta, rtol=rtol, atol=atol)
     theta = np.asarray(sol.theta)
     diff = theta - resp.theta_f
     f_n = float(beam.natural_frequencies(1)[0])
-    i_b = hinge_panel.hinge_inertia
     return BeamComparison(
         t=np.asarray(sol.t),
         theta=theta,
@@ -329,7 +324,7 @@ def compare_with_beam(
         hinge_frequency=dominant_frequency(sol.t, theta, f_min),
         beam_frequency=dominant_frequency(resp.t, resp.theta_f, f_min),
         natural_frequency=f_n,
-        hinge_natural_frequency=math.sqrt(hinge_panel.hinge_stiffness / i_b) / (2 * math.pi),
+        hinge_natural_frequency=natural_frequency(hinge_panel),
         hinge_stiffness=hinge_panel.hinge_stiffness,
         moment_scale=hinge_panel.moment_scale,
         damping_ratio=zeta,
@@ -370,25 +365,27 @@ def _calibrations(cmp: BeamComparison, panel: Panel, orbit: Orbit) -> dict[str, 
 
     enter = orbit.shadow_intervals(cmp.t[0], cmp.t[-1])[0][0]
     m = (cmp.t >= enter - 60.0) & (cmp.t <= enter + 600.0)
-    ei_l = panel.youngs_modulus * panel.bending_inertia / panel.length
     out: dict[str, Any] = {"window": [float(cmp.t[m][0]), float(cmp.t[m][-1])]}
     freq = hinge_stiffness(panel, "frequency")
+    chi = _core.derived(panel.replace(hinge_stiffness=freq).as_dict())["matching_moment_scale"]
+    small_angle = hinge_stiffness(panel, "deflection_small_angle")
     cases: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
         "stiffness_damping": (("hinge_stiffness", "damping"), {}),
         "stiffness_damping_chi": (
             ("hinge_stiffness", "damping", "moment_scale"),
-            {"hinge_stiffness": freq, "moment_scale": freq / (4.0 * ei_l)},
+            {"hinge_stiffness": freq, "moment_scale": chi},
         ),
     }
     for name, (fit, initial) in cases.items():
         r = calibrate(cmp.t[m], cmp.theta_f[m], panel=panel, orbit=orbit, fit=fit, initial=initial)
         summary = r.summary()
         summary["initial"] = {k: float(getattr(panel, k)) for k in fit} | initial
-        summary["hinge_stiffness_over_EI_L"] = r.parameters["hinge_stiffness"] / ei_l
+        # In units of EI/L (4 for the small-angle deflection criterion).
+        summary["hinge_stiffness_over_EI_L"] = 4.0 * r.parameters["hinge_stiffness"] / small_angle
         out[name] = summary
     out["criteria"] = {
         "deflection": hinge_stiffness(panel, "deflection"),
-        "deflection_small_angle": 4.0 * ei_l,
+        "deflection_small_angle": small_angle,
         "frequency": freq,
     }
     out["note"] = calibration_note(out["stiffness_damping"], panel.damping, cmp.frequency_mismatch)

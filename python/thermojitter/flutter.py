@@ -282,56 +282,37 @@ class LinearThermalResponse:
     """Sunlit equilibrium hinge angle, rad."""
     hinge_inertia: float
     """I_B, kg m²."""
-
-    @property
-    def amplitude(self) -> float:
-        """Steady amplitude of ΔT under p cos(ω t + φ), K: p/√(q² + ω²)."""
-        return self.p / math.hypot(self.q, self.omega)
-
-    @property
-    def phase_lag(self) -> float:
-        """Lag of ΔT behind the forcing, rad: atan2(ω, q), in [0, π/2)."""
-        return math.atan2(self.omega, self.q)
-
-    @property
-    def time_constant(self) -> float:
-        """1/q, s: how fast the gradient forgets its initial value."""
-        return 1.0 / self.q
-
-    @property
-    def resonant(self) -> bool:
-        """True when the forcing is at the hinge's natural frequency (within 1 %)."""
-        return abs(self.omega - self.omega_n) <= 0.01 * self.omega_n
-
-    @property
-    def thermal_damping(self) -> float:
-        """Negative damping rate from the lag, 1/s: s p sin θ* /(q² + ω_n²)."""
-        return self.s * self.p * math.sin(self.theta_star) / (self.q**2 + self.omega_n**2)
-
-    @property
-    def critical_damping_estimate(self) -> float:
-        """c_d at which the lag's pumping is balanced, N m s/rad: I_B · thermal_damping."""
-        return self.hinge_inertia * self.thermal_damping
-
-    @property
-    def growth_rate_estimate(self) -> float:
-        """Growth rate of the swing, 1/s: (thermal_damping − r)/2."""
-        return 0.5 * (self.thermal_damping - self.r)
+    amplitude: float
+    """Steady amplitude of ΔT under p cos(ω t + φ), K: p/√(q² + ω²)."""
+    phase_lag: float
+    """Lag of ΔT behind the forcing, rad: atan2(ω, q), in [0, π/2)."""
+    time_constant: float
+    """1/q, s: how fast the gradient forgets its initial value."""
+    resonant: bool
+    """True when the forcing is at the hinge's natural frequency (within 1 %)."""
+    thermal_damping: float
+    """Negative damping rate from the lag, 1/s: s p sin θ* /(q² + ω_n²)."""
+    critical_damping_estimate: float
+    """c_d at which the lag's pumping is balanced, N m s/rad: I_B · thermal_damping."""
+    growth_rate_estimate: float
+    """Growth rate of the swing, 1/s: (thermal_damping − r)/2."""
 
     def delta_T(
         self, t: ArrayLike, *, phi: float = 0.0, delta_T0: float | None = None
     ) -> NDArray[np.float64]:
-        """Closed-form ΔT(t) − ΔT(0)-response for dΔT/dt + q ΔT = p cos(ω t + φ), K.
+        """Closed-form ΔT(t) for dΔT/dt + q ΔT = p cos(ω t + φ), K.
 
         ``delta_T0``: the gradient at t = 0 (its transient decays as e^(−q t)); ``None`` gives the
         steady (long-period) solution alone."""
         times = np.asarray(t, dtype=float)
-        w, q = self.omega, self.q
-        steady = self.amplitude * np.cos(w * times + phi - self.phase_lag)
-        if delta_T0 is None:
-            return np.asarray(steady)
-        steady0 = self.amplitude * math.cos(phi - self.phase_lag)
-        return np.asarray(steady + (delta_T0 - steady0) * np.exp(-q * times))
+        fields = {name: getattr(self, name) for name in _LINEAR_FIELDS}
+        values = _core.linear_delta_t(
+            fields,
+            np.ascontiguousarray(times.ravel()),
+            float(phi),
+            None if delta_T0 is None else float(delta_T0),
+        )
+        return np.asarray(values).reshape(times.shape)
 
     def describe(self) -> str:
         """A short statement of the analysis, with numbers."""
@@ -363,39 +344,26 @@ def linear_thermal_response(
     sunlit equilibrium under ``flux``). The paper assumes ε_f = ε_b; for other panels ε is taken
     as their mean, an approximation.
     """
-    from thermojitter.simulate import steady_state
-
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
-    flux = float(flux)
-    if not (math.isfinite(flux) and flux > 0.0):
-        raise ValueError(f"flux = {flux} is invalid: must be finite and > 0")
-    eq = steady_state(panel, flux=flux)
-    derived = _core.derived(panel.as_dict())
-    inertia = float(derived["hinge_inertia"])
-    omega_n = math.sqrt(panel.hinge_stiffness / inertia)
-    if omega is None:
-        omega = omega_n
-    omega = float(omega)
-    if not (math.isfinite(omega) and omega >= 0.0):
-        raise ValueError(f"omega = {omega} is invalid: must be finite and >= 0")
-    if T_star is None:
-        T_star = 0.5 * (eq.T_front + eq.T_back)
-    T_star = float(T_star)
-    if not (math.isfinite(T_star) and T_star > 0.0):
-        raise ValueError(f"T_star = {T_star} is invalid: must be finite and > 0")
-    mc = panel.mass_per_length * panel.specific_heat
-    eps = 0.5 * (panel.emissivity_front + panel.emissivity_back)
-    sigma = float(_core.STEFAN_BOLTZMANN)
-    return LinearThermalResponse(
-        p=2.0 * panel.absorptivity * panel.solar_constant * flux / mc,
-        q=(4.0 * panel.conductance + 8.0 * sigma * eps * T_star**3) / mc,
-        r=panel.damping / inertia,
-        s=float(derived["moment_per_kelvin"]) / inertia,
-        omega=omega,
-        omega_n=omega_n,
-        T_star=T_star,
-        emissivity=eps,
-        theta_star=eq.theta,
-        hinge_inertia=inertia,
+    raw = _core.linear_thermal(
+        panel.as_dict(),
+        float(flux),
+        None if omega is None else float(omega),
+        None if T_star is None else float(T_star),
     )
+    return LinearThermalResponse(**raw)
+
+
+_LINEAR_FIELDS = (
+    "p",
+    "q",
+    "r",
+    "s",
+    "omega",
+    "omega_n",
+    "T_star",
+    "emissivity",
+    "theta_star",
+    "hinge_inertia",
+)

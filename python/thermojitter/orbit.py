@@ -36,18 +36,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 
-GEO_RADIUS = 42_164.17e3
+# The constants live in the engine (rust/src/orbit.rs); these are their Python names.
+GEO_RADIUS: float = _core.GEO_RADIUS
 """GEO orbit radius, m."""
-EARTH_RADIUS = 6_378.137e3
+EARTH_RADIUS: float = _core.EARTH_RADIUS
 """Equatorial Earth radius, m."""
-SIDEREAL_DAY = 86_164.0905
+SIDEREAL_DAY: float = _core.SIDEREAL_DAY
 """One sidereal day, s."""
-MU_EARTH = 3.986004418e14
+MU_EARTH: float = _core.MU_EARTH
 """Earth's gravitational parameter, m³/s²."""
-EQUINOX_DAY = 78.5
+EQUINOX_DAY: float = _core.EQUINOX_DAY
 """Mean March equinox, days since 1 January 00:00 UTC."""
-PERIHELION_DAY = 3.0
+PERIHELION_DAY: float = _core.PERIHELION_DAY
 """Mean perihelion, days since 1 January 00:00 UTC."""
+_GEO_EQUINOX: dict[str, Any] = dict(_core.GEO_EQUINOX_ORBIT)
 
 ShadowModel = Literal["none", "cylindrical", "penumbra"]
 _SHADOWS = ("none", "cylindrical", "penumbra")
@@ -102,21 +104,21 @@ class Orbit:
     scenario (GEO at equinox, cylindrical shadow, Sun at 1 au).
     """
 
-    radius: float = GEO_RADIUS
+    radius: float = _GEO_EQUINOX["radius"]
     """Orbit radius, m."""
-    earth_radius: float = EARTH_RADIUS
+    earth_radius: float = _GEO_EQUINOX["earth_radius"]
     """Radius of the shadowing body, m."""
-    period: float = SIDEREAL_DAY
+    period: float = _GEO_EQUINOX["period"]
     """Orbit period (inertial), s."""
-    phase0: float = 0.0
+    phase0: float = _GEO_EQUINOX["phase0"]
     """Phase at t = 0, rad."""
-    shadow: ShadowModel = "cylindrical"
+    shadow: ShadowModel = _GEO_EQUINOX["shadow"]
     """Shadow model: "none", "cylindrical" or "penumbra"."""
-    season: bool = False
+    season: bool = _GEO_EQUINOX["season"]
     """The Sun's declination and right ascension follow the year from ``epoch_day``."""
-    eccentric_sun: bool = False
+    eccentric_sun: bool = _GEO_EQUINOX["eccentric_sun"]
     """The flux (∝ 1/r²) and the Sun's size follow the Sun–Earth distance r."""
-    epoch_day: float = EQUINOX_DAY
+    epoch_day: float = _GEO_EQUINOX["epoch_day"]
     """Day of the year at t = 0 (days since 1 January 00:00 UTC)."""
 
     def __post_init__(self) -> None:
@@ -167,9 +169,8 @@ class Orbit:
             raise TypeError(f"altitude must be a real number, not {type(altitude).__name__}")
         if not (math.isfinite(altitude) and altitude > 0.0):
             raise ValueError(f"altitude = {altitude} is invalid: must be finite and > 0")
-        radius = EARTH_RADIUS + float(altitude)
-        period = 2.0 * math.pi * math.sqrt(radius**3 / MU_EARTH)
-        return cls(radius=radius, period=period, shadow=shadow)
+        leo = _core.leo_orbit(float(altitude))
+        return cls(radius=leo["radius"], period=leo["period"], shadow=shadow)
 
     @classmethod
     def sunlit(cls) -> Orbit:
@@ -187,7 +188,7 @@ class Orbit:
     def eclipse_duration(self) -> float:
         """Time in the cylindrical shadow per orbit with the Sun in the orbit plane, s:
         period · asin(R_E/r)/π. For the other models see :meth:`eclipse_durations`."""
-        return self.period * math.asin(self.earth_radius / self.radius) / math.pi
+        return float(_core.eclipse_duration(self.as_dict()))
 
     @property
     def synodic_period(self) -> float:

@@ -47,6 +47,10 @@ LAYUP_FIELDS = (
 """The fields of a panel made by :meth:`Panel.from_laminate` that its layup decides."""
 
 
+_TABLE_1: dict[str, float] = dict(_core.PAPER_PANEL)
+"""The paper's Table 1 (Case B), C = 1361 W/m², χ = 1: defined once, in the engine."""
+
+
 @dataclass(frozen=True)
 class Panel:
     """A long, thin, Sun-pointing plate of unit width; every value SI.
@@ -55,37 +59,37 @@ class Panel:
     Defaults are the paper's Table 1 (Case B), with C = 1361 W/m² and χ = 1.
     """
 
-    emissivity_front: float = 0.8
+    emissivity_front: float = _TABLE_1["emissivity_front"]
     """ε_f, emissivity of the Sun-facing side, in (0, 1]."""
-    emissivity_back: float = 0.3
+    emissivity_back: float = _TABLE_1["emissivity_back"]
     """ε_b, emissivity of the back side, in (0, 1]."""
-    absorptivity: float = 0.8
+    absorptivity: float = _TABLE_1["absorptivity"]
     """α, solar absorptivity of the front side, in (0, 1]."""
-    specific_heat: float = 900.0
+    specific_heat: float = _TABLE_1["specific_heat"]
     """c, J/(kg K)."""
-    mass_per_length: float = 5.51
+    mass_per_length: float = _TABLE_1["mass_per_length"]
     """m, kg/m (unit width, so also kg/m²)."""
-    expansion_coeff: float = 2.5e-5
+    expansion_coeff: float = _TABLE_1["expansion_coeff"]
     """a, coefficient of thermal expansion, 1/K."""
-    length: float = 50.0
+    length: float = _TABLE_1["length"]
     """L, m; the hinge model's half-arm is l = L/4."""
-    youngs_modulus: float = 70e9
+    youngs_modulus: float = _TABLE_1["youngs_modulus"]
     """E, Pa."""
-    thickness: float = 0.04
+    thickness: float = _TABLE_1["thickness"]
     """d, m."""
-    width: float = 1.0
+    width: float = _TABLE_1["width"]
     """w, m."""
-    conductance: float = 25.0
+    conductance: float = _TABLE_1["conductance"]
     """K, conductance through the thickness per unit area, W/(m² K)."""
-    hinge_stiffness: float = 4438.0
+    hinge_stiffness: float = _TABLE_1["hinge_stiffness"]
     """K_el, N m/rad."""
-    bending_inertia: float = 8e-7
+    bending_inertia: float = _TABLE_1["bending_inertia"]
     """I, second moment of area, m⁴."""
-    damping: float = 3.0
+    damping: float = _TABLE_1["damping"]
     """c_d, N m s/rad (>= 0)."""
-    solar_constant: float = 1361.0
+    solar_constant: float = _TABLE_1["solar_constant"]
     """C, solar flux at 1 au, W/m²."""
-    moment_scale: float = 1.0
+    moment_scale: float = _TABLE_1["moment_scale"]
     """χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3)."""
 
     def __post_init__(self) -> None:
@@ -104,7 +108,7 @@ class Panel:
     @classmethod
     def case_a(cls) -> Panel:
         """The paper's Case A: Table 1 with the emissivities swapped (ε_f = 0.3, ε_b = 0.8)."""
-        return cls(emissivity_front=0.3, emissivity_back=0.8)
+        return cls(**_core.CASE_A_PANEL)
 
     @classmethod
     def from_dict(cls, values: dict[str, Any]) -> Panel:
@@ -142,13 +146,13 @@ class Panel:
         cls,
         laminate: Laminate,
         *,
-        length: float = 50.0,
-        width: float = 1.0,
+        length: float = _TABLE_1["length"],
+        width: float = _TABLE_1["width"],
         hinge_stiffness: float | None = None,
         criterion: StiffnessCriterion = "deflection_small_angle",
-        damping: float = 3.0,
-        solar_constant: float = 1361.0,
-        moment_scale: float = 1.0,
+        damping: float = _TABLE_1["damping"],
+        solar_constant: float = _TABLE_1["solar_constant"],
+        moment_scale: float = _TABLE_1["moment_scale"],
     ) -> Panel:
         """The panel of a laminate, carrying its layup (``panel.layup``).
 
@@ -202,7 +206,7 @@ class Panel:
     @property
     def half_arm(self) -> float:
         """l = L/4, m."""
-        return self.length / 4.0
+        return float(_core.derived(self.as_dict())["half_arm"])
 
     @property
     def hinge_inertia(self) -> float:

@@ -21,8 +21,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import plots
+from thermojitter.flutter import linear_thermal_response
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.progress import progress_bar
 from thermojitter.results import Solution, ThermalSolution
 from thermojitter.signals import (
     detrend,
@@ -186,31 +188,6 @@ class PaperContext:
 
 # --------------------------------------------------------------------------------------------
 # Measurements on records
-
-
-def flutter_growth_estimate(panel: Panel) -> float:
-    """Linear estimate of the undamped growth rate of the jitter by thermal pumping, 1/s.
-
-    At the sunlit tilt θ0 the absorbed flux αC cos θ changes by −αC sin θ0 δθ. At the jitter
-    frequency ω the front layer (heat capacity m c/2) responds almost purely through its capacity,
-    δT_f ≈ −αC sin θ0 δθ /(iω m c/2), a quarter period behind δθ; the moment χ a E I δT_f/d then
-    acts as a negative damping c_eq = αC sin θ0 χ a E I /(d ω² m c/2), and the envelope grows as
-    exp((c_eq − c_d) t /(2 I_B)).
-    """
-    eq = steady_state(panel)
-    omega = 2.0 * math.pi * natural_frequency(panel)
-    gain = (
-        panel.absorptivity
-        * panel.solar_constant
-        * math.sin(eq.theta)
-        * panel.moment_scale
-        * panel.expansion_coeff
-        * panel.youngs_modulus
-        * panel.bending_inertia
-        / (panel.thickness * 0.5 * panel.mass_per_length * panel.specific_heat)
-    )
-    c_eq = gain / omega**2
-    return (c_eq - panel.damping) / (2.0 * panel.hinge_inertia)
 
 
 def _pct(ours: float, ref: float) -> str:
@@ -538,12 +515,14 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
     entry = ctx.entry
     t_first_exit = ctx.exit
     out: dict[str, Any] = {}
-    estimate = flutter_growth_estimate(ctx.panel.replace(damping=0.0))
+    # The closed form of Sec. 4.2 for the undamped panel and for Case A.
+    undamped = linear_thermal_response(ctx.panel.replace(damping=0.0))
+    estimate = undamped.growth_rate_estimate
     swapped = ctx.panel.replace(
         emissivity_front=ctx.panel.emissivity_back, emissivity_back=ctx.panel.emissivity_front
     )
     case_a = steady_state(swapped)
-    case_a_c = flutter_growth_estimate(swapped) * 2.0 * swapped.hinge_inertia + swapped.damping
+    case_a_c = linear_thermal_response(swapped).critical_damping_estimate
     for number, coupled in ((17, True), (18, False)):
         run = ctx.flutter_run(coupled=coupled)
         theta = np.degrees(run.theta)
@@ -608,7 +587,7 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
     out["horizon_h"] = opts.flutter_hours
     out["growth_rate_estimate_per_s"] = estimate
     out["e_folding_time_estimate_h"] = 1.0 / estimate / 3600.0 if estimate > 0 else float("inf")
-    out["negative_damping_estimate_Nms"] = estimate * 2.0 * ctx.panel.hinge_inertia
+    out["negative_damping_estimate_Nms"] = undamped.critical_damping_estimate
     out["case_a_negative_damping_estimate_Nms"] = case_a_c
     # Two thresholds exist because the two hinge equations differ (see the text); the
     # non-linear one is the model the runs integrate.
@@ -955,11 +934,7 @@ def run_paper(
     chosen = list(SECTIONS if sections is None else sections)
     started = time.perf_counter()
 
-    bar: Any = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=sum(s.figures for s in chosen), unit="fig", desc="paper", leave=False)
+    bar = progress_bar(sum(s.figures for s in chosen), unit="fig", desc="paper", enabled=progress)
 
     def check() -> None:
         if stop is not None and stop():

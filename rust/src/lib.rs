@@ -18,6 +18,7 @@ pub mod hybrid;
 pub mod integrate;
 pub mod laminate;
 pub mod layered;
+pub mod linear;
 pub mod orbit;
 pub mod params;
 pub mod simulate;

@@ -66,6 +66,16 @@ impl Panel {
         }
     }
 
+    /// The paper's Case A: Table 1 with the emissivities swapped (ε_f = 0.3, ε_b = 0.8).
+    pub fn case_a() -> Self {
+        let b = Panel::paper();
+        Panel {
+            emissivity_front: b.emissivity_back,
+            emissivity_back: b.emissivity_front,
+            ..b
+        }
+    }
+
     /// The field names, in declaration order (the Python layer and scenario files use them).
     pub const FIELDS: [&'static str; 16] = [
         "emissivity_front",
@@ -192,6 +202,19 @@ impl Panel {
         self.mass_per_length * self.specific_heat
     }
 
+    /// 4 E I / L, N m/rad: the small-angle deflection criterion's K_el, the hinge stiffness of
+    /// the continuous panel's bending under end moments.
+    pub fn flexural_stiffness(&self) -> f64 {
+        4.0 * self.youngs_modulus * self.bending_inertia / self.length
+    }
+
+    /// χ = K_el / (4 E I / L): the scale of the flexural rigidity in the thermal moment that
+    /// gives the hinge, with its own K_el, the continuous panel's static deflection (paper
+    /// Sec. 4.3, χ ≈ 1.3 with the frequency criterion's K_el).
+    pub fn matching_moment_scale(&self) -> f64 {
+        self.hinge_stiffness / self.flexural_stiffness()
+    }
+
     /// Natural angular frequency of the linearised hinge, sqrt(K_el / I_B), rad/s.
     pub fn natural_angular_frequency(&self) -> f64 {
         (self.hinge_stiffness / self.hinge_inertia()).sqrt()
@@ -225,7 +248,7 @@ pub fn hinge_stiffness(panel: &Panel, criterion: StiffnessCriterion, moment: f64
     panel.validate()?;
     let ei = panel.youngs_modulus * panel.bending_inertia;
     match criterion {
-        StiffnessCriterion::DeflectionSmallAngle => Ok(4.0 * ei / panel.length),
+        StiffnessCriterion::DeflectionSmallAngle => Ok(panel.flexural_stiffness()),
         StiffnessCriterion::Frequency => {
             let w1 = beam_first_angular_frequency(panel);
             Ok(w1 * w1 * panel.hinge_inertia())
@@ -240,7 +263,7 @@ pub fn hinge_stiffness(panel: &Panel, criterion: StiffnessCriterion, moment: f64
                 ));
             }
             if x < 1e-12 {
-                Ok(4.0 * ei / panel.length)
+                Ok(panel.flexural_stiffness())
             } else {
                 Ok(moment.abs() / x.asin())
             }

@@ -3,9 +3,10 @@
 use super::convert::{hinge_model, panel_from};
 use super::error::shield;
 use crate::flutter::{analyse, check_flux, critical_damping};
+use crate::linear::LinearThermal;
 use crate::stability::Axis;
 use crate::system::Coupling;
-use numpy::PyArray2;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -94,8 +95,102 @@ fn stability_map<'py>(
     })
 }
 
+/// The fields of the Sec. 4.2 analysis, in the order of [`LinearThermal`].
+const LINEAR_FIELDS: [&str; 10] = [
+    "p",
+    "q",
+    "r",
+    "s",
+    "omega",
+    "omega_n",
+    "T_star",
+    "emissivity",
+    "theta_star",
+    "hinge_inertia",
+];
+
+/// The closed-form linear analysis of paper Sec. 4.2: its coefficients and what follows.
+#[pyfunction]
+#[pyo3(signature = (panel, flux=1.0, omega=None, t_star=None))]
+fn linear_thermal<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    flux: f64,
+    omega: Option<f64>,
+    t_star: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let lt = LinearThermal::new(&panel_from(panel)?, flux, omega, t_star)?;
+        let d = PyDict::new(py);
+        let values = [
+            lt.p,
+            lt.q,
+            lt.r,
+            lt.s,
+            lt.omega,
+            lt.omega_n,
+            lt.t_star,
+            lt.emissivity,
+            lt.theta_star,
+            lt.hinge_inertia,
+        ];
+        for (name, v) in LINEAR_FIELDS.iter().zip(values) {
+            d.set_item(name, v)?;
+        }
+        d.set_item("amplitude", lt.amplitude())?;
+        d.set_item("phase_lag", lt.phase_lag())?;
+        d.set_item("time_constant", lt.time_constant())?;
+        d.set_item("resonant", lt.resonant())?;
+        d.set_item("thermal_damping", lt.thermal_damping())?;
+        d.set_item("critical_damping_estimate", lt.critical_damping_estimate())?;
+        d.set_item("growth_rate_estimate", lt.growth_rate_estimate())?;
+        Ok(d)
+    })
+}
+
+/// ΔT(t) of the Sec. 4.2 analysis given by its fields (as [`linear_thermal`] returns them).
+#[pyfunction]
+#[pyo3(signature = (fields, t, phi, delta_t0))]
+fn linear_delta_t<'py>(
+    py: Python<'py>,
+    fields: &Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+    phi: f64,
+    delta_t0: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    shield(|| {
+        let mut v = [0.0; 10];
+        for (slot, name) in v.iter_mut().zip(LINEAR_FIELDS) {
+            *slot = fields
+                .get_item(name)?
+                .ok_or_else(|| crate::Error::invalid("fields", name, "is missing"))?
+                .extract()?;
+        }
+        let lt = LinearThermal {
+            p: v[0],
+            q: v[1],
+            r: v[2],
+            s: v[3],
+            omega: v[4],
+            omega_n: v[5],
+            t_star: v[6],
+            emissivity: v[7],
+            theta_star: v[8],
+            hinge_inertia: v[9],
+        };
+        let out: Vec<f64> = t
+            .as_array()
+            .iter()
+            .map(|&x| lt.delta_t(x, phi, delta_t0))
+            .collect();
+        Ok(PyArray1::from_vec(py, out))
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(flutter, m)?)?;
+    m.add_function(wrap_pyfunction!(linear_thermal, m)?)?;
+    m.add_function(wrap_pyfunction!(linear_delta_t, m)?)?;
     m.add_function(wrap_pyfunction!(stability_map, m)?)?;
     Ok(())
 }

@@ -60,6 +60,15 @@ where
     Ok(d)
 }
 
+/// A panel as a mapping of its parameters.
+fn panel_dict<'py>(py: Python<'py>, p: &crate::Panel) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for name in crate::Panel::FIELDS {
+        d.set_item(name, p.get(name)?)?;
+    }
+    Ok(d)
+}
+
 /// Validates a panel given as a mapping of its parameters.
 #[pyfunction]
 fn validate_panel(panel: &Bound<'_, PyDict>) -> PyResult<()> {
@@ -127,6 +136,8 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
             beam_first_angular_frequency(&p) / (2.0 * PI),
         )?;
         d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
+        d.set_item("flexural_stiffness", p.flexural_stiffness())?;
+        d.set_item("matching_moment_scale", p.matching_moment_scale())?;
         Ok(d)
     })
 }
@@ -374,6 +385,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
     m.add("ConvergenceError", m.py().get_type::<ConvergenceError>())?;
     m.add("PANEL_FIELDS", crate::Panel::FIELDS.to_vec())?;
+    m.add("PAPER_PANEL", panel_dict(m.py(), &crate::Panel::paper())?)?;
+    m.add("CASE_A_PANEL", panel_dict(m.py(), &crate::Panel::case_a())?)?;
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;

@@ -84,7 +84,51 @@ fn synodic_period(orbit: &Bound<'_, PyDict>) -> PyResult<f64> {
     shield(|| Ok(orbit_from(orbit)?.synodic_period()))
 }
 
+/// Eclipse duration per orbit with the cylindrical shadow and the Sun in the orbit plane, s.
+#[pyfunction]
+fn eclipse_duration(orbit: &Bound<'_, PyDict>) -> PyResult<f64> {
+    shield(|| Ok(orbit_from(orbit)?.eclipse_duration()))
+}
+
+/// An orbit as the mapping `orbit_from` reads.
+fn orbit_dict<'py>(py: Python<'py>, o: &Orbit) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("radius", o.radius)?;
+    d.set_item("earth_radius", o.earth_radius)?;
+    d.set_item("period", o.period)?;
+    d.set_item("phase0", o.phase0)?;
+    d.set_item("shadow", o.shadow.name())?;
+    d.set_item("season", o.season)?;
+    d.set_item("eccentric_sun", o.eccentric_sun)?;
+    d.set_item("epoch_day", o.epoch_day)?;
+    Ok(d)
+}
+
+/// The circular low orbit at `altitude` (m): its radius and Keplerian period.
+#[pyfunction]
+fn leo_orbit(py: Python<'_>, altitude: f64) -> PyResult<Bound<'_, PyDict>> {
+    shield(|| {
+        crate::error::require_positive("altitude", altitude)?;
+        orbit_dict(py, &Orbit::leo(altitude))
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    use crate::orbit::{
+        EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, MU_EARTH, PERIHELION_DAY, SIDEREAL_DAY,
+    };
+    m.add("GEO_RADIUS", GEO_RADIUS)?;
+    m.add("EARTH_RADIUS", EARTH_RADIUS)?;
+    m.add("SIDEREAL_DAY", SIDEREAL_DAY)?;
+    m.add("MU_EARTH", MU_EARTH)?;
+    m.add("EQUINOX_DAY", EQUINOX_DAY)?;
+    m.add("PERIHELION_DAY", PERIHELION_DAY)?;
+    m.add(
+        "GEO_EQUINOX_ORBIT",
+        orbit_dict(m.py(), &Orbit::geo_equinox())?,
+    )?;
+    m.add_function(wrap_pyfunction!(eclipse_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(leo_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(eclipses, m)?)?;
     m.add_function(wrap_pyfunction!(umbra_intervals, m)?)?;
     m.add_function(wrap_pyfunction!(orbit_breakpoints, m)?)?;
