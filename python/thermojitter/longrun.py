@@ -20,7 +20,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import _core
+from thermojitter import _core, solver
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import Interruptible, progress_bar, report_interrupted
@@ -177,8 +177,8 @@ def simulate_orbits(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     y0: tuple[float, ...] | None = None,
     window: float = 600.0,
@@ -188,7 +188,7 @@ def simulate_orbits(
     checkpoint_every: float = 10.0,
     orbits_per_call: int = 1,
     progress: bool | None = True,
-    max_steps: int = 500_000_000,
+    max_steps: int = solver.MAX_STEPS,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
     hybrid: dict[str, float] | None = None,
