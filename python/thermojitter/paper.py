@@ -24,6 +24,7 @@ from thermojitter import plots, solver
 from thermojitter.flutter import linear_thermal_response
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.progress import progress_bar
 from thermojitter.results import Solution, ThermalSolution
 from thermojitter.signals import (
     detrend,
@@ -933,11 +934,7 @@ def run_paper(
     chosen = list(SECTIONS if sections is None else sections)
     started = time.perf_counter()
 
-    bar: Any = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=sum(s.figures for s in chosen), unit="fig", desc="paper", leave=False)
+    bar = progress_bar(sum(s.figures for s in chosen), unit="fig", desc="paper", enabled=progress)
 
     def check() -> None:
         if stop is not None and stop():

@@ -146,20 +146,30 @@ def simulate_scenario(
     return columns, counters, interrupted
 
 
-def write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
+def check_writer(fmt: str) -> None:
+    """Imports what writing ``fmt`` needs before a run starts: a missing package is said at once,
+    not after hours, and the write after Ctrl-C does not pay for the import."""
     try:
-        import pandas as pd
+        import pandas  # noqa: F401
     except ImportError:
         raise UserError(
             "writing time series needs pandas: pip install 'thermojitter[cli]'"
         ) from None
+    if fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise UserError("Parquet output needs pyarrow: pip install pyarrow") from None
+
+
+def write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
+    check_writer(fmt)
+    import pandas as pd
+
     frame = pd.DataFrame(columns)
     if fmt == "parquet":
         target = path.with_suffix(".parquet")
-        try:
-            frame.to_parquet(target, index=False)
-        except ImportError:
-            raise UserError("Parquet output needs pyarrow: pip install pyarrow") from None
+        frame.to_parquet(target, index=False)
     else:
         target = path.with_suffix(".csv")
         frame.to_csv(target, index=False)  # shortest round-trip representation
@@ -179,6 +189,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
             scenario.source, "simulation", f"keep = 'orbits' needs whole orbits; the span is {n:g}"
         )
     fmt = args.format or scenario.output.format
+    check_writer(fmt)
     started = time.perf_counter()
     runs = simulate_orbits(
         scenario.panel,
@@ -246,6 +257,7 @@ def run_command(args: argparse.Namespace) -> int:
     if scenario.simulation.keep == "orbits":
         return run_orbits_command(args, scenario, out)
     fmt = args.format or scenario.output.format
+    check_writer(fmt)
     make_plots = scenario.output.plots and not args.no_plots
     started = time.perf_counter()
     columns, counters, interrupted = simulate_scenario(
