@@ -168,3 +168,21 @@ def test_report_tables_are_consistent() -> None:
     for r in cantilever_table(PAPER, (-30.0, 0.0, 30.0)):
         assert r["stable"] == (r["critical_damping_ratio"] < zeta)
         assert r["stable"] == (r["growth_rate"] < 0.0)
+
+
+@pytest.mark.parametrize(
+    "orbit",
+    [tj.Orbit.leo(), tj.Orbit.leo(shadow="penumbra"), tj.Orbit.sunlit()],
+    ids=["leo", "leo-penumbra", "sunlit"],
+)
+def test_every_orbit_runs(orbit: tj.Orbit) -> None:
+    # One orbit of each kind on a coarse mesh: finite fields, and in permanent sunlight the
+    # panel stays at its equilibrium (θ_f constant to integration accuracy).
+    sol = tj.simulate_distributed(
+        PAPER, orbit, (0.0, min(orbit.period, 6000.0)), elements=6, dt_out=10.0
+    )
+    assert np.all(np.isfinite(sol.theta_f)) and np.all(np.isfinite(sol.T_front))
+    if not orbit.shadow_intervals(0.0, orbit.period):
+        assert np.ptp(sol.theta_f) < 1e-9
+    else:
+        assert sol.sunlit.min() == 0.0 and np.ptp(sol.theta_f) > 1e-3

@@ -21,6 +21,7 @@ import pytest
 
 import thermojitter as tj
 from conftest import PAPER
+from thermojitter.scenario import ScenarioError, load_scenario
 
 METRICS = ("amplitude", "exit_peak", "entry_peak", "jitter_rms", "theta_max", "theta_min")
 slow = pytest.mark.skipif(
@@ -141,3 +142,24 @@ def test_bad_hybrid_settings_are_named() -> None:
         )
     with pytest.raises(ValueError, match="warp"):
         tj.simulate_orbits(PAPER, tj.Orbit.sunlit(), 1, method="hybrid", hybrid={"warp": 9.0})
+
+
+def test_ten_years_example_runs_in_seconds(tmp_path: Path) -> None:
+    out = tmp_path / "ten"
+    done = subprocess.run(
+        [sys.executable, "-m", "thermojitter", "run", "examples/ten_years.toml", "--out", str(out),
+         "--no-progress", "--no-plots"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["orbits_done"] == meta["orbits_requested"] > 3600
+    p = meta["propagation"]
+    assert p["t_linear"] > 10 * (p["t_exponential"] + p["t_fallback"])
+
+
+def test_hybrid_scenario_needs_orbit_summaries(tmp_path: Path) -> None:
+    path = tmp_path / "s.toml"
+    path.write_text('[simulation]\nmethod = "hybrid"\n')
+    with pytest.raises(ScenarioError, match="keep = 'orbits'"):
+        load_scenario(path)

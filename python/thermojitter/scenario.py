@@ -64,7 +64,7 @@ ORBIT_PRESETS = {
 }
 SHADOWS = ("none", "cylindrical", "penumbra")
 MODELS = ("nonlinear", "linear")
-METHODS = ("rk45", "rk4")
+METHODS = ("rk45", "rk4", "hybrid")
 FORMATS = ("csv", "parquet")
 KEEP = ("samples", "orbits")
 ON_LIMIT = ("stop", "flag")
@@ -280,6 +280,12 @@ def _simulation(path: Path, table: dict[str, Any]) -> SimulationSettings:
     if settings.t_end is not None and settings.t_end <= settings.t_start:
         raise ScenarioError(
             path, s + "t_end", f"must be after t_start = {settings.t_start}, not {settings.t_end}"
+        )
+    if settings.method == "hybrid" and settings.keep != "orbits":
+        raise ScenarioError(
+            path,
+            s + "method",
+            "'hybrid' keeps one summary per orbit: it needs keep = 'orbits'",
         )
     if settings.method == "rk4" and settings.dt is None:
         raise ScenarioError(path, s + "dt", "is required with method = 'rk4' (the fixed step, s)")

@@ -226,6 +226,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         else {"t_s": crossing[0], "orbit": crossing[1], "theta_deg": math.degrees(crossing[2])},
         "n_steps": runs.n_steps,
         "n_rhs": runs.n_rhs,
+        "propagation": runs.propagation,
         "settings": runs.settings,
         "columns": "angles in rad, times in s; see thermojitter.OrbitSummaries",
         "files": files,

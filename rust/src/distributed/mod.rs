@@ -193,24 +193,41 @@ impl DistributedPanel {
             .collect()
     }
 
-    /// Per-element chord slopes ρ = D Φ q + D R M.
-    fn slopes(&self, q: &[f64], moments: &[f64]) -> Vec<f64> {
+    /// Per-element chord slopes ρ = D Φ q + D R M, written as D S M + D Φ (q − Ω⁻² G M) so that
+    /// the static part is integrated in O(n) ([`Reduction::static_slopes`]); `gm` is G M.
+    fn slopes_with(&self, q: &[f64], moments: &[f64], gm: &[f64]) -> Vec<f64> {
         let r = &self.reduction;
         let n = self.n();
         let mut rho = vec![0.0; n];
-        // Column by column (the matrices are column-major): each pass is a contiguous axpy.
-        let columns = r
-            .slope_residual
-            .as_slice()
-            .chunks_exact(n)
-            .zip(moments)
-            .chain(r.slope_modal.as_slice().chunks_exact(n).zip(q));
-        for (col, x) in columns {
+        r.static_slopes(moments, &mut rho);
+        // Column by column (column-major): each pass is a contiguous axpy.
+        for (i, col) in r.slope_modal.as_slice().chunks_exact(n).enumerate() {
+            let w = r.omega[i];
+            let x = q[i] - gm[i] / (w * w);
             for (out, a) in rho.iter_mut().zip(col) {
                 *out += a * x;
             }
         }
         rho
+    }
+
+    /// G M: the modal forces of the element moments.
+    fn modal_forces(&self, moments: &[f64]) -> Vec<f64> {
+        let r = &self.reduction;
+        (0..self.k())
+            .map(|i| {
+                moments
+                    .iter()
+                    .enumerate()
+                    .map(|(e, m)| r.force[(i, e)] * m)
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// Per-element chord slopes ρ.
+    fn slopes(&self, q: &[f64], moments: &[f64]) -> Vec<f64> {
+        self.slopes_with(q, moments, &self.modal_forces(moments))
     }
 
     /// Absorbed-area factor of each element for chord slopes `rho`.
@@ -229,8 +246,9 @@ impl DistributedPanel {
         let moments = self.moments(y);
         let q = self.modal(y);
         let v = &y[nt + k..];
+        let gm = self.modal_forces(&moments);
         let areas = match self.settings.coupling {
-            Coupling::ProjectedArea => self.areas(&self.slopes(q, &moments)),
+            Coupling::ProjectedArea => self.areas(&self.slopes_with(q, &moments, &gm)),
             Coupling::Frozen => self.areas(&vec![0.0; n]),
         };
         for (e, area) in areas.iter().enumerate() {
@@ -241,9 +259,8 @@ impl DistributedPanel {
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
             let w = r.omega[i];
-            let force: f64 = (0..n).map(|e| r.force[(i, e)] * moments[e]).sum();
             dy[nt + i] = v[i];
-            dy[nt + k + i] = force - 2.0 * zeta * w * v[i] - w * w * q[i];
+            dy[nt + k + i] = gm[i] - 2.0 * zeta * w * v[i] - w * w * q[i];
         }
     }
 

@@ -318,6 +318,9 @@ pub struct Reduction {
     /// Tip rise per unit modal coordinate (k) and per unit element moment through R (n).
     pub rise_modal: DVector<f64>,
     pub rise_residual: DVector<f64>,
+    /// Free–free only: the rigid rotation's mass-weighted reader Mφ_rot (dofs) and its constant
+    /// chord slope, to put the integrated static shape in mean axes.
+    rotation: Option<(DVector<f64>, f64)>,
 }
 
 impl Reduction {
@@ -347,7 +350,16 @@ impl Reduction {
         let residual = &s - &shapes * modal_static;
         let d = mesh.chord_slope_reader();
         let rise = mesh.rise_reader();
+        let rotation = match mesh.support {
+            Support::Cantilever => None,
+            Support::FreeFree => {
+                let m = mesh.mass_matrix();
+                let rot = mesh.rigid_shapes(&m).column(1).into_owned();
+                Some((&m * &rot, rot[1]))
+            }
+        };
         Ok(Reduction {
+            rotation,
             slope_modal: &d * &shapes,
             slope_residual: &d * &residual,
             slope_static: &d * &s,
@@ -359,6 +371,32 @@ impl Reduction {
             residual,
             mesh,
         })
+    }
+
+    /// Static chord slopes under element moments, D S M, in O(n): the static shape of element-wise
+    /// constant curvature M_e/EI is piecewise quadratic, which the cubic elements hold exactly,
+    /// so it is integrated from node 0 (slope and deflection zero: the clamp, or a gauge) and, for
+    /// the free panel, rotated into mean axes (Φ_rᵀ M w = 0; the translation moves no chord).
+    pub fn static_slopes(&self, moments: &[f64], out: &mut [f64]) {
+        let h = self.mesh.element_length();
+        let ei = self.mesh.flexural_rigidity;
+        let (mut w, mut slope, mut weighted) = (0.0, 0.0, 0.0);
+        for (e, m) in moments.iter().enumerate() {
+            let kappa = m / ei;
+            out[e] = slope + 0.5 * kappa * h;
+            if let Some((p, _)) = &self.rotation {
+                weighted += p[2 * e] * w + p[2 * e + 1] * slope;
+            }
+            w += (slope + 0.5 * kappa * h) * h;
+            slope += kappa * h;
+        }
+        if let Some((p, chord)) = &self.rotation {
+            let n = moments.len();
+            weighted += p[2 * n] * w + p[2 * n + 1] * slope;
+            for v in out.iter_mut() {
+                *v -= chord * weighted;
+            }
+        }
     }
 
     /// Number of kept modes.
@@ -505,6 +543,28 @@ mod tests {
                 let err = (eig[0].sqrt() - exact).abs() / exact;
                 assert!(err < last, "{support:?} n = {n}: {err}");
                 last = err;
+            }
+        }
+    }
+
+    #[test]
+    fn integrated_static_slopes_are_the_solved_ones() {
+        for support in [Support::FreeFree, Support::Cantilever] {
+            for n in [3, 12, 40] {
+                let red = Reduction::new(mesh(support, n), 2).unwrap();
+                let moments: Vec<f64> = (0..n).map(|e| 300.0 + 50.0 * (e as f64).sin()).collect();
+                let mut fast = vec![0.0; n];
+                red.static_slopes(&moments, &mut fast);
+                let solved = &red.slope_static * DVector::from_column_slice(&moments);
+                let scale = solved.amax();
+                for e in 0..n {
+                    assert!(
+                        (fast[e] - solved[e]).abs() < 1e-10 * scale,
+                        "{support:?} n={n} e={e}: {} vs {}",
+                        fast[e],
+                        solved[e]
+                    );
+                }
             }
         }
     }

@@ -65,7 +65,7 @@ impl Default for HybridSettings {
             tolerances: ExpTolerances {
                 rtol: 1e-4,
                 atol_temperature: 1e-2,
-                atol_angle: 1e-7,
+                atol_angle: 1e-6,
                 max_step: 300.0,
             },
             linear_tolerance: 1e-7,
