@@ -292,7 +292,11 @@ def test_examples_load() -> None:
 
 BAD = {
     "unknown key": ("[panel]\nmas_per_length = 5.0\n", "panel.mas_per_length", "unknown key"),
-    "negative mass": ("[panel]\nmass_per_length = -5.51\n", "panel.mass_per_length", "> 0"),
+    "negative mass": (
+        "[panel]\nmass_per_length = -5.51\n",
+        "panel.mass_per_length",
+        "must be in [0.001, 10000]",
+    ),
     "wrong type": ('[panel]\nmass_per_length = "heavy"\n', "panel.mass_per_length", "number"),
     "wrong type bool": ("[simulation]\ncoupled = 1\n", "simulation.coupled", "true or false"),
     "unknown table": ("[panels]\nlength = 3.0\n", "panels", "unknown table"),
@@ -446,9 +450,13 @@ def test_run_keeps_per_orbit_summaries_and_resumes(tmp_path: Path) -> None:
     meta = json.loads((out / "run.json").read_text())
     assert meta["orbits_done"] == 3 and meta["limit_crossing"] is None
     assert (out / "orbits.png").exists()
-    # Asking for more orbits with the same settings continues from the checkpoint.
+    # The folder now holds results: a second run needs --overwrite, and then asking for more
+    # orbits with the same settings continues from the checkpoint.
     scenario.write_text(scenario.read_text().replace("orbits = 3", "orbits = 5"))
-    assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 0
+    assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 2
+    assert len((out / "orbits.csv").read_text().splitlines()) == 1 + 3
+    args = ["run", str(scenario), "--out", str(out), "--no-progress", "--overwrite"]
+    assert cli.main(args) == 0
     assert len((out / "orbits.csv").read_text().splitlines()) == 1 + 5
 
 

@@ -20,7 +20,7 @@ def test_parameter_error_is_a_value_error_with_attributes() -> None:
     err = info.value
     assert err.parameter == "length"
     assert err.value == -2.0
-    assert err.allowed is not None and "> 0" in err.allowed
+    assert err.allowed is not None and "must be in [0.1, 10000]" in err.allowed
     assert "length" in str(err)
 
 

@@ -71,7 +71,7 @@ def _wait_for_progress(path: Path, proc: subprocess.Popen[str], at_least: int) -
     while time.monotonic() < deadline:
         if path.exists():
             try:
-                if json.loads(path.read_text())["next_index"] >= at_least:
+                if json.loads(path.read_text())["content"]["next_index"] >= at_least:
                     return
             except (json.JSONDecodeError, KeyError):
                 pass  # caught mid-replace; try again
@@ -90,7 +90,7 @@ def test_killed_run_resumes_to_identical_summaries(tmp_path: Path) -> None:
     _wait_for_progress(path, proc, 3)
     proc.kill()  # SIGKILL: no chance to clean up
     proc.wait()
-    done_before = json.loads(path.read_text())["next_index"]
+    done_before = json.loads(path.read_text())["content"]["next_index"]
     assert 0 < done_before < n
     resumed = tj.simulate_orbits(PAPER, LOW, n, checkpoint=path, progress=False)
     straight = tj.simulate_orbits(PAPER, LOW, n, progress=False)
@@ -111,7 +111,7 @@ def test_ctrl_c_returns_the_finished_orbits(tmp_path: Path) -> None:
     result = json.loads(out.strip().splitlines()[-1])
     assert proc.returncode == 0
     assert result["interrupted"] is True and result["done"] >= 2
-    assert json.loads(path.read_text())["next_index"] == result["done"]
+    assert json.loads(path.read_text())["content"]["next_index"] == result["done"]
 
 
 def test_checkpoint_with_other_settings_is_refused(tmp_path: Path) -> None:

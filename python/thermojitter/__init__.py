@@ -10,6 +10,7 @@ from thermojitter import beam, materials
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
+from thermojitter.checkpoint import CheckpointError
 from thermojitter.distributed import (
     DistributedFlutterResult,
     DistributedSolution,
@@ -46,6 +47,7 @@ __version__ = "0.1.0"
 __all__ = [
     "BeamComparison",
     "CalibrationResult",
+    "CheckpointError",
     "ConvergenceError",
     "DistributedFlutterResult",
     "DistributedSolution",

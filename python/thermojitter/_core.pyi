@@ -23,6 +23,7 @@ __all__ = [
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
+    "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
     "SOLVER_DEFAULTS",
@@ -83,6 +84,7 @@ PERIHELION_DAY: float
 GEO_EQUINOX_ORBIT: dict[str, Any]
 CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
+MAX_TIME: float
 
 class IntegrationError(RuntimeError): ...
 

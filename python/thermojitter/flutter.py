@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import progress_bar
@@ -73,15 +74,18 @@ def flutter(
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
     if orbit is not None:
         if flux is not None:
-            raise ValueError("give flux or orbit (with t), not both")
+            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
         if not isinstance(orbit, Orbit):
             raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
-        flux = float(orbit.flux_scale(float(t))[0])
+        flux = float(orbit.flux_scale(checks.real("t", t))[0])
     elif flux is None:
         flux = 1.0
+    flux = checks.real("flux", flux)
+    coupled = checks.flag("coupled", coupled)
+    checks.choice("model", model, ("nonlinear", "linear"))
     if layers is not None:
-        return _layered_flutter(panel, model, bool(coupled), float(flux), layers)
-    raw = _core.flutter(panel.as_dict(), model, bool(coupled), float(flux))
+        return _layered_flutter(panel, model, coupled, flux, layers)
+    raw = _core.flutter(panel.as_dict(), model, coupled, flux)
     tf, tb, th = raw["equilibrium"]
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
     return FlutterResult(
@@ -130,6 +134,8 @@ Axis = tuple[str, ArrayLike]
 
 DEFAULT_X: tuple[str, NDArray[np.float64]] = ("damping", np.linspace(0.0, 5.0, 51))
 """Default x axis of :func:`stability_map`: hinge damping c_d, N m s/rad."""
+MAX_GRID_POINTS = 4_000_000
+"""Most points of a :func:`stability_map` grid (one eigen-analysis each, ~ a microsecond)."""
 DEFAULT_Y: tuple[str, NDArray[np.float64]] = ("conductance", np.linspace(5.0, 60.0, 56))
 """Default y axis of :func:`stability_map`: through-thickness conductance K, W/(m² K)."""
 
@@ -163,15 +169,12 @@ def _axis(which: str, axis: object) -> tuple[str, NDArray[np.float64]]:
         raise TypeError(f"{which} must be a (parameter name, values) tuple")
     name, raw = axis
     if name not in _core.PANEL_FIELDS:
-        raise ValueError(
-            f"{which} = {name!r} is invalid: not a panel parameter; one of "
-            + ", ".join(_core.PANEL_FIELDS)
+        raise checks.ParameterError(
+            which, name, "not a panel parameter; one of " + ", ".join(_core.PANEL_FIELDS)
         )
-    values = np.asarray(raw, dtype=float)
-    if values.ndim != 1 or values.size == 0:
-        raise ValueError(f"{which} values for {name!r} must be a non-empty 1-D sequence")
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"{which} values for {name!r} must be finite")
+    values = checks.real_array(f"{which}[{name!r}]", raw)
+    if values.size == 0:
+        raise checks.ParameterError(f"{which}[{name!r}]", raw, "must hold at least one value")
     return name, values
 
 
@@ -198,11 +201,19 @@ def stability_map(
     x_name, xs = _axis("x", x)
     y_name, ys = _axis("y", y)
     if x_name == y_name:
-        raise ValueError(f"y = {y_name!r} is invalid: must differ from the x parameter")
+        raise checks.ParameterError("y", y_name, "must differ from the x parameter")
+    if xs.size * ys.size > MAX_GRID_POINTS:
+        raise checks.ParameterError(
+            "x", f"{xs.size} x {ys.size} points", f"the grid may hold at most {MAX_GRID_POINTS}"
+        )
+    coupled = checks.flag("coupled", coupled)
+    flux = checks.real("flux", flux)
+    checks.choice("model", model, ("nonlinear", "linear"))
     # Blocks of rows of about MAP_BLOCK points: each a parallel engine call, with progress and
     # Ctrl-C between them.
     rows_per_block = max(1, MAP_BLOCK // xs.size)
     growth, frequency = [], []
+    checks.flag("progress", progress)
     bar = progress_bar(ys.size, unit="row", desc="stability map", enabled=progress, delay=1.0)
     try:
         for start in range(0, ys.size, rows_per_block):
@@ -214,8 +225,8 @@ def stability_map(
                 y_name,
                 block.tolist(),
                 model,
-                bool(coupled),
-                float(flux),
+                coupled,
+                flux,
             )
             growth.append(np.asarray(raw["growth_rate"], dtype=float).reshape(block.size, -1))
             frequency.append(np.asarray(raw["frequency_hz"], dtype=float).reshape(block.size, -1))
@@ -348,9 +359,9 @@ def linear_thermal_response(
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
     raw = _core.linear_thermal(
         panel.as_dict(),
-        float(flux),
-        None if omega is None else float(omega),
-        None if T_star is None else float(T_star),
+        checks.positive("flux", flux),
+        None if omega is None else checks.real("omega", omega),
+        None if T_star is None else checks.real("T_star", T_star),
     )
     return LinearThermalResponse(**raw)
 

@@ -7,11 +7,10 @@ run resumed from a checkpoint gives the very same summaries as one that was neve
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,6 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import _core, solver
+from thermojitter import checkpoint as checkpoints
+from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import Interruptible, progress_bar, report_interrupted
@@ -29,6 +30,7 @@ from thermojitter.simulate import (
     check_layers,
     layup_dict,
     solver_settings,
+    start_state,
     steady_state,
 )
 
@@ -105,67 +107,93 @@ class OrbitSummaries:
         return pd.DataFrame(self.columns).set_index("index")
 
 
-def settings_fingerprint(settings: dict[str, Any]) -> str:
-    return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
-
-
 def _empty_columns() -> dict[str, list[Any]]:
     return {name: [] for name in SUMMARY_FIELDS}
 
 
 def _save_checkpoint(
     path: Path,
-    settings: dict[str, Any],
+    request: dict[str, Any],
+    n_orbits: int,
     columns: dict[str, list[Any]],
     y: list[float],
     next_index: int,
     counters: dict[str, int],
     crossing: tuple[float, int, float] | None,
-) -> None:
-    """Writes atomically: a killed writer leaves the previous checkpoint intact."""
-    payload = {
-        "fingerprint": settings_fingerprint(settings),
-        "settings": settings,
+) -> bool:
+    """Writes the checkpoint atomically; on failure (a full disk, a read-only folder) warns and
+    returns False, leaving the previous checkpoint and no partial file: the run and its result
+    go on."""
+    content = {
+        "n_orbits": n_orbits,
         "next_index": next_index,
-        "y": y,
+        "y": [float(v) for v in y],
         "counters": counters,
-        "crossing": crossing,
+        "crossing": None if crossing is None else list(crossing),
         "columns": {
             k: [float(v) if k != "index" else int(v) for v in vals] for k, vals in columns.items()
         },
     }
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as fh:
-        # repr-exact floats: json writes the shortest round-tripping form, NaN as NaN.
-        json.dump(payload, fh)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-
-
-def flatten_settings(settings: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    flat: dict[str, Any] = {}
-    for key, value in settings.items():
-        if isinstance(value, dict):
-            flat.update(flatten_settings(value, f"{prefix}{key}."))
-        else:
-            flat[prefix + key] = value
-    return flat
-
-
-def _load_checkpoint(path: Path, settings: dict[str, Any]) -> dict[str, Any] | None:
-    if not path.exists():
-        return None
-    with open(path) as fh:
-        payload: dict[str, Any] = json.load(fh)
-    if payload.get("fingerprint") != settings_fingerprint(settings):
-        old, new = flatten_settings(payload.get("settings", {})), flatten_settings(settings)
-        changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-        raise ValueError(
-            f"checkpoint {path} was written for other settings (differs in: "
-            f"{', '.join(changed) or 'unknown'}); remove it or use another path"
+    try:
+        checkpoints.save(path, request, content)
+    except OSError as exc:
+        warnings.warn(
+            f"checkpoint {path} could not be written ({exc.strerror or exc}); the orbits "
+            "computed so far are kept in memory and returned",
+            RuntimeWarning,
+            stacklevel=3,
         )
-    return payload
+        return False
+    return True
+
+
+def _check_extension(
+    path: Path, content: dict[str, Any], n_orbits: int, orbits_per_call: int, done: int
+) -> None:
+    """A checkpoint of the same settings answers a call for as many orbits, or extends to more
+    when the saved run finished and its chunks end where a fresh run's would (so the result is
+    the same to the bit). A checkpoint of more orbits than asked is refused: its rows and end
+    state are not those of the shorter run."""
+    saved = content.get("n_orbits")
+    if saved == n_orbits:
+        return
+    if not isinstance(saved, int):
+        raise checkpoints.CheckpointError("checkpoint", path, "is missing fields")
+    if saved > n_orbits:
+        raise checkpoints.CheckpointError(
+            "checkpoint",
+            path,
+            f"holds a run of n_orbits = {saved}, more than the {n_orbits} asked",
+        )
+    if done < saved or saved % orbits_per_call != 0:
+        raise checkpoints.CheckpointError(
+            "checkpoint",
+            path,
+            f"was written for n_orbits = {saved} and cannot be extended to {n_orbits} "
+            f"(unfinished, or its last chunk is not a whole orbits_per_call = {orbits_per_call})",
+        )
+
+
+def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
+    """The state of a checked checkpoint; refuses one whose rows do not run 0..next_index−1 (a
+    file the checksum vouches for was written by this code, so this guards its logic)."""
+    try:
+        columns = {k: list(content["columns"][k]) for k in SUMMARY_FIELDS}
+        next_index = int(content["next_index"])
+        y = [float(v) for v in content["y"]]
+        counters = dict(content["counters"])
+        counters["n_steps"], counters["n_rhs"] = int(counters["n_steps"]), int(counters["n_rhs"])
+        crossing = content["crossing"]
+    except (KeyError, TypeError, ValueError):
+        raise checkpoints.CheckpointError("checkpoint", path, "is missing fields") from None
+    rows = columns["index"]
+    if rows != list(range(next_index)):
+        raise checkpoints.CheckpointError(
+            "checkpoint", path, f"holds rows {rows[:1]}..{rows[-1:]} for next_index {next_index}"
+        )
+    if len(y) != 4 or any(len(v) != len(rows) for v in columns.values()):
+        raise checkpoints.CheckpointError("checkpoint", path, "has columns of unequal length")
+    return columns, y, next_index, counters, None if crossing is None else tuple(crossing)
 
 
 def simulate_orbits(
@@ -225,80 +253,85 @@ def simulate_orbits(
       :func:`thermojitter.simulate`); ``y0`` and ``y_end`` are then (node temperatures…, θ, θ̇).
     """
     check_inputs(panel, orbit)
-    if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
-        raise ValueError(f"n_orbits = {n_orbits!r} is invalid: must be an integer >= 1")
-    if (
-        isinstance(orbits_per_call, bool)
-        or not isinstance(orbits_per_call, int)
-        or orbits_per_call < 1
-    ):
-        raise ValueError(
-            f"orbits_per_call = {orbits_per_call!r} is invalid: must be an integer >= 1"
+    n_orbits = checks.integer("n_orbits", n_orbits, 1)
+    orbits_per_call = checks.integer("orbits_per_call", orbits_per_call, 1)
+    on_limit = checks.choice("on_limit", on_limit, ("stop", "flag"))  # type: ignore[assignment]
+    model = checks.choice("model", model, ("nonlinear", "linear"))  # type: ignore[assignment]
+    coupled = checks.flag("coupled", coupled)
+    t_start = checks.finite("t_start", t_start)
+    window = checks.positive("window", window)
+    theta_limit = checks.real("theta_limit", theta_limit)
+    checkpoint_every = checks.finite("checkpoint_every", checkpoint_every)
+    steps_per_period = checks.in_range("steps_per_period", steps_per_period, 0.0, 1e4)
+    if progress is not None:
+        checks.flag("progress", progress)
+    if stop is not None and not callable(stop):
+        raise TypeError(f"stop must be callable, not {type(stop).__name__}")
+    t_end = t_start + n_orbits * orbit.period
+    if not abs(t_end) <= _core.MAX_TIME:
+        # Each chunk is checked by the engine; the whole run is checked here, before any work.
+        raise checks.ParameterError(
+            "n_orbits",
+            n_orbits,
+            f"reaches t = {t_end:.4g} s; a run may reach at most {_core.MAX_TIME:g} s "
+            f"({_core.MAX_TIME / orbit.period:.4g} orbits of this one)",
         )
-    if on_limit not in ("stop", "flag"):
-        raise ValueError(f"on_limit = {on_limit!r} is invalid: must be 'stop' or 'flag'")
-    for name, value in (
-        ("t_start", t_start),
-        ("window", window),
-        ("theta_limit", theta_limit),
-        ("checkpoint_every", checkpoint_every),
-    ):
-        if not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ValueError(f"{name} = {value!r} is invalid: must be a finite number")
-    if not isinstance(steps_per_period, (int, float)) or not (
-        math.isfinite(steps_per_period) and steps_per_period >= 0
-    ):
-        raise ValueError(
-            f"steps_per_period = {steps_per_period!r} is invalid: must be a finite number >= 0"
-        )
+    method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
     nodes = None if layers is None else check_layers(layers)
     if nodes is not None and method == "hybrid":
         # The hybrid propagator covers the two-layer model; layered panels are integrated in full.
         method = "rk45"
+    # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
+    solver = solver_settings(
+        "rk45" if method == "hybrid" else method, rtol, atol, dt, math.inf, max_steps
+    )
+    if hybrid is not None and not isinstance(hybrid, dict):
+        raise TypeError(f"hybrid must be a dict of engine settings, not {type(hybrid).__name__}")
+    if y0 is not None:
+        y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
     if y0 is None:
         # The sunlit equilibrium at the solar flux of the start date.
-        flux = float(orbit.flux_scale(float(t_start))[0])
+        flux = float(orbit.flux_scale(t_start)[0])
         if nodes is None:
             eq = steady_state(panel, coupled=coupled, flux=flux)
             y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
         else:
             raw_eq = _core.layered_steady_state(
-                panel.as_dict(), layup_dict(panel), nodes, bool(coupled), flux
+                panel.as_dict(), layup_dict(panel), nodes, coupled, flux
             )
             y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_dict(),
-        "t_start": float(t_start),
+        "t_start": t_start,
         "model": model,
-        "coupled": bool(coupled),
+        "coupled": coupled,
         "method": method,
-        "rtol": float(rtol),
-        "atol": float(atol),
-        "dt": dt,
+        "rtol": solver["rtol"],
+        "atol": solver["atol"],
+        "dt": solver["dt"],
         "y0": [float(v) for v in y0],
-        "window": float(window),
-        "theta_limit": float(theta_limit),
+        "window": window,
+        "theta_limit": theta_limit,
         "on_limit": on_limit,
         "orbits_per_call": orbits_per_call,
-        "steps_per_period": float(steps_per_period),
+        "steps_per_period": steps_per_period,
+        "max_steps": solver["max_steps"],
     }
     if nodes is not None:
         settings["layers"] = nodes
         settings["layup"] = layup_dict(panel)
-    hybrid_settings = {k: float(v) for k, v in (hybrid or {}).items()}
+    hybrid_settings = {k: checks.real(f"hybrid[{k!r}]", v) for k, v in (hybrid or {}).items()}
     if method == "hybrid":
         settings["hybrid"] = hybrid_settings
     core_args: dict[str, Any] = {
         "model": model,
-        "coupled": bool(coupled),
-        "solver": solver_settings(
-            "rk45" if method == "hybrid" else method, rtol, atol, dt, math.inf, max_steps
-        ),
-        "window": float(window),
-        "theta_limit": float(theta_limit),
+        "coupled": coupled,
+        "solver": solver,
+        "window": window,
+        "theta_limit": theta_limit,
         "stop_at_limit": on_limit == "stop",
-        "steps_per_period": float(steps_per_period),
+        "steps_per_period": steps_per_period,
     }
     if nodes is not None:
         core_args["layup"] = layup_dict(panel)
@@ -313,12 +346,10 @@ def simulate_orbits(
     crossing: tuple[float, int, float] | None = None
     path = Path(checkpoint) if checkpoint is not None else None
     if path is not None:
-        saved = _load_checkpoint(path, settings)
+        saved = checkpoints.load(path, settings)
         if saved is not None:
-            columns = {k: list(v) for k, v in saved["columns"].items()}
-            y, next_index = saved["y"], int(saved["next_index"])
-            counters = saved["counters"]
-            crossing = tuple(saved["crossing"]) if saved["crossing"] else None  # type: ignore[assignment]
+            columns, y, next_index, counters, crossing = _restore(path, saved)
+            _check_extension(path, saved, n_orbits, orbits_per_call, next_index)
 
     bar = progress_bar(n_orbits, initial=next_index, unit="orbit", enabled=progress)
     interrupted = report = False
@@ -360,7 +391,9 @@ def simulate_orbits(
             if bar is not None:
                 bar.update(count)
             if path is not None and time.monotonic() - last_save > checkpoint_every:
-                _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
+                _save_checkpoint(
+                    path, settings, n_orbits, columns, y, next_index, counters, crossing
+                )
                 last_save = time.monotonic()
             if stop is not None and stop() and next_index < n_orbits and not stopped:
                 interrupted = True  # the caller asked, and reports it
@@ -372,7 +405,7 @@ def simulate_orbits(
         if bar is not None:
             bar.close()
         if path is not None:
-            _save_checkpoint(path, settings, columns, y, next_index, counters, crossing)
+            _save_checkpoint(path, settings, n_orbits, columns, y, next_index, counters, crossing)
     if report:
         kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
         if path is not None:

@@ -17,7 +17,6 @@ import concurrent.futures as cf
 import contextlib
 import hashlib
 import itertools
-import json
 import math
 import os
 import threading
@@ -33,8 +32,10 @@ from scipy import stats
 from scipy.stats import qmc
 
 from thermojitter import _core, solver
+from thermojitter import checkpoint as checkpoints
+from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
-from thermojitter.longrun import DEFAULT_THETA_LIMIT, flatten_settings, settings_fingerprint
+from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import progress_bar, report_interrupted
@@ -427,8 +428,29 @@ def _chunk_path(directory: Path, k: int) -> Path:
     return directory / f"chunk-{k:05d}.parquet"
 
 
-def _write_chunk(directory: Path, k: int, start: int, metrics: dict[str, Any]) -> None:
-    """Writes atomically: a killed writer leaves no partial chunk behind."""
+_CHUNK_REQUEST = b"thermojitter.request"
+_CHUNK_CHECKSUM = b"thermojitter.checksum"
+
+
+def _chunk_digest(columns: dict[str, Any]) -> str:
+    """SHA-256 over a chunk's columns (names, values to the bit, error strings)."""
+    h = hashlib.sha256()
+    for name in sorted(columns):
+        h.update(name.encode() + b"\0")
+        value = columns[name]
+        if name == "error":
+            h.update(checkpoints.canonical(list(value)))
+        else:
+            h.update(np.ascontiguousarray(np.asarray(value, dtype=float)).tobytes())
+    return h.hexdigest()
+
+
+def _write_chunk(
+    directory: Path, k: int, start: int, metrics: dict[str, Any], request: str
+) -> bool:
+    """Writes chunk ``k`` atomically, with the request's fingerprint and a checksum of its
+    content in the Parquet metadata. On failure (a full disk, say) warns and returns False: the
+    chunk stays in memory and in the result, and no partial file is left."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -436,58 +458,88 @@ def _write_chunk(directory: Path, k: int, start: int, metrics: dict[str, Any]) -
     columns: dict[str, Any] = {"sample": np.arange(start, start + n, dtype=np.int64)}
     for m in METRICS:
         columns[m] = metrics[m]
+    meta = {_CHUNK_REQUEST: request.encode(), _CHUNK_CHECKSUM: _chunk_digest(columns).encode()}
     columns["error"] = pa.array(metrics["error"], type=pa.string())
+    table = pa.table(columns).replace_schema_metadata(meta)
     path = _chunk_path(directory, k)
-    tmp = path.with_name(path.name + ".tmp")
     try:
-        pq.write_table(pa.table(columns), tmp)
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+        checkpoints.write_atomic(path, lambda fh: pq.write_table(table, fh))
+    except OSError as exc:
+        warnings.warn(
+            f"checkpoint chunk {path} could not be written ({exc.strerror or exc}); its samples "
+            "are kept in memory and returned",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        return False
+    return True
 
 
-def _read_chunk(directory: Path, k: int, start: int, stop: int) -> dict[str, Any] | None:
+def _read_chunk(
+    directory: Path, k: int, start: int, stop: int, request: str
+) -> dict[str, Any] | None:
+    """Chunk ``k`` if it is intact and was written for ``request``; None if absent. A damaged,
+    edited or foreign chunk is refused naming the file."""
     import pyarrow.parquet as pq
 
     path = _chunk_path(directory, k)
     if not path.exists():
         return None
-    table = pq.read_table(path)
-    sample = table.column("sample").to_numpy()
-    if not np.array_equal(sample, np.arange(start, stop)):
-        raise ValueError(f"checkpoint chunk {path} does not hold samples {start}..{stop - 1}")
-    out: dict[str, Any] = {m: table.column(m).to_numpy() for m in METRICS if m != "error"}
-    out["error"] = table.column("error").to_pylist()
-    return out
+    try:
+        table = pq.read_table(path)
+        meta = table.schema.metadata or {}
+        columns: dict[str, Any] = {"sample": table.column("sample").to_numpy()}
+        for m in METRICS:
+            if m == "error":
+                columns[m] = table.column(m).to_pylist()
+            else:
+                columns[m] = table.column(m).to_numpy()
+    except Exception:  # pyarrow raises several kinds on a damaged file
+        raise checkpoints.CheckpointError(
+            "checkpoint", path, "is damaged (not a readable chunk)"
+        ) from None
+    if meta.get(_CHUNK_REQUEST) != request.encode():
+        raise checkpoints.CheckpointError(
+            "checkpoint", path, "was written for another request (seed, n, design or settings)"
+        )
+    if meta.get(_CHUNK_CHECKSUM) != _chunk_digest(columns).encode():
+        raise checkpoints.CheckpointError(
+            "checkpoint", path, "is damaged or was edited (its checksum does not match)"
+        )
+    if not np.array_equal(columns["sample"], np.arange(start, stop)):
+        raise checkpoints.CheckpointError(
+            "checkpoint", path, f"does not hold samples {start}..{stop - 1}"
+        )
+    del columns["sample"]
+    return columns
 
 
 def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_size: int) -> int:
-    """Creates or checks the manifest; returns the chunk size the directory was started with."""
-    directory.mkdir(parents=True, exist_ok=True)
+    """Creates or checks the manifest; returns the chunk size the directory was started with.
+    Without a manifest, chunks already in the folder are still checked one by one against the
+    request's fingerprint when they are read."""
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise checkpoints.CheckpointError(
+            "checkpoint", directory, f"cannot be created ({exc.strerror or exc})"
+        ) from None
     manifest = directory / "manifest.json"
-    fingerprint = settings_fingerprint(settings)
-    if manifest.exists():
-        saved = json.loads(manifest.read_text())
-        if saved.get("fingerprint") != fingerprint:
-            old, new = flatten_settings(saved.get("settings", {})), flatten_settings(settings)
-            changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-            raise ValueError(
-                f"checkpoint {directory} was written for other settings (differs in: "
-                f"{', '.join(changed) or 'unknown'}); remove it or use another directory"
-            )
-        return int(saved["chunk_size"])
-    payload = {
-        "format": FORMAT_VERSION,
-        "fingerprint": fingerprint,
-        "settings": settings,
-        "n": n,
-        "chunk_size": chunk_size,
-    }
-    tmp = manifest.with_name("manifest.json.tmp")
-    tmp.write_text(json.dumps(payload, indent=1))
-    os.replace(tmp, manifest)
+    saved = checkpoints.load(manifest, settings)
+    if saved is not None:
+        size = saved.get("chunk_size")
+        if not isinstance(size, int) or size < 1:
+            raise checkpoints.CheckpointError("checkpoint", manifest, "has no valid chunk_size")
+        return size
+    try:
+        checkpoints.save(manifest, settings, {"n": n, "chunk_size": chunk_size})
+    except OSError as exc:
+        warnings.warn(
+            f"checkpoint {manifest} could not be written ({exc.strerror or exc}); the run goes "
+            "on and returns its result",
+            RuntimeWarning,
+            stacklevel=3,
+        )
     return chunk_size
 
 
@@ -542,6 +594,7 @@ def _run_design(
     progress: bool,
 ) -> Any:
     n = len(matrix)
+    checks.flag("progress", progress)
     if threads is not None and (
         isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1
     ):
@@ -557,13 +610,14 @@ def _run_design(
         "design_sha256": hashlib.sha256(np.ascontiguousarray(matrix).tobytes()).hexdigest(),
     }
     directory = Path(checkpoint) if checkpoint is not None else None
+    request = checkpoints.digest(settings)
     if directory is not None:
         chunk_size = _open_checkpoint(directory, settings, n, chunk_size)
     bounds = [(k, a, min(n, a + chunk_size)) for k, a in enumerate(range(0, n, chunk_size))]
     done: dict[int, dict[str, Any]] = {}
     if directory is not None:
         for k, a, b in bounds:
-            chunk = _read_chunk(directory, k, a, b)
+            chunk = _read_chunk(directory, k, a, b, request)
             if chunk is not None:
                 done[k] = chunk
     todo = [c for c in bounds if c[0] not in done]
@@ -581,22 +635,23 @@ def _run_design(
                 else _dask_chunks(client, matrix, todo, options)
             )
             written = set(done)
+            failed_write = False  # after one failed write, the rest are kept in memory only
             # closing: on any error (Ctrl-C included) the pending chunks are cancelled at once.
             with contextlib.closing(stream):
                 try:
                     for k, metrics in stream:
                         done[k] = metrics
                         start, stop = bounds[k][1], bounds[k][2]
-                        if directory is not None:
-                            _write_chunk(directory, k, start, metrics)
+                        if directory is not None and not failed_write:
+                            failed_write = not _write_chunk(directory, k, start, metrics, request)
                             written.add(k)
                         if bar is not None:
                             bar.update(stop - start)
                 except BaseException as exc:
                     # A finished chunk whose write was interrupted is written before leaving.
-                    if directory is not None:
+                    if directory is not None and not failed_write:
                         for k in sorted(set(done) - written):
-                            _write_chunk(directory, k, bounds[k][1], done[k])
+                            _write_chunk(directory, k, bounds[k][1], done[k], request)
                     if not isinstance(exc, KeyboardInterrupt):
                         raise
                     interrupted = True

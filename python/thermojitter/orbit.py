@@ -27,7 +27,6 @@ about a day; the equation of time is ignored.
 from __future__ import annotations
 
 import datetime as _dt
-import math
 from dataclasses import dataclass, fields
 from typing import Any, Literal
 
@@ -35,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import errors as checks
 
 # The constants live in the engine (rust/src/orbit.rs); these are their Python names.
 GEO_RADIUS: float = _core.GEO_RADIUS
@@ -50,6 +50,12 @@ EQUINOX_DAY: float = _core.EQUINOX_DAY
 PERIHELION_DAY: float = _core.PERIHELION_DAY
 """Mean perihelion, days since 1 January 00:00 UTC."""
 _GEO_EQUINOX: dict[str, Any] = dict(_core.GEO_EQUINOX_ORBIT)
+
+MIN_LEO_ALTITUDE = 100e3
+"""Lowest altitude of :meth:`Orbit.leo`, m (the Kármán line; lower, the atmosphere ends an orbit
+within hours)."""
+MAX_LEO_ALTITUDE = 1e9
+"""Highest altitude of :meth:`Orbit.leo`, m (beyond the Moon)."""
 
 ShadowModel = Literal["none", "cylindrical", "penumbra"]
 _SHADOWS = ("none", "cylindrical", "penumbra")
@@ -68,11 +74,8 @@ def day_of_year(date: DateLike) -> float:
     """
     if isinstance(date, bool):
         raise TypeError("start_date must be a date, an ISO date string or a day of the year")
-    if isinstance(date, (int, float)):
-        value = float(date)
-        if not math.isfinite(value):
-            raise ValueError(f"start_date = {date} is invalid: must be finite")
-        return value
+    if isinstance(date, (int, float, np.integer, np.floating)):
+        return checks.finite("start_date", date)
     if isinstance(date, str):
         try:
             parsed: _dt.date = _dt.datetime.fromisoformat(date)
@@ -125,17 +128,13 @@ class Orbit:
         for f in fields(self):
             value = getattr(self, f.name)
             if f.name in _FLOATS:
-                if isinstance(value, bool) or not isinstance(value, (int, float)):
-                    raise TypeError(f"{f.name} must be a real number, not {type(value).__name__}")
-                object.__setattr__(self, f.name, float(value))
+                object.__setattr__(self, f.name, checks.real(f.name, value))
             elif f.name in _BOOLS:
                 if not isinstance(value, (bool, np.bool_)):
                     raise TypeError(f"{f.name} must be a bool, not {type(value).__name__}")
                 object.__setattr__(self, f.name, bool(value))
-            elif f.name == "shadow" and value not in _SHADOWS:
-                raise ValueError(
-                    f"shadow = {value!r} is invalid: must be 'none', 'cylindrical' or 'penumbra'"
-                )
+            elif f.name == "shadow":
+                checks.choice("shadow", value, _SHADOWS)
         _core.validate_orbit(self.as_dict())
 
     @classmethod
@@ -165,11 +164,20 @@ class Orbit:
     def leo(cls, altitude: float = 540e3, *, shadow: ShadowModel = "cylindrical") -> Orbit:
         """A Hubble-like circular low orbit at ``altitude`` (m): Keplerian period (about 95 min at
         540 km), the Sun in the orbit plane (the longest eclipses, about 36 min)."""
-        if isinstance(altitude, bool) or not isinstance(altitude, (int, float)):
-            raise TypeError(f"altitude must be a real number, not {type(altitude).__name__}")
-        if not (math.isfinite(altitude) and altitude > 0.0):
-            raise ValueError(f"altitude = {altitude} is invalid: must be finite and > 0")
-        leo = _core.leo_orbit(float(altitude))
+        height = checks.real("altitude", altitude)
+        if 0.0 < height < MIN_LEO_ALTITUDE:
+            # Below 100 km nothing stays in orbit: the number was almost surely given in km.
+            raise checks.ParameterError(
+                "altitude",
+                altitude,
+                f"must be in [{MIN_LEO_ALTITUDE:g}, {MAX_LEO_ALTITUDE:g}] m; below 100 km nothing "
+                f"orbits: if km were meant, {height:g} km = {height * 1e3:g} m",
+            )
+        if not (MIN_LEO_ALTITUDE <= height <= MAX_LEO_ALTITUDE):
+            raise checks.ParameterError(
+                "altitude", altitude, f"must be in [{MIN_LEO_ALTITUDE:g}, {MAX_LEO_ALTITUDE:g}] m"
+            )
+        leo = _core.leo_orbit(height)
         return cls(radius=leo["radius"], period=leo["period"], shadow=shadow)
 
     @classmethod
@@ -200,21 +208,27 @@ class Orbit:
 
         Cylinder: shadow entry and exit. Penumbra: first and last contact, where s starts to fall
         below 1 and where it is back to 1 (see :meth:`umbra_intervals` for s = 0)."""
-        return list(_core.shadow_intervals(self.as_dict(), float(t0), float(t1)))
+        return list(
+            _core.shadow_intervals(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
+        )
 
     def umbra_intervals(self, t0: float, t1: float) -> list[tuple[float, float]]:
         """Intervals where s = 0, s, clipped to [t0, t1] (the shadow intervals for the cylinder)."""
-        return list(_core.umbra_intervals(self.as_dict(), float(t0), float(t1)))
+        return list(
+            _core.umbra_intervals(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
+        )
 
     def breakpoints(self, t0: float, t1: float) -> list[float]:
         """Times in (t0, t1) where s jumps (cylinder) or has a kink (penumbra contacts and umbra
         boundaries); the integrators stop on each."""
-        return list(_core.orbit_breakpoints(self.as_dict(), float(t0), float(t1)))
+        return list(
+            _core.orbit_breakpoints(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
+        )
 
     def eclipses(self, t0: float, t1: float) -> NDArray[np.float64]:
         """Eclipses overlapping [t0, t1], unclipped, one row each: (deepest point, first contact,
         last contact, umbra entry, umbra exit), s; NaN where there is no umbra."""
-        rows = _core.eclipses(self.as_dict(), float(t0), float(t1))
+        rows = _core.eclipses(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
         return np.asarray(rows, dtype=float).reshape(-1, 5)
 
     def eclipse_durations(
@@ -222,8 +236,7 @@ class Orbit:
     ) -> NDArray[np.float64]:
         """Duration, s, of each eclipse whose deepest point is in [t0, t1): ``kind="total"`` from
         first to last contact (s < 1), ``"umbra"`` with s = 0."""
-        if kind not in ("total", "umbra"):
-            raise ValueError(f"kind = {kind!r} is invalid: must be 'total' or 'umbra'")
+        checks.choice("kind", kind, ("total", "umbra"))
         e = self.eclipses(t0, t1)
         e = e[(e[:, 0] >= t0) & (e[:, 0] < t1)]
         if kind == "total":
@@ -233,19 +246,16 @@ class Orbit:
 
     def illumination(self, t: ArrayLike) -> NDArray[np.float64]:
         """Illuminated fraction of the Sun s(t): 1 in sunlight, 0 in umbra, between in penumbra."""
-        times = np.atleast_1d(np.asarray(t, dtype=float))
-        return np.asarray(_core.illumination(self.as_dict(), np.ascontiguousarray(times)))
+        return np.asarray(_core.illumination(self.as_dict(), checks.real_array("t", t)))
 
     def flux_scale(self, t: ArrayLike) -> NDArray[np.float64]:
         """Solar flux at time t relative to the solar constant at 1 au: 1/r², r in au (1 unless
         ``eccentric_sun``). Pass it to :func:`thermojitter.flutter` as ``flux``."""
-        times = np.atleast_1d(np.asarray(t, dtype=float))
-        return np.asarray(_core.flux_scale(self.as_dict(), np.ascontiguousarray(times)))
+        return np.asarray(_core.flux_scale(self.as_dict(), checks.real_array("t", t)))
 
     def declination(self, t: ArrayLike) -> NDArray[np.float64]:
         """The Sun's declination at time t, rad (0 unless ``season``)."""
-        times = np.atleast_1d(np.asarray(t, dtype=float))
-        return np.asarray(_core.declination(self.as_dict(), np.ascontiguousarray(times)))
+        return np.asarray(_core.declination(self.as_dict(), checks.real_array("t", t)))
 
     def time_of(self, date: DateLike) -> float:
         """Seconds from t = 0 (``epoch_day``) to ``date`` within the same year's day count."""

@@ -8,6 +8,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING, Any, Literal
 
 from thermojitter import _core
+from thermojitter import errors as checks
 
 if TYPE_CHECKING:
     from thermojitter.laminate import Laminate
@@ -94,10 +95,7 @@ class Panel:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise TypeError(f"{f.name} must be a real number, not {type(value).__name__}")
-            object.__setattr__(self, f.name, float(value))
+            object.__setattr__(self, f.name, checks.real(f.name, getattr(self, f.name)))
         _core.validate_panel(self.as_dict())
 
     @classmethod
@@ -113,9 +111,13 @@ class Panel:
     @classmethod
     def from_dict(cls, values: dict[str, Any]) -> Panel:
         """A panel from a mapping of parameter names (missing ones take Table 1 values)."""
+        if not isinstance(values, dict):
+            raise TypeError(f"values must be a dict, not {type(values).__name__}")
         unknown = sorted(set(values) - set(cls.field_names()))
         if unknown:
-            raise ValueError(f"unknown panel parameter(s): {', '.join(unknown)}")
+            raise checks.ParameterError(
+                str(unknown[0]), values[unknown[0]], "is not a panel parameter"
+            )
         return cls(**values)
 
     @staticmethod
@@ -129,7 +131,7 @@ class Panel:
         (:data:`LAYUP_FIELDS`) cannot be changed on it (change the laminate instead)."""
         unknown = sorted(set(changes) - set(self.field_names()))
         if unknown:
-            raise ValueError(f"unknown panel parameter(s): {', '.join(unknown)}")
+            raise checks.ParameterError(unknown[0], changes[unknown[0]], "is not a panel parameter")
         if self.layup is not None:
             fixed = sorted(set(changes) & set(LAYUP_FIELDS))
             if fixed:
@@ -214,13 +216,20 @@ class Panel:
         return float(_core.derived(self.as_dict())["hinge_inertia"])
 
 
+def _check_panel(panel: Any) -> None:
+    if not isinstance(panel, Panel):
+        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+
+
 def natural_frequency(panel: Panel) -> float:
     """Natural frequency of the linearised hinge, sqrt(K_el/I_B)/2π, Hz."""
+    _check_panel(panel)
     return float(_core.derived(panel.as_dict())["natural_frequency_hz"])
 
 
 def beam_frequency(panel: Panel) -> float:
     """First free–free bending frequency of the continuous panel, (β₁L)² sqrt(EI/(mL⁴))/2π, Hz."""
+    _check_panel(panel)
     return float(_core.derived(panel.as_dict())["beam_frequency_hz"])
 
 
@@ -232,6 +241,8 @@ def hinge_stiffness(panel: Panel, criterion: StiffnessCriterion = "deflection") 
     - ``"deflection_small_angle"``: its small-angle limit, 4EI/L.
     - ``"frequency"``: equal first free–free frequency, (β₁L)⁴ EI I_B/(m L⁴) ≈ 5.21 EI/L.
     """
+    _check_panel(panel)
+    checks.choice("criterion", criterion, ("deflection", "deflection_small_angle", "frequency"))
     moment = 0.0
     if criterion == "deflection":
         from thermojitter.simulate import steady_state

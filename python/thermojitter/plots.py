@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from thermojitter.checkpoint import write_atomic
 from thermojitter.panel import PANEL_UNITS
 
 Array = NDArray[np.float64]
@@ -204,8 +205,11 @@ def save(fig: Any, path: Path) -> Path:
     """Writes the PNG and closes the figure."""
     if fig.get_layout_engine() is None:
         fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    pyplot().close(fig)
+    try:
+        # Atomic: a failed write (a full disk) leaves no partial image.
+        write_atomic(path, lambda fh: fig.savefig(fh, dpi=DPI, format="png"))
+    finally:
+        pyplot().close(fig)
     return path
 
 

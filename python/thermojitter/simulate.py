@@ -9,6 +9,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from thermojitter import _core, solver
+from thermojitter import errors as checks
+from thermojitter.errors import ParameterError
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -20,28 +22,34 @@ DEFAULT_DT_OUT = 0.5
 """Default reporting interval, s: 16 samples per period of the paper panel's ~8 s jitter."""
 
 
-def _check_type(name: str, value: Any, kind: type | tuple[type, ...]) -> None:
-    if isinstance(value, bool) and kind is not bool or not isinstance(value, kind):
-        raise TypeError(
-            f"{name} must be {getattr(kind, '__name__', kind)}, not {type(value).__name__}"
-        )
+_MODELS = ("nonlinear", "linear")
+_METHODS = ("rk45", "rk4")
 
 
 def time_span(t_span: Sequence[float]) -> tuple[float, float]:
-    try:
-        t0, t1 = (float(v) for v in t_span)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(
-            f"t_span = {t_span!r} is invalid: must be two numbers (t0, t1) in s"
-        ) from exc
-    return t0, t1
+    if isinstance(t_span, (str, bytes)) or not isinstance(t_span, (Sequence, np.ndarray)):
+        raise TypeError(
+            f"t_span must be a pair of numbers (t0, t1) in s, not {type(t_span).__name__}"
+        )
+    if len(t_span) != 2:
+        raise ParameterError("t_span", t_span, "must be two numbers (t0, t1) in s")
+    return checks.real("t_span[0]", t_span[0]), checks.real("t_span[1]", t_span[1])
 
 
 def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
     if t_eval is None:
         return None
-    arr = np.ascontiguousarray(np.asarray(t_eval, dtype=float).ravel())
-    return arr
+    return checks.real_array("t_eval", t_eval)
+
+
+def start_state(y0: Any, size: int) -> list[float] | None:
+    """A start state of ``size`` real numbers (the engine checks their ranges)."""
+    if y0 is None:
+        return None
+    arr = checks.real_array("y0", y0, finite_only=False)
+    if arr.size != size:
+        raise ParameterError("y0", y0, f"must hold {size} numbers")
+    return [float(v) for v in arr]
 
 
 def solver_args(
@@ -54,13 +62,12 @@ def solver_args(
     t_eval: ArrayLike | None,
     dt_out: float | None,
 ) -> dict[str, Any]:
-    _check_type("method", method, str)
     if t_eval is None and dt_out is None:
         dt_out = DEFAULT_DT_OUT
     return {
         "solver": solver_settings(method, rtol, atol, dt, max_step, max_steps),
         "t_eval": _times(t_eval),
-        "dt_out": None if dt_out is None else float(dt_out),
+        "dt_out": None if dt_out is None else checks.real("dt_out", dt_out),
     }
 
 
@@ -68,24 +75,27 @@ def solver_settings(
     method: str, rtol: float, atol: float, dt: float | None, max_step: float, max_steps: int
 ) -> dict[str, Any]:
     """The integrator settings as the engine takes them (it checks the values and names any bad
-    one); ``dt`` is the fixed step of rk4, ``max_step`` caps rk45's step (s)."""
-    _check_type("method", method, str)
-    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
-        raise ValueError(f"max_steps = {max_steps!r} is invalid: must be an integer >= 1")
+    one); ``dt`` is the fixed step of rk4, ``max_step`` caps rk45's step (s). Types are checked
+    here: a bool or a string is not a number."""
     return {
-        "method": method,
-        "rtol": float(rtol),
-        "atol": float(atol),
-        "dt": None if dt is None else float(dt),
-        "max_step": float(max_step),
-        "max_steps": int(max_steps),
+        "method": checks.choice("method", method, _METHODS),
+        "rtol": checks.real("rtol", rtol),
+        "atol": checks.real("atol", atol),
+        "dt": None if dt is None else checks.real("dt", dt),
+        "max_step": checks.real("max_step", max_step),
+        "max_steps": checks.integer("max_steps", max_steps, 1),
     }
 
 
-def check_inputs(panel: Panel, orbit: Orbit | None = None) -> None:
+_NO_ORBIT: Any = object()
+
+
+def check_inputs(panel: Panel, orbit: Orbit = _NO_ORBIT) -> None:
+    """TypeError unless ``panel`` is a Panel (and ``orbit``, when the call takes one, an Orbit:
+    None is not an orbit)."""
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
-    if orbit is not None and not isinstance(orbit, Orbit):
+    if orbit is not _NO_ORBIT and not isinstance(orbit, Orbit):
         raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
 
 
@@ -115,7 +125,7 @@ def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Eq
     """
     check_inputs(panel)
     pd = panel.as_dict()
-    tf, tb, th = _core.steady_state(pd, bool(coupled), float(flux))
+    tf, tb, th = _core.steady_state(pd, checks.flag("coupled", coupled), checks.real("flux", flux))
     moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
     return Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
 
@@ -205,9 +215,9 @@ def simulate(
         orbit.as_dict(),
         t0,
         t1,
-        model=model,
-        coupled=bool(coupled),
-        y0=None if y0 is None else [float(v) for v in y0],
+        model=checks.choice("model", model, _MODELS),
+        coupled=checks.flag("coupled", coupled),
+        y0=start_state(y0, 4),
         **args,
     )
     return Solution(
@@ -246,8 +256,7 @@ def simulate_thermal(
     """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
     (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
     check_inputs(panel, orbit)
-    if layers not in (1, 2) or isinstance(layers, bool):
-        raise ValueError(f"layers = {layers!r} is invalid: must be 1 or 2")
+    layers = checks.integer("layers", layers, 1, 2)  # type: ignore[assignment]
     t0, t1 = time_span(t_span)
     args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
     raw = _core.simulate_thermal(
@@ -256,7 +265,7 @@ def simulate_thermal(
         t0,
         t1,
         layers=int(layers),
-        y0=None if y0 is None else [float(v) for v in y0],
+        y0=start_state(y0, int(layers)),
         **args,
     )
     return ThermalSolution(
@@ -295,16 +304,16 @@ def simulate_hinge(
     check_inputs(panel)
     t0, t1 = time_span(t_span)
     args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
-    m = np.ascontiguousarray(np.atleast_1d(np.asarray(moment, dtype=float)).ravel())
-    mt = None if moment_t is None else _times(moment_t)
+    m = checks.real_array("moment", moment)
+    mt = None if moment_t is None else checks.real_array("moment_t", moment_t)
     raw = _core.simulate_hinge(
         panel.as_dict(),
         t0,
         t1,
-        model=model,
+        model=checks.choice("model", model, _MODELS),
         moment=m,
         moment_t=mt,
-        y0=[float(v) for v in y0],
+        y0=start_state(y0, 2) or [],
         **args,
     )
     return HingeSolution(
@@ -329,6 +338,9 @@ def hinge_energy(
     """Energy of the hinge in a constant moment field (kinetic + spring − M θ), J.
     Conserved when c_d = 0."""
     check_inputs(panel)
-    th = np.ascontiguousarray(np.atleast_1d(np.asarray(theta, dtype=float)))
-    om = np.ascontiguousarray(np.atleast_1d(np.asarray(theta_dot, dtype=float)))
-    return np.asarray(_core.energy(panel.as_dict(), model, th, om, float(moment)))
+    th = checks.real_array("theta", theta)
+    om = checks.real_array("theta_dot", theta_dot)
+    if th.shape != om.shape:
+        raise ParameterError("theta_dot", theta_dot, f"must have theta's shape {th.shape}")
+    m = checks.finite("moment", moment)
+    return np.asarray(_core.energy(panel.as_dict(), model, th, om, m))

@@ -12,6 +12,44 @@ pub enum HingeModel {
     Linear,
 }
 
+/// |θ| the hinge model describes, rad: its two rigid halves fold by θ each, so beyond π/2 they
+/// would pass through each other (and the paper's use is for a few degrees).
+pub const MAX_HINGE_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Checks an angle given to the hinge model (a start state, a limit): within ±π/2 rad. The
+/// message says what a value in degrees would have been, the likely slip.
+pub fn check_hinge_angle(name: &str, theta: f64) -> crate::Result<()> {
+    if theta.is_finite() && theta.abs() <= MAX_HINGE_ANGLE {
+        return Ok(());
+    }
+    let mut reason = "must be within ±π/2 rad (the hinge model's range)".to_string();
+    if theta.is_finite() && theta.abs() <= 360.0 {
+        reason += &format!(
+            "; if degrees were meant, {theta}° = {:.6} rad",
+            theta.to_radians()
+        );
+    }
+    Err(crate::Error::invalid(name, theta, &reason))
+}
+
+/// The static angle M/K_el of a moment on the hinge, checked against the hinge model's range:
+/// a larger moment would fold the panel beyond what the model describes.
+pub fn check_moment(panel: &Panel, moment: f64) -> crate::Result<()> {
+    let angle = moment / panel.hinge_stiffness;
+    if angle.is_finite() && angle.abs() <= MAX_HINGE_ANGLE {
+        return Ok(());
+    }
+    Err(crate::Error::invalid(
+        "moment",
+        moment,
+        &format!(
+            "gives a static angle M/K_el = {angle:.3e} rad, beyond the hinge model's range \
+             (|M| <= {:.4e} N m with this hinge_stiffness)",
+            MAX_HINGE_ANGLE * panel.hinge_stiffness
+        ),
+    ))
+}
+
 /// A structural model of the plate: its states (positions, then velocities), their rates under
 /// the thermal moment, and the projected-area factor its shape imposes on the absorbed flux.
 ///
@@ -43,6 +81,12 @@ pub trait StructuralModel {
 
     /// Refuses a rest shape outside the model's range (the hinge beyond 90°).
     fn check_static(&self, _positions: &[f64]) -> Result<()> {
+        Ok(())
+    }
+
+    /// Refuses a start state outside the model's range; `offset` is the index of the first of
+    /// `states` in the full state, to name it.
+    fn check_start(&self, _offset: usize, _states: &[f64]) -> Result<()> {
         Ok(())
     }
 }
@@ -160,6 +204,9 @@ impl StructuralModel for Hinge {
     /// coincide.
     fn static_residual(&self, moment: f64, positions: &[f64], out: &mut [f64]) {
         out[0] = (moment - self.hinge_stiffness * positions[0]) / self.hinge_stiffness;
+    }
+    fn check_start(&self, offset: usize, states: &[f64]) -> Result<()> {
+        check_hinge_angle(&format!("y0[{offset}]"), states[0])
     }
     fn check_static(&self, positions: &[f64]) -> Result<()> {
         let theta = positions[0];

@@ -52,6 +52,18 @@ impl EnsembleSettings {
         if self.n_orbits == 0 {
             return Err(Error::invalid("horizon", 0, "must be >= 1 orbit"));
         }
+        let t_end = self.n_orbits as f64 * self.orbit.period;
+        if self.orbit.check_span(0.0, t_end).is_err() {
+            return Err(Error::invalid(
+                "horizon",
+                self.n_orbits,
+                &format!(
+                    "reaches t = {t_end:e} s; at most {:e} s and {:e} eclipses per sample",
+                    crate::integrate::MAX_TIME,
+                    crate::orbit::MAX_ECLIPSES
+                ),
+            ));
+        }
         if let Some(th) = self.threshold {
             require_positive("threshold", th)?;
         }

@@ -28,9 +28,27 @@ impl Error {
     pub fn invalid(name: &str, value: impl std::fmt::Display, reason: &str) -> Self {
         Error::InvalidParameter {
             name: name.to_string(),
-            value: value.to_string(),
+            value: readable(value.to_string()),
             reason: reason.to_string(),
         }
+    }
+}
+
+/// A number as a person writes it: Rust prints 1e300 with all its 301 digits, so long numbers
+/// are shown in exponent form (the value itself is unchanged).
+fn readable(text: String) -> String {
+    match text.parse::<f64>() {
+        Ok(x) if text.len() > 16 => format!("{x:e}"),
+        _ => text,
+    }
+}
+
+/// A bound as a person writes it: plain between 1e-3 and 1e5, else in exponent form.
+pub fn short(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }
 

@@ -26,6 +26,17 @@
 use crate::error::{require_finite, require_positive, Error, Result};
 use std::f64::consts::PI;
 
+/// Shortest orbit period accepted, s: a grazing orbit of a dense body takes tens of minutes; a
+/// shorter one is a unit slip (minutes or hours given for seconds) and would cost an eclipse
+/// every few steps.
+pub const MIN_PERIOD: f64 = 60.0;
+/// Largest |phase0|, rad: beyond it the phase loses its precision (1e3 rad: ~1e-13 rad).
+pub const MAX_PHASE0: f64 = 1e3;
+/// Largest |epoch_day|, days.
+pub const MAX_EPOCH_DAY: f64 = 1e5;
+/// Most eclipses one call may compute (intervals, breakpoints of one integration).
+pub const MAX_ECLIPSES: f64 = 1e6;
+
 /// GEO radius, m.
 pub const GEO_RADIUS: f64 = 42_164_170.0;
 /// Equatorial Earth radius, m.
@@ -162,6 +173,27 @@ impl Orbit {
         require_positive("period", self.period)?;
         require_finite("phase0", self.phase0)?;
         require_finite("epoch_day", self.epoch_day)?;
+        if self.period < MIN_PERIOD {
+            return Err(Error::invalid(
+                "period",
+                self.period,
+                &format!("must be >= {MIN_PERIOD} s (no orbit is faster)"),
+            ));
+        }
+        if self.phase0.abs() > MAX_PHASE0 {
+            return Err(Error::invalid(
+                "phase0",
+                self.phase0,
+                &format!("must be in [-{MAX_PHASE0}, {MAX_PHASE0}] rad (reduce it modulo 2π)"),
+            ));
+        }
+        if self.epoch_day.abs() > MAX_EPOCH_DAY {
+            return Err(Error::invalid(
+                "epoch_day",
+                self.epoch_day,
+                &format!("must be in [-{MAX_EPOCH_DAY}, {MAX_EPOCH_DAY}] days"),
+            ));
+        }
         if self.earth_radius >= self.radius {
             return Err(Error::invalid(
                 "earth_radius",
@@ -187,6 +219,42 @@ impl Orbit {
             }
         }
         Ok(())
+    }
+
+    /// Checks a span of time for the shadow computations: finite, increasing, and holding at
+    /// most [`MAX_ECLIPSES`] eclipses, counted up front, so that no list grows without bound.
+    pub fn check_span(&self, t0: f64, t1: f64) -> Result<()> {
+        crate::integrate::check_span(t0, t1)?;
+        if self.shadow == Shadow::None {
+            return Ok(());
+        }
+        let n = (t1 - t0) / self.synodic_period() + 2.0;
+        if n > MAX_ECLIPSES {
+            return Err(Error::invalid(
+                "t_span",
+                format!("({t0}, {t1})"),
+                &format!(
+                    "covers about {n:.3e} eclipses; at most {MAX_ECLIPSES:e} per call \
+                     (long runs go orbit by orbit: simulate_orbits)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks one time at which s(t), the flux or the declination is asked: finite and within
+    /// ±[`crate::integrate::MAX_TIME`].
+    pub fn check_time(t: f64) -> Result<()> {
+        let limit = crate::integrate::MAX_TIME;
+        if t.abs() <= limit {
+            Ok(())
+        } else {
+            Err(Error::invalid(
+                "t",
+                t,
+                &format!("must be finite and in [-{limit:e}, {limit:e}] s"),
+            ))
+        }
     }
 
     /// Half the orbit arc spent in the cylindrical shadow at equinox, asin(R_E / r), rad.

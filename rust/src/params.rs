@@ -1,7 +1,7 @@
 //! The panel: every parameter of the paper's Table 1, plus the solar constant and the χ scaling of
 //! the thermal moment. Validation returns errors; nothing here panics.
 
-use crate::error::{require_non_negative, require_positive, Error, Result};
+use crate::error::{short, Error, Result};
 
 /// A long, thin, Sun-pointing plate of unit width (all quantities SI).
 ///
@@ -155,26 +155,81 @@ impl Panel {
         })
     }
 
-    /// Checks every parameter; the first offending one is named in the error.
+    /// The physical range of each parameter: (name, low, high, low end open); the high end is
+    /// closed. The ranges are wide (a thin film to a truss boom, polymers to steel) but finite:
+    /// values outside them are unit slips or typing errors, and would make the model meaningless
+    /// or the integration endless.
+    pub const RANGES: [(&'static str, f64, f64, bool); 16] = [
+        ("emissivity_front", 0.0, 1.0, true),
+        ("emissivity_back", 0.0, 1.0, true),
+        ("absorptivity", 0.0, 1.0, true),
+        ("specific_heat", 10.0, 1e5, false),
+        ("mass_per_length", 1e-3, 1e4, false),
+        ("expansion_coeff", 0.0, 1e-3, true),
+        ("length", 0.1, 1e4, false),
+        ("youngs_modulus", 1e6, 1e13, false),
+        ("thickness", 1e-5, 10.0, false),
+        ("width", 1e-3, 1e3, false),
+        ("conductance", 0.0, 1e6, true),
+        ("hinge_stiffness", 0.0, 1e12, true),
+        ("bending_inertia", 0.0, 1e3, true),
+        ("damping", 0.0, 1e9, false),
+        ("solar_constant", 0.0, 1e5, true),
+        ("moment_scale", 0.0, 100.0, true),
+    ];
+
+    /// The fastest rate the model may have, 1/s: the hinge's natural angular frequency, its
+    /// damping rate c_d/I_B and the thermal rate 2K/(m c) are each at most this. Beyond it an
+    /// explicit integrator needs more than ~10⁸ steps per orbit (the paper's panel: 0.8 rad/s).
+    pub const MAX_RATE: f64 = 1e3;
+
+    /// Checks every parameter against [`Panel::RANGES`], then the rates against
+    /// [`Panel::MAX_RATE`]; the first offending parameter is named in the error.
     pub fn validate(&self) -> Result<()> {
-        for name in ["emissivity_front", "emissivity_back", "absorptivity"] {
+        for (name, low, high, open) in Self::RANGES {
             let v = self.get(name)?;
-            if !(v.is_finite() && v > 0.0 && v <= 1.0) {
-                return Err(Error::invalid(name, v, "must be in (0, 1]"));
+            let above_low = if open { v > low } else { v >= low };
+            if !(v.is_finite() && above_low && v <= high) {
+                let (low, high) = (short(low), short(high));
+                let range = if open {
+                    format!("must be in ({low}, {high}]")
+                } else {
+                    format!("must be in [{low}, {high}]")
+                };
+                return Err(Error::invalid(name, v, &range));
             }
         }
-        for name in Self::FIELDS {
-            if matches!(
-                name,
-                "emissivity_front" | "emissivity_back" | "absorptivity"
-            ) {
-                continue;
-            }
-            let v = self.get(name)?;
-            if name == "damping" {
-                require_non_negative(name, v)?;
-            } else {
-                require_positive(name, v)?;
+        let inertia = self.hinge_inertia();
+        let rates = [
+            (
+                "hinge_stiffness",
+                self.hinge_stiffness,
+                self.natural_angular_frequency(),
+                "the hinge's natural angular frequency sqrt(K_el/I_B)",
+            ),
+            (
+                "damping",
+                self.damping,
+                self.damping / inertia,
+                "the damping rate c_d/I_B",
+            ),
+            (
+                "conductance",
+                self.conductance,
+                2.0 * self.conductance / self.heat_capacity(),
+                "the conduction rate 2K/(m c)",
+            ),
+        ];
+        for (name, value, rate, what) in rates {
+            if rate.is_nan() || rate > Self::MAX_RATE {
+                return Err(Error::invalid(
+                    name,
+                    value,
+                    &format!(
+                        "gives {what} = {rate:.3e} 1/s with the other parameters; at most {:e} 1/s",
+                        Self::MAX_RATE
+                    ),
+                ));
             }
         }
         Ok(())

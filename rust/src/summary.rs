@@ -122,6 +122,10 @@ pub struct SummaryOptions {
     pub steps_per_period: f64,
 }
 
+/// Largest [`SummaryOptions::steps_per_period`]: finer steps than T_n/10⁴ resolve nothing more
+/// and only multiply the cost.
+pub const MAX_STEPS_PER_PERIOD: f64 = 1e4;
+
 /// Default of [`SummaryOptions::steps_per_period`]: Dormand–Prince's dissipation then stays
 /// below 1 % of a growth rate of 1e-6 1/s (it falls as the fifth power of the step).
 pub const STEPS_PER_HINGE_PERIOD: f64 = 40.0;
@@ -166,6 +170,21 @@ impl<V: SummaryView> Collector<V> {
         n_orbits: u64,
         theta0: f64,
     ) -> Result<Self> {
+        // The span (and with it the eclipses and the rows kept) is checked before anything is
+        // allocated for it.
+        let t_end = t_start + n_orbits as f64 * orbit.period;
+        orbit.check_span(t_start, t_end).map_err(|_| {
+            crate::Error::invalid(
+                "n_orbits",
+                n_orbits,
+                &format!(
+                    "with t_start = {t_start} s reaches t = {t_end:e} s; at most {:e} s and \
+                     {:e} eclipses",
+                    crate::integrate::MAX_TIME,
+                    crate::orbit::MAX_ECLIPSES
+                ),
+            )
+        })?;
         let mut collector = Collector {
             view,
             orbit: *orbit,
@@ -496,11 +515,19 @@ where
     cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
-    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    crate::dynamics::check_hinge_angle(&format!("y0[{theta_index}]"), y0[theta_index])?;
+    if !(0.0..=MAX_STEPS_PER_PERIOD).contains(&options.steps_per_period) {
+        return Err(crate::Error::invalid(
+            "steps_per_period",
+            options.steps_per_period,
+            &format!("must be in [0, {MAX_STEPS_PER_PERIOD:e}] (0: error control alone)"),
+        ));
+    }
     let method = &resolve_hinge(method, panel, options.steps_per_period);
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
+    let t_end = t_start + n_orbits as f64 * orbit.period;
     let collector = Collector::new(
         view,
         orbit,
@@ -515,7 +542,6 @@ where
         error: None,
         cancel,
     };
-    let t_end = t_start + n_orbits as f64 * orbit.period;
     let (stats, y_end) = solve(system, method, t_start, y0, t_end, &mut observer)?;
     if let Some(e) = observer.error {
         return Err(e);

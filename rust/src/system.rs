@@ -149,6 +149,12 @@ where
         self.thermal.moment(&y.as_slice()[..self.thermal.size()])
     }
 
+    /// Refuses a start state the structural model does not describe (the hinge beyond ±π/2).
+    pub fn check_start(&self, y: &State<D>) -> Result<()> {
+        let n = self.thermal.size();
+        self.structure.check_start(n, &y.as_slice()[n..])
+    }
+
     /// The steady state under constant flux factor `flux`, velocities zero: the default start
     /// of a run.
     pub fn steady_state(&self, flux: f64) -> Result<State<D>> {
@@ -199,6 +205,9 @@ where
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)
     }
+    fn check_span(&self, t0: f64, t1: f64) -> crate::Result<()> {
+        self.sun.orbit.check_span(t0, t1)
+    }
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
@@ -228,6 +237,17 @@ impl MomentHistory {
                 let w = (t - ts[i]) / (ts[i + 1] - ts[i]);
                 moment[i] + w * (moment[i + 1] - moment[i])
             }
+        }
+    }
+
+    /// Checks every value against the hinge model's range for this panel
+    /// ([`crate::dynamics::check_moment`]).
+    pub fn check_against(&self, panel: &crate::Panel) -> Result<()> {
+        match self {
+            MomentHistory::Constant(m) => crate::dynamics::check_moment(panel, *m),
+            MomentHistory::Samples { moment, .. } => moment
+                .iter()
+                .try_for_each(|&m| crate::dynamics::check_moment(panel, m)),
         }
     }
 

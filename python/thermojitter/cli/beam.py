@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from thermojitter.cli.common import out_dir
+from thermojitter.cli.common import add_out, out_dir
 
 
 def add_parser(sub: Any) -> None:
@@ -22,7 +22,7 @@ def add_parser(sub: Any) -> None:
         ),
         epilog="Example: thermojitter beam --out out/beam",
     )
-    beam.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    add_out(beam, required=True, help="output folder (created)")
     beam.add_argument(
         "--elements",
         type=int,
@@ -47,5 +47,8 @@ def run(args: argparse.Namespace) -> int:
     from thermojitter.beam import write_beam_comparison
 
     return write_beam_comparison(
-        out_dir(args.out), args.elements, not args.no_calibrate, not args.no_distributed
+        out_dir(args.out, args.overwrite),
+        args.elements,
+        not args.no_calibrate,
+        not args.no_distributed,
     )

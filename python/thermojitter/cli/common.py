@@ -7,8 +7,11 @@ import argparse
 import math
 import signal
 import threading
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, BinaryIO, NoReturn
+
+from thermojitter.checkpoint import write_atomic
 
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
@@ -55,16 +58,46 @@ STOP = StopFlag()
 """The flag of the running command (polled by long runs and ``paper``)."""
 
 
-def out_dir(path: str | Path) -> Path:
-    """The output folder, created; a UserError when it cannot be."""
+def out_dir(path: str | Path, overwrite: bool = False) -> Path:
+    """The output folder, created; a UserError when it cannot be, or when it already holds files
+    and ``overwrite`` (--overwrite) is not given, so that earlier results are never replaced
+    silently."""
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise UserError(f"--out {path}: exists and is not a folder")
+    if folder.is_dir() and not overwrite and any(folder.iterdir()):
+        raise UserError(
+            f"--out {path}: the folder is not empty; pass --overwrite to replace its files "
+            "(and to resume a run from the checkpoint there), or choose another folder"
+        )
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise UserError(f"--out {path}: cannot create the folder ({exc.strerror})") from None
     return folder
+
+
+def add_out(parser: argparse.ArgumentParser, **kwargs: Any) -> None:
+    """--out DIR and --overwrite, the same for every subcommand."""
+    parser.add_argument("--out", metavar="DIR", **kwargs)
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="write into a non-empty --out, replacing its files (a run resumes from the "
+        "checkpoint there)",
+    )
+
+
+def write_output(path: Path, write: Callable[[BinaryIO], object]) -> Path:
+    """Writes one output file atomically (a temporary file renamed over it): a failure, such as
+    a full disk, leaves no partial file and is reported in one line naming the file."""
+    try:
+        write_atomic(path, write)
+    except OSError as exc:
+        raise UserError(
+            f"{path}: cannot be written ({exc.strerror or exc}); no partial file was left"
+        ) from None
+    return path
 
 
 def positive(text: str) -> float:

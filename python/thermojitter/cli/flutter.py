@@ -26,7 +26,7 @@ from typing import Any, Literal, cast
 import numpy as np
 
 from thermojitter import _core
-from thermojitter.cli.common import UserError, out_dir
+from thermojitter.cli.common import UserError, add_out, out_dir, write_output
 from thermojitter.flutter import (
     FlutterResult,
     flutter,
@@ -99,7 +99,7 @@ def add_parser(sub: Any) -> None:
         epilog="Example: thermojitter flutter examples/paper.toml --out out/flutter",
     )
     parser.add_argument("scenario", nargs="?", help="TOML scenario (default: Table 1 at GEO)")
-    parser.add_argument("--out", default="out/flutter", help="output directory")
+    add_out(parser, default="out/flutter", help="output folder (created)")
     parser.add_argument("--x", default=None, help=f"map x axis NAME:START:STOP:N ({DEFAULT_X})")
     parser.add_argument("--y", default=None, help=f"map y axis NAME:START:STOP:N ({DEFAULT_Y})")
     parser.add_argument("--model", choices=MODELS, default=None, help="hinge model of the map")
@@ -186,7 +186,7 @@ def run(args: argparse.Namespace) -> int:
         )
     print("\n".join(lines))
 
-    out = out_dir(args.out)
+    out = out_dir(args.out, args.overwrite)
     png = out / "stability_map.png"
     if not args.no_plot:
         from thermojitter.plots import stability_map_figure
@@ -227,6 +227,6 @@ def run(args: argparse.Namespace) -> int:
             "png": None if args.no_plot else png.name,
         },
     }
-    (out / "flutter.json").write_text(json.dumps(record, indent=2))
+    write_output(out / "flutter.json", lambda fh: fh.write(json.dumps(record, indent=2).encode()))
     print(f"  wrote {out / 'flutter.json'}" + ("" if args.no_plot else f" and {png}"))
     return 0

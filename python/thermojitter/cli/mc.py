@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from thermojitter.cli.common import Interrupted, out_dir
+from thermojitter.cli.common import Interrupted, add_out, out_dir, write_output
 from thermojitter.montecarlo import monte_carlo
 from thermojitter.scenario import ScenarioError, load_scenario
 
@@ -68,7 +68,7 @@ def add_parser(sub: Any) -> None:
         epilog="Example: thermojitter mc examples/montecarlo.toml --n 200 --out out/mc",
     )
     p.add_argument("scenario", help="scenario TOML with [panel], [orbit], [vary] tables")
-    p.add_argument("--out", required=True, help="output directory")
+    add_out(p, required=True, help="output folder (created)")
     p.add_argument("--n", type=int, help="number of samples (default 1000)")
     p.add_argument("--seed", type=int, help="seed of the design (default 0)")
     p.add_argument("--sampler", choices=("random", "lhs", "sobol"))
@@ -92,7 +92,7 @@ def add_parser(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     scenario = read_scenario(args.scenario)
     s = scenario["settings"]
-    out = out_dir(args.out)
+    out = out_dir(args.out, args.overwrite)
     run = {k: s[k] for k in RUN_KEYS if k in s}
     for key in ("horizon", "threshold"):
         if getattr(args, key) is not None:
@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
     )
     if frame.attrs["interrupted"]:
         raise Interrupted  # monte_carlo said what it kept and how to resume
-    frame.to_parquet(out / "samples.parquet")
+    write_output(out / "samples.parquet", lambda fh: frame.to_parquet(fh))
     names = list(scenario["vary"])
     flutter = int((~frame["stable"]).sum())
     failed = int(frame["error"].notna().sum())

@@ -6,7 +6,7 @@ import argparse
 import time
 from typing import Any
 
-from thermojitter.cli.common import STOP, out_dir, positive
+from thermojitter.cli.common import STOP, add_out, out_dir, positive
 
 
 def add_parser(sub: Any) -> None:
@@ -20,7 +20,7 @@ def add_parser(sub: Any) -> None:
         ),
         epilog="Example: thermojitter paper --out out/",
     )
-    paper.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    add_out(paper, required=True, help="output folder (created)")
     paper.add_argument(
         "--flutter-hours",
         type=positive,
@@ -62,7 +62,9 @@ def run(args: argparse.Namespace) -> int:
         flutter_hours=args.flutter_hours if args.flutter_hours is not None else base.flutter_hours,
     )
     started = time.perf_counter()
-    summary = run_paper(out_dir(args.out), options, progress=not args.no_progress, stop=STOP)
+    summary = run_paper(
+        out_dir(args.out, args.overwrite), options, progress=not args.no_progress, stop=STOP
+    )
     elapsed = time.perf_counter() - started
     print(
         f"wrote {len(summary['figures'])} figures, summary.json and report.md to {args.out} "

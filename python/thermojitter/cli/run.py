@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from thermojitter.cli.common import STOP, Interrupted, UserError, out_dir
+from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_dir, write_output
 from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.scenario import Scenario, ScenarioError, load_scenario
 
@@ -168,12 +168,15 @@ def write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
 
     frame = pd.DataFrame(columns)
     if fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise UserError("Parquet output needs pyarrow: pip install pyarrow") from None
         target = path.with_suffix(".parquet")
-        frame.to_parquet(target, index=False)
-    else:
-        target = path.with_suffix(".csv")
-        frame.to_csv(target, index=False)  # shortest round-trip representation
-    return target
+        return write_output(target, lambda fh: frame.to_parquet(fh, index=False))
+    target = path.with_suffix(".csv")
+    # Shortest round-trip representation of each float.
+    return write_output(target, lambda fh: fh.write(frame.to_csv(index=False).encode()))
 
 
 def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) -> int:
@@ -187,6 +190,13 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
     if sim.years is None and abs(n - n_orbits) > 1e-6 * max(n, 1.0):
         raise ScenarioError(
             scenario.source, "simulation", f"keep = 'orbits' needs whole orbits; the span is {n:g}"
+        )
+    if n_orbits > MAX_ORBITS:
+        key = next(k for k in ("years", "orbits", "t_end") if getattr(sim, k) is not None)
+        raise ScenarioError(
+            scenario.source,
+            f"simulation.{key}",
+            f"the span covers {n:.3g} orbits, more than {MAX_ORBITS:.0e}: shorten it",
         )
     fmt = args.format or scenario.output.format
     check_writer(fmt)
@@ -232,7 +242,9 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         "files": files,
         "wall_time_s": round(time.perf_counter() - started, 2),
     }
-    (out / "run.json").write_text(json.dumps(meta, indent=2) + "\n")
+    write_output(
+        out / "run.json", lambda fh: fh.write((json.dumps(meta, indent=2) + "\n").encode())
+    )
     if runs.interrupted:
         report_interrupted(
             f"kept {len(runs)} of {n_orbits} orbits in {out / 'checkpoint.json'}",
@@ -254,7 +266,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
 
 def run_command(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
-    out = out_dir(args.out)
+    out = out_dir(args.out, args.overwrite)
     if scenario.simulation.keep == "orbits":
         return run_orbits_command(args, scenario, out)
     fmt = args.format or scenario.output.format
@@ -307,7 +319,9 @@ def run_command(args: argparse.Namespace) -> int:
         "files": files,
         "wall_time_s": round(time.perf_counter() - started, 2),
     }
-    (out / "run.json").write_text(json.dumps(meta, indent=2) + "\n")
+    write_output(
+        out / "run.json", lambda fh: fh.write((json.dumps(meta, indent=2) + "\n").encode())
+    )
     if interrupted:
         report_interrupted(
             f"kept {len(t)} samples up to t = {t[-1] if len(t) else 0:.0f} s in {args.out}",
@@ -338,7 +352,7 @@ def add_parser(sub: Any) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     run.add_argument("scenario", metavar="SCENARIO.toml", help="the scenario file")
-    run.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    add_out(run, required=True, help="output folder (created)")
     run.add_argument(
         "--format", choices=("csv", "parquet"), help="override [output] format of the file"
     )

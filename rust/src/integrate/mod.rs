@@ -36,6 +36,12 @@ where
         Vec::new()
     }
 
+    /// Refuses a span whose breakpoints could not be listed at a bounded cost (called before
+    /// [`OdeSystem::breakpoints`]); by default only the checks of [`check_span`].
+    fn check_span(&self, t0: f64, t1: f64) -> Result<()> {
+        check_span(t0, t1)
+    }
+
     /// Called before integrating the segment [a, b] between two breakpoints.
     fn enter_segment(&mut self, _a: f64, _b: f64) {}
 }
@@ -185,13 +191,21 @@ impl Method {
         match self {
             Method::Rk4 { dt } => require_positive("dt", *dt),
             Method::Dopri5(tol) => {
-                require_positive("rtol", tol.rtol)?;
-                require_positive("atol", tol.atol)?;
-                if tol.rtol < 1e-14 {
+                // Tolerances looser than these let the error control accept steps past the
+                // stability limit: the run then wanders off to θ of thousands of radians, or
+                // stalls rejecting steps, instead of failing.
+                if !(1e-14..=MAX_RTOL).contains(&tol.rtol) {
                     return Err(Error::invalid(
                         "rtol",
                         tol.rtol,
-                        "must be >= 1e-14 (double precision)",
+                        &format!("must be in [1e-14, {MAX_RTOL:e}] (double precision to 1 %)"),
+                    ));
+                }
+                if !(tol.atol > 0.0 && tol.atol <= MAX_ATOL) {
+                    return Err(Error::invalid(
+                        "atol",
+                        tol.atol,
+                        &format!("must be in (0, {MAX_ATOL:e}] (K, rad, rad/s)"),
                     ));
                 }
                 if tol.max_step.is_nan() || tol.max_step <= 0.0 {
@@ -232,7 +246,20 @@ where
     DefaultAllocator: Allocator<D>,
 {
     method.validate()?;
-    check_span(t0, t1)?;
+    system.check_span(t0, t1)?;
+    if let Method::Rk4 { dt } = method {
+        // A fixed step's cost is known up front.
+        let n = (t1 - t0) / dt;
+        if n > MAX_FIXED_STEPS {
+            return Err(Error::invalid(
+                "dt",
+                dt,
+                &format!(
+                    "would take {n:.3e} steps over the span; at most {MAX_FIXED_STEPS:e} (use a larger dt)"
+                ),
+            ));
+        }
+    }
     if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
         return Err(Error::invalid(
             "y0",
@@ -268,10 +295,29 @@ where
     Ok((stats, y))
 }
 
-/// Checks an integration span: finite ends, t1 > t0.
+/// Loosest relative tolerance accepted.
+pub const MAX_RTOL: f64 = 1e-2;
+/// Loosest absolute tolerance accepted (the state is in K, rad and rad/s; θ is ~0.1 rad).
+pub const MAX_ATOL: f64 = 1e-3;
+
+/// Most steps a fixed-step run may take (the adaptive one stops at `max_steps`).
+pub const MAX_FIXED_STEPS: f64 = 5e8;
+
+/// Largest |t| of a span, s (about 3,000 years): beyond it a step of a second is lost in the
+/// rounding of t, and the orbit's phase means nothing.
+pub const MAX_TIME: f64 = 1e11;
+
+/// Checks an integration span: finite ends within ±[`MAX_TIME`], t1 > t0.
 pub fn check_span(t0: f64, t1: f64) -> Result<()> {
-    crate::error::require_finite("t_span[0]", t0)?;
-    crate::error::require_finite("t_span[1]", t1)?;
+    for (name, t) in [("t_span[0]", t0), ("t_span[1]", t1)] {
+        if t.is_nan() || t.abs() > MAX_TIME {
+            return Err(Error::invalid(
+                name,
+                t,
+                &format!("must be finite and in [-{MAX_TIME:e}, {MAX_TIME:e}] s"),
+            ));
+        }
+    }
     if t1 <= t0 {
         return Err(Error::invalid(
             "t_span",

@@ -55,6 +55,7 @@ fn run_orbits<'py>(
             Coupling::Frozen
         };
         let m = solver_from(solver)?;
+        crate::dynamics::check_hinge_angle("theta_limit", theta_limit)?;
         let options = SummaryOptions {
             window,
             theta_limit,
@@ -191,6 +192,8 @@ fn run_orbits_hybrid<'py>(
         };
         let m = solver_from(solver)?;
         let y = state(&y0, U4)?;
+        crate::dynamics::check_hinge_angle("theta_limit", theta_limit)?;
+        crate::dynamics::check_hinge_angle("y0[2]", y[2])?;
         let options = SummaryOptions {
             window,
             theta_limit,

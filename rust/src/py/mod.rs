@@ -151,7 +151,7 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
 fn shadow_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        crate::integrate::check_span(t0, t1)?;
+        o.check_span(t0, t1)?;
         Ok(o.shadow_intervals(t0, t1))
     })
 }
@@ -165,7 +165,11 @@ fn illumination<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        let s = t.as_array().iter().map(|&x| o.illumination(x)).collect();
+        let t = t.as_array();
+        for &x in t.iter() {
+            crate::Orbit::check_time(x)?;
+        }
+        let s = t.iter().map(|&x| o.illumination(x)).collect();
         Ok(array(py, s))
     })
 }
@@ -274,7 +278,11 @@ where
 {
     let orbit = *sys.orbit();
     let y_start = match y0 {
-        Some(v) => state(&v, sys.dim())?,
+        Some(v) => {
+            let y = state(&v, sys.dim())?;
+            sys.check_start(&y)?;
+            y
+        }
         None => sys.steady_state(orbit.flux_scale(span.0))?,
     };
     let traj = py.detach(|| run(&mut sys, method, span, y_start, out))?;
@@ -367,7 +375,9 @@ fn simulate_hinge<'py>(
             },
         };
         history.validate()?;
+        history.check_against(&p)?;
         let y_start = state(&y0, U2)?;
+        crate::dynamics::check_hinge_angle("y0[0]", y_start[0])?;
         let traj = py.detach(|| {
             let mut sys = DrivenHinge {
                 panel: p,
@@ -399,6 +409,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("CASE_A_PANEL", panel_dict(m.py(), &crate::Panel::case_a())?)?;
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
+    m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(steady_state, m)?)?;

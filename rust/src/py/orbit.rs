@@ -16,7 +16,7 @@ type EclipseRow = (f64, f64, f64, f64, f64);
 fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<EclipseRow>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        crate::integrate::check_span(t0, t1)?;
+        o.check_span(t0, t1)?;
         Ok(o.eclipses(t0, t1)
             .iter()
             .map(|e| {
@@ -32,7 +32,7 @@ fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<Eclipse
 fn umbra_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        crate::integrate::check_span(t0, t1)?;
+        o.check_span(t0, t1)?;
         Ok(o.umbra_intervals(t0, t1))
     })
 }
@@ -42,7 +42,7 @@ fn umbra_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<
 fn orbit_breakpoints(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<f64>> {
     shield(|| {
         let o = orbit_from(orbit)?;
-        crate::integrate::check_span(t0, t1)?;
+        o.check_span(t0, t1)?;
         Ok(o.breakpoints(t0, t1))
     })
 }
@@ -54,7 +54,11 @@ fn map_times<'py>(
     f: impl Fn(&Orbit, f64) -> f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let o = orbit_from(orbit)?;
-    let v: Vec<f64> = t.as_array().iter().map(|&x| f(&o, x)).collect();
+    let t = t.as_array();
+    for &x in t.iter() {
+        Orbit::check_time(x)?;
+    }
+    let v: Vec<f64> = t.iter().map(|&x| f(&o, x)).collect();
     Ok(PyArray1::from_vec(py, v))
 }
 

@@ -1,0 +1,99 @@
+"""The long run of the fuzz harness (tests/fuzzing.py): N generated hostile calls of the public API
+and the scenario parser, each in a worker process under a 20 s watchdog; prints the count of each
+outcome, the share of refusals that name the parameter, and every failure.
+
+    python benches/fuzz.py --n 10000
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import platform
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
+from fuzzing import FAILURES, OUTCOMES, Example, Runner, examples  # noqa: E402
+from hypothesis import HealthCheck, given, seed, settings  # noqa: E402
+
+
+def cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=10_000, help="number of generated calls")
+    parser.add_argument("--limit", type=float, default=20.0, help="watchdog per call, s")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+
+    counts: collections.Counter[str] = collections.Counter()
+    by_target: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
+    failures: list[tuple[Example, str, str]] = []
+    unnamed: list[tuple[Example, str]] = []
+    slowest: tuple[float, Example | None] = (0.0, None)
+    runner = Runner(limit=args.limit)
+    started = time.perf_counter()
+
+    @settings(
+        max_examples=args.n,
+        deadline=None,
+        database=None,
+        derandomize=False,
+        suppress_health_check=list(HealthCheck),
+    )
+    @given(example=examples())
+    def one(example: Example) -> None:
+        nonlocal slowest
+        t = time.perf_counter()
+        outcome, detail = runner.run(example)
+        elapsed = time.perf_counter() - t
+        if elapsed > slowest[0]:
+            slowest = (elapsed, example)
+        counts[outcome] += 1
+        by_target[example.target][outcome] += 1
+        if outcome in FAILURES:
+            failures.append((example, outcome, detail))
+        elif outcome == "refused_unnamed":
+            unnamed.append((example, detail))
+        done = sum(counts.values())
+        if done % 1000 == 0:
+            print(f"  {done} calls, {time.perf_counter() - started:.0f} s", file=sys.stderr)
+
+    seed(args.seed)(one)()
+    runner.close()
+    total = sum(counts.values())
+    refusals = counts["refused_named"] + counts["refused_unnamed"]
+    print(f"CPU: {cpu_model()}")
+    print(f"{total} generated calls in {time.perf_counter() - started:.0f} s")
+    for outcome in OUTCOMES:
+        print(f"  {outcome:16s} {counts[outcome]:6d}")
+    if refusals:
+        print(f"refusals naming the parameter: {100.0 * counts['refused_named'] / refusals:.2f} %")
+    print(f"slowest call: {slowest[0]:.2f} s ({slowest[1]})")
+    print("per entry point (ok / refused / runtime error):")
+    for target in sorted(by_target):
+        c = by_target[target]
+        print(
+            f"  {target:24s} {c['ok']:5d} {c['refused_named'] + c['refused_unnamed']:5d} "
+            f"{c['runtime_error']:5d}"
+        )
+    for example, outcome, detail in failures[:50]:
+        print(f"FAILURE {outcome}: {example}: {detail}")
+    for example, detail in unnamed[:50]:
+        print(f"UNNAMED: {example}: {detail}")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
