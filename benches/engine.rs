@@ -1,16 +1,20 @@
 //! Engine micro-benchmarks with std-only timing (no harness): the coupled right-hand side, one
-//! Dormand–Prince step, and one GEO orbit at rtol 1e-8 / atol 1e-10.
+//! Dormand–Prince step, one GEO orbit at rtol 1e-8 / atol 1e-10, and Monte Carlo samples of one
+//! orbit on one thread, one at a time and in lockstep lanes.
 //!
 //!     cargo bench --bench engine
 //!
 //! Each figure is the median over several batches, in ns per call (per step for the orbit).
 //! A word after `--` keeps only the benches whose name contains it: rhs, step, orbit-none,
-//! orbit-end, orbit-every (`-- orbit` runs the three orbits).
+//! orbit-end, orbit-every (`-- orbit` runs the three orbits), ensemble. The first line names the
+//! processor and the instruction sets it has and the build uses.
 
 use nalgebra::Vector4;
 use std::hint::black_box;
 use std::time::Instant;
+use thermojitter::cancel::Cancel;
 use thermojitter::dynamics::HingeModel;
+use thermojitter::ensemble::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::integrate::dopri5;
 use thermojitter::integrate::{solve, Method, OdeSystem, Sampler, StepCounter, Tolerances};
 use thermojitter::steady::equilibrium;
@@ -32,12 +36,25 @@ fn median_ns(batches: usize, per_batch: u64, mut f: impl FnMut()) -> f64 {
     times[batches / 2]
 }
 
+/// CPU time of this process so far, ns: the sum over its threads of the time on a CPU as the
+/// Linux scheduler counts it (/proc/self/task/*/schedstat); None elsewhere. Less sensitive than
+/// wall time to other work sharing the machine.
+fn process_cpu_ns() -> Option<u64> {
+    let mut total = 0;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(total)
+}
+
 fn main() {
     let filter: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with('-'))
         .collect();
     let wanted = |name: &str| filter.is_empty() || filter.iter().any(|f| name.contains(f.as_str()));
+    println!("{}", thermojitter::cpu::describe());
     let panel = Panel::paper();
     let orbit = Orbit::geo_equinox();
     let eq = equilibrium(&panel, Coupling::ProjectedArea, 1.0).expect("equilibrium");
@@ -124,4 +141,76 @@ fn main() {
         black_box(&sampler.y);
         stats.n_steps
     });
+
+    let paths = [
+        ("ensemble-scalar", "one at a time ", Path::Scalar),
+        ("ensemble-lockstep", "lockstep lanes", Path::Lockstep),
+    ];
+    if paths.iter().any(|(key, _, _)| wanted(key)) {
+        // Eight panels around Table 1 on one thread, each one GEO orbit with the per-orbit
+        // summary and the flutter analysis (a Monte Carlo sample), alternating the two paths.
+        let panels: Vec<Panel> = (0..8)
+            .map(|k| Panel {
+                damping: 2.0 + 0.25 * k as f64,
+                conductance: 22.0 + 0.75 * k as f64,
+                ..panel
+            })
+            .collect();
+        let settings = EnsembleSettings {
+            orbit,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method,
+            n_orbits: 1,
+            window: 600.0,
+            threshold: None,
+            stop_at_threshold: false,
+            validity_limit: 0.35,
+            hybrid: None,
+        };
+        let one = pool(1).expect("pool");
+        // CPU time where the OS reports it (the machine may be shared), else wall time.
+        let clock = if process_cpu_ns().is_some() {
+            "CPU"
+        } else {
+            "wall"
+        };
+        let mut per_sample = [Vec::new(), Vec::new()];
+        for _ in 0..3 {
+            for (i, (key, _, path)) in paths.iter().enumerate() {
+                if !wanted(key) {
+                    continue;
+                }
+                let (start, cpu) = (Instant::now(), process_cpu_ns());
+                let rows = run_batch_on(&one, &panels, &settings, &Cancel::new(), *path);
+                black_box(rows.expect("batch"));
+                let seconds = match (cpu, process_cpu_ns()) {
+                    (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
+                    _ => start.elapsed().as_secs_f64(),
+                };
+                per_sample[i].push(seconds / panels.len() as f64);
+            }
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied()
+        };
+        let scalar = median(&mut per_sample[0]);
+        let lanes = median(&mut per_sample[1]);
+        if let Some(s) = scalar {
+            println!(
+                "ensemble sample, {}    {:8.2} ms/sample ({clock} time)",
+                paths[0].1,
+                1e3 * s
+            );
+        }
+        if let Some(l) = lanes {
+            let ratio = scalar.map_or(String::new(), |s| format!(" ({:.2}x)", s / l));
+            println!(
+                "ensemble sample, {}    {:8.2} ms/sample ({clock} time){ratio}",
+                paths[1].1,
+                1e3 * l
+            );
+        }
+    }
 }

@@ -21,6 +21,7 @@ import platform
 import resource
 import time
 
+import machine  # benches/machine.py
 import numpy as np
 
 import thermojitter as tj
@@ -77,6 +78,7 @@ def main() -> None:
     parser.add_argument("--damping", type=float, default=None, help="override c_d, N m s/rad")
     parser.add_argument("--start", default="2026-01-01", help="start date of geo_year")
     args = parser.parse_args()
+    print(machine.describe())
 
     panel = tj.Panel.paper()
     if args.damping is not None:

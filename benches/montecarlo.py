@@ -1,7 +1,10 @@
 """Monte Carlo throughput: 200 panels around Table 1, one GEO orbit each (rk45, rtol 1e-8,
-atol 1e-10), on 1 and 2 rayon threads; and the cost of a sample against one ``tj.simulate`` call
-of the same orbit for the same panels (the sample adds the flutter analysis, the critical damping
-and the per-orbit summary). Run it on a quiet machine (check ``uptime``).
+atol 1e-10), on 1 and 2 rayon threads, along both of the engine's paths in the same run: the
+lockstep lanes (several samples per core at once, the default) and one sample at a time per core
+(the scalar path); and the cost of a sample against one ``tj.simulate`` call of the same orbit for
+the same panels (the sample adds the flutter analysis, the critical damping and the per-orbit
+summary). The paths alternate, so a change of load touches both alike; run it on a quiet
+machine anyway (the header prints the load average).
 
     python benches/montecarlo.py [--n 200] [--threads 1 2] [--repeat 1] [--simulate 50]
 """
@@ -9,11 +12,13 @@ and the per-orbit summary). Run it on a quiet machine (check ``uptime``).
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from typing import Any
 
+import machine  # benches/machine.py
+
 import thermojitter as tj
+import thermojitter.montecarlo as mc
 
 RTOL, ATOL = 1e-8, 1e-10
 VARY = {
@@ -21,6 +26,7 @@ VARY = {
     "emissivity_back": ("normal", 0.3, 0.03),
     "conductance": ("normal", 25.0, 2.5),
 }
+PATHS = {"lockstep": True, "scalar": False}
 
 
 def main() -> None:
@@ -32,45 +38,57 @@ def main() -> None:
     args = parser.parse_args()
 
     panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
-    print(
-        f"load average: {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores"
-    )
+    print(machine.describe())
     print(f"{args.n} samples x 1 GEO orbit, rtol={RTOL:g}, atol={ATOL:g}, vary={list(VARY)}")
 
-    def batch(threads: int) -> Any:
-        return tj.monte_carlo(
-            panel, orbit, vary=VARY, n=args.n, seed=1, threads=threads, rtol=RTOL, atol=ATOL,
-            progress=False,
-        )  # fmt: skip
+    def batch(threads: int, lockstep: bool) -> Any:
+        mc._LOCKSTEP = lockstep
+        try:
+            return tj.monte_carlo(
+                panel, orbit, vary=VARY, n=args.n, seed=1, threads=threads, rtol=RTOL, atol=ATOL,
+                progress=False,
+            )  # fmt: skip
+        finally:
+            mc._LOCKSTEP = True
 
-    walls: dict[int, float] = {}
-    cores: dict[int, float] = {}
+    runs: dict[tuple[int, str], list[tuple[float, float]]] = {}
     frames = {}
     for threads in args.threads:
-        runs = []
         for _ in range(args.repeat):
-            cpu, start = time.process_time(), time.perf_counter()
-            frames[threads] = batch(threads)
-            wall = time.perf_counter() - start
-            runs.append((wall, (time.process_time() - cpu) / wall))
-        walls[threads], cores[threads] = min(runs)
-    frame = frames[args.threads[0]]
+            for path, lockstep in PATHS.items():
+                cpu, start = time.process_time(), time.perf_counter()
+                frames[threads, path] = batch(threads, lockstep)
+                wall = time.perf_counter() - start
+                busy = (time.process_time() - cpu) / wall
+                runs.setdefault((threads, path), []).append((wall, busy))
+    best = {key: min(v) for key, v in runs.items()}
+    frame = frames[args.threads[0], "lockstep"]
     steps = int(frame["n_steps"].sum())
-    base = walls[args.threads[0]]
     # "cores busy": process CPU time over wall time (below `threads` when others hold cores).
+    # "per core": samples per second per core busy, the throughput that does not depend on how
+    # much of the machine the others left.
     print(
-        f"{'threads':>8}{'wall s':>10}{'samples/s':>12}{'speed-up':>10}{'cores busy':>12}"
-        f"{'ns/step':>10}"
+        f"{'threads':>8}{'path':>10}{'wall s':>10}{'samples/s':>11}{'cores busy':>12}"
+        f"{'per core':>10}{'ns/step':>9}{'x scalar':>10}"
     )
-    for threads, wall in walls.items():
-        print(
-            f"{threads:>8}{wall:>10.2f}{args.n / wall:>12.1f}{base / wall:>10.2f}"
-            f"{cores[threads]:>12.2f}{1e9 * wall * threads / steps:>10.0f}"
-        )
-    same = all(frames[t].equals(frame) for t in frames)
-    print(f"identical frames across thread counts: {same}")
+    for threads in args.threads:
+        scalar_rate = 0.0
+        for path in ("scalar", "lockstep"):
+            wall, busy = best[threads, path]
+            per_core = args.n / wall / max(busy, 1e-9)
+            if path == "scalar":
+                scalar_rate = per_core
+            print(
+                f"{threads:>8}{path:>10}{wall:>10.2f}{args.n / wall:>11.1f}{busy:>12.2f}"
+                f"{per_core:>10.1f}{1e9 * wall * busy / steps:>9.0f}"
+                f"{per_core / scalar_rate:>10.2f}"
+            )
+    same = all(f.equals(frame) for f in frames.values())
+    print(f"identical frames across paths and thread counts: {same}")
+    # CPU seconds per sample (wall x cores busy): less sensitive to other work than wall time.
+    cpu_per = {key: wall * busy / args.n for key, (wall, busy) in best.items()}
 
-    if 1 not in walls:
+    if 1 not in args.threads:
         return
     # The same panels, one call each on this thread: tj.simulate (end state only) and
     # tj.simulate_orbits (the per-orbit summary a sample is reduced from).
@@ -81,27 +99,28 @@ def main() -> None:
     ]
     # Samples resolve the hinge period (step <= T_n/40, as tj.simulate_orbits does); the same
     # cap here makes both integrate the same steps, so the difference is the sample's own cost.
-    start = time.perf_counter()
+    start = time.process_time()
     for p in panels:
         cap = 1.0 / (40.0 * tj.natural_frequency(p))
         tj.simulate(
             p, orbit, (0.0, orbit.period), rtol=RTOL, atol=ATOL, t_eval=[orbit.period], max_step=cap
         )
-    per_sim = (time.perf_counter() - start) / k
-    start = time.perf_counter()
+    per_sim = (time.process_time() - start) / k
+    start = time.process_time()
     for p in panels:
         tj.simulate_orbits(p, orbit, 1, rtol=RTOL, atol=ATOL, progress=False)
-    per_orbits = (time.perf_counter() - start) / k
-    per_sample = walls[1] / args.n
+    per_orbits = (time.process_time() - start) / k
+    per_sample = cpu_per[1, "lockstep"]
+    per_scalar = cpu_per[1, "scalar"]
     mc_steps = int(frame["n_steps"].iloc[:k].sum())
-    print(f"per sample, same {k} panels ({mc_steps // k} steps each):")
+    print(f"CPU time per sample, same {k} panels ({mc_steps // k} steps each), one thread:")
     for name, t in (
         ("tj.simulate (end state, same cap)", per_sim),
         ("tj.simulate_orbits (summary)", per_orbits),
-        ("tj.monte_carlo, 1 thread", per_sample),
+        ("tj.monte_carlo, scalar path", per_scalar),
+        ("tj.monte_carlo, lockstep", per_sample),
     ):
-        print(f"  {name:<30}{1e3 * t:8.1f} ms {100.0 * (t / per_sim - 1.0):+8.1f} %")
-    print(f"overhead of a sample over one tj.simulate call: {1e3 * (per_sample - per_sim):+.1f} ms")
+        print(f"  {name:<34}{1e3 * t:8.1f} ms {t / per_sim:8.2f} x tj.simulate")
 
 
 if __name__ == "__main__":

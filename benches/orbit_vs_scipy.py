@@ -11,6 +11,7 @@ import argparse
 import statistics
 import time
 
+import machine  # benches/machine.py
 import numpy as np
 
 import thermojitter as tj
@@ -33,6 +34,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="runs of thermojitter (median)")
     parser.add_argument("--repeat-scipy", type=int, default=1, help="runs of scipy (median)")
     args = parser.parse_args()
+    print(machine.describe())
 
     panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
     span = (0.0, orbit.period)

@@ -47,6 +47,7 @@ from typing import Any
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+import machine  # noqa: E402  (benches/machine.py)
 import numpy as np  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
@@ -430,6 +431,7 @@ def main() -> None:
     parser.add_argument("--repeat-slow", type=int, default=3, help="runs of scipy and pysolve")
     args = parser.parse_args()
 
+    print(machine.describe())
     print(f"thermojitter {tj.__version__}", end="")
     if CyRK is not None:
         print(f", CyRK {CyRK.__version__}, numba {numba.__version__}", end="")

@@ -47,6 +47,31 @@ def test_same_frame_for_any_threads_and_chunking() -> None:
     pd.testing.assert_frame_equal(run(n=5), one.iloc[:5], check_exact=True)
 
 
+def test_lockstep_lanes_give_the_frame_of_one_sample_at_a_time(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The engine runs four samples per core at once in SIMD lanes; one at a time (the scalar
+    # path) must give the same frame, bit for bit: sweeps and Monte Carlo, a sample stopped at
+    # its threshold, a linear model, a frozen coupling and an invalid panel among them.
+    def both(study: Any, **kwargs: Any) -> tuple[pd.DataFrame, pd.DataFrame]:
+        frames = []
+        for lockstep in (True, False):
+            monkeypatch.setattr(montecarlo, "_LOCKSTEP", lockstep)
+            frames.append(study(PAPER, LOW, **FAST, threads=2, **kwargs))
+        return frames[0], frames[1]
+
+    lanes, scalar = both(
+        tj.monte_carlo, vary=VARY, n=11, seed=3, threshold=0.15, stop_at_threshold=True
+    )
+    pd.testing.assert_frame_equal(lanes, scalar, check_exact=True)
+    assert (lanes["t_reached"] < LOW.period).any() and (lanes["t_reached"] == LOW.period).any()
+    grid = {"damping": [0.0, 1.5, 3.0], "conductance": [15.0, 25.0, 40.0]}
+    for kwargs in ({}, {"model": "linear"}, {"coupled": False, "horizon": 2}):
+        lanes, scalar = both(tj.sweep, grid=grid, **kwargs)
+        pd.testing.assert_frame_equal(lanes, scalar, check_exact=True)
+        assert lanes["error"].isna().all()
+
+
 def test_same_frame_on_a_dask_cluster() -> None:
     distributed = pytest.importorskip("distributed")
     local = run(threads=2, chunk_size=3)

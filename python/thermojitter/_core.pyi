@@ -33,6 +33,7 @@ __all__ = [
     "beam_static",
     "check_panels",
     "conduction_grid",
+    "cpu_info",
     "declination",
     "derived",
     "distributed_defaults",
@@ -286,6 +287,7 @@ class EnsemblePool:
         validity_limit: float = 0.3490658503988659,
         hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
+        lockstep: bool = True,
     ) -> dict[str, Any]: ...
 
 # --- laminates and the N-node model -------------------------------------------------------------
@@ -330,3 +332,4 @@ def simulate_layers(
     dt_out: float | None,
     y0: list[float] | None,
 ) -> dict[str, Any]: ...
+def cpu_info() -> dict[str, Any]: ...

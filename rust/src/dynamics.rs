@@ -100,7 +100,7 @@ pub fn thermal_moment(panel: &Panel, t_front: f64, t_back: f64) -> f64 {
 /// The generalised moment on the hinge, M − c_d θ̇ − K_el θ, in the unit of its coefficients
 /// (N m, or per I_B when all three are divided by it).
 #[inline(always)]
-fn generalised_moment(
+pub(crate) fn generalised_moment(
     moment: f64,
     damping: f64,
     stiffness: f64,
@@ -113,7 +113,13 @@ fn generalised_moment(
 /// θ̈ from the generalised moment over I_B, `forced`: eq. 28, or eq. 20 with 3/(2 m l³) = 1/I_B
 /// factored out. `sin`, `cos` are those of θ (unused by the linear model).
 #[inline(always)]
-fn angular_acceleration(model: HingeModel, forced: f64, theta_dot: f64, sin: f64, cos: f64) -> f64 {
+pub(crate) fn angular_acceleration(
+    model: HingeModel,
+    forced: f64,
+    theta_dot: f64,
+    sin: f64,
+    cos: f64,
+) -> f64 {
     match model {
         HingeModel::Linear => forced,
         HingeModel::Nonlinear => {
@@ -170,6 +176,13 @@ impl Hinge {
             stiffness: panel.hinge_stiffness / inertia,
             hinge_stiffness: panel.hinge_stiffness,
         }
+    }
+}
+
+impl Hinge {
+    /// (model, c_d / I_B, K_el / I_B): what [`StructuralModel::rates`] uses of the hinge.
+    pub(crate) fn rate_form(&self) -> (HingeModel, f64, f64) {
+        (self.model, self.damping, self.stiffness)
     }
 }
 
@@ -259,6 +272,13 @@ pub fn sin_cos(theta: f64) -> (f64, f64) {
     if theta.abs() > std::f64::consts::FRAC_PI_4 {
         return theta.sin_cos();
     }
+    sin_cos_kernel(theta)
+}
+
+/// The polynomials of [`sin_cos`] alone, for |θ| ≤ π/4 (no branch, so that a loop over SIMD
+/// lanes vectorises; the caller handles the lanes beyond π/4).
+#[inline(always)]
+pub(crate) fn sin_cos_kernel(theta: f64) -> (f64, f64) {
     const S: [f64; 6] = [
         -0.16666666666666632,
         0.00833333333332249,

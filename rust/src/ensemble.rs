@@ -10,15 +10,21 @@ use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
 use crate::flutter::{analyse, critical_damping};
 use crate::hybrid::{run_orbits_hybrid, HybridSettings};
-use crate::integrate::Method;
+use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LANES};
+use crate::integrate::{DenseStep, Method, Observer};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::steady::equilibrium;
-use crate::summary::{run_orbits_cancellable, OrbitRun, SummaryOptions};
+use crate::summary::{
+    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, SummaryObserver,
+    SummaryOptions, TwoLayerView,
+};
 use crate::system::Coupling;
-use nalgebra::Vector4;
+use nalgebra::{Vector4, U4};
 use rayon::prelude::*;
 use rayon::ThreadPool;
+use std::cell::RefCell;
+use std::ops::ControlFlow;
 
 /// What every sample of a batch shares.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -202,20 +208,8 @@ pub fn run_sample(
     settings: &EnsembleSettings,
     cancel: &Cancel,
 ) -> Result<SampleMetrics> {
-    cancel.check()?;
-    panel.validate()?;
+    let (head, y0, options) = sample_head(panel, settings, cancel)?;
     let s = settings;
-    let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
-    let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
-    let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
-    let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-    let options = SummaryOptions {
-        window: s.window,
-        // Without a threshold nothing is timed: a limit no angle reaches.
-        theta_limit: s.threshold.unwrap_or(f64::MAX),
-        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
-        steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
-    };
     let (run, t_nonlinear) = match &s.hybrid {
         None => {
             let run = run_orbits_cancellable(
@@ -233,12 +227,59 @@ pub fn run_sample(
             (out.run, out.t_exponential + out.t_fallback)
         }
     };
-    let (theta_abs_max, amplitude, entry_peak, exit_peak, jitter_rms, jitter_peak) = reduce(&run);
-    Ok(SampleMetrics {
+    Ok(sample_metrics(&head, settings, &run, t_nonlinear))
+}
+
+/// What a sample knows before its run: the flutter analysis of its equilibrium.
+struct SampleHead {
+    theta_eq: f64,
+    growth_rate: f64,
+    frequency_hz: f64,
+    critical_damping: f64,
+}
+
+/// The flutter analysis of a sample, its initial state and its summary options.
+fn sample_head(
+    panel: &Panel,
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+) -> Result<(SampleHead, Vector4<f64>, SummaryOptions)> {
+    cancel.check()?;
+    panel.validate()?;
+    let s = settings;
+    let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
+    let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
+    let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
+    let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+    let options = SummaryOptions {
+        window: s.window,
+        // Without a threshold nothing is timed: a limit no angle reaches.
+        theta_limit: s.threshold.unwrap_or(f64::MAX),
+        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
+        steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
+    };
+    let head = SampleHead {
         theta_eq: flutter.equilibrium.theta,
         growth_rate: flutter.growth_rate,
         frequency_hz: flutter.frequency_hz,
         critical_damping: critical,
+    };
+    Ok((head, y0, options))
+}
+
+/// A sample's metrics from its head and its run.
+fn sample_metrics(
+    head: &SampleHead,
+    settings: &EnsembleSettings,
+    run: &OrbitRun,
+    t_nonlinear: f64,
+) -> SampleMetrics {
+    let (theta_abs_max, amplitude, entry_peak, exit_peak, jitter_rms, jitter_peak) = reduce(run);
+    SampleMetrics {
+        theta_eq: head.theta_eq,
+        growth_rate: head.growth_rate,
+        frequency_hz: head.frequency_hz,
+        critical_damping: head.critical_damping,
         theta_abs_max,
         amplitude,
         entry_peak,
@@ -247,13 +288,79 @@ pub fn run_sample(
         jitter_peak,
         t_threshold: run.crossing.map_or(f64::NAN, |c| c.t),
         orbit_threshold: run.crossing.map_or(f64::NAN, |c| c.orbit as f64),
-        orbit_limit: first_orbit_beyond(&run, s.validity_limit),
-        amplitude_slope: log_slope(&run),
+        orbit_limit: first_orbit_beyond(run, settings.validity_limit),
+        amplitude_slope: log_slope(run),
         t_nonlinear,
         t_reached: run.stats.t_end,
         n_steps: run.stats.n_steps,
         error: None,
-    })
+    }
+}
+
+/// A sample's run in a lane, with what it needs to become a row.
+struct LaneSample<'c> {
+    index: usize,
+    head: SampleHead,
+    observer: SummaryObserver<'c, TwoLayerView>,
+}
+
+impl Observer<U4> for LaneSample<'_> {
+    #[inline]
+    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+        self.observer.on_step(step)
+    }
+}
+
+/// Runs `panels` (hinge-resolved Dormand–Prince samples) on this thread, [`LANES`] at a time in
+/// lockstep; results in input order, each the same, bit for bit, as [`run_sample`]'s.
+fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> Vec<SampleMetrics> {
+    // Rows are written by `next` (a sample that fails before its run) and by `done`.
+    let out = RefCell::new(vec![None; panels.len()]);
+    let mut queue = panels.iter().enumerate();
+    let s = settings;
+    let next = || {
+        for (index, panel) in queue.by_ref() {
+            let prepared = sample_head(panel, s, cancel).and_then(|(head, y0, options)| {
+                let run = prepare_orbits(
+                    panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0,
+                    options, cancel,
+                )?;
+                Ok((head, run))
+            });
+            match prepared {
+                Ok((head, run)) => {
+                    let Method::Dopri5(tol) = run.method else {
+                        unreachable!("only Dormand–Prince batches run in lockstep")
+                    };
+                    return Some(Job {
+                        system: run.system,
+                        tol,
+                        t0: run.t0,
+                        t1: run.t1,
+                        y0: run.y0,
+                        observer: LaneSample {
+                            index,
+                            head,
+                            observer: run.observer,
+                        },
+                    });
+                }
+                Err(e) => out.borrow_mut()[index] = Some(SampleMetrics::failed(e)),
+            }
+        }
+        None
+    };
+    let done = |sample: LaneSample<'_>, outcome| {
+        let row = finish_orbits(sample.observer, outcome)
+            .map(|run| sample_metrics(&sample.head, s, &run, run.stats.t_end))
+            .unwrap_or_else(SampleMetrics::failed);
+        out.borrow_mut()[sample.index] = Some(row);
+    };
+    solve_lockstep(Kernel::detect(), next, done);
+    out.into_inner()
+        .into_iter()
+        .map(|row| row.expect("every sample ends"))
+        .collect()
 }
 
 /// A rayon pool of its own with `threads` workers (0: rayon's default, one per core).
@@ -274,13 +381,50 @@ pub fn run_batch(
     settings: &EnsembleSettings,
     cancel: &Cancel,
 ) -> Result<Vec<SampleMetrics>> {
+    run_batch_on(pool, panels, settings, cancel, Path::Lockstep)
+}
+
+/// How a batch's samples are integrated; both give the same rows, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Path {
+    /// [`LANES`] samples at a time per thread, in SIMD lanes (hinge-resolved Dormand–Prince
+    /// batches; others run one at a time).
+    Lockstep,
+    /// One sample at a time per thread.
+    Scalar,
+}
+
+/// Samples given to one lockstep group: one per lane. Samples of a batch take about the same
+/// number of steps, so the lanes of a group end together; a group of one runs alone.
+const GROUP: usize = LANES;
+
+/// [`run_batch`] along `path`.
+pub fn run_batch_on(
+    pool: &ThreadPool,
+    panels: &[Panel],
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+    path: Path,
+) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
+    let lockstep = path == Path::Lockstep
+        && settings.hybrid.is_none()
+        && matches!(settings.method, Method::Dopri5(_));
+    let scalar = |p: &Panel| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed);
     let out = pool.install(|| {
-        panels
-            .par_iter()
-            .with_max_len(1)
-            .map(|p| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed))
-            .collect()
+        if lockstep {
+            let groups: Vec<Vec<SampleMetrics>> = panels
+                .par_chunks(GROUP)
+                .with_max_len(1)
+                .map(|group| match group {
+                    [p] => vec![scalar(p)],
+                    _ => run_group(group, settings, cancel),
+                })
+                .collect();
+            groups.into_iter().flatten().collect()
+        } else {
+            panels.par_iter().with_max_len(1).map(scalar).collect()
+        }
     });
     cancel.check()?;
     Ok(out)
@@ -366,6 +510,47 @@ mod tests {
         let mut back = run_batch(&pool(2).unwrap(), &reversed, &s, &Cancel::new()).unwrap();
         back.reverse();
         assert_eq!(bits(&one), bits(&back));
+    }
+
+    #[test]
+    fn lockstep_rows_equal_scalar_rows() {
+        // Eleven samples: groups of four, four and three; one invalid panel, some
+        // that stop at their threshold early.
+        let mut ps: Vec<Panel> = (0..11)
+            .map(|k| Panel {
+                damping: 0.35 * k as f64,
+                conductance: 20.0 + k as f64,
+                emissivity_back: 0.25 + 0.01 * k as f64,
+                ..Panel::paper()
+            })
+            .collect();
+        ps[4].emissivity_front = 1.5;
+        let mut s = settings();
+        // |θ| peaks from 0.128 (most damped) to 0.183 (undamped) in this set.
+        s.threshold = Some(0.15);
+        s.stop_at_threshold = true;
+        let p = pool(2).unwrap();
+        let scalar = run_batch_on(&p, &ps, &s, &Cancel::new(), Path::Scalar).unwrap();
+        let lanes = run_batch_on(&p, &ps, &s, &Cancel::new(), Path::Lockstep).unwrap();
+        assert_eq!(bits(&lanes), bits(&scalar));
+        assert!(scalar[4].error.is_some());
+        assert!(scalar.iter().any(|m| m.t_reached < s.orbit.period));
+        assert!(scalar.iter().any(|m| m.t_reached == s.orbit.period));
+        // The same with the other models and two orbits.
+        for (model, coupling) in [
+            (HingeModel::Linear, Coupling::ProjectedArea),
+            (HingeModel::Nonlinear, Coupling::Frozen),
+        ] {
+            let s = EnsembleSettings {
+                model,
+                coupling,
+                n_orbits: 2,
+                ..settings()
+            };
+            let scalar = run_batch_on(&p, &ps[..5], &s, &Cancel::new(), Path::Scalar).unwrap();
+            let lanes = run_batch_on(&p, &ps[..5], &s, &Cancel::new(), Path::Lockstep).unwrap();
+            assert_eq!(bits(&lanes), bits(&scalar), "{model:?} {coupling:?}");
+        }
     }
 
     #[test]

@@ -8,6 +8,7 @@
 pub mod beam;
 pub mod cancel;
 pub mod conduction;
+pub mod cpu;
 pub mod distributed;
 pub mod dynamics;
 pub mod ensemble;

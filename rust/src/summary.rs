@@ -480,6 +480,81 @@ pub fn run_orbits_cancellable(
 }
 
 /// A summarised run of any model: the summaries, the counters and the end state.
+/// A summarised run of the two-layer panel set up but not yet integrated: integrate `system` with
+/// `method` from (`t0`, `y0`) to `t1` into `observer` (with [`solve`], or in lockstep with
+/// other runs), then hand the outcome to [`finish_orbits`]. The same checks and observer as
+/// [`run_orbits_cancellable`].
+pub(crate) struct PreparedOrbits<'c> {
+    pub system: Coupled,
+    pub method: Method,
+    pub t0: f64,
+    pub t1: f64,
+    pub y0: Vector4<f64>,
+    pub observer: SummaryObserver<'c, TwoLayerView>,
+}
+
+/// Sets up what [`run_orbits_cancellable`] integrates.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn prepare_orbits<'c>(
+    panel: &Panel,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vector4<f64>,
+    options: SummaryOptions,
+    cancel: &'c Cancel,
+) -> Result<PreparedOrbits<'c>> {
+    cancel.check()?;
+    crate::error::require_positive("window", options.window)?;
+    crate::error::require_positive("theta_limit", options.theta_limit)?;
+    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    let method = resolve_hinge(method, panel, options.steps_per_period);
+    if n_orbits == 0 {
+        return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
+    }
+    let view = TwoLayerView {
+        panel: *panel,
+        coupling,
+    };
+    let collector = Collector::new(view, orbit, options, t_start, first_index, n_orbits, y0[2])?;
+    Ok(PreparedOrbits {
+        system: Coupled::new(*panel, *orbit, model, coupling),
+        method,
+        t0: t_start,
+        t1: t_start + n_orbits as f64 * orbit.period,
+        y0,
+        observer: SummaryObserver {
+            collector,
+            error: None,
+            cancel,
+        },
+    })
+}
+
+/// The summaries of a prepared run from the outcome of its integration (as
+/// [`run_orbits_cancellable`] returns them).
+pub(crate) fn finish_orbits(
+    observer: SummaryObserver<'_, TwoLayerView>,
+    outcome: Result<(Stats, Vector4<f64>)>,
+) -> Result<OrbitRun> {
+    let (stats, y_end) = outcome?;
+    if let Some(e) = observer.error {
+        return Err(e);
+    }
+    let mut c = observer.collector;
+    c.close();
+    Ok(OrbitRun {
+        summaries: c.done,
+        stats,
+        y_end,
+        crossing: c.crossing,
+    })
+}
+
 #[derive(Debug, Clone)]
 pub struct Summarised<D: Dim>
 where

@@ -7,7 +7,7 @@ use crate::integrate::{OdeSystem, State};
 use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
 use crate::steady::{rest, steady};
-use crate::thermal::{AsWritten, ThermalModel, TwoLayer};
+use crate::thermal::{AsWritten, Balance, ThermalModel, TwoLayer};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, DimName, Dyn, SVector, Vector2, Vector4, U1, U2, U4};
 
@@ -48,6 +48,15 @@ impl Sunlight {
         self.constant_s = if varies { None } else { Some(mid) };
     }
 
+    /// The flux over the current segment when it is the same at every time of it (s constant
+    /// there and the Sun at 1 au): what [`Sunlight::flux`] returns at any t of the segment.
+    pub(crate) fn constant_flux(&self) -> Option<f64> {
+        match self.constant_s {
+            Some(s) if !self.orbit.eccentric_sun => Some(s * self.orbit.flux_scale(self.segment.0)),
+            _ => None,
+        }
+    }
+
     #[inline]
     pub(crate) fn flux(&self, t: f64) -> f64 {
         let s = match self.constant_s {
@@ -85,6 +94,40 @@ impl Coupled<TwoLayer, Hinge, U4> {
         let (thermal, structure) = (TwoLayer::new(&panel), Hinge::new(&panel, model));
         Self::compose(thermal, structure, orbit, coupling, U4::name())
             .expect("two temperatures and two hinge states make four")
+    }
+}
+
+/// What a kernel that evaluates [`Coupled::rhs_at_flux`] of the panel model for several panels at
+/// once needs, so that it can do the same arithmetic lane by lane (the ensemble's lockstep lanes).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LaneForm {
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    /// The two-layer balance per half capacity.
+    pub balance: Balance,
+    /// Thermal moment per kelvin over I_B.
+    pub load_per_kelvin: f64,
+    /// c_d / I_B and K_el / I_B.
+    pub damping: f64,
+    pub stiffness: f64,
+}
+
+impl Coupled<TwoLayer, Hinge, U4> {
+    /// [`Sunlight::constant_flux`] of the current segment.
+    pub(crate) fn constant_flux(&self) -> Option<f64> {
+        self.sun.constant_flux()
+    }
+
+    pub(crate) fn lane_form(&self) -> LaneForm {
+        let (model, damping, stiffness) = self.structure.rate_form();
+        LaneForm {
+            model,
+            coupling: self.coupling,
+            balance: self.thermal.rate_balance(),
+            load_per_kelvin: self.load_per_kelvin,
+            damping,
+            stiffness,
+        }
     }
 }
 

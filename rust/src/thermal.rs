@@ -202,14 +202,14 @@ impl ThermalModel for OneNode {
 /// Coefficients of eq. 2's two heat balances, in W/m² per unit of their variable, or divided by
 /// the layer's heat capacity (per second).
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Balance {
+pub(crate) struct Balance {
     /// α C: absorbed per unit flux factor.
-    heating: f64,
+    pub(crate) heating: f64,
     /// K: conducted per kelvin of T_f − T_b.
-    conduction: f64,
+    pub(crate) conduction: f64,
     /// σ ε_f and σ ε_b: emitted per T⁴.
-    radiation_front: f64,
-    radiation_back: f64,
+    pub(crate) radiation_front: f64,
+    pub(crate) radiation_back: f64,
 }
 
 impl Balance {
@@ -224,7 +224,7 @@ impl Balance {
 
     /// Eq. 2: (front, back) = (α C flux − K (T_f − T_b) − σ ε_f T_f⁴, K (T_f − T_b) − σ ε_b T_b⁴).
     #[inline(always)]
-    fn flows(&self, flux: f64, t_front: f64, t_back: f64) -> (f64, f64) {
+    pub(crate) fn flows(&self, flux: f64, t_front: f64, t_back: f64) -> (f64, f64) {
         let conducted = self.conduction * (t_front - t_back);
         let tf4 = (t_front * t_front) * (t_front * t_front);
         let tb4 = (t_back * t_back) * (t_back * t_back);
@@ -268,6 +268,11 @@ impl TwoLayer {
     }
 
     /// (dT_f/dt, dT_b/dt), K/s.
+    /// The balance per half capacity that [`TwoLayer::rates_of`] evaluates.
+    pub(crate) fn rate_balance(&self) -> Balance {
+        self.rate
+    }
+
     #[inline(always)]
     pub fn rates_of(&self, flux: f64, t_front: f64, t_back: f64) -> (f64, f64) {
         self.rate.flows(flux, t_front, t_back)

@@ -51,7 +51,7 @@ pub const B_HAT: [f64; 7] = [
     1.0 / 40.0,
 ];
 /// Dense-output coefficients (Hairer, Nørsett & Wanner, dopri5).
-const DENSE: [f64; 7] = [
+pub(crate) const DENSE: [f64; 7] = [
     -12715105075.0 / 11282082432.0,
     0.0,
     87487479700.0 / 32700410799.0,
@@ -61,13 +61,13 @@ const DENSE: [f64; 7] = [
     69997945.0 / 29380423.0,
 ];
 
-const SAFETY: f64 = 0.9;
-const MIN_FACTOR: f64 = 0.2;
-const MAX_FACTOR: f64 = 10.0;
-const ERROR_EXPONENT: f64 = -1.0 / 5.0;
+pub(crate) const SAFETY: f64 = 0.9;
+pub(crate) const MIN_FACTOR: f64 = 0.2;
+pub(crate) const MAX_FACTOR: f64 = 10.0;
+pub(crate) const ERROR_EXPONENT: f64 = -1.0 / 5.0;
 
 /// Hairer's estimate of a first step for an order-4 error estimator.
-fn initial_step<D: Dim, S: OdeSystem<D>>(
+pub(crate) fn initial_step<D: Dim, S: OdeSystem<D>>(
     system: &S,
     t0: f64,
     y0: &State<D>,
@@ -289,7 +289,7 @@ where
 }
 
 /// The next representable f64 above x (x finite).
-fn next_up(x: f64) -> f64 {
+pub(crate) fn next_up(x: f64) -> f64 {
     if x == 0.0 {
         return f64::from_bits(1);
     }

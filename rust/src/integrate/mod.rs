@@ -8,6 +8,7 @@
 //! callers keep only what they need (samples, per-orbit summaries) and never every step.
 
 pub mod dopri5;
+pub mod lockstep;
 pub mod output;
 pub mod rk4;
 
@@ -75,6 +76,8 @@ where
     Hermite([State<D>; 2]),
     /// (k1, k3, k4, k5, k6, k7): Dormand–Prince's continuous extension.
     Dopri5([State<D>; 6]),
+    /// None: the coefficients were given on construction.
+    Given,
 }
 
 impl<D: Dim> DenseStep<D>
@@ -118,6 +121,26 @@ where
         }
     }
 
+    /// A step whose interpolant's coefficients r1..r5 the caller has built (with
+    /// `dopri5::dense_coefficients`' arithmetic: the lockstep lanes build them for several steps at
+    /// once).
+    pub(crate) fn with_coefficients(
+        t0: f64,
+        t1: f64,
+        y0: State<D>,
+        y1: State<D>,
+        r: [State<D>; 5],
+    ) -> Self {
+        DenseStep {
+            t0,
+            t1,
+            y0,
+            y1,
+            slopes: Slopes::Given,
+            r: OnceCell::from(r),
+        }
+    }
+
     /// The interpolant's coefficients r1..r5.
     fn coefficients(&self) -> [State<D>; 5] {
         let h = self.t1 - self.t0;
@@ -130,6 +153,7 @@ where
                 [self.y0.clone(), diff, r3, r4, zero]
             }
             Slopes::Dopri5(k) => dopri5::dense_coefficients(h, &self.y0, diff, k),
+            Slopes::Given => unreachable!("the coefficients were given on construction"),
         }
     }
 

@@ -5,7 +5,7 @@ use super::convert::{hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use super::longrun::hybrid_from;
-use crate::ensemble::{pool, run_batch, EnsembleSettings, SampleMetrics};
+use crate::ensemble::{pool, run_batch_on, EnsembleSettings, Path, SampleMetrics};
 use crate::system::Coupling;
 use crate::Panel;
 use numpy::{PyArray1, PyReadonlyArray2};
@@ -84,8 +84,9 @@ impl EnsemblePool {
         self.pool.current_num_threads()
     }
 
-    /// Runs one sample per row of `panels`; returns the metrics as columns.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=0.3490658503988659, hybrid=None, cancel=None))]
+    /// Runs one sample per row of `panels`; returns the metrics as columns. `lockstep`: several
+    /// samples per thread in SIMD lanes (the same rows, bit for bit, as one at a time).
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=0.3490658503988659, hybrid=None, cancel=None, lockstep=true))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -102,8 +103,14 @@ impl EnsemblePool {
         validity_limit: f64,
         hybrid: Option<&Bound<'py, PyDict>>,
         cancel: Option<&Bound<'py, CancelToken>>,
+        lockstep: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let cancel = token(cancel);
+        let path = if lockstep {
+            Path::Lockstep
+        } else {
+            Path::Scalar
+        };
         shield(|| {
             let ps = panels_from(&panels)?;
             let settings = EnsembleSettings {
@@ -123,7 +130,7 @@ impl EnsemblePool {
                 hybrid: hybrid.map(hybrid_from).transpose()?,
             };
             let pool = &self.pool;
-            let out = py.detach(|| run_batch(pool, &ps, &settings, &cancel))?;
+            let out = py.detach(|| run_batch_on(pool, &ps, &settings, &cancel, path))?;
             let d = PyDict::new(py);
             let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };
             for (name, values) in [
@@ -157,8 +164,25 @@ impl EnsemblePool {
     }
 }
 
+/// The processor, the instruction sets it has and the build uses, and the ensemble kernel
+/// chosen on it, for benchmark reports.
+#[pyfunction]
+fn cpu_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("model", crate::cpu::model_name())?;
+    d.set_item("has", crate::cpu::detected())?;
+    d.set_item("build", crate::cpu::compiled())?;
+    d.set_item(
+        "ensemble_kernel",
+        crate::integrate::lockstep::Kernel::detect().name(),
+    )?;
+    d.set_item("summary", crate::cpu::describe())?;
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<EnsemblePool>()?;
+    m.add_function(wrap_pyfunction!(cpu_info, m)?)?;
     m.add_function(wrap_pyfunction!(check_panels, m)?)?;
     Ok(())
 }

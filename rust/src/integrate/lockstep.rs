@@ -1,0 +1,849 @@
+//! Several independent runs of the coupled system advanced together, one run per SIMD lane.
+//!
+//! One panel's Dormand–Prince step is a chain of dependent operations (each stage waits for the
+//! one before, each step for the step size of the one before), which leaves most of a core's
+//! arithmetic units idle. Ensembles integrate many panels over the same span: running [`LANES`]
+//! of them side by side fills those units, and the stage arithmetic maps onto vector
+//! instructions (two SSE2 or one AVX2 operation for four lanes).
+//!
+//! Every lane has its own step size, accept/reject decision, segments (shadow crossings),
+//! counters and observer: lanes share only the instruction stream. A lane performs for its run
+//! exactly the floating-point operations of [`super::solve`] with [`super::dopri5`], in the same
+//! order, and no fused multiply-add (Rust never contracts on its own, and neither kernel enables
+//! FMA), so a run gives the same bits in any lane as alone, whatever the other lanes hold
+//! (`tests::lanes_equal_single_runs`). A lane whose run ends takes the next job; a lane without
+//! one computes on zeros and is ignored.
+//!
+//! The kernel is compiled twice: for the build's baseline and for AVX2, picked at run time
+//! ([`Kernel::detect`]). Both give the same bits.
+
+use super::dopri5::{
+    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY,
+};
+use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
+use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
+use crate::error::{Error, Result};
+use crate::system::{Coupled, Coupling, LaneForm};
+use crate::thermal::Balance;
+use nalgebra::Vector4;
+use std::f64::consts::FRAC_PI_4;
+
+/// Runs advanced together on one core.
+pub const LANES: usize = 4;
+
+/// One value per lane.
+type V = [f64; LANES];
+
+/// One run for a lane: integrate `system` from (`t0`, `y0`) to `t1` with Dormand–Prince at `tol`,
+/// telling `observer` of every accepted step.
+pub struct Job<O> {
+    pub system: Coupled,
+    pub tol: Tolerances,
+    pub t0: f64,
+    pub t1: f64,
+    pub y0: Vector4<f64>,
+    pub observer: O,
+}
+
+/// Which compilation of the lane kernel runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kernel {
+    /// The build's baseline instruction set (SSE2 on x86-64).
+    Portable,
+    /// AVX2 (x86-64 only, when the processor has it).
+    Avx2,
+}
+
+impl Kernel {
+    /// The best kernel this processor runs.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return Kernel::Avx2;
+            }
+        }
+        Kernel::Portable
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Portable => "portable",
+            Kernel::Avx2 => "avx2",
+        }
+    }
+}
+
+/// Runs every job `next` hands out, [`LANES`] at a time, and hands each observer back to `done`
+/// with the run's outcome (as [`solve`] returns it) as soon as its run ends. Jobs whose model or
+/// coupling differs from the first job's run alone, through [`solve`].
+pub fn solve_lockstep<O, N, F>(kernel: Kernel, next: N, done: F)
+where
+    O: Observer<nalgebra::U4>,
+    N: FnMut() -> Option<Job<O>>,
+    F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+{
+    match kernel {
+        #[cfg(target_arch = "x86_64")]
+        Kernel::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
+            // SAFETY: the processor has AVX2 (checked just above).
+            unsafe { drive_avx2(next, done) }
+        }
+        _ => drive(next, done),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn drive_avx2<O, N, F>(next: N, done: F)
+where
+    O: Observer<nalgebra::U4>,
+    N: FnMut() -> Option<Job<O>>,
+    F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+{
+    drive(next, done)
+}
+
+/// The lanes' inputs to one trial step, lane by lane in each array.
+#[derive(Clone, Copy)]
+struct Pack {
+    t: V,
+    h: V,
+    y0: [V; 4],
+    k1: [V; 4],
+    /// Each lane's coefficients: the balance (heating, conduction, radiation front and back),
+    /// then load per kelvin, damping and stiffness (see [`Coupled::lane_form`]).
+    coef: [V; 7],
+    atol: V,
+    rtol: V,
+    /// Illumination at the stage times t + c_i h (i = 2..5) and at t + h (stages 6 and 7).
+    flux: [V; 5],
+}
+
+/// The lanes' results of one trial step.
+struct Trial {
+    y_new: [V; 4],
+    /// The continuous extension's coefficients r2..r5 (r1 is y0).
+    dense: [[V; 4]; 4],
+    /// k7 = f(t + h, y_new), the next step's k1.
+    k7: [V; 4],
+    /// The error norm squared (mean square of the weighted error).
+    mean_square: V,
+}
+
+const ZERO: V = [0.0; LANES];
+
+impl Pack {
+    fn zeros() -> Self {
+        Pack {
+            t: ZERO,
+            h: ZERO,
+            y0: [ZERO; 4],
+            k1: [ZERO; 4],
+            coef: [ZERO; 7],
+            atol: ZERO,
+            rtol: ZERO,
+            flux: [ZERO; 5],
+        }
+    }
+
+    /// Empties lane `l`: zeros keep its arithmetic finite and cheap.
+    fn clear(&mut self, l: usize) {
+        self.t[l] = 0.0;
+        self.h[l] = 0.0;
+        for i in 0..4 {
+            self.y0[i][l] = 0.0;
+            self.k1[i][l] = 0.0;
+        }
+        for c in &mut self.coef {
+            c[l] = 0.0;
+        }
+        self.atol[l] = 0.0;
+        self.rtol[l] = 0.0;
+        for f in &mut self.flux {
+            f[l] = 0.0;
+        }
+    }
+}
+
+/// The coupled right-hand side in every lane: [`Coupled::rhs_at_flux`]'s arithmetic.
+#[inline(always)]
+fn rhs_lanes(model: HingeModel, coupling: Coupling, p: &Pack, flux: &V, y: &[V; 4]) -> [V; 4] {
+    // One loop per (model, coupling), each with its constants folded, so that the loops hold
+    // no branch and vectorise.
+    use {Coupling::*, HingeModel::*};
+    match (model, coupling) {
+        (Nonlinear, ProjectedArea) => rhs_lanes_of(Nonlinear, ProjectedArea, p, flux, y),
+        (Nonlinear, Frozen) => rhs_lanes_of(Nonlinear, Frozen, p, flux, y),
+        (Linear, ProjectedArea) => rhs_lanes_of(Linear, ProjectedArea, p, flux, y),
+        (Linear, Frozen) => rhs_lanes_of(Linear, Frozen, p, flux, y),
+    }
+}
+
+#[inline(always)]
+fn rhs_lanes_of(model: HingeModel, coupling: Coupling, p: &Pack, flux: &V, y: &[V; 4]) -> [V; 4] {
+    let (mut sin, mut cos) = (ZERO, [1.0; LANES]);
+    if !matches!((coupling, model), (Coupling::Frozen, HingeModel::Linear)) {
+        // `sin_cos`: the polynomials in every lane, the library for a lane beyond π/4.
+        let mut far = false;
+        for l in 0..LANES {
+            (sin[l], cos[l]) = sin_cos_kernel(y[2][l]);
+            far |= y[2][l].abs() > FRAC_PI_4;
+        }
+        if far {
+            for l in 0..LANES {
+                if y[2][l].abs() > FRAC_PI_4 {
+                    (sin[l], cos[l]) = y[2][l].sin_cos();
+                }
+            }
+        }
+    }
+    // `Coupled::rhs_at_flux` of the two-layer plate on the hinge, lane by lane.
+    let mut out = [ZERO; 4];
+    for l in 0..LANES {
+        let balance = Balance {
+            heating: p.coef[0][l],
+            conduction: p.coef[1][l],
+            radiation_front: p.coef[2][l],
+            radiation_back: p.coef[3][l],
+        };
+        let (tf, tb, th, om) = (y[0][l], y[1][l], y[2][l], y[3][l]);
+        let load = p.coef[4][l] * (tf - tb);
+        let forced = generalised_moment(load, p.coef[5][l], p.coef[6][l], th, om);
+        let acc = angular_acceleration(model, forced, om, sin[l], cos[l]);
+        let area = match coupling {
+            Coupling::ProjectedArea => cos[l],
+            Coupling::Frozen => 1.0,
+        };
+        let (front, back) = balance.flows(flux[l] * area, tf, tb);
+        out[0][l] = front;
+        out[1][l] = back;
+        out[2][l] = om;
+        out[3][l] = acc;
+    }
+    out
+}
+
+/// y0 + Σ k_j (a_j h), summed in the order given (as nalgebra sums `y0 + k1 * x + k2 * y`).
+#[inline(always)]
+fn stage<const M: usize>(y0: &[V; 4], h: &V, terms: [(&[V; 4], f64); M]) -> [V; 4] {
+    let mut out = *y0;
+    for (k, a) in terms {
+        for i in 0..4 {
+            for l in 0..LANES {
+                out[i][l] += k[i][l] * (a * h[l]);
+            }
+        }
+    }
+    out
+}
+
+/// One Dormand–Prince trial step in every lane: [`dopri5::step`] and the error norm of
+/// [`dopri5`]'s segment loop, operation for operation.
+#[inline(always)]
+fn step_lanes(model: HingeModel, coupling: Coupling, p: &Pack) -> Trial {
+    let (y0, k1, h) = (&p.y0, &p.k1, &p.h);
+    let f = |flux: &V, y: &[V; 4]| rhs_lanes(model, coupling, p, flux, y);
+    let k2 = f(&p.flux[0], &stage(y0, h, [(k1, A21)]));
+    let k3 = f(&p.flux[1], &stage(y0, h, [(k1, A3[0]), (&k2, A3[1])]));
+    let k4 = f(
+        &p.flux[2],
+        &stage(y0, h, [(k1, A4[0]), (&k2, A4[1]), (&k3, A4[2])]),
+    );
+    let k5 = f(
+        &p.flux[3],
+        &stage(
+            y0,
+            h,
+            [(k1, A5[0]), (&k2, A5[1]), (&k3, A5[2]), (&k4, A5[3])],
+        ),
+    );
+    let k6 = f(
+        &p.flux[4],
+        &stage(
+            y0,
+            h,
+            [
+                (k1, A6[0]),
+                (&k2, A6[1]),
+                (&k3, A6[2]),
+                (&k4, A6[3]),
+                (&k5, A6[4]),
+            ],
+        ),
+    );
+    let y_new = stage(
+        y0,
+        h,
+        [
+            (k1, B[0]),
+            (&k3, B[2]),
+            (&k4, B[3]),
+            (&k5, B[4]),
+            (&k6, B[5]),
+        ],
+    );
+    let k7 = f(&p.flux[4], &y_new);
+    // err = Σ k_j ((b_j − b̂_j) h), starting from the first product (no y0 term).
+    let weights = [
+        (k1, B[0] - B_HAT[0]),
+        (&k3, B[2] - B_HAT[2]),
+        (&k4, B[3] - B_HAT[3]),
+        (&k5, B[4] - B_HAT[4]),
+        (&k6, B[5] - B_HAT[5]),
+        (&k7, B[6] - B_HAT[6]),
+    ];
+    let mut err = [ZERO; 4];
+    for (j, (k, w)) in weights.into_iter().enumerate() {
+        for i in 0..4 {
+            for l in 0..LANES {
+                let term = k[i][l] * (w * h[l]);
+                err[i][l] = if j == 0 { term } else { err[i][l] + term };
+            }
+        }
+    }
+    // The scaled error e_i = err_i / (atol + rtol max(|y0_i|, |y_new_i|)), and its mean square
+    // summed as nalgebra's norm_squared sums a 4-vector: (e0² + e2²) + (e1² + e3²).
+    let mut e = [ZERO; 4];
+    for i in 0..4 {
+        for l in 0..LANES {
+            let weight = 1.0 / (p.atol[l] + y0[i][l].abs().max(y_new[i][l].abs()) * p.rtol[l]);
+            e[i][l] = err[i][l] * weight;
+        }
+    }
+    let mut mean_square = ZERO;
+    for l in 0..LANES {
+        let a = e[0][l] * e[0][l] + e[2][l] * e[2][l];
+        let b = e[1][l] * e[1][l] + e[3][l] * e[3][l];
+        mean_square[l] = (a + b) / 4.0;
+    }
+    // `dopri5::dense_coefficients`, computed for every lane (most trials are accepted and the
+    // summary reads every step).
+    let mut dense = [[ZERO; 4]; 4];
+    for i in 0..4 {
+        for l in 0..LANES {
+            let diff = y_new[i][l] - y0[i][l];
+            let bspl = k1[i][l] * h[l] - diff;
+            let r4 = diff - k7[i][l] * h[l] - bspl;
+            let r5 = (k1[i][l] * DENSE[0]
+                + k3[i][l] * DENSE[2]
+                + k4[i][l] * DENSE[3]
+                + k5[i][l] * DENSE[4]
+                + k6[i][l] * DENSE[5]
+                + k7[i][l] * DENSE[6])
+                * h[l];
+            dense[0][i][l] = diff;
+            dense[1][i][l] = bspl;
+            dense[2][i][l] = r4;
+            dense[3][i][l] = r5;
+        }
+    }
+    Trial {
+        y_new,
+        dense,
+        k7,
+        mean_square,
+    }
+}
+
+/// A run in a lane: [`super::solve`]'s loop over segments and `dopri5::segment`'s loop over
+/// steps, unrolled into states so that each trial step is taken with the other lanes'.
+struct Lane<O> {
+    system: Coupled,
+    tol: Tolerances,
+    observer: O,
+    cuts: Vec<f64>,
+    /// Index in `cuts` of the end of the current segment.
+    seg: usize,
+    t: f64,
+    b: f64,
+    t1: f64,
+    h_abs: f64,
+    min_step: f64,
+    /// The trial under way follows a rejection.
+    rejected: bool,
+    t_new: f64,
+    stats: Stats,
+    y: Vector4<f64>,
+    k1: Vector4<f64>,
+    /// The illumination when it is the same over the whole segment.
+    constant_flux: Option<f64>,
+}
+
+/// How a run left its lane.
+type Outcome = Result<(Stats, Vector4<f64>)>;
+
+impl<O: Observer<nalgebra::U4>> Lane<O> {
+    /// Sets up a run (the checks of [`super::solve`]); `Err` hands the job back with its outcome
+    /// when it ends before its first step.
+    fn start(job: Job<O>) -> std::result::Result<Self, (O, Outcome)> {
+        let Job {
+            system,
+            tol,
+            t0,
+            t1,
+            y0,
+            observer,
+        } = job;
+        let checked = Method::Dopri5(tol)
+            .validate()
+            .and_then(|()| check_span(t0, t1))
+            .and_then(|()| match y0.iter().position(|v| !v.is_finite()) {
+                Some(i) => Err(Error::invalid(
+                    "y0",
+                    y0[i],
+                    "every component must be finite",
+                )),
+                None => Ok(()),
+            });
+        if let Err(e) = checked {
+            return Err((observer, Err(e)));
+        }
+        let mut cuts = vec![t0];
+        cuts.extend(system.breakpoints(t0, t1));
+        cuts.push(t1);
+        let mut lane = Lane {
+            system,
+            tol,
+            observer,
+            cuts,
+            seg: 0,
+            t: t0,
+            b: t0,
+            t1,
+            h_abs: 0.0,
+            min_step: 0.0,
+            rejected: false,
+            t_new: t0,
+            stats: Stats {
+                t_end: t0,
+                ..Stats::default()
+            },
+            y: y0,
+            k1: y0,
+            constant_flux: None,
+        };
+        if lane.enter_segment() {
+            Ok(lane)
+        } else {
+            let (stats, y) = (lane.stats, lane.y);
+            Err((lane.observer, Ok((stats, y))))
+        }
+    }
+
+    /// Enters the next non-empty segment (false: none is left): the prologue of
+    /// `dopri5::segment`.
+    fn enter_segment(&mut self) -> bool {
+        while self.seg + 1 < self.cuts.len() {
+            let (a, b) = (self.cuts[self.seg], self.cuts[self.seg + 1]);
+            self.seg += 1;
+            if b <= a {
+                continue;
+            }
+            self.system.enter_segment(a, b);
+            self.constant_flux = self.system.constant_flux();
+            self.t = a;
+            self.b = b;
+            self.k1 = self.system.rhs(a, &self.y);
+            self.stats.n_rhs += 1;
+            let h0 = dopri5::initial_step(
+                &self.system,
+                a,
+                &self.y,
+                &self.k1,
+                b - a,
+                &self.tol,
+                &mut self.stats,
+            );
+            self.h_abs = h0.min(self.tol.max_step);
+            self.rejected = false;
+            return true;
+        }
+        false
+    }
+
+    /// Chooses the trial step and loads the lane's inputs into `p`.
+    fn begin_trial(&mut self, p: &mut Pack, l: usize) -> Result<()> {
+        let t = self.t;
+        if !self.rejected {
+            self.min_step = 10.0 * (dopri5::next_up(t) - t);
+            if self.h_abs < self.min_step {
+                self.h_abs = self.min_step;
+            }
+        }
+        if self.stats.n_steps + self.stats.n_rejected >= self.tol.max_steps {
+            return Err(Error::Integration {
+                t,
+                reason: format!("max_steps = {} reached", self.tol.max_steps),
+            });
+        }
+        let t_new = if t + self.h_abs >= self.b {
+            self.b
+        } else {
+            t + self.h_abs
+        };
+        self.t_new = t_new;
+        let h = t_new - t;
+        p.t[l] = t;
+        p.h[l] = h;
+        for i in 0..4 {
+            p.y0[i][l] = self.y[i];
+            p.k1[i][l] = self.k1[i];
+        }
+        if let Some(flux) = self.constant_flux {
+            for f in &mut p.flux {
+                f[l] = flux;
+            }
+        } else {
+            for (j, c) in C[1..5].iter().enumerate() {
+                p.flux[j][l] = self.system.flux_at(t + c * h);
+            }
+            p.flux[4][l] = self.system.flux_at(t_new);
+        }
+        Ok(())
+    }
+
+    /// Loads what stays fixed over the run into lane `l` of `p`.
+    fn load(&self, p: &mut Pack, l: usize) {
+        let f = self.system.lane_form();
+        let b = f.balance;
+        let coef = [
+            b.heating,
+            b.conduction,
+            b.radiation_front,
+            b.radiation_back,
+            f.load_per_kelvin,
+            f.damping,
+            f.stiffness,
+        ];
+        for (c, v) in p.coef.iter_mut().zip(coef) {
+            c[l] = v;
+        }
+        p.atol[l] = self.tol.atol;
+        p.rtol[l] = self.tol.rtol;
+    }
+
+    /// Accepts or rejects the trial in lane `l` of `trial` (the tail of `dopri5::segment`'s
+    /// loop); `Some` when the run has ended.
+    fn end_trial(&mut self, trial: &Trial, l: usize) -> Option<Outcome> {
+        let (t, t_new) = (self.t, self.t_new);
+        let h = t_new - t;
+        self.stats.n_rhs += 6;
+        let mean_square = trial.mean_square[l];
+        let lane = |v: &[V; 4]| Vector4::new(v[0][l], v[1][l], v[2][l], v[3][l]);
+        if mean_square < 1.0 {
+            let mut factor = if mean_square == 0.0 {
+                MAX_FACTOR
+            } else {
+                let grow = (mean_square as f32).powf(0.5 * ERROR_EXPONENT as f32);
+                MAX_FACTOR.min(SAFETY * f64::from(grow))
+            };
+            if self.rejected {
+                factor = factor.min(1.0);
+            }
+            self.stats.n_steps += 1;
+            let y0 = self.y;
+            let y_new = lane(&trial.y_new);
+            let [r2, r3, r4, r5] = &trial.dense;
+            let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
+            self.y = y_new;
+            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r);
+            self.t = t_new;
+            self.stats.t_end = t_new;
+            self.k1 = lane(&trial.k7);
+            self.h_abs = (h * factor).min(self.tol.max_step);
+            self.rejected = false;
+            if self.observer.on_step(&dense).is_break() {
+                self.stats.stopped = self.stats.t_end < self.t1;
+                return Some(Ok((self.stats, self.y)));
+            }
+            if self.t >= self.b && !self.enter_segment() {
+                return Some(Ok((self.stats, self.y)));
+            }
+            return None;
+        }
+        self.stats.n_rejected += 1;
+        let err_norm = mean_square.sqrt();
+        let shrink = if err_norm.is_finite() {
+            MIN_FACTOR.max(SAFETY * err_norm.powf(ERROR_EXPONENT))
+        } else {
+            MIN_FACTOR
+        };
+        self.h_abs = h * shrink;
+        self.rejected = true;
+        if self.h_abs < self.min_step {
+            return Some(Err(Error::Integration {
+                t,
+                reason: format!(
+                    "step size {:e} s fell below the smallest resolvable step \
+                     (state {:?}); the solution is not finite or the problem is too stiff",
+                    self.h_abs,
+                    self.y.as_slice()
+                ),
+            }));
+        }
+        None
+    }
+}
+
+/// The lockstep loop (compiled once per [`Kernel`]).
+#[inline(always)]
+fn drive<O, N, F>(mut next: N, mut done: F)
+where
+    O: Observer<nalgebra::U4>,
+    N: FnMut() -> Option<Job<O>>,
+    F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+{
+    let mut lanes: [Option<Lane<O>>; LANES] = std::array::from_fn(|_| None);
+    let mut pack = Pack::zeros();
+    let mut form: Option<(HingeModel, Coupling)> = None;
+    let mut exhausted = false;
+    loop {
+        // Give every idle lane the next job.
+        for (l, slot) in lanes.iter_mut().enumerate() {
+            while slot.is_none() && !exhausted {
+                let Some(mut job) = next() else {
+                    exhausted = true;
+                    break;
+                };
+                let LaneForm {
+                    model, coupling, ..
+                } = job.system.lane_form();
+                let (m, c) = *form.get_or_insert((model, coupling));
+                if (model, coupling) != (m, c) {
+                    let outcome = solve(
+                        &mut job.system,
+                        &Method::Dopri5(job.tol),
+                        job.t0,
+                        job.y0,
+                        job.t1,
+                        &mut job.observer,
+                    );
+                    done(job.observer, outcome);
+                    continue;
+                }
+                match Lane::start(job) {
+                    Ok(lane) => {
+                        lane.load(&mut pack, l);
+                        *slot = Some(lane);
+                    }
+                    Err((observer, outcome)) => done(observer, outcome),
+                }
+            }
+        }
+        let Some((model, coupling)) = form else {
+            return;
+        };
+        let mut busy = false;
+        for (l, slot) in lanes.iter_mut().enumerate() {
+            let Some(lane) = slot else {
+                continue;
+            };
+            match lane.begin_trial(&mut pack, l) {
+                Ok(()) => busy = true,
+                Err(e) => {
+                    let lane = slot.take().expect("a lane");
+                    pack.clear(l);
+                    done(lane.observer, Err(e));
+                }
+            }
+        }
+        if !busy {
+            if exhausted {
+                return;
+            }
+            continue;
+        }
+        let trial = step_lanes(model, coupling, &pack);
+        for (l, slot) in lanes.iter_mut().enumerate() {
+            let Some(lane) = slot else {
+                continue;
+            };
+            if let Some(outcome) = lane.end_trial(&trial, l) {
+                let lane = slot.take().expect("a lane");
+                pack.clear(l);
+                done(lane.observer, outcome);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::Sampler;
+    use crate::orbit::Orbit;
+    use crate::params::Panel;
+    use crate::steady::equilibrium;
+    use nalgebra::U4;
+
+    /// A run's samples, with its index.
+    struct Tagged(usize, Sampler<U4>);
+
+    impl Observer<U4> for Tagged {
+        fn on_step(&mut self, step: &DenseStep<U4>) -> std::ops::ControlFlow<()> {
+            self.1.on_step(step)
+        }
+    }
+
+    /// A job per panel: one orbit sampled at 200 times, with its index.
+    fn jobs(panels: &[Panel], model: HingeModel, coupling: Coupling) -> Vec<Job<Tagged>> {
+        let orbit = Orbit {
+            radius: 7.0e6,
+            period: 5828.5,
+            ..Orbit::geo_equinox()
+        };
+        jobs_on(orbit, panels, model, coupling)
+    }
+
+    fn jobs_on(
+        orbit: Orbit,
+        panels: &[Panel],
+        model: HingeModel,
+        coupling: Coupling,
+    ) -> Vec<Job<Tagged>> {
+        panels
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let eq = equilibrium(p, coupling, orbit.flux_scale(0.0)).unwrap();
+                Job {
+                    system: Coupled::new(*p, orbit, model, coupling),
+                    tol: Tolerances {
+                        rtol: 1e-7,
+                        atol: 1e-9,
+                        max_step: 3.0 + k as f64,
+                        ..Tolerances::default()
+                    },
+                    t0: 0.0,
+                    t1: orbit.period,
+                    y0: Vector4::new(eq.t_front, eq.t_back, eq.theta + 0.15 * k as f64, 0.0),
+                    observer: Tagged(k, Sampler::every(0.0, orbit.period, orbit.period / 200.0)),
+                }
+            })
+            .collect()
+    }
+
+    fn panels(n: usize) -> Vec<Panel> {
+        (0..n)
+            .map(|k| Panel {
+                damping: 0.4 * k as f64,
+                conductance: 18.0 + 1.5 * k as f64,
+                ..Panel::paper()
+            })
+            .collect()
+    }
+
+    /// A run's samples and end state by their bits, with its counters.
+    type Run = (Vec<u64>, Vec<u64>, Stats);
+    type Runs = Vec<Run>;
+
+    /// Each job's samples and end state by their bits, with its counters, in job order.
+    fn in_lockstep(kernel: Kernel, jobs: Vec<Job<Tagged>>) -> Runs {
+        let n = jobs.len();
+        let mut out: Vec<Option<Run>> = vec![None; n];
+        let mut queue = jobs.into_iter();
+        solve_lockstep(
+            kernel,
+            || queue.next(),
+            |Tagged(k, sampler), outcome| {
+                let (stats, y_end) = outcome.unwrap();
+                out[k] = Some(bits(&sampler, &y_end, stats));
+            },
+        );
+        out.into_iter().map(Option::unwrap).collect()
+    }
+
+    fn bits(s: &Sampler<U4>, y: &Vector4<f64>, stats: Stats) -> Run {
+        let samples = s.y.iter().flat_map(|v| v.iter()).map(|x| x.to_bits());
+        let end = y.iter().map(|x| x.to_bits()).collect();
+        (samples.collect(), end, stats)
+    }
+
+    fn alone(jobs: Vec<Job<Tagged>>) -> Runs {
+        jobs.into_iter()
+            .map(|mut j| {
+                let method = Method::Dopri5(j.tol);
+                let (stats, y_end) =
+                    solve(&mut j.system, &method, j.t0, j.y0, j.t1, &mut j.observer.1).unwrap();
+                bits(&j.observer.1, &y_end, stats)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn lanes_equal_single_runs() {
+        // Seven runs on four lanes: lanes refill, and the last ones run with idle lanes. The
+        // last two start beyond π/4, where sin/cos come from the library.
+        for (model, coupling) in [
+            (HingeModel::Nonlinear, Coupling::ProjectedArea),
+            (HingeModel::Linear, Coupling::Frozen),
+            (HingeModel::Nonlinear, Coupling::Frozen),
+        ] {
+            let ps = panels(7);
+            let want = alone(jobs(&ps, model, coupling));
+            assert!(want
+                .iter()
+                .all(|(_, _, s)| s.n_rejected > 0 || s.n_steps > 100));
+            for kernel in [Kernel::Portable, Kernel::detect()] {
+                let got = in_lockstep(kernel, jobs(&ps, model, coupling));
+                for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert_eq!(g, w, "{model:?} {coupling:?} {kernel:?}: run {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lanes_equal_single_runs_through_a_penumbra() {
+        // The Sun's distance and the penumbra make the illumination vary within segments.
+        let orbit = Orbit::geo_year(273.0);
+        assert!(orbit.eclipses(0.0, orbit.period).len() == 1);
+        let ps = panels(5);
+        let (m, c) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let want = alone(jobs_on(orbit, &ps, m, c));
+        for kernel in [Kernel::Portable, Kernel::detect()] {
+            assert_eq!(in_lockstep(kernel, jobs_on(orbit, &ps, m, c)), want);
+        }
+    }
+
+    #[test]
+    fn a_failing_run_leaves_the_others_alone() {
+        let ps = panels(5);
+        let mut js = jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea);
+        js[1].tol.max_steps = 50;
+        js[3].y0[0] = f64::NAN;
+        let want = alone(jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea));
+        let mut errors = Vec::new();
+        let mut ok = Vec::new();
+        let mut queue = js.into_iter();
+        solve_lockstep(
+            Kernel::detect(),
+            || queue.next(),
+            |Tagged(k, s), outcome| match outcome {
+                Ok((stats, y)) => ok.push((k, bits(&s, &y, stats))),
+                Err(e) => errors.push((k, e.to_string())),
+            },
+        );
+        errors.sort_by_key(|e| e.0);
+        assert_eq!(errors.len(), 2, "{errors:?}");
+        assert_eq!(errors[0].0, 1);
+        assert!(errors[0].1.contains("max_steps = 50"), "{}", errors[0].1);
+        assert_eq!(errors[1].0, 3);
+        assert!(errors[1].1.starts_with("y0"), "{}", errors[1].1);
+        for (k, got) in ok {
+            assert_eq!(got, want[k], "run {k}");
+        }
+    }
+
+    #[test]
+    fn a_job_of_another_model_runs_alone() {
+        let ps = panels(3);
+        let mut js = jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let other = jobs(&ps, HingeModel::Linear, Coupling::ProjectedArea);
+        js[1] = other.into_iter().nth(1).unwrap();
+        let mut want = alone(jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea));
+        want[1] = alone(jobs(&ps, HingeModel::Linear, Coupling::ProjectedArea)).remove(1);
+        assert_eq!(in_lockstep(Kernel::detect(), js), want);
+    }
+}
