@@ -26,6 +26,7 @@ __all__ = [
     "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
+    "SOLVER_DEFAULTS",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -74,6 +75,7 @@ __all__ = [
 
 PANEL_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
+SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
 EARTH_RADIUS: float
 SIDEREAL_DAY: float

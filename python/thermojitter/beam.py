@@ -25,7 +25,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from thermojitter import _core
+from thermojitter import _core, solver
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
@@ -125,13 +125,13 @@ class FreeFreeBeam:
         damping_ratio: float | None = None,
         residual: bool = True,
         method: Method = "rk45",
-        rtol: float = 1e-8,
-        atol: float = 1e-10,
+        rtol: float = solver.RTOL,
+        atol: float = solver.ATOL,
         dt: float | None = None,
         t_eval: ArrayLike | None = None,
         dt_out: float | None = None,
-        max_step: float = float("inf"),
-        max_steps: int = 500_000_000,
+        max_step: float = solver.MAX_STEP,
+        max_steps: int = solver.MAX_STEPS,
     ) -> BeamResponse:
         """Modal transient response to end moments ±M(t), M given as samples ``moments`` (N m)
         at ``times`` (s, increasing; linear in between, held beyond the ends).
@@ -271,8 +271,8 @@ def compare_with_beam(
     model: Model = "nonlinear",
     coupled: bool = True,
     f_min: float = DEFAULT_F_MIN,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
 ) -> BeamComparison:
     """Runs the hinge model and the beam through an eclipse and compares θ(t) with θ_f(t).
 

@@ -33,7 +33,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from thermojitter import _core
+from thermojitter import _core, solver
 from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
@@ -190,11 +190,11 @@ def simulate_distributed(
     sun_angle: float = 0.0,
     layers: int = 2,
     method: Method = "rk45",
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     max_step: float = math.inf,
-    max_steps: int = 500_000_000,
+    max_steps: int = solver.MAX_STEPS,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: ArrayLike | None = None,

@@ -21,6 +21,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from thermojitter import solver
 from thermojitter.beam import eclipse_window
 from thermojitter.distributed import (
     distributed_convergence,
@@ -68,8 +69,8 @@ def compare_hinge_with_distributed(
     dt_out: float = 0.5,
     elements: int | None = None,
     modes: int | None = None,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
 ) -> HingeVsDistributed:
     """Runs the hinge model (K_el: the panel's own for ``"deflection"`` — Table 1's 4438 N m/rad
     is that criterion — or 5.21 EI/L for ``"frequency"``) and the coupled distributed panel

@@ -19,7 +19,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import _core
+from thermojitter import _core, solver
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
@@ -205,8 +205,8 @@ def simulate_orbits(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     y0: tuple[float, ...] | None = None,
     window: float = 600.0,
@@ -216,7 +216,7 @@ def simulate_orbits(
     checkpoint_every: float = 10.0,
     orbits_per_call: int = 1,
     progress: bool | None = True,
-    max_steps: int = 500_000_000,
+    max_steps: int = solver.MAX_STEPS,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
     hybrid: dict[str, float] | None = None,

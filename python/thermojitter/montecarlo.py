@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from scipy import stats
 from scipy.stats import qmc
 
-from thermojitter import _core
+from thermojitter import _core, solver
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
@@ -754,11 +754,11 @@ def monte_carlo(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     window: float = 600.0,
-    max_steps: int = 500_000_000,
+    max_steps: int = solver.MAX_STEPS,
 ) -> Any:
     """Runs ``n`` panels drawn around ``panel`` and returns a pandas DataFrame, one row a sample:
     the sampled parameters, then the metrics (see ``METRICS``).
@@ -835,11 +835,11 @@ def sweep(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     window: float = 600.0,
-    max_steps: int = 500_000_000,
+    max_steps: int = solver.MAX_STEPS,
 ) -> Any:
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
@@ -907,11 +907,11 @@ def sensitivity(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     window: float = 600.0,
-    max_steps: int = 500_000_000,
+    max_steps: int = solver.MAX_STEPS,
 ) -> SensitivityResult:
     """Sobol sensitivity indices of one metric to the parameters in ``vary`` (needs SALib:
     ``pip install 'thermojitter[sensitivity]'``).

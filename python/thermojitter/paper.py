@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import plots
+from thermojitter import plots, solver
 from thermojitter.flutter import linear_thermal_response
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
@@ -52,8 +52,8 @@ WINDOW_S = 600.0
 class PaperOptions:
     """Settings of ``thermojitter paper`` (SI)."""
 
-    rtol: float = 1e-8
-    atol: float = 1e-10
+    rtol: float = solver.RTOL
+    atol: float = solver.ATOL
     dt_out: float = 0.5
     """Reporting interval of the coupled runs, s (the jitter period is about 8 s)."""
     thermal_dt_out: float = 2.0

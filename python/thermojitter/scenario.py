@@ -29,6 +29,7 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
+from thermojitter import solver
 from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
@@ -80,8 +81,8 @@ class SimulationSettings:
     model: str = "nonlinear"
     coupled: bool = True
     method: str = "rk45"
-    rtol: float = 1e-8
-    atol: float = 1e-10
+    rtol: float = solver.RTOL
+    atol: float = solver.ATOL
     dt: float | None = None
     dt_out: float = 0.5
     years: float | None = None

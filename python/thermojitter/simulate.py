@@ -8,7 +8,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from thermojitter import _core
+from thermojitter import _core, solver
 from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
 from thermojitter.orbit import Orbit
@@ -138,14 +138,14 @@ def simulate(
     model: Model = "nonlinear",
     coupled: bool = True,
     method: Method = "rk45",
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: Sequence[float] | None = None,
-    max_step: float = float("inf"),
-    max_steps: int = 500_000_000,
+    max_step: float = solver.MAX_STEP,
+    max_steps: int = solver.MAX_STEPS,
     layers: int | None = None,
 ) -> Solution:
     """Integrates the coupled thermo-structural model over ``t_span`` (s).
@@ -199,7 +199,7 @@ def simulate(
             n_rejected=raw["n_rejected"],
             n_rhs=raw["n_rhs"],
             method=method,
-            settings={**settings, "layers": nodes},
+            settings={**settings, "layers": nodes, "solver": args["solver"]},
             T_front=temps[:, 0],
             T_back=temps[:, -1],
             theta=raw["theta"],
@@ -226,7 +226,7 @@ def simulate(
         n_rejected=raw["n_rejected"],
         n_rhs=raw["n_rhs"],
         method=method,
-        settings=settings,
+        settings={**settings, "solver": dict(raw["solver"])},
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         theta=raw["theta"],
@@ -244,14 +244,14 @@ def simulate_thermal(
     *,
     layers: Literal[1, 2] = 2,
     method: Method = "rk45",
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: Sequence[float] | None = None,
-    max_step: float = float("inf"),
-    max_steps: int = 500_000_000,
+    max_step: float = solver.MAX_STEP,
+    max_steps: int = solver.MAX_STEPS,
 ) -> ThermalSolution:
     """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
     (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
@@ -290,13 +290,13 @@ def simulate_hinge(
     model: Model = "nonlinear",
     y0: Sequence[float] = (0.0, 0.0),
     method: Method = "rk45",
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
+    rtol: float = solver.RTOL,
+    atol: float = solver.ATOL,
     dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
-    max_step: float = float("inf"),
-    max_steps: int = 500_000_000,
+    max_step: float = solver.MAX_STEP,
+    max_steps: int = solver.MAX_STEPS,
 ) -> HingeSolution:
     """The hinge alone under a prescribed thermal moment (N m): a constant, or samples
     ``moment`` at times ``moment_t`` (linear in between, held beyond the ends).

@@ -25,6 +25,8 @@ where
     pub stats: Stats,
     /// State at `stats.t_end`.
     pub y_end: State<D>,
+    /// The integrator and the settings the run used.
+    pub method: Method,
 }
 
 impl<D: Dim> Trajectory<D>
@@ -100,5 +102,6 @@ where
         y: sampler.y,
         stats,
         y_end,
+        method: *method,
     })
 }

@@ -217,3 +217,26 @@ where
     }
     Ok(State::from_column_slice_generic(dim, U1, v))
 }
+
+/// The integrator settings as a solver mapping (what [`solver_from`] reads): the engine's
+/// defaults, and the settings a run used.
+pub fn solver_dict<'py>(py: Python<'py>, method: &Method) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let tol = match method {
+        Method::Rk4 { dt } => {
+            d.set_item("method", "rk4")?;
+            d.set_item("dt", *dt)?;
+            Tolerances::default()
+        }
+        Method::Dopri5(tol) => {
+            d.set_item("method", "rk45")?;
+            d.set_item("dt", py.None())?;
+            *tol
+        }
+    };
+    d.set_item("rtol", tol.rtol)?;
+    d.set_item("atol", tol.atol)?;
+    d.set_item("max_step", tol.max_step)?;
+    d.set_item("max_steps", tol.max_steps)?;
+    Ok(d)
+}

@@ -57,6 +57,10 @@ where
         intern!(py, "y_end"),
         array(py, traj.y_end.as_slice().to_vec()),
     )?;
+    d.set_item(
+        intern!(py, "solver"),
+        convert::solver_dict(py, &traj.method)?,
+    )?;
     Ok(d)
 }
 
@@ -396,6 +400,13 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConvergenceError", m.py().get_type::<ConvergenceError>())?;
     m.add("PANEL_FIELDS", crate::Panel::FIELDS.to_vec())?;
     m.add("PAPER_PANEL", panel_dict(m.py(), &crate::Panel::paper())?)?;
+    m.add(
+        "SOLVER_DEFAULTS",
+        convert::solver_dict(
+            m.py(),
+            &crate::integrate::Method::Dopri5(Default::default()),
+        )?,
+    )?;
     m.add("CASE_A_PANEL", panel_dict(m.py(), &crate::Panel::case_a())?)?;
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
     m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
