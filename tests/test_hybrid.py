@@ -118,13 +118,13 @@ def test_killed_hybrid_run_resumes_to_identical_summaries(tmp_path: Path) -> Non
     )
     while proc.poll() is None:
         try:
-            if json.loads(path.read_text())["next_index"] >= 5:
+            if json.loads(path.read_text())["content"]["next_index"] >= 5:
                 break
         except (FileNotFoundError, json.JSONDecodeError, KeyError):
             pass
     proc.kill()
     proc.wait()
-    done = json.loads(path.read_text())["next_index"]
+    done = json.loads(path.read_text())["content"]["next_index"]
     assert 0 < done < n, "the child finished before it could be killed"
     orbit = tj.Orbit.geo_year("2026-03-01")
     kw = {"method": "hybrid", "orbits_per_call": 1, "progress": False}
