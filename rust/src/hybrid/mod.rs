@@ -33,10 +33,7 @@ use crate::longrun::{
     STEPS_PER_HINGE_PERIOD,
 };
 use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
-use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::params::Panel;
-use crate::params::Panel;
-use crate::steady::equilibrium;
 use crate::steady::{equilibrium, newton};
 use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
