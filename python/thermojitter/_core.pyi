@@ -8,6 +8,7 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "least_steps",
     "leo_orbit",
     "eclipse_duration",
     "SIDEREAL_DAY",
@@ -23,6 +24,7 @@ __all__ = [
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
+    "MAX_THREADS",
     "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
@@ -70,8 +72,7 @@ __all__ = [
     "validate_laminate",
     "validate_layer",
     "validate_orbit",
-    "validate_panel",
-]
+    "validate_panel",]
 
 PANEL_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
@@ -85,6 +86,7 @@ PERIHELION_DAY: float
 GEO_EQUINOX_ORBIT: dict[str, Any]
 CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
+MAX_THREADS: int
 MAX_TIME: float
 
 class IntegrationError(RuntimeError): ...
@@ -266,6 +268,9 @@ def stability_map(
 
 # --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
 def check_panels(panels: _F) -> list[tuple[int, str, str]]: ...
+def least_steps(
+    panels: _F, solver: dict[str, Any], span: float, steps_per_period: float | None = None
+) -> _F: ...
 
 @final
 class EnsemblePool:

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 
 from thermojitter import solver
 from thermojitter.beam import eclipse_window
+from thermojitter.checkpoint import write_atomic
 from thermojitter.distributed import (
     distributed_convergence,
     distributed_flutter,
@@ -225,8 +226,11 @@ def _figure(cases: dict[str, HingeVsDistributed], out: Path) -> str:
     axes[-1].set_xlabel(f"time from t = {next(iter(cases.values())).t[0]:.0f} s (min)")
     path = out / FIGURE
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        # Atomic: a failed write (a full disk) leaves no partial image.
+        write_atomic(path, lambda fh: fig.savefig(fh, dpi=120, format="png"))
+    finally:
+        plt.close(fig)
     return str(path)
 
 

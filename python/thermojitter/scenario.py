@@ -29,6 +29,7 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
+from thermojitter import errors as checks
 from thermojitter import solver
 from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
@@ -133,7 +134,10 @@ class Scenario:
 def _real(path: Path, key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ScenarioError(path, key, f"must be a number, not {_toml_type(value)} {value!r}")
-    number = float(value)
+    try:
+        number = checks.real(key, value)
+    except ParameterError as exc:  # an integer too large for a float
+        raise ScenarioError(path, key, str(exc.allowed)) from None
     if not math.isfinite(number):
         raise ScenarioError(path, key, f"must be finite, not {value!r}")
     return number

@@ -324,6 +324,30 @@ pub fn hinge_energy(
     kinetic + 0.5 * panel.hinge_stiffness * theta * theta - moment * theta
 }
 
+/// [`hinge_energy`] of a state given by a caller: θ within the hinge model's range, a moment
+/// whose static angle is too, and a rate whose kinetic energy is a number (a rate of 1e160
+/// rad/s would give inf).
+pub fn checked_hinge_energy(
+    panel: &Panel,
+    model: HingeModel,
+    theta: f64,
+    theta_dot: f64,
+    moment: f64,
+) -> Result<f64> {
+    check_hinge_angle("theta", theta)?;
+    check_moment(panel, moment)?;
+    let energy = hinge_energy(panel, model, theta, theta_dot, moment);
+    if energy.is_finite() {
+        Ok(energy)
+    } else {
+        Err(Error::invalid(
+            "theta_dot",
+            theta_dot,
+            "must be finite, with a kinetic energy within a float's range",
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -363,8 +363,19 @@ fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> 
         .collect()
 }
 
+/// Most worker threads a pool may have: more than any machine's cores, few enough that a typo
+/// (or 2**63) does not spawn threads until the operating system refuses.
+pub const MAX_THREADS: usize = 1024;
+
 /// A rayon pool of its own with `threads` workers (0: rayon's default, one per core).
 pub fn pool(threads: usize) -> Result<ThreadPool> {
+    if threads > MAX_THREADS {
+        return Err(Error::invalid(
+            "threads",
+            threads,
+            &format!("must be in [1, {MAX_THREADS}] (or None for one per core)"),
+        ));
+    }
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
