@@ -194,6 +194,15 @@ def test_hinge_energy_of_states_beyond_the_model_is_refused_not_inf() -> None:
     assert e == pytest.approx(0.5 * P.hinge_stiffness * 0.01 - 40.0, rel=1e-12)
 
 
+@pytest.mark.parametrize("flux", [5e-324, 3e-63, 540.0, 2395.0, 1e12, 1.7976931348623157e308])
+def test_flux_factors_beyond_any_orbit_are_refused_not_a_failed_newton(flux: float) -> None:
+    # These used to end in "steady state did not converge" (a singular Jacobian, a panel folded
+    # beyond 90°, Newton giving up) without naming the flux.
+    refused(lambda: tj.steady_state(P, flux=flux), "flux", "1 au")
+    refused(lambda: tj.flutter(P, flux=flux), "flux")
+    refused(lambda: tj.linear_thermal_response(P, omega=1e16, flux=flux), "flux")
+
+
 # --- used to raise a PanicException (a BaseException) -----------------------------------------
 
 

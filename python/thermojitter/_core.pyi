@@ -72,7 +72,8 @@ __all__ = [
     "validate_laminate",
     "validate_layer",
     "validate_orbit",
-    "validate_panel",]
+    "validate_panel",
+]
 
 PANEL_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]

@@ -65,6 +65,11 @@ fn rest_state<S: StructuralModel>(structure: &S, positions: &[f64]) -> Vec<f64> 
     q
 }
 
+/// Flux factors a steady state is sought for: from far beyond the planets (1e-6, at 1000 au) to
+/// 100 (0.1 au, well inside Mercury's orbit). Beyond them a panel's temperatures underflow or
+/// soar to thousands of kelvin, and Newton fails without saying why.
+pub const FLUX_RANGE: (f64, f64) = (1e-6, 100.0);
+
 /// The steady state of `thermal` coupled to `structure` under constant flux factor `flux`:
 /// (temperatures, positions), velocities being zero. Newton from the isothermal plate's
 /// temperature and the unloaded shape, with a forward-difference Jacobian.
@@ -78,8 +83,13 @@ where
     T: ThermalModel + ?Sized,
     S: StructuralModel,
 {
-    if !(flux.is_finite() && flux > 0.0) {
-        return Err(Error::invalid("flux", flux, "must be finite and > 0"));
+    let (low, high) = FLUX_RANGE;
+    if !(low..=high).contains(&flux) {
+        return Err(Error::invalid(
+            "flux",
+            flux,
+            &format!("must be in [{low:e}, {high}] (the solar flux over its value at 1 au)"),
+        ));
     }
     let n = thermal.size();
     let m = n + structure.positions();
