@@ -34,6 +34,7 @@ __all__ = [
     "beam_response",
     "beam_static",
     "check_panels",
+    "check_solver",
     "conduction_grid",
     "cpu_info",
     "declination",
@@ -101,6 +102,7 @@ class CancelToken:
 
 class ConvergenceError(RuntimeError): ...
 
+def check_solver(solver: dict[str, Any]) -> dict[str, Any]: ...
 def validate_panel(panel: dict[str, float]) -> None: ...
 def validate_orbit(orbit: dict[str, Any]) -> None: ...
 def steady_state(

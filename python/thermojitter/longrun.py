@@ -19,7 +19,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import _core, solver
+from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
@@ -29,10 +29,10 @@ from thermojitter.simulate import (
     check_inputs,
     check_layers,
     layup_dict,
-    solver_settings,
     start_state,
     steady_state,
 )
+from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -234,8 +234,8 @@ def simulate_orbits(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     y0: tuple[float, ...] | None = None,
     window: float = 600.0,
@@ -245,11 +245,12 @@ def simulate_orbits(
     checkpoint_every: float = 10.0,
     orbits_per_call: int = 1,
     progress: bool | None = True,
-    max_steps: int = solver.MAX_STEPS,
+    max_steps: int = MAX_STEPS,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
     hybrid: dict[str, float] | None = None,
     layers: int | None = None,
+    solver: SolverSettings | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -283,6 +284,8 @@ def simulate_orbits(
       is within 1 % of the eigen-analysis; it costs about twice the steps of error control alone.
     - ``layers=N``: the N-node through-thickness model on the panel's layup (see
       :func:`thermojitter.simulate`); ``y0`` and ``y_end`` are then (node temperatures…, θ, θ̇).
+    - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
+      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback).
     """
     check_inputs(panel, orbit)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
@@ -306,10 +309,18 @@ def simulate_orbits(
     if nodes is not None and method == "hybrid":
         # The hybrid propagator covers the two-layer model; layered panels are integrated in full.
         method = "rk45"
-    # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
-    solver = solver_settings(
-        "rk45" if method == "hybrid" else method, rtol, atol, dt, math.inf, max_steps
+    used = SolverSettings.of(
+        solver,
+        method=None if method == "hybrid" else method,
+        rtol=rtol,
+        atol=atol,
+        dt=dt,
+        max_steps=max_steps,
     )
+    if method == "hybrid":
+        # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
+        used = used.replace(method="rk45")
+    full = used.as_dict()
     if hybrid is not None and not isinstance(hybrid, dict):
         raise TypeError(f"hybrid must be a dict of engine settings, not {type(hybrid).__name__}")
     if y0 is not None:
@@ -332,16 +343,16 @@ def simulate_orbits(
         "model": model,
         "coupled": coupled,
         "method": method,
-        "rtol": solver["rtol"],
-        "atol": solver["atol"],
-        "dt": solver["dt"],
+        "rtol": full["rtol"],
+        "atol": full["atol"],
+        "dt": full["dt"],
         "y0": [float(v) for v in y0],
         "window": window,
         "theta_limit": theta_limit,
         "on_limit": on_limit,
         "orbits_per_call": orbits_per_call,
         "steps_per_period": steps_per_period,
-        "max_steps": solver["max_steps"],
+        "max_steps": full["max_steps"],
     }
     if nodes is not None:
         settings["layers"] = nodes
@@ -352,7 +363,7 @@ def simulate_orbits(
     core_args: dict[str, Any] = {
         "model": model,
         "coupled": coupled,
-        "solver": solver,
+        "solver": full,
         "window": window,
         "theta_limit": theta_limit,
         "stop_at_limit": on_limit == "stop",

@@ -1,6 +1,6 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
-use super::convert::{output, panel_from, solver_from};
+use super::convert::{output, panel_from, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use crate::beam::{respond, FreeFreeBeam, BEAM_MODES};
@@ -136,6 +136,7 @@ fn beam_response<'py>(
         d.set_item("n_steps", r.stats.n_steps)?;
         d.set_item("n_rejected", r.stats.n_rejected)?;
         d.set_item("n_rhs", r.stats.n_rhs)?;
+        d.set_item("solver", solver_dict(py, &m)?)?;
         Ok(d)
     })
 }

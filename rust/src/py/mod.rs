@@ -73,6 +73,14 @@ fn panel_dict<'py>(py: Python<'py>, p: &crate::Panel) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+/// Validates a solver mapping {method, rtol, atol, dt, max_step, max_steps} and returns it as the
+/// engine reads it: `tj.SolverSettings` is checked here, by the same code that checks every run.
+#[pyfunction]
+fn check_solver<'py>(py: Python<'py>, solver: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
+    let m = solver_from(solver)?;
+    convert::solver_dict(py, &m)
+}
+
 /// Validates a panel given as a mapping of its parameters.
 #[pyfunction]
 fn validate_panel(panel: &Bound<'_, PyDict>) -> PyResult<()> {
@@ -411,6 +419,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
     m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
     m.add("MAX_THREADS", crate::ensemble::MAX_THREADS)?;
+    m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(steady_state, m)?)?;
