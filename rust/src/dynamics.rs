@@ -426,4 +426,25 @@ mod tests {
             assert!(rate.abs() < 1e-5 * (de_dth * om).abs(), "{model:?}: {rate}");
         }
     }
+
+    #[test]
+    fn checked_hinge_energy_refuses_states_beyond_the_model_and_agrees_within() {
+        let p = Panel::paper();
+        let m = HingeModel::Nonlinear;
+        let name = |r: Result<f64>| match r {
+            Err(Error::InvalidParameter { name, .. }) => name,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            name(checked_hinge_energy(&p, m, 1e300, 0.0, 400.0)),
+            "theta"
+        );
+        assert_eq!(
+            name(checked_hinge_energy(&p, m, 0.1, 1e200, 400.0)),
+            "theta_dot"
+        );
+        assert_eq!(name(checked_hinge_energy(&p, m, 0.1, 0.0, 1e300)), "moment");
+        let e = checked_hinge_energy(&p, m, 0.1, 0.02, 400.0).unwrap();
+        assert_eq!(e, hinge_energy(&p, m, 0.1, 0.02, 400.0));
+    }
 }

@@ -200,4 +200,21 @@ mod tests {
             assert!((y[0] - exact).abs() <= 1e-13 * exact, "{} vs {exact}", y[0]);
         }
     }
+
+    #[test]
+    fn flux_factors_outside_the_range_are_named() {
+        let p = Panel::paper();
+        for flux in [0.0, 5e-324, 0.9e-6, 100.1, 1e12, f64::NAN, f64::INFINITY] {
+            match equilibrium(&p, Coupling::ProjectedArea, flux) {
+                Err(crate::Error::InvalidParameter { name, .. }) => assert_eq!(name, "flux"),
+                other => panic!("flux {flux}: {other:?}"),
+            }
+        }
+        for flux in [FLUX_RANGE.0, 0.0111, 1.0, 10.6] {
+            assert!(
+                equilibrium(&p, Coupling::ProjectedArea, flux).is_ok(),
+                "flux {flux}"
+            );
+        }
+    }
 }
