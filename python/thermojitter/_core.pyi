@@ -25,10 +25,12 @@ __all__ = [
     "IntegrationError",
     "LAYER_FIELDS",
     "MAX_THREADS",
+    "LINEAR_FIELDS",
     "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
     "SOLVER_DEFAULTS",
+    "VALIDITY_LIMIT",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -47,6 +49,7 @@ __all__ = [
     "equivalent_panel",
     "flutter",
     "flux_scale",
+    "hinge_points",
     "hinge_equivalent_damping_ratio",
     "illumination",
     "laminate_properties",
@@ -66,6 +69,7 @@ __all__ = [
     "simulate_layers",
     "simulate_thermal",
     "stability_map",
+    "start_state",
     "steady_state",
     "stiffness",
     "synodic_period",
@@ -77,6 +81,7 @@ __all__ = [
 ]
 
 PANEL_FIELDS: list[str]
+LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
@@ -90,6 +95,7 @@ CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
 MAX_THREADS: int
 MAX_TIME: float
+VALIDITY_LIMIT: float
 
 class IntegrationError(RuntimeError): ...
 
@@ -108,12 +114,16 @@ def validate_orbit(orbit: dict[str, Any]) -> None: ...
 def steady_state(
     panel: dict[str, float], coupled: bool = True, flux: float = 1.0
 ) -> tuple[float, float, float]: ...
+def start_state(
+    panel: dict[str, float], orbit: dict[str, Any], t0: float, coupled: bool
+) -> list[float]: ...
 def stiffness(panel: dict[str, float], criterion: str, moment: float = 0.0) -> float: ...
 def derived(panel: dict[str, float]) -> dict[str, float]: ...
 def shadow_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[float, float]]: ...
 def illumination(orbit: dict[str, Any], t: _F) -> _F: ...
 def moment(panel: dict[str, float], t_front: _F, t_back: _F) -> _F: ...
 def energy(panel: dict[str, float], model: str, theta: _F, theta_dot: _F, moment: float) -> _F: ...
+def hinge_points(panel: dict[str, float], zeta: float, theta: _F) -> tuple[_F, _F]: ...
 def simulate(
     panel: dict[str, float],
     orbit: dict[str, Any],
@@ -292,7 +302,7 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
-        validity_limit: float = 0.3490658503988659,
+        validity_limit: float = ...,
         hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
         lockstep: bool = True,

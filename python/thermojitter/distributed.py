@@ -93,8 +93,24 @@ def distributed_defaults(panel: Panel | None = None) -> dict[str, Any]:
     return dict(_core.distributed_defaults(panel.as_dict()))
 
 
+class _FaceTemperatures:
+    """The face temperatures by name, from ``temperatures`` (element fields, K)."""
+
+    temperatures: dict[str, Array]
+
+    @property
+    def T_front(self) -> Array:
+        """Front-face temperature per element, K (over time × element for a run)."""
+        return self.temperatures["T_front"]
+
+    @property
+    def T_back(self) -> Array:
+        """Back-face temperature per element, K (over time × element for a run)."""
+        return self.temperatures["T_back"]
+
+
 @dataclass(frozen=True)
-class DistributedSolution(Run):
+class DistributedSolution(_FaceTemperatures, Run):
     """The distributed panel at the reported times.
 
     ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
@@ -121,16 +137,6 @@ class DistributedSolution(Run):
     @property
     def theta_f_deg(self) -> Array:
         return np.degrees(self.theta_f)
-
-    @property
-    def T_front(self) -> Array:
-        """Front-face temperature per element, K, shape (time, element)."""
-        return self.temperatures["T_front"]
-
-    @property
-    def T_back(self) -> Array:
-        """Back-face temperature per element, K, shape (time, element)."""
-        return self.temperatures["T_back"]
 
     @property
     def delta_T(self) -> Array:
@@ -276,7 +282,7 @@ class OscillatoryMode:
 
 
 @dataclass(frozen=True)
-class DistributedFlutterResult:
+class DistributedFlutterResult(_FaceTemperatures):
     """Linear stability of the distributed panel's sunlit equilibrium.
 
     ``growth_rate`` (1/s) is the largest real part of all eigenvalues; ``oscillatory_modes`` lists
@@ -319,14 +325,6 @@ class DistributedFlutterResult:
     @property
     def theta_f_deg(self) -> float:
         return math.degrees(self.theta_f)
-
-    @property
-    def T_front(self) -> Array:
-        return self.temperatures["T_front"]
-
-    @property
-    def T_back(self) -> Array:
-        return self.temperatures["T_back"]
 
 
 def distributed_flutter(

@@ -7,7 +7,6 @@ run resumed from a checkpoint gives the very same summaries as one that was neve
 
 from __future__ import annotations
 
-import math
 import os
 import time
 import warnings
@@ -30,7 +29,6 @@ from thermojitter.simulate import (
     check_layers,
     layup_dict,
     start_state,
-    steady_state,
 )
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
@@ -47,9 +45,9 @@ HYBRID_COUNTERS = (
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model and the hinge-resolved fallback."""
 
-DEFAULT_THETA_LIMIT = math.radians(20.0)
-"""abs(θ) beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
-meant for modest angles)."""
+DEFAULT_THETA_LIMIT: float = _core.VALIDITY_LIMIT
+"""abs(θ) beyond which the hinge model is not trusted, rad (20°; its rigid halves and cos θ
+coupling are meant for modest angles): the engine's ``dynamics::VALIDITY_LIMIT``."""
 
 
 @dataclass
@@ -325,17 +323,16 @@ def simulate_orbits(
         raise TypeError(f"hybrid must be a dict of engine settings, not {type(hybrid).__name__}")
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None:
-        # The sunlit equilibrium at the solar flux of the start date.
+    if y0 is None and nodes is None:
+        # The engine's default start: the sunlit equilibrium at the start date's solar flux.
+        y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
+    elif y0 is None:
+        assert nodes is not None
         flux = float(orbit.flux_scale(t_start)[0])
-        if nodes is None:
-            eq = steady_state(panel, coupled=coupled, flux=flux)
-            y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
-        else:
-            raw_eq = _core.layered_steady_state(
-                panel.as_dict(), layup_dict(panel), nodes, coupled, flux
-            )
-            y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
+        raw_eq = _core.layered_steady_state(
+            panel.as_dict(), layup_dict(panel), nodes, coupled, flux
+        )
+        y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_dict(),
