@@ -7,7 +7,7 @@ use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::Result;
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, State, Stats};
-use crate::orbit::Orbit;
+use crate::orbit::{EclipseTable, Orbit};
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
@@ -157,6 +157,8 @@ pub(crate) struct Collector<V> {
     pub(crate) sq_sum: f64,
     pub(crate) duration: f64,
     pub(crate) crossing: Option<LimitCrossing>,
+    /// The orbit's eclipses, searched a stretch of orbits at a time.
+    eclipses: EclipseTable,
 }
 
 impl<V: SummaryView> Collector<V> {
@@ -196,6 +198,7 @@ impl<V: SummaryView> Collector<V> {
             sq_sum: 0.0,
             duration: 0.0,
             crossing: None,
+            eclipses: EclipseTable::new(orbit),
         };
         collector.current = collector.open(first_index)?;
         collector.current.theta_max = theta0;
@@ -212,7 +215,12 @@ impl<V: SummaryView> Collector<V> {
         } else {
             0.0
         };
-        let eclipse = self.orbit.shadow_intervals(t0, t1).first().copied();
+        // The first eclipse overlapping the orbit, clipped to it (Orbit::shadow_intervals).
+        let eclipse = self
+            .eclipses
+            .overlapping(t0, t1)
+            .first()
+            .map(|e| (e.outer.0.max(t0), e.outer.1.min(t1)));
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
     }
 
