@@ -958,8 +958,8 @@ def sensitivity(
 
     Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design (best with n
     a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
-    arguments (``layers`` too) these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` per parameter
-    (first-order and total indices, 95 % confidence half-widths).
+    arguments (``layers`` too) these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``,
+    ``ST_conf`` per parameter (first-order and total indices, 95 % confidence half-widths).
     """
     try:
         from SALib.analyze import sobol as sobol_analyze
