@@ -1,4 +1,5 @@
-//! Per-orbit summaries of long runs: memory grows with the number of orbits, not of steps.
+//! Long runs (`tj.simulate_orbits`, `python/thermojitter/longrun.py`): per-orbit summaries, so
+//! that memory grows with the number of orbits, not of steps.
 //!
 //! Each accepted step is read at four evenly spaced points of its dense output, fine enough to
 //! catch the peaks of an oscillation that needs tens of steps per period.
