@@ -305,7 +305,7 @@ def _laminate(path: Path, table: dict[str, Any]) -> Laminate:
         raise ScenarioError(
             path, "laminate.layers", "at least one [[laminate.layers]] table is required"
         )
-    layers = [_layer(path, i, entry) for i, entry in enumerate(entries)]
+    layers = tuple(_layer(path, i, entry) for i, entry in enumerate(entries))
     missing = [k for k in ("emissivity_front", "emissivity_back", "absorptivity") if k not in table]
     if missing:
         raise ScenarioError(path, f"laminate.{missing[0]}", "is required")
