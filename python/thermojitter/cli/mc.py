@@ -33,7 +33,17 @@ from thermojitter.scenario import ScenarioError, load_scenario
 
 SETTING_KEYS = ("n", "seed", "sampler", "truncate")
 """Keys of [montecarlo] that set the design."""
-RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window", "layers")
+RUN_KEYS = (
+    "horizon",
+    "threshold",
+    "rtol",
+    "atol",
+    "model",
+    "coupled",
+    "window",
+    "max_steps",
+    "layers",
+)
 
 
 def read_scenario(path: str | Path) -> dict[str, Any]:
