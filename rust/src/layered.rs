@@ -735,6 +735,9 @@ impl crate::summary::SummaryView for LayeredView {
             self.system.moment_of(flux, y) / self.panel.hinge_stiffness,
         )
     }
+    fn rate(&self, y: &[f64]) -> f64 {
+        y[self.system.thermal_size() + 1]
+    }
 }
 
 /// Per-orbit summaries of the N-node system (as [`crate::summary::run_orbits`]), from `y0` =

@@ -109,6 +109,8 @@ where
 struct Pack {
     t: V,
     h: V,
+    /// t + h as the lane's run has it (the step's end, bit for bit).
+    t_new: V,
     y0: [V; 4],
     k1: [V; 4],
     /// Each lane's coefficients: the balance (heating, conduction, radiation front and back),
@@ -127,6 +129,8 @@ struct Trial {
     dense: [[V; 4]; 4],
     /// k7 = f(t + h, y_new), the next step's k1.
     k7: [V; 4],
+    /// The interpolant at the middle of the step ([`DenseStep::midpoint`]).
+    mid: [V; 4],
     /// The error norm squared (mean square of the weighted error).
     mean_square: V,
 }
@@ -138,6 +142,7 @@ impl Pack {
         Pack {
             t: ZERO,
             h: ZERO,
+            t_new: ZERO,
             y0: [ZERO; 4],
             k1: [ZERO; 4],
             coef: [ZERO; 7],
@@ -151,6 +156,7 @@ impl Pack {
     fn clear(&mut self, l: usize) {
         self.t[l] = 0.0;
         self.h[l] = 0.0;
+        self.t_new[l] = 0.0;
         for i in 0..4 {
             self.y0[i][l] = 0.0;
             self.k1[i][l] = 0.0;
@@ -338,10 +344,29 @@ fn step_lanes(model: HingeModel, coupling: Coupling, p: &Pack) -> Trial {
             dense[3][i][l] = r5;
         }
     }
+    // `DenseStep::midpoint`: the interpolant at t + h/2 as `DenseStep::eval` evaluates it
+    // (the summaries read every step there).
+    let mut mid = [ZERO; 4];
+    for l in 0..LANES {
+        let t_mid = p.t[l] + 0.5 * h[l];
+        let th = (t_mid - p.t[l]) / h[l];
+        let th1 = 1.0 - th;
+        for i in 0..4 {
+            let [r2, r3, r4, r5] = [
+                dense[0][i][l],
+                dense[1][i][l],
+                dense[2][i][l],
+                dense[3][i][l],
+            ];
+            let y = y0[i][l] + (r2 + (r3 + (r4 + r5 * th1) * th) * th1) * th;
+            mid[i][l] = if t_mid == p.t_new[l] { y_new[i][l] } else { y };
+        }
+    }
     Trial {
         y_new,
         dense,
         k7,
+        mid,
         mean_square,
     }
 }
@@ -486,6 +511,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
         let h = t_new - t;
         p.t[l] = t;
         p.h[l] = h;
+        p.t_new[l] = t_new;
         for i in 0..4 {
             p.y0[i][l] = self.y[i];
             p.k1[i][l] = self.k1[i];
@@ -547,7 +573,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             let [r2, r3, r4, r5] = &trial.dense;
             let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
             self.y = y_new;
-            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r);
+            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r, lane(&trial.mid));
             self.t = t_new;
             self.stats.t_end = t_new;
             self.k1 = lane(&trial.k7);
