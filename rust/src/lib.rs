@@ -19,6 +19,7 @@ pub mod integrate;
 pub mod laminate;
 pub mod layered;
 pub mod linear;
+mod num;
 pub mod orbit;
 pub mod params;
 pub mod simulate;
