@@ -1,7 +1,7 @@
 //! Thermal bending moment and the one-degree-of-freedom hinge model (paper Sec. 3, eqs. 20, 28).
 
-use crate::num::Num;
 use crate::error::{Error, Result};
+use crate::num::Num;
 use crate::params::Panel;
 
 /// Structural model of the hinge.
@@ -125,7 +125,8 @@ pub(crate) fn angular_acceleration<T: Num>(
     match model {
         HingeModel::Linear => forced,
         HingeModel::Nonlinear => {
-            (forced - three * theta_dot * theta_dot * sin * cos) / (T::from(1.0) + three * sin * sin)
+            (forced - three * theta_dot * theta_dot * sin * cos)
+                / (T::from(1.0) + three * sin * sin)
         }
     }
 }

@@ -67,7 +67,13 @@ impl Lanes for Portable {
     }
     #[inline(always)]
     fn or_where(self, take: [bool; LANES], a: Portable) -> Portable {
-        Portable(std::array::from_fn(|l| if take[l] { a.0[l] } else { self.0[l] }))
+        Portable(std::array::from_fn(|l| {
+            if take[l] {
+                a.0[l]
+            } else {
+                self.0[l]
+            }
+        }))
     }
 }
 

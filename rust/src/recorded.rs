@@ -559,7 +559,11 @@ fn check_summaries(got: Vec<u64>, want: &[u64]) {
             );
         }
     }
-    check("SUMMARIES (end state, steps)", got[24..].to_vec(), &want[24..]);
+    check(
+        "SUMMARIES (end state, steps)",
+        got[24..].to_vec(),
+        &want[24..],
+    );
 }
 
 #[test]

@@ -179,6 +179,8 @@ pub(crate) struct Collector<V> {
     pub(crate) sq_sum: f64,
     pub(crate) duration: f64,
     pub(crate) crossing: Option<LimitCrossing>,
+    /// The last step's end as read: (t, dynamic part), the next step's start.
+    pub(crate) end: (f64, f64),
 }
 
 impl<V: SummaryView> Collector<V> {
@@ -218,6 +220,7 @@ impl<V: SummaryView> Collector<V> {
             sq_sum: 0.0,
             duration: 0.0,
             crossing: None,
+            end: (f64::NAN, 0.0),
         };
         collector.current = collector.open(first_index)?;
         collector.current.theta_max = theta0;
@@ -474,46 +477,57 @@ where
             return ControlFlow::Break(());
         }
         let c = &mut self.collector;
+        let (t0, t1) = (step.t0, step.t1);
         let (t_mid, y_mid) = step.midpoint();
         let rate = |y: &State<D>| c.view.rate(y.as_slice()) > 0.0;
         let (r0, r_mid, r1) = (rate(&step.y0), rate(&y_mid), rate(&step.y1));
-        let mut points = [Point::default(); FINE_READS];
-        // ∫(dynamic)² by Simpson's rule over the step's start and the points.
-        let start = c.point(step.t0, step.y0.as_slice()).dynamic;
-        let n = if r0 == r_mid && r_mid == r1 {
-            points[0] = c.point(t_mid, y_mid.as_slice());
-            points[1] = c.point(step.t1, step.y1.as_slice());
-            2
-        } else {
-            // t0 + 4 (h/8) is the midpoint, bit for bit (h/8 and 4 (h/8) are exact).
-            let dt = (step.t1 - step.t0) / FINE_READS as f64;
-            for (j, p) in points.iter_mut().enumerate() {
-                *p = match j + 1 {
-                    FINE_READS => c.point(step.t1, step.y1.as_slice()),
-                    k if 2 * k == FINE_READS => c.point(t_mid, y_mid.as_slice()),
-                    k => {
-                        let t = step.t0 + k as f64 * dt;
-                        c.point(t, step.eval(t).as_slice())
-                    }
-                };
-            }
-            FINE_READS
+        // ∫(dynamic)² by Simpson's rule over the step's start and the points. The start is the
+        // last step's end (read then) unless the run began or resumed here.
+        let start = match c.end {
+            (t, dynamic) if t == t0 => dynamic,
+            _ => c.point(t0, step.y0.as_slice()).dynamic,
         };
-        let dt = (step.t1 - step.t0) / n as f64;
-        // Simpson's weights dt/3 (1, 4, 2, 4, …, 2, 4, 1); the start's goes with the first point.
-        let third = dt / 3.0;
-        for (j, p) in points[..n].iter_mut().enumerate() {
-            let w = if j + 1 == n {
-                1.0
-            } else if j % 2 == 0 {
-                4.0
-            } else {
-                2.0
-            };
-            p.sq = w * third * (p.dynamic * p.dynamic);
-        }
-        points[0].sq += third * (start * start);
-        if let Err(e) = c.read_points(&points[..n], dt) {
+        let read = if r0 == r_mid && r_mid == r1 {
+            let (mut mid, mut end) = (
+                c.point(t_mid, y_mid.as_slice()),
+                c.point(t1, step.y1.as_slice()),
+            );
+            let dt = 0.5 * (t1 - t0);
+            let third = dt / 3.0;
+            mid.sq = third * (start * start + 4.0 * (mid.dynamic * mid.dynamic));
+            end.sq = third * (end.dynamic * end.dynamic);
+            c.end = (t1, end.dynamic);
+            c.read_points(&[mid, end], dt)
+        } else {
+            let mut points = [Point::default(); FINE_READS];
+            // t0 + 4 (h/8) is the midpoint, bit for bit (h/8 and 4 (h/8) are exact).
+            let dt = (t1 - t0) / FINE_READS as f64;
+            let third = dt / 3.0;
+            for (j, p) in points.iter_mut().enumerate() {
+                let k = j + 1;
+                *p = if k == FINE_READS {
+                    c.point(t1, step.y1.as_slice())
+                } else if 2 * k == FINE_READS {
+                    c.point(t_mid, y_mid.as_slice())
+                } else {
+                    let t = t0 + k as f64 * dt;
+                    c.point(t, step.eval(t).as_slice())
+                };
+                // Simpson's weights (1, 4, 2, 4, …, 2, 4, 1).
+                let w = if k == FINE_READS {
+                    1.0
+                } else if k % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                p.sq = w * third * (p.dynamic * p.dynamic);
+            }
+            points[0].sq += third * (start * start);
+            c.end = (t1, points[FINE_READS - 1].dynamic);
+            c.read_points(&points, dt)
+        };
+        if let Err(e) = read {
             self.error = Some(e);
             return ControlFlow::Break(());
         }

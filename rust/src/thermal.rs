@@ -8,8 +8,8 @@
 //! heat flows, divided by the heat capacity to give rates) or already divided by the capacity
 //! (K/s, the form the integrator's hot path uses, with no division left in it).
 
-use crate::num::Num;
 use crate::error::{Error, Result};
+use crate::num::Num;
 use crate::params::Panel;
 use crate::STEFAN_BOLTZMANN;
 
@@ -231,7 +231,6 @@ impl Balance {
             radiation_back: self.radiation_back / capacity,
         }
     }
-
 }
 
 impl<T: Num> Balance<T> {

@@ -18,15 +18,15 @@
 //! ([`Kernel::detect`]). Both give the same bits.
 
 use super::dopri5::{
-    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY,
+    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
 };
 use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
 use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::error::{Error, Result};
-use crate::system::{Coupled, Coupling, LaneForm};
-use crate::num::{Lanes, Portable};
 #[cfg(target_arch = "x86_64")]
 use crate::num::Avx;
+use crate::num::{Lanes, Portable};
+use crate::system::{Coupled, Coupling, LaneForm};
 use crate::thermal::Balance;
 use nalgebra::Vector4;
 use std::f64::consts::FRAC_PI_4;
@@ -182,8 +182,14 @@ impl<V: Lanes> Pack<V> {
         }
         put(&mut self.balance.heating, &from.balance.heating);
         put(&mut self.balance.conduction, &from.balance.conduction);
-        put(&mut self.balance.radiation_front, &from.balance.radiation_front);
-        put(&mut self.balance.radiation_back, &from.balance.radiation_back);
+        put(
+            &mut self.balance.radiation_front,
+            &from.balance.radiation_front,
+        );
+        put(
+            &mut self.balance.radiation_back,
+            &from.balance.radiation_back,
+        );
         put(&mut self.load_per_kelvin, &from.load_per_kelvin);
         put(&mut self.damping, &from.damping);
         put(&mut self.stiffness, &from.stiffness);
@@ -562,15 +568,6 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
         let mean_square = trial.mean_square.lanes()[l];
         let lane = |v: &[V; 4]| Vector4::from(v.map(|x| x.lanes()[l]));
         if mean_square < 1.0 {
-            let mut factor = if mean_square == 0.0 {
-                MAX_FACTOR
-            } else {
-                let grow = (mean_square as f32).powf(0.5 * ERROR_EXPONENT as f32);
-                MAX_FACTOR.min(SAFETY * f64::from(grow))
-            };
-            if self.rejected {
-                factor = factor.min(1.0);
-            }
             self.stats.n_steps += 1;
             let y0 = self.y;
             let y_new = lane(&trial.y_new);
@@ -581,7 +578,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             self.t = t_new;
             self.stats.t_end = t_new;
             self.k1 = lane(&trial.k7);
-            self.h_abs = (h * factor).min(self.tol.max_step);
+            self.h_abs = dopri5::next_step(h, mean_square, self.rejected, self.tol.max_step);
             self.rejected = false;
             if self.observer.on_step(&dense).is_break() {
                 self.stats.stopped = self.stats.t_end < self.t1;
