@@ -41,6 +41,7 @@ from thermojitter.simulate import (
     simulate_thermal,
     steady_state,
 )
+from thermojitter.solver import SolverSettings
 
 __version__ = "0.1.0"
 
@@ -66,6 +67,7 @@ __all__ = [
     "ParameterError",
     "SensitivityResult",
     "Solution",
+    "SolverSettings",
     "StabilityMap",
     "ThermalSolution",
     "beam",

@@ -23,15 +23,18 @@ __all__ = [
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
+    "LINEAR_FIELDS",
     "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
     "SOLVER_DEFAULTS",
+    "VALIDITY_LIMIT",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
     "beam_static",
     "check_panels",
+    "check_solver",
     "conduction_grid",
     "cpu_info",
     "declination",
@@ -44,6 +47,7 @@ __all__ = [
     "equivalent_panel",
     "flutter",
     "flux_scale",
+    "hinge_points",
     "hinge_equivalent_damping_ratio",
     "illumination",
     "laminate_properties",
@@ -63,6 +67,7 @@ __all__ = [
     "simulate_layers",
     "simulate_thermal",
     "stability_map",
+    "start_state",
     "steady_state",
     "stiffness",
     "synodic_period",
@@ -74,6 +79,7 @@ __all__ = [
 ]
 
 PANEL_FIELDS: list[str]
+LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
@@ -86,6 +92,7 @@ GEO_EQUINOX_ORBIT: dict[str, Any]
 CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
 MAX_TIME: float
+VALIDITY_LIMIT: float
 
 class IntegrationError(RuntimeError): ...
 
@@ -98,17 +105,22 @@ class CancelToken:
 
 class ConvergenceError(RuntimeError): ...
 
+def check_solver(solver: dict[str, Any]) -> dict[str, Any]: ...
 def validate_panel(panel: dict[str, float]) -> None: ...
 def validate_orbit(orbit: dict[str, Any]) -> None: ...
 def steady_state(
     panel: dict[str, float], coupled: bool = True, flux: float = 1.0
 ) -> tuple[float, float, float]: ...
+def start_state(
+    panel: dict[str, float], orbit: dict[str, Any], t0: float, coupled: bool
+) -> list[float]: ...
 def stiffness(panel: dict[str, float], criterion: str, moment: float = 0.0) -> float: ...
 def derived(panel: dict[str, float]) -> dict[str, float]: ...
 def shadow_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[float, float]]: ...
 def illumination(orbit: dict[str, Any], t: _F) -> _F: ...
 def moment(panel: dict[str, float], t_front: _F, t_back: _F) -> _F: ...
 def energy(panel: dict[str, float], model: str, theta: _F, theta_dot: _F, moment: float) -> _F: ...
+def hinge_points(panel: dict[str, float], zeta: float, theta: _F) -> tuple[_F, _F]: ...
 def simulate(
     panel: dict[str, float],
     orbit: dict[str, Any],
@@ -284,7 +296,7 @@ class EnsemblePool:
         window: float,
         threshold: float | None,
         stop_at_threshold: bool,
-        validity_limit: float = 0.3490658503988659,
+        validity_limit: float = ...,
         hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
         lockstep: bool = True,

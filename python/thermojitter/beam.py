@@ -25,12 +25,13 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from thermojitter import _core, solver
+from thermojitter import _core
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
 from thermojitter.simulate import Method, Model, check_inputs, simulate, solver_args, time_span
+from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Array = NDArray[np.float64]
 Criterion = Literal["deflection", "deflection_small_angle", "frequency"]
@@ -60,6 +61,8 @@ class BeamResponse:
     damping_ratio: float
     n_steps: int
     n_rhs: int
+    solver: SolverSettings | None = None
+    """The integrator settings the engine used."""
 
     @property
     def theta_f_deg(self) -> Array:
@@ -125,13 +128,14 @@ class FreeFreeBeam:
         damping_ratio: float | None = None,
         residual: bool = True,
         method: Method = "rk45",
-        rtol: float = solver.RTOL,
-        atol: float = solver.ATOL,
+        rtol: float = RTOL,
+        atol: float = ATOL,
         dt: float | None = None,
         t_eval: ArrayLike | None = None,
         dt_out: float | None = None,
-        max_step: float = solver.MAX_STEP,
-        max_steps: int = solver.MAX_STEPS,
+        max_step: float = MAX_STEP,
+        max_steps: int = MAX_STEPS,
+        solver: SolverSettings | None = None,
     ) -> BeamResponse:
         """Modal transient response to end moments ±M(t), M given as samples ``moments`` (N m)
         at ``times`` (s, increasing; linear in between, held beyond the ends).
@@ -151,7 +155,16 @@ class FreeFreeBeam:
         if t_eval is None and dt_out is None:
             t_eval = ts[(ts >= t0) & (ts <= t1)]
         zeta = default_damping_ratio(self.panel) if damping_ratio is None else damping_ratio
-        args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+        used = SolverSettings.of(
+            solver,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            dt=dt,
+            max_step=max_step,
+            max_steps=max_steps,
+        )
+        args = solver_args(used, t_eval, dt_out)
         raw = _core.beam_response(
             self.panel.as_dict(),
             self.n_elements,
@@ -170,6 +183,7 @@ class FreeFreeBeam:
             damping_ratio=float(zeta),
             n_steps=raw["n_steps"],
             n_rhs=raw["n_rhs"],
+            solver=SolverSettings(**raw["solver"]),
         )
 
     def theta_f(self, times: ArrayLike, moments: ArrayLike, **kwargs: Any) -> Array:
@@ -271,8 +285,8 @@ def compare_with_beam(
     model: Model = "nonlinear",
     coupled: bool = True,
     f_min: float = DEFAULT_F_MIN,
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
 ) -> BeamComparison:
     """Runs the hinge model and the beam through an eclipse and compares θ(t) with θ_f(t).
 

@@ -33,12 +33,13 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from thermojitter import _core, solver
+from thermojitter import _core
 from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Run
 from thermojitter.simulate import Method, check_inputs, solver_args, time_span
+from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Array = NDArray[np.float64]
 Support = Literal["free-free", "cantilever"]
@@ -92,8 +93,24 @@ def distributed_defaults(panel: Panel | None = None) -> dict[str, Any]:
     return dict(_core.distributed_defaults(panel.as_dict()))
 
 
+class _FaceTemperatures:
+    """The face temperatures by name, from ``temperatures`` (element fields, K)."""
+
+    temperatures: dict[str, Array]
+
+    @property
+    def T_front(self) -> Array:
+        """Front-face temperature per element, K (over time × element for a run)."""
+        return self.temperatures["T_front"]
+
+    @property
+    def T_back(self) -> Array:
+        """Back-face temperature per element, K (over time × element for a run)."""
+        return self.temperatures["T_back"]
+
+
 @dataclass(frozen=True)
-class DistributedSolution(Run):
+class DistributedSolution(_FaceTemperatures, Run):
     """The distributed panel at the reported times.
 
     ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
@@ -120,16 +137,6 @@ class DistributedSolution(Run):
     @property
     def theta_f_deg(self) -> Array:
         return np.degrees(self.theta_f)
-
-    @property
-    def T_front(self) -> Array:
-        """Front-face temperature per element, K, shape (time, element)."""
-        return self.temperatures["T_front"]
-
-    @property
-    def T_back(self) -> Array:
-        """Back-face temperature per element, K, shape (time, element)."""
-        return self.temperatures["T_back"]
 
     @property
     def delta_T(self) -> Array:
@@ -190,14 +197,15 @@ def simulate_distributed(
     sun_angle: float = 0.0,
     layers: int = 2,
     method: Method = "rk45",
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
-    max_step: float = math.inf,
-    max_steps: int = solver.MAX_STEPS,
+    max_step: float = MAX_STEP,
+    max_steps: int = MAX_STEPS,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: ArrayLike | None = None,
+    solver: SolverSettings | None = None,
 ) -> DistributedSolution:
     """Integrates the distributed panel over ``t_span`` (s) on ``orbit``, through its eclipses
     and penumbrae.
@@ -226,7 +234,10 @@ def simulate_distributed(
         coupled=coupled,
         layers=layers,
     )
-    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    used = SolverSettings.of(
+        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
+    )
+    args = solver_args(used, t_eval, dt_out)
     start = None if y0 is None else np.ascontiguousarray(np.asarray(y0, dtype=float).ravel())
     raw = _core.simulate_distributed(
         panel.as_dict(), orbit.as_dict(), settings, t0, t1, y0=start, **args
@@ -236,13 +247,14 @@ def simulate_distributed(
         n_steps=int(raw["n_steps"]),
         n_rejected=int(raw["n_rejected"]),
         n_rhs=int(raw["n_rhs"]),
-        method=method,
+        method=used.method,
         settings={
             **settings,
             "damping_ratio": float(raw["damping_ratio"]),
-            "rtol": rtol,
-            "atol": atol,
-            "dt": dt,
+            "rtol": used.rtol,
+            "atol": used.atol,
+            "dt": used.dt,
+            "solver": used.as_dict(),
         },
         x=raw["x"],
         x_node=raw["x_node"],
@@ -270,7 +282,7 @@ class OscillatoryMode:
 
 
 @dataclass(frozen=True)
-class DistributedFlutterResult:
+class DistributedFlutterResult(_FaceTemperatures):
     """Linear stability of the distributed panel's sunlit equilibrium.
 
     ``growth_rate`` (1/s) is the largest real part of all eigenvalues; ``oscillatory_modes`` lists
@@ -313,14 +325,6 @@ class DistributedFlutterResult:
     @property
     def theta_f_deg(self) -> float:
         return math.degrees(self.theta_f)
-
-    @property
-    def T_front(self) -> Array:
-        return self.temperatures["T_front"]
-
-    @property
-    def T_back(self) -> Array:
-        return self.temperatures["T_back"]
 
 
 def distributed_flutter(

@@ -21,7 +21,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import solver
+from thermojitter import plots, solver
 from thermojitter.beam import eclipse_window
 from thermojitter.distributed import (
     distributed_convergence,
@@ -203,31 +203,8 @@ def hinge_vs_distributed(
 
 
 def _figure(cases: dict[str, HingeVsDistributed], out: Path) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     out.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(len(cases), 1, figsize=(8, 6), sharex=True)
-    for ax, case in zip(axes, cases.values(), strict=True):
-        minutes = (case.t - case.t[0]) / 60.0
-        ax.plot(minutes, np.degrees(case.theta), lw=0.6, label="hinge model θ")
-        ax.plot(minutes, np.degrees(case.theta_f), lw=0.6, label="distributed panel θ_f")
-        ax.set_ylabel("angle (deg)")
-        ax.set_title(
-            f"K_el = {case.hinge_stiffness:.0f} N m/rad ({case.criterion}); "
-            f"RMSE {case.rmse_deg:.3f}°",
-            fontsize=9,
-        )
-        ax.grid(alpha=0.3)
-        ax.legend(loc="best", fontsize=8)
-    axes[-1].set_xlabel(f"time from t = {next(iter(cases.values())).t[0]:.0f} s (min)")
-    path = out / FIGURE
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return str(path)
+    return str(plots.hinge_vs_distributed_figure(list(cases.values()), out / FIGURE))
 
 
 def hinge_vs_distributed_markdown(result: dict[str, Any]) -> str:

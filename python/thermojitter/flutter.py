@@ -316,7 +316,7 @@ class LinearThermalResponse:
         ``delta_T0``: the gradient at t = 0 (its transient decays as e^(−q t)); ``None`` gives the
         steady (long-period) solution alone."""
         times = np.asarray(t, dtype=float)
-        fields = {name: getattr(self, name) for name in _LINEAR_FIELDS}
+        fields = {name: getattr(self, name) for name in _core.LINEAR_FIELDS}
         values = _core.linear_delta_t(
             fields,
             np.ascontiguousarray(times.ravel()),
@@ -364,17 +364,3 @@ def linear_thermal_response(
         None if T_star is None else checks.real("T_star", T_star),
     )
     return LinearThermalResponse(**raw)
-
-
-_LINEAR_FIELDS = (
-    "p",
-    "q",
-    "r",
-    "s",
-    "omega",
-    "omega_n",
-    "T_star",
-    "emissivity",
-    "theta_star",
-    "hinge_inertia",
-)

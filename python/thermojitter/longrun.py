@@ -7,7 +7,6 @@ run resumed from a checkpoint gives the very same summaries as one that was neve
 
 from __future__ import annotations
 
-import math
 import os
 import time
 import warnings
@@ -19,7 +18,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import _core, solver
+from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
@@ -29,10 +28,9 @@ from thermojitter.simulate import (
     check_inputs,
     check_layers,
     layup_dict,
-    solver_settings,
     start_state,
-    steady_state,
 )
+from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -47,9 +45,9 @@ HYBRID_COUNTERS = (
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model and the hinge-resolved fallback."""
 
-DEFAULT_THETA_LIMIT = math.radians(20.0)
-"""abs(θ) beyond which the hinge model is not trusted (its rigid halves and cos θ coupling are
-meant for modest angles)."""
+DEFAULT_THETA_LIMIT: float = _core.VALIDITY_LIMIT
+"""abs(θ) beyond which the hinge model is not trusted, rad (20°; its rigid halves and cos θ
+coupling are meant for modest angles): the engine's ``dynamics::VALIDITY_LIMIT``."""
 
 
 @dataclass
@@ -205,8 +203,8 @@ def simulate_orbits(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     y0: tuple[float, ...] | None = None,
     window: float = 600.0,
@@ -216,11 +214,12 @@ def simulate_orbits(
     checkpoint_every: float = 10.0,
     orbits_per_call: int = 1,
     progress: bool | None = True,
-    max_steps: int = solver.MAX_STEPS,
+    max_steps: int = MAX_STEPS,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
     hybrid: dict[str, float] | None = None,
     layers: int | None = None,
+    solver: SolverSettings | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -251,6 +250,8 @@ def simulate_orbits(
       is within 1 % of the eigen-analysis; it costs about twice the steps of error control alone.
     - ``layers=N``: the N-node through-thickness model on the panel's layup (see
       :func:`thermojitter.simulate`); ``y0`` and ``y_end`` are then (node temperatures…, θ, θ̇).
+    - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
+      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback).
     """
     check_inputs(panel, orbit)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
@@ -281,25 +282,32 @@ def simulate_orbits(
     if nodes is not None and method == "hybrid":
         # The hybrid propagator covers the two-layer model; layered panels are integrated in full.
         method = "rk45"
-    # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
-    solver = solver_settings(
-        "rk45" if method == "hybrid" else method, rtol, atol, dt, math.inf, max_steps
+    used = SolverSettings.of(
+        solver,
+        method=None if method == "hybrid" else method,
+        rtol=rtol,
+        atol=atol,
+        dt=dt,
+        max_steps=max_steps,
     )
+    if method == "hybrid":
+        # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
+        used = used.replace(method="rk45")
+    full = used.as_dict()
     if hybrid is not None and not isinstance(hybrid, dict):
         raise TypeError(f"hybrid must be a dict of engine settings, not {type(hybrid).__name__}")
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None:
-        # The sunlit equilibrium at the solar flux of the start date.
+    if y0 is None and nodes is None:
+        # The engine's default start: the sunlit equilibrium at the start date's solar flux.
+        y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
+    elif y0 is None:
+        assert nodes is not None
         flux = float(orbit.flux_scale(t_start)[0])
-        if nodes is None:
-            eq = steady_state(panel, coupled=coupled, flux=flux)
-            y0 = (eq.T_front, eq.T_back, eq.theta, 0.0)
-        else:
-            raw_eq = _core.layered_steady_state(
-                panel.as_dict(), layup_dict(panel), nodes, coupled, flux
-            )
-            y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
+        raw_eq = _core.layered_steady_state(
+            panel.as_dict(), layup_dict(panel), nodes, coupled, flux
+        )
+        y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_dict(),
@@ -307,16 +315,16 @@ def simulate_orbits(
         "model": model,
         "coupled": coupled,
         "method": method,
-        "rtol": solver["rtol"],
-        "atol": solver["atol"],
-        "dt": solver["dt"],
+        "rtol": full["rtol"],
+        "atol": full["atol"],
+        "dt": full["dt"],
         "y0": [float(v) for v in y0],
         "window": window,
         "theta_limit": theta_limit,
         "on_limit": on_limit,
         "orbits_per_call": orbits_per_call,
         "steps_per_period": steps_per_period,
-        "max_steps": solver["max_steps"],
+        "max_steps": full["max_steps"],
     }
     if nodes is not None:
         settings["layers"] = nodes
@@ -327,7 +335,7 @@ def simulate_orbits(
     core_args: dict[str, Any] = {
         "model": model,
         "coupled": coupled,
-        "solver": solver,
+        "solver": full,
         "window": window,
         "theta_limit": theta_limit,
         "stop_at_limit": on_limit == "stop",

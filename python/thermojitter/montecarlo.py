@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from scipy import stats
 from scipy.stats import qmc
 
-from thermojitter import _core, solver
+from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
@@ -39,7 +39,8 @@ from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import progress_bar, report_interrupted
-from thermojitter.simulate import check_inputs, solver_settings
+from thermojitter.simulate import check_inputs
+from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 Sampler = Literal["random", "lhs", "sobol"]
 
@@ -283,13 +284,10 @@ def _options(
     model: str,
     coupled: bool,
     method: str,
-    rtol: float,
-    atol: float,
-    dt: float | None,
+    full: SolverSettings,
     window: float,
     threshold: float | None,
     stop_at_threshold: bool,
-    max_steps: int,
 ) -> dict[str, Any]:
     """The keyword arguments of EnsemblePool.run shared by every chunk (plain data)."""
     if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
@@ -304,9 +302,7 @@ def _options(
         "model": str(model),
         "coupled": bool(coupled),
         # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
-        "solver": solver_settings(
-            "rk45" if hybrid else str(method), rtol, atol, dt, math.inf, max_steps
-        ),
+        "solver": (full.replace(method="rk45") if hybrid else full).as_dict(),
         "n_orbits": int(horizon),
         "window": float(window),
         "threshold": None if threshold is None else float(threshold),
@@ -754,11 +750,12 @@ def monte_carlo(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     window: float = 600.0,
-    max_steps: int = solver.MAX_STEPS,
+    max_steps: int = MAX_STEPS,
+    solver: SolverSettings | None = None,
 ) -> Any:
     """Runs ``n`` panels drawn around ``panel`` and returns a pandas DataFrame, one row a sample:
     the sampled parameters, then the metrics (see ``METRICS``).
@@ -787,6 +784,9 @@ def monte_carlo(
       complete, and a run with the same settings resumes from them. Settings that differ are
       refused, naming them.
 
+    - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
+      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback).
+
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
     check_inputs(panel, orbit)
@@ -796,9 +796,10 @@ def monte_carlo(
     if sampler not in ("random", "lhs", "sobol"):
         raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
     options = _options(
-        orbit, horizon, model, coupled, _default_method(method, orbit, horizon), rtol, atol, dt,
-        window, threshold,
-        stop_at_threshold, max_steps,
+        orbit, horizon, model, coupled, _default_method(method, orbit, horizon),
+        SolverSettings.of(solver, method=method if method != "hybrid" else None, rtol=rtol,
+                          atol=atol, dt=dt, max_steps=max_steps),
+        window, threshold, stop_at_threshold,
     )  # fmt: skip
     u = _unit_design(sampler, n, len(vary), seed)
     names, values, matrix = _sampled(panel, vary, u, bool(truncate))
@@ -835,11 +836,12 @@ def sweep(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     window: float = 600.0,
-    max_steps: int = solver.MAX_STEPS,
+    max_steps: int = MAX_STEPS,
+    solver: SolverSettings | None = None,
 ) -> Any:
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
@@ -855,9 +857,10 @@ def sweep(
             raise ValueError(f"grid[{name!r}] = {vals!r} is invalid: must be finite numbers")
         axes.append(arr.tolist())
     options = _options(
-        orbit, horizon, model, coupled, _default_method(method, orbit, horizon), rtol, atol, dt,
-        window, threshold,
-        stop_at_threshold, max_steps,
+        orbit, horizon, model, coupled, _default_method(method, orbit, horizon),
+        SolverSettings.of(solver, method=method if method != "hybrid" else None, rtol=rtol,
+                          atol=atol, dt=dt, max_steps=max_steps),
+        window, threshold, stop_at_threshold,
     )  # fmt: skip
     names = list(grid)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
@@ -907,11 +910,12 @@ def sensitivity(
     model: Literal["nonlinear", "linear"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     window: float = 600.0,
-    max_steps: int = solver.MAX_STEPS,
+    max_steps: int = MAX_STEPS,
+    solver: SolverSettings | None = None,
 ) -> SensitivityResult:
     """Sobol sensitivity indices of one metric to the parameters in ``vary`` (needs SALib:
     ``pip install 'thermojitter[sensitivity]'``).
@@ -937,9 +941,10 @@ def sensitivity(
     if metric not in _FLOAT_METRICS and metric != "stable":
         raise ValueError(f"metric = {metric!r} is invalid: choose from {', '.join(_FLOAT_METRICS)}")
     options = _options(
-        orbit, horizon, model, coupled, _default_method(method, orbit, horizon), rtol, atol, dt,
-        window, threshold,
-        stop_at_threshold, max_steps,
+        orbit, horizon, model, coupled, _default_method(method, orbit, horizon),
+        SolverSettings.of(solver, method=method if method != "hybrid" else None, rtol=rtol,
+                          atol=atol, dt=dt, max_steps=max_steps),
+        window, threshold, stop_at_threshold,
     )  # fmt: skip
     names = list(vary)
     problem = {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}

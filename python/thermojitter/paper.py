@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter import plots, solver
+from thermojitter import _core, plots, solver
 from thermojitter.flutter import linear_thermal_response
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
@@ -37,12 +37,14 @@ from thermojitter.simulate import simulate, simulate_thermal, steady_state
 
 Array = NDArray[np.float64]
 
-# What the paper states (Parisse & Angeletti 2024), for the comparison table.
+# What the paper reports as its results (Parisse & Angeletti 2024), quoted for the comparison
+# table: these are the paper's findings to compare with, not inputs of any computation.
 PAPER_THETA_DEG = 5.0
 PAPER_ECLIPSE_MIN = 70.0
 PAPER_BEAM_FREQUENCY_HZ = 0.144
 PAPER_FREQUENCY_MISMATCH = 0.12
-PAPER_K_EL = 4438.0
+PAPER_K_EL = Panel.paper().hinge_stiffness
+"""Table 1's K_el, N m/rad: the engine's paper panel (``rust/src/params.rs``)."""
 
 WINDOW_S = 600.0
 """The window after shadow entry / exit in which the extreme angles are taken, s."""
@@ -203,18 +205,10 @@ def thermal_section(ctx: PaperContext) -> SectionResult:
     res = SectionResult()
     period, entry, exit_ = ctx.orbit.period, ctx.entry, ctx.exit
     shadows = ctx.shadows(0.0, period)
-    hours = 3600.0
 
     one = ctx.thermal_run(ctx.panel, 1, "thermal_one_node")
     assert one.T is not None
-    fig, (ax,) = plots.figure(1, height=3.8)
-    plots.line(ax, one.t / hours, one.T, lw=1.2, color="C3")
-    plots.shade_shadow(ax, shadows, scale=hours)
-    ax.set_xlabel("time from the subsolar point [h]")
-    ax.set_ylabel("plate temperature $T$ [K]")
-    ax.set_title("Fig. 2 — one-node (isothermal) plate temperature over one GEO orbit (Case B)")
-    plots.legend(fig)
-    ax.grid(alpha=0.3)
+    fig = plots.one_node_figure(one.t, one.T, shadows)
     res.figures.append(ctx.save(fig, "fig02_one_node_temperature.png"))
     res.summary["one_node_T_max_K"] = float(one.T.max())
     res.summary["one_node_T_min_K"] = float(one.T.min())
@@ -235,29 +229,15 @@ def thermal_section(ctx: PaperContext) -> SectionResult:
         run = ctx.thermal_run(panel, 2, f"thermal_case_{name.lower()}")
         assert run.T_front is not None and run.T_back is not None
         eps = f"ε_f = {panel.emissivity_front:g}, ε_b = {panel.emissivity_back:g}"
-        fig, (ax,) = plots.figure(1, height=3.8)
-        plots.line(ax, run.t / hours, run.T_front, lw=1.2, label="front (Sun side) $T_f$")
-        plots.line(ax, run.t / hours, run.T_back, lw=1.2, ls="--", label="back $T_b$")
-        plots.shade_shadow(ax, shadows, scale=hours)
-        ax.set_xlabel("time from the subsolar point [h]")
-        ax.set_ylabel("layer temperature [K]")
-        ax.set_title(f"Fig. {fig_t} — Case {name} ({eps}): two-layer temperatures, one orbit")
-        plots.legend(fig)
-        ax.grid(alpha=0.3)
+        title = f"Fig. {fig_t} — Case {name} ({eps}): two-layer temperatures, one orbit"
+        fig = plots.layer_temperatures_figure(run.t, run.T_front, run.T_back, shadows, title)
         res.figures.append(ctx.save(fig, f"fig{fig_t:02d}_case_{name.lower()}_temperatures.png"))
 
         dT = run.T_front - run.T_back
         t0, t1 = entry - 20 * 60.0, exit_ + 60 * 60.0
         tw, dw = window(run.t, dT, t0, t1)
-        fig, (ax,) = plots.figure(1, height=3.8)
-        ax.plot((tw - entry) / 60.0, dw, lw=1.2, color="C2")
-        ax.axhline(0.0, color="k", lw=0.6)
-        plots.shade_shadow(ax, ctx.shadows(t0, t1), scale=60.0, offset=entry)
-        ax.set_xlabel("time from shadow entry [min]")
-        ax.set_ylabel(r"$\Delta T = T_f - T_b$ [K]")
-        ax.set_title(f"Fig. {fig_dt} — Case {name} ({eps}): ΔT around the eclipse (zoom)")
-        plots.legend(fig)
-        ax.grid(alpha=0.3)
+        title = f"Fig. {fig_dt} — Case {name} ({eps}): ΔT around the eclipse (zoom)"
+        fig = plots.delta_t_figure(tw, dw, ctx.shadows(t0, t1), entry, title)
         res.figures.append(ctx.save(fig, f"fig{fig_dt:02d}_case_{name.lower()}_delta_T.png"))
 
         _, eclipse_dT = window(run.t, dT, entry, exit_)
@@ -315,45 +295,17 @@ def kinematics_section(ctx: PaperContext) -> SectionResult:
     """Fig. 12: the paths of the points of the two-bar hinge model (paper Sec. 3.1), and the
     phase-plane path of the simulated orbit."""
     res = SectionResult()
-    plt = plots.pyplot()
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10.0, 5.4), layout="constrained")
     arm = ctx.panel.half_arm
     theta = np.radians(np.linspace(-90.0, 90.0, 721))
-    for zeta in np.arange(0.0, 2.0 * arm + 1e-9, 2.5):
-        x = (arm - zeta) * np.sin(theta)
-        for sign in (1.0, -1.0):
-            ax1.plot(x, sign * zeta * np.cos(theta), lw=0.8, color="C0")
-    zeta = np.linspace(0.0, 2.0 * arm, 2)
+    pd = ctx.panel.as_dict()
+    paths = [_core.hinge_points(pd, float(z), theta) for z in np.arange(0.0, 2.0 * arm + 1e-9, 2.5)]
     th = ctx.equilibrium.theta
-    for sign in (1.0, -1.0):
-        ax1.plot(
-            (arm - zeta) * np.sin(th),
-            sign * zeta * np.cos(th),
-            lw=2.5,
-            color="k",
-            label=f"panel at θ = {math.degrees(th):.1f}° (sunlit)" if sign > 0 else None,
-        )
-    ax1.set_aspect("equal")
-    ax1.set_xlabel("x, normal to the panel [m]")
-    ax1.set_ylabel("y, along the panel [m]")
-    ax1.set_title(
-        "Fig. 12 — paths of points Q, −90° ≤ θ ≤ 90°,\nζ = 0 … 2l every 2.5 m", fontsize=10
-    )
-    ax1.grid(alpha=0.3)
-
+    ends = [_core.hinge_points(pd, z, np.array([th])) for z in (0.0, 2.0 * arm)]
+    panel_at = (np.array([e[0][0] for e in ends]), np.array([e[1][0] for e in ends]))
     run = ctx.orbit_run()
-    tw, thw = window(run.t, run.theta, ctx.entry - 60.0, ctx.exit + 3600.0)
+    _, thw = window(run.t, run.theta, ctx.entry - 60.0, ctx.exit + 3600.0)
     _, omw = window(run.t, run.theta_dot, ctx.entry - 60.0, ctx.exit + 3600.0)
-    ax2.plot(np.degrees(thw), np.degrees(omw), lw=0.3, color="C1")
-    ax2.plot([ctx.equilibrium.theta_deg], [0.0], "ko", ms=4, label="sunlit equilibrium")
-    plots.legend(fig)
-    ax2.set_xlabel(r"$\theta$ [deg]")
-    ax2.set_ylabel(r"$\dot\theta$ [deg/s]")
-    ax2.set_title(
-        "(added) phase plane θ–θ̇, shadow entry to 1 h after exit\n(Table 1, non-linear, coupled)",
-        fontsize=10,
-    )
-    ax2.grid(alpha=0.3)
+    fig = plots.kinematics_figure(paths, panel_at, th, thw, omw)
     res.figures.append(ctx.save(fig, "fig12_kinematics.png"))
     res.text = (
         "Fig. 12 is, as in the paper, the family of elliptic arcs x = (l − ζ) sin θ, y = ζ cos θ "
@@ -377,34 +329,15 @@ def jitter_section(ctx: PaperContext) -> SectionResult:
     eq = ctx.equilibrium
     p = ctx.panel
 
-    fig, (ax,) = plots.figure(1, height=3.8)
-    plots.line(ax, run.t / 3600.0, theta, lw=0.7)
-    plots.shade_shadow(ax, ctx.shadows(0.0, ctx.orbit.period), scale=3600.0)
-    ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("time from the subsolar point [h]")
-    ax.set_ylabel(r"hinge angle $\theta$ [deg]")
-    ax.set_title("Fig. 14 — thermal shock: hinge angle θ over one orbit (non-linear, coupled)")
-    plots.legend(fig)
-    ax.grid(alpha=0.3)
+    fig = plots.theta_orbit_figure(run.t, theta, ctx.shadows(0.0, ctx.orbit.period))
     res.figures.append(ctx.save(fig, "fig14_theta_orbit.png"))
 
     for number, (t_event, name) in ((15, (entry, "entry")), (16, (exit_, "exit"))):
         t0, t1 = t_event - 60.0, t_event + 15 * 60.0
         tw, thw = window(run.t, theta, t0, t1)
         _, mw = window(run.t, run.thermal_moment, t0, t1)
-        fig, (ax1, ax2) = plots.figure(2, height=5.5)
-        ax1.plot((tw - t_event) / 60.0, thw, lw=0.8)
-        ax1.set_ylabel(r"$\theta$ [deg]")
-        ax2.plot((tw - t_event) / 60.0, mw, lw=1.0, color="C3")
-        ax2.set_ylabel("thermal moment $M_T$ [N m]")
-        for ax in (ax1, ax2):
-            plots.shade_shadow(ax, ctx.shadows(t0, t1), scale=60.0, offset=t_event)
-            ax.axhline(0.0, color="k", lw=0.5)
-            ax.grid(alpha=0.3)
-        plots.legend(fig)
-        ax2.set_xlabel(f"time from shadow {name} [min]")
-        where = "entering" if name == "entry" else "leaving"
-        ax1.set_title(f"Fig. {number} — zoom: {where} the shadow, hinge angle and thermal moment")
+        shadows = ctx.shadows(t0, t1)
+        fig = plots.shadow_event_figure(tw, thw, mw, shadows, t_event, name, number)
         res.figures.append(ctx.save(fig, f"fig{number}_{name}.png"))
 
     _, after_entry = window(run.t, theta, entry, entry + WINDOW_S)
@@ -419,7 +352,6 @@ def jitter_section(ctx: PaperContext) -> SectionResult:
         c: hinge_stiffness(p, c) for c in ("deflection", "deflection_small_angle", "frequency")
     }
     mismatch = (f_fft - f_beam) / f_beam
-    ei = p.youngs_modulus * p.bending_inertia
     # the residual jitter in sunlight at the end of the orbit (1 h before the end)
     _, late = window(run.t, theta, ctx.orbit.period - 3600.0, ctx.orbit.period)
     res.summary.update(
@@ -480,7 +412,8 @@ def jitter_section(ctx: PaperContext) -> SectionResult:
             "K_el, frequency criterion",
             "≈ 5.21 EI/L",
             f"{stiffness['frequency']:.0f} N m/rad "
-            f"= {stiffness['frequency'] * p.length / ei:.2f} EI/L",
+            # in units of EI/L: 4EI/L is the small-angle deflection criterion's K_el
+            f"= {4.0 * stiffness['frequency'] / stiffness['deflection_small_angle']:.2f} EI/L",
             "–",
         ),
     ]
@@ -534,44 +467,12 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
         rate = float("nan")
         if fit.sum() >= 3:
             rate = float(np.polyfit(centres[fit], np.log(amps[fit]), 1)[0])
-        fig, (ax1, ax2) = plots.figure(2, height=6.0)
-        hours = (run.t - entry) / 3600.0
-        plots.line(ax1, hours, theta, lw=0.5)
-        ax1.set_ylabel(r"$\theta$ [deg]")
-        ax2.semilogy(
-            (centres - entry) / 3600.0,
-            np.maximum(amps, 1e-6),
-            "o-",
-            ms=2.5,
-            lw=0.8,
-            color="C1",
-            label="half peak-to-peak of θ per 10 min (with the thermal drift)",
-        )
+        fitted = None
         if math.isfinite(rate) and coupled:
             c = centres[fit]
-            ax2.semilogy(
-                (c - entry) / 3600.0,
-                np.exp(np.polyval(np.polyfit(c, np.log(amps[fit]), 1), c)),
-                "k--",
-                lw=1.0,
-                label=f"fit: e-folding {1 / rate / 3600:.2f} h",
-            )
-        ax2.axhline(20.0, color="C3", lw=0.8, ls=":", label="20°: beyond modest angles")
-        ax2.set_ylim(bottom=0.01)
-        ax2.set_ylabel("oscillation amplitude [deg]")
-        ax2.set_xlabel("time from the first shadow entry [h]")
-        for ax in (ax1, ax2):
-            plots.shade_shadow(ax, ctx.shadows(run.t[0], run.t[-1]), scale=3600.0, offset=entry)
-            ax.grid(alpha=0.3)
-        plots.legend(fig)
-        if coupled:
-            ax1.set_title(
-                "Fig. 17 — thermal flutter, c_d = 0, projected area ∝ cos θ: θ grows", fontsize=10
-            )
-        else:
-            ax1.set_title(
-                "Fig. 18 — c_d = 0, projected area frozen (cos θ → 1): no growth", fontsize=10
-            )
+            fitted = (c, np.exp(np.polyval(np.polyfit(c, np.log(amps[fit]), 1), c)), rate)
+        shadows = ctx.shadows(run.t[0], run.t[-1])
+        fig = plots.flutter_figure(run.t, theta, centres, amps, fitted, shadows, entry, coupled)
         res.figures.append(
             ctx.save(fig, f"fig{number}_flutter_{'coupled' if coupled else 'frozen'}.png")
         )
@@ -596,7 +497,7 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
     critical = {m: flutter(ctx.panel, m).critical_damping for m in ("nonlinear", "linear")}
     out["critical_damping_Nms"] = {
         **critical,
-        "closed_form_estimate": estimate * 2.0 * ctx.panel.hinge_inertia,
+        "closed_form_estimate": undamped.critical_damping_estimate,
         "threshold": "nonlinear",
     }
     res.summary["flutter"] = out
@@ -630,7 +531,7 @@ def flutter_section(ctx: PaperContext) -> SectionResult:
         f"grows exponentially in sunlight with an e-folding time of {co['e_folding_time_h']:.2f} h "
         f"(linear estimate from the quarter-period lag of the front layer: "
         f"{out['e_folding_time_estimate_h']:.2f} h; the equivalent negative damping is "
-        f"{estimate * 2 * ctx.panel.hinge_inertia:.2f} N m s/rad). The threshold of flutter is "
+        f"{undamped.critical_damping_estimate:.2f} N m s/rad). The threshold of flutter is "
         f"the critical damping c_d* of the eigen-analysis of the sunlit equilibrium: "
         f"{critical['nonlinear']:.2f} N m s/rad with the non-linear hinge (eq. 20, the model "
         f"every run integrates by default; use this one) and {critical['linear']:.2f} with the "
@@ -671,22 +572,15 @@ def linearity_section(ctx: PaperContext) -> SectionResult:
     for number, (t_event, name) in ((19, (ctx.entry, "entry")), (20, (ctx.exit, "exit"))):
         t0, t1 = t_event - 30.0, t_event + 120.0
         mask = (nl.t >= t0) & (nl.t <= t1)
-        x = nl.t[mask] - t_event
-        fig, (ax1, ax2) = plots.figure(2, height=5.5)
-        ax1.plot(x, np.degrees(nl.theta[mask]), lw=1.6, label="non-linear (eq. 20)")
-        ax1.plot(
-            x, np.degrees(li.theta[mask]), lw=1.0, ls="--", color="C3", label="linearised (eq. 28)"
+        fig = plots.linearity_figure(
+            nl.t[mask],
+            np.degrees(nl.theta[mask]),
+            np.degrees(li.theta[mask]),
+            ctx.shadows(t0, t1),
+            t_event,
+            name,
+            number,
         )
-        ax1.set_ylabel(r"$\theta$ [deg]")
-        plots.legend(fig)
-        ax2.plot(x, diff[mask], lw=0.8, color="k")
-        ax2.set_ylabel(r"$\theta_{nl} - \theta_{lin}$ [deg]")
-        ax2.set_xlabel(f"time from shadow {name} [s]")
-        for ax in (ax1, ax2):
-            plots.shade_shadow(ax, ctx.shadows(t0, t1), offset=t_event, label=None)
-            ax.grid(alpha=0.3)
-        where = "entering" if name == "entry" else "leaving"
-        ax1.set_title(f"Fig. {number} — {where} the shadow: linearised vs non-linear hinge")
         res.figures.append(ctx.save(fig, f"fig{number}_{name}_linear_vs_nonlinear.png"))
 
     w0, w1 = ctx.entry, ctx.exit + WINDOW_S

@@ -527,3 +527,224 @@ def beam_spectrum_figure(case: Any, number: str, path: Path) -> Path:
     ax.grid(alpha=0.3, which="both")
     legend(fig)
     return save(fig, path)
+
+
+# --- the paper's figures (``thermojitter paper``) -------------------------------------------
+# Each takes the records and returns the figure; paper.py computes, saves and reports.
+
+_HOUR = 3600.0
+
+
+def _finish(fig: Any, axes: Sequence[Any]) -> Any:
+    legend(fig)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    return fig
+
+
+def one_node_figure(t: Array, T: Array, shadows: Sequence[tuple[float, float]]) -> Any:
+    """Fig. 2: the isothermal plate over one orbit."""
+    fig, (ax,) = figure(1, height=3.8)
+    line(ax, t / _HOUR, T, lw=1.2, color="C3")
+    shade_shadow(ax, shadows, scale=_HOUR)
+    ax.set_xlabel("time from the subsolar point [h]")
+    ax.set_ylabel("plate temperature $T$ [K]")
+    ax.set_title("Fig. 2 — one-node (isothermal) plate temperature over one GEO orbit (Case B)")
+    return _finish(fig, [ax])
+
+
+def layer_temperatures_figure(
+    t: Array, T_front: Array, T_back: Array, shadows: Sequence[tuple[float, float]], title: str
+) -> Any:
+    """Figs. 3–4: the two layers over one orbit."""
+    fig, (ax,) = figure(1, height=3.8)
+    line(ax, t / _HOUR, T_front, lw=1.2, label="front (Sun side) $T_f$")
+    line(ax, t / _HOUR, T_back, lw=1.2, ls="--", label="back $T_b$")
+    shade_shadow(ax, shadows, scale=_HOUR)
+    ax.set_xlabel("time from the subsolar point [h]")
+    ax.set_ylabel("layer temperature [K]")
+    ax.set_title(title)
+    return _finish(fig, [ax])
+
+
+def delta_t_figure(
+    t: Array, delta_T: Array, shadows: Sequence[tuple[float, float]], entry: float, title: str
+) -> Any:
+    """Figs. 5–6: ΔT = T_f − T_b around the eclipse, time from shadow entry."""
+    fig, (ax,) = figure(1, height=3.8)
+    ax.plot((t - entry) / 60.0, delta_T, lw=1.2, color="C2")
+    ax.axhline(0.0, color="k", lw=0.6)
+    shade_shadow(ax, shadows, scale=60.0, offset=entry)
+    ax.set_xlabel("time from shadow entry [min]")
+    ax.set_ylabel(r"$\Delta T = T_f - T_b$ [K]")
+    ax.set_title(title)
+    return _finish(fig, [ax])
+
+
+def kinematics_figure(
+    paths: Sequence[tuple[Array, Array]],
+    panel_at: tuple[Array, Array],
+    theta_eq: float,
+    theta: Array,
+    theta_dot: Array,
+) -> Any:
+    """Fig. 12: the paths (x, y) of points of the hinge model's halves (both halves drawn, y and
+    −y), the panel at the sunlit angle ``theta_eq`` (rad); beside it the θ–θ̇ phase plane of the
+    simulated orbit (rad, rad/s)."""
+    fig, (ax1, ax2) = pyplot().subplots(1, 2, figsize=(10.0, 5.4), layout="constrained")
+    for x, y in paths:
+        for sign in (1.0, -1.0):
+            ax1.plot(x, sign * y, lw=0.8, color="C0")
+    for sign in (1.0, -1.0):
+        ax1.plot(
+            panel_at[0],
+            sign * panel_at[1],
+            lw=2.5,
+            color="k",
+            label=f"panel at θ = {np.degrees(theta_eq):.1f}° (sunlit)" if sign > 0 else None,
+        )
+    ax1.set_aspect("equal")
+    ax1.set_xlabel("x, normal to the panel [m]")
+    ax1.set_ylabel("y, along the panel [m]")
+    ax1.set_title(
+        "Fig. 12 — paths of points Q, −90° ≤ θ ≤ 90°,\nζ = 0 … 2l every 2.5 m", fontsize=10
+    )
+    ax2.plot(np.degrees(theta), np.degrees(theta_dot), lw=0.3, color="C1")
+    ax2.plot([np.degrees(theta_eq)], [0.0], "ko", ms=4, label="sunlit equilibrium")
+    ax2.set_xlabel(r"$\theta$ [deg]")
+    ax2.set_ylabel(r"$\dot\theta$ [deg/s]")
+    ax2.set_title(
+        "(added) phase plane θ–θ̇, shadow entry to 1 h after exit\n(Table 1, non-linear, coupled)",
+        fontsize=10,
+    )
+    return _finish(fig, [ax1, ax2])
+
+
+def theta_orbit_figure(t: Array, theta_deg: Array, shadows: Sequence[tuple[float, float]]) -> Any:
+    """Fig. 14: θ over one orbit."""
+    fig, (ax,) = figure(1, height=3.8)
+    line(ax, t / _HOUR, theta_deg, lw=0.7)
+    shade_shadow(ax, shadows, scale=_HOUR)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("time from the subsolar point [h]")
+    ax.set_ylabel(r"hinge angle $\theta$ [deg]")
+    ax.set_title("Fig. 14 — thermal shock: hinge angle θ over one orbit (non-linear, coupled)")
+    return _finish(fig, [ax])
+
+
+def shadow_event_figure(
+    t: Array,
+    theta_deg: Array,
+    moment: Array,
+    shadows: Sequence[tuple[float, float]],
+    t_event: float,
+    name: str,
+    number: int,
+) -> Any:
+    """Figs. 15–16: θ and the thermal moment (N m) from shadow ``name`` ("entry" or "exit")."""
+    fig, (ax1, ax2) = figure(2, height=5.5)
+    ax1.plot((t - t_event) / 60.0, theta_deg, lw=0.8)
+    ax1.set_ylabel(r"$\theta$ [deg]")
+    ax2.plot((t - t_event) / 60.0, moment, lw=1.0, color="C3")
+    ax2.set_ylabel("thermal moment $M_T$ [N m]")
+    for ax in (ax1, ax2):
+        shade_shadow(ax, shadows, scale=60.0, offset=t_event)
+        ax.axhline(0.0, color="k", lw=0.5)
+    ax2.set_xlabel(f"time from shadow {name} [min]")
+    where = "entering" if name == "entry" else "leaving"
+    ax1.set_title(f"Fig. {number} — zoom: {where} the shadow, hinge angle and thermal moment")
+    return _finish(fig, [ax1, ax2])
+
+
+def flutter_figure(
+    t: Array,
+    theta_deg: Array,
+    centres: Array,
+    amplitudes: Array,
+    fit: tuple[Array, Array, float] | None,
+    shadows: Sequence[tuple[float, float]],
+    entry: float,
+    coupled: bool,
+) -> Any:
+    """Figs. 17–18: θ (deg) with c_d = 0, and its amplitude per 10 min on a log scale; ``fit``:
+    (times s, fitted amplitudes deg, growth rate 1/s) of the exponential fit, or None."""
+    fig, (ax1, ax2) = figure(2, height=6.0)
+    line(ax1, (t - entry) / _HOUR, theta_deg, lw=0.5)
+    ax1.set_ylabel(r"$\theta$ [deg]")
+    ax2.semilogy(
+        (centres - entry) / _HOUR,
+        np.maximum(amplitudes, 1e-6),
+        "o-",
+        ms=2.5,
+        lw=0.8,
+        color="C1",
+        label="half peak-to-peak of θ per 10 min (with the thermal drift)",
+    )
+    if fit is not None:
+        times, fitted, rate = fit
+        ax2.semilogy(
+            (times - entry) / _HOUR,
+            fitted,
+            "k--",
+            lw=1.0,
+            label=f"fit: e-folding {1 / rate / 3600:.2f} h",
+        )
+    ax2.axhline(20.0, color="C3", lw=0.8, ls=":", label="20°: beyond modest angles")
+    ax2.set_ylim(bottom=0.01)
+    ax2.set_ylabel("oscillation amplitude [deg]")
+    ax2.set_xlabel("time from the first shadow entry [h]")
+    for ax in (ax1, ax2):
+        shade_shadow(ax, shadows, scale=_HOUR, offset=entry)
+    if coupled:
+        title = "Fig. 17 — thermal flutter, c_d = 0, projected area ∝ cos θ: θ grows"
+    else:
+        title = "Fig. 18 — c_d = 0, projected area frozen (cos θ → 1): no growth"
+    ax1.set_title(title, fontsize=10)
+    return _finish(fig, [ax1, ax2])
+
+
+def linearity_figure(
+    t: Array,
+    nonlinear_deg: Array,
+    linear_deg: Array,
+    shadows: Sequence[tuple[float, float]],
+    t_event: float,
+    name: str,
+    number: int,
+) -> Any:
+    """Figs. 19–20: the non-linear and the linearised hinge from shadow ``name``, and their
+    difference."""
+    x = t - t_event
+    fig, (ax1, ax2) = figure(2, height=5.5)
+    ax1.plot(x, nonlinear_deg, lw=1.6, label="non-linear (eq. 20)")
+    ax1.plot(x, linear_deg, lw=1.0, ls="--", color="C3", label="linearised (eq. 28)")
+    ax1.set_ylabel(r"$\theta$ [deg]")
+    ax2.plot(x, nonlinear_deg - linear_deg, lw=0.8, color="k")
+    ax2.set_ylabel(r"$\theta_{nl} - \theta_{lin}$ [deg]")
+    ax2.set_xlabel(f"time from shadow {name} [s]")
+    for ax in (ax1, ax2):
+        shade_shadow(ax, shadows, offset=t_event, label=None)
+    where = "entering" if name == "entry" else "leaving"
+    ax1.set_title(f"Fig. {number} — {where} the shadow: linearised vs non-linear hinge")
+    return _finish(fig, [ax1, ax2])
+
+
+def hinge_vs_distributed_figure(cases: Sequence[Any], path: Path) -> Path:
+    """θ of the hinge model and θ_f of the distributed panel through the eclipse, one axis per
+    hinge stiffness (``cases``: records with ``t``, ``theta``, ``theta_f`` in rad, s)."""
+    fig, axes = figure(len(cases), height=6.0)
+    start = float(cases[0].t[0])
+    for ax, case in zip(axes, cases, strict=True):
+        minutes = (case.t - start) / 60.0
+        ax.plot(minutes, np.degrees(case.theta), lw=0.6, label="hinge model θ")
+        ax.plot(minutes, np.degrees(case.theta_f), lw=0.6, label="distributed panel θ_f")
+        ax.set_ylabel("angle [deg]")
+        ax.set_title(
+            f"K_el = {case.hinge_stiffness:.0f} N m/rad ({case.criterion}); "
+            f"RMSE {case.rmse_deg:.3f}°",
+            fontsize=9,
+        )
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel(f"time from t = {start:.0f} s [min]")
+    legend(fig, ncols=2)
+    return save(fig, path)

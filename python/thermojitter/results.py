@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from thermojitter.solver import SolverSettings
+
 Array = NDArray[np.float64]
 
 
@@ -41,6 +43,12 @@ class _Run:
     n_rhs: int
     method: str
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def solver(self) -> SolverSettings | None:
+        """The integrator settings the engine used (None where the run does not report them)."""
+        used = self.settings.get("solver")
+        return None if used is None else SolverSettings(**used)
 
     @property
     def nfev(self) -> int:

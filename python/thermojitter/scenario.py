@@ -29,11 +29,11 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
-from thermojitter import solver
 from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.solver import ATOL, RTOL, SolverSettings
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -81,8 +81,8 @@ class SimulationSettings:
     model: str = "nonlinear"
     coupled: bool = True
     method: str = "rk45"
-    rtol: float = solver.RTOL
-    atol: float = solver.ATOL
+    rtol: float = RTOL
+    atol: float = ATOL
     dt: float | None = None
     dt_out: float = 0.5
     years: float | None = None
@@ -97,6 +97,13 @@ class SimulationSettings:
     layers: int | None = None
     """Nodes through the thickness of the N-node model (one homogeneous layer for a [panel]);
     None: the two-layer model."""
+
+    @property
+    def solver(self) -> SolverSettings:
+        """The integrator settings of ``method`` (rk45 for the hybrid propagator's fallback),
+        ``rtol``, ``atol`` and ``dt``, checked by the engine when a run asks for them."""
+        method = "rk45" if self.method == "hybrid" else self.method
+        return SolverSettings(method, self.rtol, self.atol, self.dt)  # type: ignore[arg-type]
 
     def span(self, orbit: Orbit) -> tuple[float, float]:
         """(t0, t1) in s: t_end if given, else t_start + orbits · period (one orbit by default)."""

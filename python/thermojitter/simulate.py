@@ -8,12 +8,13 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from thermojitter import _core, solver
+from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
+from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Model = Literal["nonlinear", "linear"]
 Method = Literal["rk45", "rk4"]
@@ -53,19 +54,13 @@ def start_state(y0: Any, size: int) -> list[float] | None:
 
 
 def solver_args(
-    method: str,
-    rtol: float,
-    atol: float,
-    dt: float | None,
-    max_step: float,
-    max_steps: int,
-    t_eval: ArrayLike | None,
-    dt_out: float | None,
+    solver: SolverSettings, t_eval: ArrayLike | None, dt_out: float | None
 ) -> dict[str, Any]:
+    """The engine's keyword arguments for the integrator and the reporting times."""
     if t_eval is None and dt_out is None:
         dt_out = DEFAULT_DT_OUT
     return {
-        "solver": solver_settings(method, rtol, atol, dt, max_step, max_steps),
+        "solver": solver.as_dict(),
         "t_eval": _times(t_eval),
         "dt_out": None if dt_out is None else checks.real("dt_out", dt_out),
     }
@@ -74,17 +69,9 @@ def solver_args(
 def solver_settings(
     method: str, rtol: float, atol: float, dt: float | None, max_step: float, max_steps: int
 ) -> dict[str, Any]:
-    """The integrator settings as the engine takes them (it checks the values and names any bad
-    one); ``dt`` is the fixed step of rk4, ``max_step`` caps rk45's step (s). Types are checked
-    here: a bool or a string is not a number."""
-    return {
-        "method": checks.choice("method", method, _METHODS),
-        "rtol": checks.real("rtol", rtol),
-        "atol": checks.real("atol", atol),
-        "dt": None if dt is None else checks.real("dt", dt),
-        "max_step": checks.real("max_step", max_step),
-        "max_steps": checks.integer("max_steps", max_steps, 1),
-    }
+    """The integrator settings as the engine takes them, checked (see :class:`SolverSettings`);
+    ``dt`` is the fixed step of rk4, ``max_step`` caps rk45's step (s)."""
+    return SolverSettings(method, rtol, atol, dt, max_step, max_steps).as_dict()  # type: ignore[arg-type]
 
 
 _NO_ORBIT: Any = object()
@@ -138,15 +125,16 @@ def simulate(
     model: Model = "nonlinear",
     coupled: bool = True,
     method: Method = "rk45",
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: Sequence[float] | None = None,
-    max_step: float = solver.MAX_STEP,
-    max_steps: int = solver.MAX_STEPS,
+    max_step: float = MAX_STEP,
+    max_steps: int = MAX_STEPS,
     layers: int | None = None,
+    solver: SolverSettings | None = None,
 ) -> Solution:
     """Integrates the coupled thermo-structural model over ``t_span`` (s).
 
@@ -171,13 +159,20 @@ def simulate(
     The solution then carries ``T_nodes`` (time × node, K) and ``depth`` (m below the front
     face); ``y0`` is (node temperatures…, θ, θ̇).
 
+    ``solver``: a :class:`thermojitter.SolverSettings` in place of ``method``, ``rtol``, ``atol``,
+    ``dt``, ``max_step`` and ``max_steps``; ``sol.solver`` is what the engine used.
+
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
     """
     check_inputs(panel, orbit)
     t0, t1 = time_span(t_span)
-    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
-    settings = {"rtol": rtol, "atol": atol, "dt": dt, "model": model, "coupled": coupled}
+    used = SolverSettings.of(
+        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
+    )
+    args = solver_args(used, t_eval, dt_out)
+    settings = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt, "model": model}
+    settings["coupled"] = coupled
     if layers is not None:
         nodes = check_layers(layers)
         raw = _core.simulate_layers(
@@ -198,7 +193,7 @@ def simulate(
             n_steps=raw["n_steps"],
             n_rejected=raw["n_rejected"],
             n_rhs=raw["n_rhs"],
-            method=method,
+            method=used.method,
             settings={**settings, "layers": nodes, "solver": args["solver"]},
             T_front=temps[:, 0],
             T_back=temps[:, -1],
@@ -225,7 +220,7 @@ def simulate(
         n_steps=raw["n_steps"],
         n_rejected=raw["n_rejected"],
         n_rhs=raw["n_rhs"],
-        method=method,
+        method=used.method,
         settings={**settings, "solver": dict(raw["solver"])},
         T_front=raw["T_front"],
         T_back=raw["T_back"],
@@ -244,21 +239,25 @@ def simulate_thermal(
     *,
     layers: Literal[1, 2] = 2,
     method: Method = "rk45",
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: Sequence[float] | None = None,
-    max_step: float = solver.MAX_STEP,
-    max_steps: int = solver.MAX_STEPS,
+    max_step: float = MAX_STEP,
+    max_steps: int = MAX_STEPS,
+    solver: SolverSettings | None = None,
 ) -> ThermalSolution:
     """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
     (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
     check_inputs(panel, orbit)
     layers = checks.integer("layers", layers, 1, 2)  # type: ignore[assignment]
     t0, t1 = time_span(t_span)
-    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    used = SolverSettings.of(
+        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
+    )
+    args = solver_args(used, t_eval, dt_out)
     raw = _core.simulate_thermal(
         panel.as_dict(),
         orbit.as_dict(),
@@ -273,7 +272,8 @@ def simulate_thermal(
         n_steps=raw["n_steps"],
         n_rejected=raw["n_rejected"],
         n_rhs=raw["n_rhs"],
-        method=method,
+        method=used.method,
+        settings={"solver": dict(raw["solver"])},
         layers=int(layers),
         T=raw.get("T"),
         T_front=raw.get("T_front"),
@@ -290,20 +290,24 @@ def simulate_hinge(
     model: Model = "nonlinear",
     y0: Sequence[float] = (0.0, 0.0),
     method: Method = "rk45",
-    rtol: float = solver.RTOL,
-    atol: float = solver.ATOL,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
-    max_step: float = solver.MAX_STEP,
-    max_steps: int = solver.MAX_STEPS,
+    max_step: float = MAX_STEP,
+    max_steps: int = MAX_STEPS,
+    solver: SolverSettings | None = None,
 ) -> HingeSolution:
     """The hinge alone under a prescribed thermal moment (N m): a constant, or samples
     ``moment`` at times ``moment_t`` (linear in between, held beyond the ends).
     ``y0`` = (θ rad, θ̇ rad/s)."""
     check_inputs(panel)
     t0, t1 = time_span(t_span)
-    args = solver_args(method, rtol, atol, dt, max_step, max_steps, t_eval, dt_out)
+    used = SolverSettings.of(
+        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
+    )
+    args = solver_args(used, t_eval, dt_out)
     m = checks.real_array("moment", moment)
     mt = None if moment_t is None else checks.real_array("moment_t", moment_t)
     raw = _core.simulate_hinge(
@@ -321,7 +325,8 @@ def simulate_hinge(
         n_steps=raw["n_steps"],
         n_rejected=raw["n_rejected"],
         n_rhs=raw["n_rhs"],
-        method=method,
+        method=used.method,
+        settings={"solver": dict(raw["solver"])},
         theta=raw["theta"],
         theta_dot=raw["theta_dot"],
     )

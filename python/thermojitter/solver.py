@@ -1,15 +1,20 @@
-"""The integrator's default settings, as the engine defines them (written once, in Rust).
+"""The integrator's settings: one object, its defaults written once (in the engine).
 
-Every run function's ``rtol``, ``atol``, ``max_step`` and ``max_steps`` keyword defaults to these;
-``simulate.solver_settings`` turns the keywords into the mapping the engine validates, and each
-run reports the settings it used (``Solution.settings["solver"]``).
+:class:`SolverSettings` holds what every run function's ``method``, ``rtol``, ``atol``, ``dt``,
+``max_step`` and ``max_steps`` keywords say. Its defaults are the engine's
+(``Tolerances::default`` in ``rust/src/integrate/mod.rs``, exported as ``_core.SOLVER_DEFAULTS``),
+and it is validated on construction: the types here (a bool or a string is not a number), the
+values by the engine's own check, the one every run goes through. A run function takes either the
+keywords or ``solver=SolverSettings(...)``, and its result reports the settings the engine used.
 """
 
 from __future__ import annotations
 
-from typing import Any
+import dataclasses
+from typing import Any, Literal
 
 from thermojitter import _core
+from thermojitter import errors as checks
 
 DEFAULTS: dict[str, Any] = dict(_core.SOLVER_DEFAULTS)
 """method "rk45", rtol, atol, max_step (s), max_steps."""
@@ -17,3 +22,64 @@ RTOL: float = DEFAULTS["rtol"]
 ATOL: float = DEFAULTS["atol"]
 MAX_STEP: float = DEFAULTS["max_step"]
 MAX_STEPS: int = DEFAULTS["max_steps"]
+METHODS = ("rk45", "rk4")
+
+
+@dataclasses.dataclass(frozen=True)
+class SolverSettings:
+    """How a run integrates: ``method`` ``"rk45"`` (Dormand–Prince 5(4), error control by
+    ``rtol``/``atol``, step at most ``max_step`` s) or ``"rk4"`` (classical, fixed step ``dt`` s);
+    at most ``max_steps`` steps (accepted + rejected). Immutable; a bad value raises
+    :class:`thermojitter.ParameterError` naming it when the object is made. Every run function
+    takes it as ``solver=``, e.g. ``tj.simulate(panel, orbit, span, solver=fine)`` with
+    ``fine = tj.SolverSettings(rtol=1e-10, atol=1e-12)``.
+    """
+
+    method: Literal["rk45", "rk4"] = DEFAULTS["method"]
+    rtol: float = RTOL
+    atol: float = ATOL
+    dt: float | None = None
+    max_step: float = MAX_STEP
+    max_steps: int = MAX_STEPS
+
+    def __post_init__(self) -> None:
+        checked = {
+            "method": checks.choice("method", self.method, METHODS),
+            "rtol": checks.real("rtol", self.rtol),
+            "atol": checks.real("atol", self.atol),
+            "dt": None if self.dt is None else checks.real("dt", self.dt),
+            "max_step": checks.real("max_step", self.max_step),
+            "max_steps": checks.integer("max_steps", self.max_steps, 1),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+        _core.check_solver(self.as_dict())
+
+    def as_dict(self) -> dict[str, Any]:
+        """The settings as the engine takes them (a plain mapping)."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+
+    def replace(self, **changes: Any) -> SolverSettings:
+        """A validated copy with ``changes``."""
+        return dataclasses.replace(self, **changes)
+
+    @classmethod
+    def of(cls, solver: SolverSettings | None, **keywords: Any) -> SolverSettings:
+        """The settings of one run: ``solver`` when given, else those of the ``keywords``
+        (``method``, ``rtol``, …; ``method=None`` leaves the method at its default). Given both,
+        a keyword set away from its default and from ``solver``'s value is refused rather than
+        silently ignored."""
+        given = {k: v for k, v in keywords.items() if not (k == "method" and v is None)}
+        if solver is None:
+            return cls(**given)
+        if not isinstance(solver, SolverSettings):
+            raise TypeError(
+                f"solver must be a thermojitter.SolverSettings, not {checks.type_name(solver)}"
+            )
+        default = cls.__dataclass_fields__
+        clash = [k for k, v in given.items() if v != default[k].default and v != getattr(solver, k)]
+        if clash:
+            raise checks.ParameterError(
+                "solver", solver, f"give solver= or {', '.join(clash)}, not both"
+            )
+        return solver

@@ -59,6 +59,16 @@ impl Modes {
     pub fn rigid_eigenvalues(&self) -> [f64; 2] {
         [self.eigenvalues[0], self.eigenvalues[1]]
     }
+    /// Number of elastic modes of the mesh.
+    pub fn elastic_count(&self) -> usize {
+        self.eigenvalues.len() - 2
+    }
+    /// Deflection w of elastic mode `k` (0: the first) at every node, in node order: the
+    /// translation entries (even DOFs) of its shape.
+    pub fn elastic_deflection(&self, k: usize) -> Vec<f64> {
+        let shape = self.shapes.column(k + 2);
+        shape.iter().step_by(2).copied().collect()
+    }
 }
 
 impl FreeFreeBeam {
@@ -84,6 +94,20 @@ impl FreeFreeBeam {
     /// Number of degrees of freedom, 2 (n + 1).
     pub fn dofs(&self) -> usize {
         2 * (self.n_elements + 1)
+    }
+
+    /// Position of every node along the beam, m (0 to L).
+    pub fn node_positions(&self) -> Vec<f64> {
+        (0..=self.n_elements)
+            .map(|j| self.length * j as f64 / self.n_elements as f64)
+            .collect()
+    }
+
+    /// Total mass as the consistent mass matrix carries it, kg: tᵀ M t for the unit
+    /// translation t (equal to m L).
+    pub fn total_mass(&self) -> f64 {
+        let t = self.translation();
+        t.dot(&(self.mass_matrix() * &t))
     }
 
     fn element_length(&self) -> f64 {
@@ -451,6 +475,27 @@ mod tests {
         let t = b.translation();
         let total = t.dot(&(b.mass_matrix() * &t));
         assert!((total - 5.51 * 50.0).abs() < 1e-9 * total, "{total}");
+        assert!((b.total_mass() - 5.51 * 50.0).abs() < 1e-9 * total);
+    }
+
+    #[test]
+    fn node_deflections_read_the_translation_dofs() {
+        let b = paper_beam(20);
+        let x = b.node_positions();
+        assert_eq!((x.len(), x[0], x[20]), (21, 0.0, b.length));
+        let modes = b.modes().unwrap();
+        assert_eq!(modes.elastic_count(), b.dofs() - 2);
+        // The first free–free mode is symmetric about the centre, with the ends moving against
+        // it; the second is antisymmetric. Read from the shape's even entries directly.
+        let first = modes.elastic_deflection(0);
+        let second = modes.elastic_deflection(1);
+        assert_eq!(first.len(), 21);
+        for j in 0..=20 {
+            assert_eq!(first[j], modes.shapes[(2 * j, 2)]);
+            assert!((first[j] - first[20 - j]).abs() < 1e-9 * first[0].abs());
+            assert!((second[j] + second[20 - j]).abs() < 1e-9 * second[0].abs());
+        }
+        assert!(first[0] * first[10] < 0.0);
     }
 
     #[test]

@@ -17,6 +17,11 @@ pub enum HingeModel {
 /// would pass through each other (and the paper's use is for a few degrees).
 pub const MAX_HINGE_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
 
+/// |θ| up to which the hinge model is trusted by default, rad (20°): its rigid halves and the
+/// cos θ coupling are meant for modest angles. Long runs and Monte Carlo samples stop or flag
+/// the first orbit beyond it.
+pub const VALIDITY_LIMIT: f64 = 20.0 * (std::f64::consts::PI / 180.0);
+
 /// Checks an angle given to the hinge model (a start state, a limit): within ±π/2 rad. The
 /// message says what a value in degrees would have been, the likely slip.
 pub fn check_hinge_angle(name: &str, theta: f64) -> crate::Result<()> {
@@ -90,6 +95,15 @@ pub trait StructuralModel {
     fn check_start(&self, _offset: usize, _states: &[f64]) -> Result<()> {
         Ok(())
     }
+}
+
+/// Where the point at ζ ∈ [0, 2l] along one rigid half of the hinge model is when the panel
+/// is folded by θ (paper Sec. 3.1, Fig. 12), m: x = (l − ζ) sin θ normal to the undeformed
+/// panel, y = ζ cos θ along it. As θ varies each point runs on an ellipse of semi-axes |l − ζ|
+/// and ζ (the half slides like a trammel, its ends on the two axes).
+pub fn hinge_point(panel: &Panel, zeta: f64, theta: f64) -> (f64, f64) {
+    let arm = panel.half_arm();
+    ((arm - zeta) * theta.sin(), zeta * theta.cos())
 }
 
 /// M_T = χ a E I (T_f − T_b) / d, N m.
@@ -335,6 +349,23 @@ pub fn hinge_energy(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_half_of_the_hinge_model_stays_rigid() {
+        // Its ends (ζ = 0 and 2l) stay 2l apart at every fold, and the point at ζ = l (the
+        // middle) stays on the panel's axis at distance l cos θ.
+        let p = Panel::paper();
+        let arm = p.half_arm();
+        for deg in [-90.0, -30.0, 0.0, 5.0, 45.0, 90.0] {
+            let th = f64::to_radians(deg);
+            let (x0, y0) = hinge_point(&p, 0.0, th);
+            let (x1, y1) = hinge_point(&p, 2.0 * arm, th);
+            let length = (x1 - x0).hypot(y1 - y0);
+            assert!((length - 2.0 * arm).abs() < 1e-12 * arm, "{deg}: {length}");
+            let (xm, ym) = hinge_point(&p, arm, th);
+            assert!(xm.abs() < 1e-15 && (ym - arm * th.cos()).abs() < 1e-12 * arm);
+        }
+    }
 
     /// Units in the last place between a and b.
     fn ulps(a: f64, b: f64) -> f64 {

@@ -159,6 +159,50 @@ impl Spectrum {
     }
 }
 
+/// Scales that balance `jac` (Parlett–Reinsch): powers of two d such that D⁻¹ J D has rows and
+/// columns of matching norms, for [`Spectrum::of`]. Being powers of two, they change no digit
+/// of the eigenvalues; they even out scales the caller cannot know in advance (kelvin against
+/// the coordinates of many modes).
+pub fn balancing(jac: &DMatrix<f64>) -> Vec<f64> {
+    let n = jac.nrows();
+    let mut a = jac.clone();
+    let mut d = vec![1.0; n];
+    for _ in 0..100 {
+        let mut done = true;
+        for i in 0..n {
+            let c: f64 = (0..n).filter(|&r| r != i).map(|r| a[(r, i)].abs()).sum();
+            let r: f64 = (0..n).filter(|&c| c != i).map(|c| a[(i, c)].abs()).sum();
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let mut f = 1.0;
+            let (mut cc, mut rr) = (c, r);
+            while cc < rr / 2.0 {
+                cc *= 2.0;
+                rr /= 2.0;
+                f *= 2.0;
+            }
+            while cc > rr * 2.0 {
+                cc /= 2.0;
+                rr *= 2.0;
+                f /= 2.0;
+            }
+            if (cc + rr) < 0.95 * (c + r) {
+                done = false;
+                d[i] *= f;
+                for k in 0..n {
+                    a[(i, k)] /= f;
+                    a[(k, i)] *= f;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    d
+}
+
 /// ∂f/∂y of `f` at `y` by central differences, step ε^(1/3) · max(|y_j|, `floor[j]`) in
 /// component j (`floor`: a magnitude typical of the component where it passes through zero).
 pub fn finite_difference_jacobian(

@@ -43,6 +43,54 @@ pub struct LinearThermal {
 }
 
 impl LinearThermal {
+    /// The coefficients' names, in the order of [`LinearThermal::values`] (`T_star` is
+    /// `t_star`, named as in the paper).
+    pub const FIELDS: [&'static str; 10] = [
+        "p",
+        "q",
+        "r",
+        "s",
+        "omega",
+        "omega_n",
+        "T_star",
+        "emissivity",
+        "theta_star",
+        "hinge_inertia",
+    ];
+
+    /// The coefficients in the order of [`LinearThermal::FIELDS`].
+    pub fn values(&self) -> [f64; 10] {
+        [
+            self.p,
+            self.q,
+            self.r,
+            self.s,
+            self.omega,
+            self.omega_n,
+            self.t_star,
+            self.emissivity,
+            self.theta_star,
+            self.hinge_inertia,
+        ]
+    }
+
+    /// The analysis from its coefficients in the order of [`LinearThermal::FIELDS`].
+    pub fn from_values(v: [f64; 10]) -> Self {
+        let [p, q, r, s, omega, omega_n, t_star, emissivity, theta_star, hinge_inertia] = v;
+        LinearThermal {
+            p,
+            q,
+            r,
+            s,
+            omega,
+            omega_n,
+            t_star,
+            emissivity,
+            theta_star,
+            hinge_inertia,
+        }
+    }
+
     /// The analysis of `panel` under flux factor `flux`; `omega` defaults to ω_n (as in the
     /// paper), `t_star` to the mean layer temperature at the sunlit equilibrium.
     pub fn new(panel: &Panel, flux: f64, omega: Option<f64>, t_star: Option<f64>) -> Result<Self> {

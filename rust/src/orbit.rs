@@ -491,21 +491,63 @@ impl Orbit {
     /// Times in (t0, t1) where s(t) jumps (cylinder) or has a kink (penumbra: first and last
     /// contact, umbra entry and exit), sorted.
     pub fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
-        let mut out: Vec<f64> = Vec::new();
-        for e in self.eclipses(t0, t1) {
-            let (a, b) = e.outer;
-            let mut times = vec![a];
-            if let Some((c, d)) = e.umbra {
-                times.extend([c, d]);
-            }
-            times.push(b);
-            for t in times {
-                if t > t0 && t < t1 && out.last().is_none_or(|&last| t > last) {
-                    out.push(t);
-                }
+        breakpoints_of(&self.eclipses(t0, t1), t0, t1)
+    }
+}
+
+/// The breakpoints in (t0, t1) of the eclipses `eclipses` (in time order), as
+/// [`Orbit::breakpoints`].
+pub fn breakpoints_of(eclipses: &[Eclipse], t0: f64, t1: f64) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for e in eclipses {
+        let (a, b) = e.outer;
+        let contacts = match e.umbra {
+            Some((c, d)) => [a, c, d, b],
+            None => [a, a, b, b],
+        };
+        for t in contacts {
+            if t > t0 && t < t1 && out.last().is_none_or(|&last| t > last) {
+                out.push(t);
             }
         }
-        out
+    }
+    out
+}
+
+/// The eclipses of an orbit searched once over a stretch of several orbits and then looked up:
+/// a long run asks for the eclipses of the same orbit many times. Each eclipse depends only on
+/// its passage behind the Earth, not on the window asked for, so a look-up returns exactly what
+/// [`Orbit::eclipses`] returns for the same window.
+#[derive(Debug, Clone)]
+pub struct EclipseTable {
+    orbit: Orbit,
+    /// The span searched, and every eclipse overlapping it, in time order.
+    span: (f64, f64),
+    list: Vec<Eclipse>,
+}
+
+/// Orbits searched at a time by [`EclipseTable`].
+const TABLE_ORBITS: f64 = 16.0;
+
+impl EclipseTable {
+    pub fn new(orbit: &Orbit) -> Self {
+        EclipseTable {
+            orbit: *orbit,
+            span: (0.0, 0.0),
+            list: Vec::new(),
+        }
+    }
+
+    /// Every eclipse overlapping [t0, t1], unclipped, in time order (as [`Orbit::eclipses`]).
+    pub fn overlapping(&mut self, t0: f64, t1: f64) -> &[Eclipse] {
+        if !(self.span.0 <= t0 && t1 <= self.span.1) {
+            let end = t1.max(t0 + TABLE_ORBITS * self.orbit.period);
+            self.span = (t0, end);
+            self.list = self.orbit.eclipses(t0, end);
+        }
+        let first = self.list.partition_point(|e| e.outer.1 <= t0);
+        let last = self.list.partition_point(|e| e.outer.0 < t1);
+        &self.list[first..last.max(first)]
     }
 }
 
@@ -677,6 +719,35 @@ mod tests {
         let jan = Orbit::geo_year(PERIHELION_DAY);
         assert!((jan.flux_scale(0.0) - 1.0 / (1.0 - EARTH_ECCENTRICITY).powi(2)).abs() < 1e-12);
         assert_eq!(Orbit::geo_equinox().flux_scale(1e7), 1.0);
+    }
+
+    #[test]
+    fn the_eclipse_table_returns_what_a_search_of_the_window_returns() {
+        // Windows of odd lengths and starts, forward and back, across the eclipse season's edge
+        // and inside it, for the searched penumbra and the closed-form cylinder.
+        for orbit in [
+            Orbit::geo_year(EQUINOX_DAY - 30.0),
+            Orbit::geo_equinox(),
+            Orbit::leo(540e3),
+        ] {
+            let mut table = EclipseTable::new(&orbit);
+            let p = orbit.period;
+            let mut t0 = 0.3 * p;
+            let mut seen = 0;
+            for k in 0..120 {
+                let t1 = t0 + p * (0.2 + 0.7 * ((k * 7) % 5) as f64);
+                let want = orbit.eclipses(t0, t1);
+                seen += want.len();
+                assert_eq!(table.overlapping(t0, t1), want.as_slice(), "[{t0}, {t1}]");
+                assert_eq!(
+                    breakpoints_of(&want, t0, t1),
+                    orbit.breakpoints(t0, t1),
+                    "[{t0}, {t1}]"
+                );
+                t0 += if k % 9 == 8 { -1.3 * p } else { 0.45 * p };
+            }
+            assert!(seen > 20, "{seen}");
+        }
     }
 
     #[test]

@@ -86,8 +86,8 @@ where
     let mut x = DVector::zeros(m);
     thermal.initial_guess(flux, &mut x.as_mut_slice()[..n]);
     let f_of = |x: &DVector<f64>| residual(thermal, structure, coupling, flux, x.as_slice());
-    for _ in 0..100 {
-        let f = f_of(&x);
+    let residual_and_jacobian = |x: &DVector<f64>| {
+        let f = f_of(x);
         let mut jac = DMatrix::zeros(m, m);
         for j in 0..m {
             let h = 1e-7 * x[j].abs().max(1e-3);
@@ -95,25 +95,46 @@ where
             xp[j] += h;
             jac.set_column(j, &((f_of(&xp) - &f) / h));
         }
+        (f, jac)
+    };
+    let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
+        let temperatures_settled = (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]);
+        let shape_settled = (n..m).all(|i| dx[i].abs() < 1e-14);
+        temperatures_settled && shape_settled
+    };
+    let x = newton("steady state", x, n, residual_and_jacobian, settled)?;
+    structure.check_static(&x.as_slice()[n..])?;
+    Ok(x)
+}
+
+/// Newton's method from `x` for a steady state whose first `n_temps` unknowns are temperatures:
+/// each step solves J dx = −f, with (f, J) at x from `system`, shortened by halves where it
+/// would take a temperature to zero or below (wild parameter sets); it stops when
+/// `settled(x, dx)` after a step, and gives up after 100 steps. `what` names the state in errors.
+pub fn newton(
+    what: &str,
+    mut x: DVector<f64>,
+    n_temps: usize,
+    mut system: impl FnMut(&DVector<f64>) -> (DVector<f64>, DMatrix<f64>),
+    settled: impl Fn(&DVector<f64>, &DVector<f64>) -> bool,
+) -> Result<DVector<f64>> {
+    for _ in 0..100 {
+        let (f, jac) = system(&x);
         let dx = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
-            what: "steady state".into(),
+            what: what.into(),
             reason: "singular Jacobian".into(),
         })?;
-        // Damped update keeps the temperatures positive on wild parameter sets.
         let mut lambda = 1.0;
-        while (0..n).any(|i| x[i] + lambda * dx[i] <= 0.0) {
+        while (0..n_temps).any(|i| x[i] + lambda * dx[i] <= 0.0) {
             lambda *= 0.5;
         }
         x += &dx * lambda;
-        let temperatures_settled = (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]);
-        let shape_settled = (n..m).all(|i| dx[i].abs() < 1e-14);
-        if temperatures_settled && shape_settled {
-            structure.check_static(&x.as_slice()[n..])?;
+        if settled(&x, &dx) {
             return Ok(x);
         }
     }
     Err(Error::NoConvergence {
-        what: "steady state".into(),
+        what: what.into(),
         reason: "Newton did not converge in 100 iterations".into(),
     })
 }
@@ -127,15 +148,6 @@ where
     let mut y = State::<D>::zeros_generic(dim, nalgebra::U1);
     y.as_mut_slice()[..x.len()].copy_from_slice(x.as_slice());
     y
-}
-
-/// The steady temperatures of a thermal model alone under `flux`, as a start state.
-pub fn thermal_start<T: ThermalModel + ?Sized>(
-    thermal: &T,
-    flux: f64,
-) -> Result<State<nalgebra::Dyn>> {
-    let x = steady(thermal, &crate::dynamics::Rigid, Coupling::Frozen, flux)?;
-    Ok(rest(&x, nalgebra::Dyn(thermal.size())))
 }
 
 /// The paper model's steady state: two layers and the hinge (whose static balance does not
@@ -181,12 +193,15 @@ mod tests {
     }
 
     #[test]
-    fn thermal_start_is_the_isothermal_closed_form_for_one_node() {
+    fn thermal_steady_state_is_the_isothermal_closed_form_for_one_node() {
         let p = Panel::paper();
         for flux in [1.0, 0.97] {
             let one = crate::thermal::OneNode::new(&p);
-            let y = thermal_start(&one, flux).unwrap();
             let exact = one.equilibrium(flux);
+            let orbit = crate::Orbit::geo_equinox();
+            let y = crate::system::Coupled::thermal_only(one, orbit)
+                .steady_state(flux)
+                .unwrap();
             assert!((y[0] - exact).abs() <= 1e-13 * exact, "{} vs {exact}", y[0]);
         }
     }

@@ -11,7 +11,7 @@ use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::Result;
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, State, Stats};
-use crate::orbit::Orbit;
+use crate::orbit::{EclipseTable, Orbit};
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
@@ -181,6 +181,8 @@ pub(crate) struct Collector<V> {
     pub(crate) crossing: Option<LimitCrossing>,
     /// The last step's end as read: (t, dynamic part), the next step's start.
     pub(crate) end: (f64, f64),
+    /// The orbit's eclipses, searched a stretch of orbits at a time.
+    eclipses: EclipseTable,
 }
 
 impl<V: SummaryView> Collector<V> {
@@ -221,6 +223,7 @@ impl<V: SummaryView> Collector<V> {
             duration: 0.0,
             crossing: None,
             end: (f64::NAN, 0.0),
+            eclipses: EclipseTable::new(orbit),
         };
         collector.current = collector.open(first_index)?;
         collector.current.theta_max = theta0;
@@ -237,7 +240,12 @@ impl<V: SummaryView> Collector<V> {
         } else {
             0.0
         };
-        let eclipse = self.orbit.shadow_intervals(t0, t1).first().copied();
+        // The first eclipse overlapping the orbit, clipped to it (Orbit::shadow_intervals).
+        let eclipse = self
+            .eclipses
+            .overlapping(t0, t1)
+            .first()
+            .map(|e| (e.outer.0.max(t0), e.outer.1.min(t1)));
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
     }
 

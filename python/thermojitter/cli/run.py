@@ -118,10 +118,7 @@ def simulate_scenario(
                 (a, b),
                 model=sim.model,  # type: ignore[arg-type]
                 coupled=sim.coupled,
-                method=sim.method,  # type: ignore[arg-type]
-                rtol=sim.rtol,
-                atol=sim.atol,
-                dt=sim.dt,
+                solver=sim.solver,
                 t_eval=t_eval,
                 y0=y0,
                 layers=sim.layers,
@@ -211,9 +208,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         model=sim.model,  # type: ignore[arg-type]
         coupled=sim.coupled,
         method=sim.method,  # type: ignore[arg-type]
-        rtol=sim.rtol,
-        atol=sim.atol,
-        dt=sim.dt,
+        solver=sim.solver,
         theta_limit=math.radians(sim.theta_limit_deg),
         on_limit=sim.on_limit,  # type: ignore[arg-type]
         layers=sim.layers,

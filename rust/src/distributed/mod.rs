@@ -25,7 +25,9 @@ pub mod run;
 pub mod structure;
 
 use crate::error::{require_finite, require_non_negative, Error, Result};
+use crate::flutter::{balancing, critical_value, Spectrum};
 use crate::params::Panel;
+use crate::steady::newton;
 use crate::system::Coupling;
 use crate::thermal::{self, ThermalModel};
 use nalgebra::{Complex, DMatrix, DVector};
@@ -376,10 +378,10 @@ impl DistributedPanel {
         // Start from the uniform panel at the rigid incidence.
         let mut guess = vec![0.0; s];
         self.thermal.initial_guess(flux * sun.1, &mut guess);
-        let mut x = DVector::from_fn(nt, |i, _| guess[i % s]);
+        let x = DVector::from_fn(nt, |i, _| guess[i % s]);
         let fs = &self.reduction.slope_static;
         let mut flows = vec![0.0; s];
-        for _ in 0..100 {
+        let residual_and_jacobian = |x: &DVector<f64>| {
             let moments = self.moments(x.as_slice());
             let rho: Vec<f64> = if coupled {
                 (0..n)
@@ -413,28 +415,23 @@ impl DistributedPanel {
                     }
                 }
             }
-            let dx = jac.lu().solve(&(-&f)).ok_or_else(|| Error::NoConvergence {
-                what: "distributed steady state".into(),
-                reason: "singular Jacobian".into(),
-            })?;
-            let mut lambda = 1.0;
-            while (0..nt).any(|i| x[i] + lambda * dx[i] <= 0.0) {
-                lambda *= 0.5;
-            }
-            x += &dx * lambda;
-            if (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]) {
-                let y = self.static_state(x.as_slice());
-                self.theta_f(&y, 0.0).map_err(|_| Error::NoConvergence {
-                    what: "distributed steady state".into(),
-                    reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
-                })?;
-                return Ok(y);
-            }
-        }
-        Err(Error::NoConvergence {
+            (f, jac)
+        };
+        let settled =
+            |x: &DVector<f64>, dx: &DVector<f64>| (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]);
+        let x = newton(
+            "distributed steady state",
+            x,
+            nt,
+            residual_and_jacobian,
+            settled,
+        )?;
+        let y = self.static_state(x.as_slice());
+        self.theta_f(&y, 0.0).map_err(|_| Error::NoConvergence {
             what: "distributed steady state".into(),
-            reason: "Newton did not converge in 100 iterations".into(),
-        })
+            reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
+        })?;
+        Ok(y)
     }
 
     /// ∂f/∂y of the right-hand side at state `y` under illumination factor `flux`.
@@ -517,56 +514,6 @@ pub struct DistributedFlutter {
     pub critical_damping: f64,
 }
 
-/// Eigenvalues of a real matrix, after a diagonal balancing (a similarity, so the eigenvalues
-/// are unchanged) that evens out the kelvin and modal-coordinate scales.
-fn eigenvalues(j: &DMatrix<f64>) -> Result<Vec<Complex<f64>>> {
-    let n = j.nrows();
-    let mut a = j.clone();
-    // Parlett–Reinsch: scale row and column i by powers of two until their norms match.
-    for _ in 0..100 {
-        let mut done = true;
-        for i in 0..n {
-            let c: f64 = (0..n).filter(|&r| r != i).map(|r| a[(r, i)].abs()).sum();
-            let r: f64 = (0..n).filter(|&c| c != i).map(|c| a[(i, c)].abs()).sum();
-            if c == 0.0 || r == 0.0 {
-                continue;
-            }
-            let mut f = 1.0;
-            let (mut cc, mut rr) = (c, r);
-            while cc < rr / 2.0 {
-                cc *= 2.0;
-                rr /= 2.0;
-                f *= 2.0;
-            }
-            while cc > rr * 2.0 {
-                cc /= 2.0;
-                rr *= 2.0;
-                f /= 2.0;
-            }
-            if (cc + rr) < 0.95 * (c + r) {
-                done = false;
-                for k in 0..n {
-                    a[(i, k)] /= f;
-                    a[(k, i)] *= f;
-                }
-            }
-        }
-        if done {
-            break;
-        }
-    }
-    let ev = a.complex_eigenvalues();
-    if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
-        return Err(Error::NoConvergence {
-            what: "eigenvalues".into(),
-            reason: "non-finite result".into(),
-        });
-    }
-    let mut v: Vec<Complex<f64>> = ev.iter().copied().collect();
-    v.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
-    Ok(v)
-}
-
 impl DistributedPanel {
     /// Eigenvalues of the Jacobian `base` with the modal damping ratio set to `zeta` (only the
     /// q̇ diagonal depends on it; the equilibrium does not).
@@ -576,7 +523,8 @@ impl DistributedPanel {
         for (i, w) in self.reduction.omega.iter().enumerate() {
             j[(nt + k + i, nt + k + i)] = -2.0 * zeta * w;
         }
-        eigenvalues(&j)
+        // Balanced first: the kelvin and modal-coordinate scales differ by orders of magnitude.
+        Ok(Spectrum::of(&j, &balancing(&j))?.eigenvalues)
     }
 
     /// Linear stability of the sunlit equilibrium under illumination factor `flux` (1: full Sun
@@ -606,32 +554,7 @@ impl DistributedPanel {
             .collect();
         modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
         let growth = |zeta: f64| -> Result<f64> { Ok(self.spectrum(&base, zeta)?[0].re) };
-        let zeta_star = if growth(0.0)? < 0.0 {
-            0.0
-        } else {
-            let mut hi = self.settings.damping_ratio.max(1e-6);
-            let mut tries = 0;
-            while growth(hi)? >= 0.0 {
-                hi *= 2.0;
-                tries += 1;
-                if tries > 60 {
-                    return Err(Error::NoConvergence {
-                        what: "critical damping".into(),
-                        reason: "no stabilising damping ratio found".into(),
-                    });
-                }
-            }
-            let mut lo = 0.0;
-            while hi - lo > 1e-10 * hi {
-                let mid = 0.5 * (lo + hi);
-                if growth(mid)? >= 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            0.5 * (lo + hi)
-        };
+        let zeta_star = critical_value(growth, self.settings.damping_ratio.max(1e-6), 1e-10)?;
         Ok(DistributedFlutter {
             theta_f: self.theta_f(&y, 0.0)?,
             equilibrium: y,

@@ -5,23 +5,15 @@
 //! of degree 16 is exact to about 1e-18 relative; it is evaluated in powers of B³ (six products
 //! instead of sixteen), then squared s times.
 //!
-//! φ_k(A) w follows from one exponential of an augmented matrix (Al-Mohy & Higham 2011, Thm 2.1):
-//! for Ã = [[A, W], [0, K]] with W = [w_p, …, w_1] and K the p×p upward shift, the last column of
-//! the top-right block of exp(Ã) is Σ_k φ_k(A) w_k.
+//! φ_k(A) for k ≤ 3 follow by the same scaling and squaring, as matrices ([`phi_matrices`]).
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 const TAYLOR_DEGREE: usize = 16;
 
 /// exp(a).
 pub fn expm<const M: usize>(a: &SMatrix<f64, M, M>) -> SMatrix<f64, M, M> {
-    let norm = (0..M)
-        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let mut squarings = 0i32;
-    if norm > 0.5 {
-        squarings = (norm / 0.5).log2().ceil() as i32;
-    }
+    let squarings = squarings_for(a);
     let b = a * 0.5f64.powi(squarings);
     // 1/j! for j = 0..=TAYLOR_DEGREE.
     let mut inv_fact = [1.0; TAYLOR_DEGREE + 1];
@@ -47,48 +39,53 @@ pub fn expm<const M: usize>(a: &SMatrix<f64, M, M>) -> SMatrix<f64, M, M> {
     e
 }
 
-/// φ1(a) w1 + φ2(a) w2 for a 4×4 `a` (one exponential of a 6×6 matrix).
-pub fn phi12(
-    a: &SMatrix<f64, 4, 4>,
-    w1: &SVector<f64, 4>,
-    w2: &SVector<f64, 4>,
-) -> SVector<f64, 4> {
-    // The vectors are scaled to the size of `a` so that they do not set the number of squarings.
-    let gamma = balance(a, &[w1, w2]);
-    let mut m = SMatrix::<f64, 6, 6>::zeros();
-    m.fixed_view_mut::<4, 4>(0, 0).copy_from(a);
-    m.fixed_view_mut::<4, 1>(0, 4).copy_from(&(w2 * gamma));
-    m.fixed_view_mut::<4, 1>(0, 5).copy_from(&(w1 * gamma));
-    m[(4, 5)] = 1.0;
-    let e = expm(&m);
-    e.fixed_view::<4, 1>(0, 5).into_owned() / gamma
-}
-
-/// φ3(a) w for a 4×4 `a` (one exponential of a 7×7 matrix).
-pub fn phi3(a: &SMatrix<f64, 4, 4>, w: &SVector<f64, 4>) -> SVector<f64, 4> {
-    let gamma = balance(a, &[w]);
-    let mut m = SMatrix::<f64, 7, 7>::zeros();
-    m.fixed_view_mut::<4, 4>(0, 0).copy_from(a);
-    m.fixed_view_mut::<4, 1>(0, 4).copy_from(&(w * gamma));
-    m[(4, 5)] = 1.0;
-    m[(5, 6)] = 1.0;
-    let e = expm(&m);
-    e.fixed_view::<4, 1>(0, 6).into_owned() / gamma
-}
-
-/// A power of two that brings the vectors' 1-norms to about the 1-norm of `a` (at least 1).
-fn balance(a: &SMatrix<f64, 4, 4>, ws: &[&SVector<f64, 4>]) -> f64 {
-    let a_norm = (0..4)
-        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(1.0, f64::max);
-    let w_norm = ws
-        .iter()
-        .map(|w| w.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    if w_norm == 0.0 || !w_norm.is_finite() {
-        return 1.0;
+/// The matrices φ_k(a), k = 0..=3 (φ0 = exp), by scaling and squaring (Skaflestad & Wright
+/// 2009): with B = a / 2^s of 1-norm at most 1/2, φ3(B) by its Taylor polynomial of degree
+/// [`PHI_DEGREE`] (exact to about 1e-17 relative), the lower ones by φ_{k−1}(B) = I/(k−1)! + B φ_k(B),
+/// then s doublings φ_k(2z) = 2^{−k} (φ0(z) φ_k(z) + Σ_{j=1..k} φ_j(z) / (k − j)!).
+///
+/// One such evaluation serves every φ-function product of a step, at the cost of matrices of
+/// the state's size (the augmented-matrix form needs one exponential of a larger matrix for
+/// each combination of vectors).
+pub fn phi_matrices<const M: usize>(a: &SMatrix<f64, M, M>) -> [SMatrix<f64, M, M>; 4] {
+    let squarings = squarings_for(a);
+    let b = a * 0.5f64.powi(squarings);
+    let id = SMatrix::<f64, M, M>::identity();
+    // φ3(B) = Σ_j B^j / (j + 3)!, by Horner from the top term.
+    let coef = |j: usize| 1.0 / (1..=j + 3).map(|v| v as f64).product::<f64>();
+    let mut p3 = id * coef(PHI_DEGREE);
+    for j in (0..PHI_DEGREE).rev() {
+        p3 = b * p3 + id * coef(j);
     }
-    2f64.powi((a_norm / w_norm).log2().round() as i32)
+    let p2 = id * 0.5 + b * p3;
+    let p1 = id + b * p2;
+    let p0 = id + b * p1;
+    let mut phi = [p0, p1, p2, p3];
+    for _ in 0..squarings {
+        let [p0, p1, p2, p3] = phi;
+        phi = [
+            p0 * p0,
+            (p0 * p1 + p1) * 0.5,
+            (p0 * p2 + p1 + p2) * 0.25,
+            (p0 * p3 + p1 * 0.5 + p2 + p3) * 0.125,
+        ];
+    }
+    phi
+}
+
+/// Degree of the Taylor polynomial of φ3 in [`phi_matrices`].
+const PHI_DEGREE: usize = 12;
+
+/// The number of halvings that bring a's 1-norm to at most 1/2.
+fn squarings_for<const M: usize>(a: &SMatrix<f64, M, M>) -> i32 {
+    let norm = (0..M)
+        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    if norm > 0.5 {
+        (norm / 0.5).log2().ceil() as i32
+    } else {
+        0
+    }
 }
 
 #[cfg(test)]
@@ -118,10 +115,7 @@ mod tests {
     fn phi_functions_of_a_diagonal_matrix_are_the_scalar_ones() {
         let lam = [-0.02, -3e-3, 1e-9, -40.0];
         let a = Matrix4::from_diagonal(&Vector4::from(lam));
-        let w1 = Vector4::new(1.0, -2.0, 300.0, 1e-3);
-        let w2 = Vector4::new(-5.0, 0.5, 2.0, 7.0);
-        let got = phi12(&a, &w1, &w2);
-        let got3 = phi3(&a, &w2);
+        let phi = phi_matrices(&a);
         for i in 0..4 {
             let z: f64 = lam[i];
             // The series Σ z^j / (j + k)! for |z| < 1, the recurrences φ_{k+1} = (φ_k − 1/k!)/z
@@ -136,16 +130,45 @@ mod tests {
                 }
                 sum
             };
-            let (p1, p2, p3) = if z.abs() < 1.0 {
-                (series(1), series(2), series(3))
+            let want = if z.abs() < 1.0 {
+                [series(0), series(1), series(2), series(3)]
             } else {
                 let p1 = z.exp_m1() / z;
                 let p2 = (p1 - 1.0) / z;
-                (p1, p2, (p2 - 0.5) / z)
+                [z.exp(), p1, p2, (p2 - 0.5) / z]
             };
-            let want = p1 * w1[i] + p2 * w2[i];
-            assert!((got[i] - want).abs() < 1e-12 * want.abs().max(1.0), "{i}");
-            assert!((got3[i] - p3 * w2[i]).abs() < 1e-12 * w2[i].abs(), "{i}");
+            for k in 0..4 {
+                let got = phi[k][(i, i)];
+                assert!(
+                    (got - want[k]).abs() < 1e-13 * want[k].abs(),
+                    "φ{k} of {z}: {got}"
+                );
+                let off = (0..4).filter(|&j| j != i).all(|j| phi[k][(i, j)] == 0.0);
+                assert!(off, "φ{k} row {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn phi_functions_of_a_long_oscillator_step_satisfy_their_recurrence() {
+        // A hinge-like oscillator coupled to two thermal layers, over a step of many periods:
+        // A φ_{k+1}(A) = φ_k(A) − I/k!, with φ0 against the independent exponential.
+        let j = Matrix4::new(
+            -0.025, 0.01, -0.4, 0.0, 0.01, -0.012, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 4.9e-3, -4.9e-3,
+            -0.62, -3e-4,
+        );
+        for h in [0.3, 7.0, 150.0] {
+            let a = j * h;
+            let phi = phi_matrices(&a);
+            let e = expm(&a);
+            let size = e.amax().max(1.0);
+            assert!((phi[0] - e).amax() < 1e-12 * size, "h {h}");
+            let id = Matrix4::<f64>::identity();
+            for (k, fact) in [(0, 1.0), (1, 1.0), (2, 2.0)] {
+                let lhs = a * phi[k + 1];
+                let rhs = phi[k] - id / fact;
+                assert!((lhs - rhs).amax() < 1e-11 * size, "h {h} k {k}");
+            }
         }
     }
 }

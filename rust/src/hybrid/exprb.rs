@@ -14,7 +14,7 @@
 //! u⁺ = U + 2h φ3(hJ) D          (third order; U is the embedded second-order solution)
 //! ```
 
-use super::expm::{phi12, phi3};
+use super::expm::phi_matrices;
 use super::jacobian::Linearisation;
 use crate::error::{Error, Result};
 use crate::system::Coupled;
@@ -98,13 +98,13 @@ pub fn segment(
                     ),
                 });
             }
-            let a_mat = jac * hs;
-            let du = phi12(&a_mat, &(f0 * hs), &(v * (hs * hs)));
+            let [_, phi1, phi2, phi3] = phi_matrices(&(jac * hs));
+            let du = phi1 * (f0 * hs) + phi2 * (v * (hs * hs));
             let u_mid = y0 + du;
             let f_mid = system.rhs_at_flux(system.flux_at(t1), &u_mid);
             // g(t1, U) − g(t0, u) with g(t, u) = f(t, u) − J u − v t.
             let d = f_mid - f0 - jac * du - v * hs;
-            let corr = phi3(&a_mat, &(d * (2.0 * hs)));
+            let corr = phi3 * (d * (2.0 * hs));
             let y1 = u_mid + corr;
             let mut acc = 0.0;
             for i in 0..4 {

@@ -29,8 +29,6 @@ pub struct Signal {
     q1: f64,
     a: [C64; 4],
     lambda: [C64; 4],
-    /// Angular frequency of the fastest oscillatory term (0: none), rad/s.
-    omega: f64,
 }
 
 impl Arc {
@@ -127,13 +125,11 @@ impl Arc {
     /// The functional w·y(τ).
     pub fn signal(&self, w: &Vector4<f64>) -> Signal {
         let a = self.modes.map(|m| (0..4).map(|i| m[i] * w[i]).sum::<C64>());
-        let omega = self.lambda.iter().map(|l| l.im.abs()).fold(0.0, f64::max);
         Signal {
             q0: w.dot(&self.base),
             q1: w.dot(&self.slope),
             a,
             lambda: self.lambda,
-            omega,
         }
     }
 }
@@ -165,15 +161,30 @@ impl Signal {
         v
     }
 
+    /// The signal and its first two derivatives at τ.
+    fn with_derivatives(&self, tau: f64) -> (f64, f64, f64) {
+        let (mut v, mut d1, mut d2) = (self.q0 + self.q1 * tau, self.q1, 0.0);
+        for k in 0..4 {
+            let l = self.lambda[k];
+            let term = self.a[k] * (l * tau).exp();
+            v += term.re;
+            d1 += (term * l).re;
+            d2 += (term * l * l).re;
+        }
+        (v, d1, d2)
+    }
+
     /// Smooth part (drift and real modes) and the envelope of the oscillatory terms at τ.
     fn smooth_and_envelope(&self, tau: f64) -> (f64, f64) {
         let (mut smooth, mut env) = (self.q0 + self.q1 * tau, 0.0);
         for k in 0..4 {
             let l = self.lambda[k];
+            // Re(a e^{λτ}) of a real λ is Re(a) e^{λτ}.
+            let decay = (l.re * tau).exp();
             if l.im != 0.0 {
-                env += self.a[k].norm() * (l.re * tau).exp();
+                env += self.a[k].norm() * decay;
             } else {
-                smooth += (self.a[k] * (l * tau).exp()).re;
+                smooth += self.a[k].re * decay;
             }
         }
         (smooth, env)
@@ -206,9 +217,9 @@ impl Signal {
         total.re.max(0.0)
     }
 
-    /// (min, max) of the signal over [t0, t1]: the extremes of its upper and lower envelopes
-    /// (smooth part ± oscillation envelope) located on a grid and refined, then the signal itself
-    /// searched over a period either side of them.
+    /// (min, max) of the signal over [t0, t1]: where its upper (lower) envelope, the smooth part
+    /// ± the oscillation's envelope, is largest (smallest), located on a grid and refined; then
+    /// the signal's own peaks within a period either side, in closed form (below).
     pub fn extremes(&self, t0: f64, t1: f64) -> (f64, f64) {
         let hi = self.search(t0, t1, 1.0);
         let lo = -self.search(t0, t1, -1.0);
@@ -216,27 +227,90 @@ impl Signal {
     }
 
     /// max over [t0, t1] of sign × signal.
+    ///
+    /// The hinge's pair of modes makes the oscillation 2|a| e^{στ} cos(ωτ + arg a), so sign × signal
+    /// peaks near ωτ + arg a = 2πm (+ π for the minimum), at most one peak within a quarter period
+    /// of each: its slope falls there from positive to negative (the smooth part varies on the
+    /// thermal time scales, far slower). Each peak is the zero of the slope, found by Newton's
+    /// method safeguarded by bisection; where the slope does not change sign the largest value is
+    /// at an end. Between peaks the slope rises, so no maximum lies there.
     fn search(&self, t0: f64, t1: f64, sign: f64) -> f64 {
         let bound = |tau: f64| {
             let (s, e) = self.smooth_and_envelope(tau);
             sign * s + e
         };
         let value = |tau: f64| sign * self.at(tau);
-        let t_star = grid_max(&bound, t0, t1, 64);
-        if self.omega == 0.0 {
-            return value(t_star).max(value(t0)).max(value(t1));
-        }
-        let period = 2.0 * std::f64::consts::PI / self.omega;
+        let oscillating = (0..4)
+            .filter(|&k| self.lambda[k].im > 0.0)
+            .max_by(|&i, &j| self.a[i].norm().total_cmp(&self.a[j].norm()));
+        let Some(k) = oscillating else {
+            let t_star = grid_max(&bound, t0, t1, 64, 0.0);
+            return value(t0).max(value(t1)).max(value(t_star));
+        };
+        let omega = self.lambda[k].im;
+        let period = 2.0 * std::f64::consts::PI / omega;
+        // The signal's peaks are searched a period either side: an eighth of one will do here.
+        let t_star = grid_max(&bound, t0, t1, 64, 0.125 * period);
+        let ends = value(t0).max(value(t1)).max(value(t_star));
         let (a, b) = ((t_star - period).max(t0), (t_star + period).min(t1));
-        let n = (((b - a) / period) * 48.0).ceil().max(8.0) as usize;
-        let best = grid_max(&value, a, b, n);
-        value(best).max(value(t0)).max(value(t1))
+        let shift = self.a[k].arg()
+            + if sign > 0.0 {
+                0.0
+            } else {
+                std::f64::consts::PI
+            };
+        let quarter = 0.25 * period;
+        // Peaks at τ_m = (2πm − shift) / ω, from the last one before a.
+        let mut peak =
+            period * ((a * omega + shift) / (2.0 * std::f64::consts::PI)).floor() - shift / omega;
+        let mut best = ends.max(value(a)).max(value(b));
+        while peak - quarter < b {
+            let (lo, hi) = ((peak - quarter).max(a), (peak + quarter).min(b));
+            if hi > lo {
+                best = best.max(self.peak(lo, hi, sign, period));
+            }
+            peak += period;
+        }
+        best
+    }
+
+    /// max over [lo, hi] of sign × signal, where its slope falls (at most one zero).
+    fn peak(&self, mut lo: f64, mut hi: f64, sign: f64, period: f64) -> f64 {
+        let slope = |tau: f64| {
+            let (_, d1, d2) = self.with_derivatives(tau);
+            (sign * d1, sign * d2)
+        };
+        let ends = (sign * self.at(lo)).max(sign * self.at(hi));
+        if !(slope(lo).0 > 0.0 && slope(hi).0 < 0.0) {
+            return ends;
+        }
+        let mut x = 0.5 * (lo + hi);
+        for _ in 0..60 {
+            let (g, dg) = slope(x);
+            if g > 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let newton = x - g / dg;
+            let next = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            let done = (next - x).abs() <= 1e-9 * period;
+            x = next;
+            if done {
+                break;
+            }
+        }
+        ends.max(sign * self.at(x))
     }
 }
 
 /// The maximiser of f over [a, b] on an n-interval grid, refined by golden section between the
-/// best point's neighbours.
-fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+/// best point's neighbours (until the bracket is narrower than `width`, at most 40 times).
+fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, n: usize, width: f64) -> f64 {
     if b <= a {
         return a;
     }
@@ -256,6 +330,9 @@ fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
     let mut d = lo + g * (hi - lo);
     let (mut fc, mut fd) = (f(c), f(d));
     for _ in 0..40 {
+        if hi - lo < width {
+            break;
+        }
         if fc > fd {
             hi = d;
             d = c;
@@ -362,5 +439,25 @@ mod tests {
             shi = shi.max(v);
         }
         assert!((whi - shi).abs() < 1e-6 * span && (wlo - slo).abs() < 1e-6 * span);
+        // Windows shorter and longer than the hinge period (8 s), anywhere in the arc.
+        for (start, width) in [(0.0, 3.0), (17.3, 9.0), (400.0, 40.0), (2210.0, 700.0)] {
+            let steps = (width * 1e3) as usize;
+            let (mut slo, mut shi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..=steps {
+                let v = sig.at(start + width * i as f64 / steps as f64);
+                slo = slo.min(v);
+                shi = shi.max(v);
+            }
+            let (wlo, whi) = sig.extremes(start, start + width);
+            let tol = 1e-9 * span;
+            assert!(
+                whi >= shi - tol && whi - shi < 1e-6 * span,
+                "{start}+{width}"
+            );
+            assert!(
+                wlo <= slo + tol && slo - wlo < 1e-6 * span,
+                "{start}+{width}"
+            );
+        }
     }
 }

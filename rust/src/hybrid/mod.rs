@@ -28,7 +28,7 @@ use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::{require_positive, Error, Result};
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
-use crate::orbit::{Eclipse, Orbit};
+use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::summary::{
@@ -128,6 +128,7 @@ struct Driver<'a> {
     judge: Judge,
     /// Units of the state for the modal decomposition.
     scale: Vector4<f64>,
+    eclipses: EclipseTable,
 }
 
 /// Integrates orbits `first_index .. first_index + n_orbits` from (t_start, y0) with the hybrid
@@ -227,6 +228,7 @@ pub fn run_orbits_hybrid(
             theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
         },
         scale: Vector4::new(1.0, 1.0, 1.0 / t_ref, wn / t_ref),
+        eclipses: EclipseTable::new(orbit),
     };
     d.run()?;
     let Driver {
@@ -384,7 +386,7 @@ impl Driver<'_> {
         while self.t < self.t_end && !self.stopped() {
             self.obs.cancel.check()?;
             let horizon = (self.t + self.orbit.period).min(self.t_end);
-            let eclipses = self.orbit.eclipses(self.t, horizon);
+            let eclipses = self.eclipses.overlapping(self.t, horizon).to_vec();
             if fallback {
                 self.full(horizon, &eclipses)?;
                 fallback = false;
@@ -457,7 +459,14 @@ impl Driver<'_> {
         if length > 0.0 {
             let (dlo, dhi) = dynamic.extremes(0.0, length);
             let sq = dynamic.integral_sq(length);
-            let extremes = |a: f64, b: f64| theta.extremes(a - t0, b - t0);
+            // The whole span's extremes are known already.
+            let extremes = |a: f64, b: f64| {
+                if (a, b) == (t0, t0 + length) {
+                    (lo, hi)
+                } else {
+                    theta.extremes(a - t0, b - t0)
+                }
+            };
             self.obs.collector.record_span(
                 t0,
                 t0 + length,
@@ -520,7 +529,7 @@ impl Driver<'_> {
     fn exponential(&mut self, horizon: f64, eclipses: &[Eclipse]) -> Result<bool> {
         let start = self.t;
         let mut cuts = vec![self.t];
-        cuts.extend(self.orbit.breakpoints(self.t, horizon));
+        cuts.extend(breakpoints_of(eclipses, self.t, horizon));
         cuts.push(horizon);
         let window = self.obs.collector.options.window;
         let period = 2.0 * std::f64::consts::PI / self.panel.natural_angular_frequency();

@@ -1,6 +1,6 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
-use super::convert::{output, panel_from, solver_from};
+use super::convert::{output, panel_from, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use crate::beam::{respond, FreeFreeBeam, BEAM_MODES};
@@ -35,7 +35,7 @@ fn beam_modes<'py>(
         let beam = beam_from(panel, n_elements)?;
         let (modes, moment_modes) =
             py.detach(|| Ok::<_, crate::Error>((beam.modes()?, beam.end_moment_modes()?)))?;
-        let elastic = modes.eigenvalues.len() - 2;
+        let elastic = modes.elastic_count();
         let k = usize::try_from(n_modes)
             .ok()
             .filter(|&k| k >= 1 && k <= elastic)
@@ -50,24 +50,19 @@ fn beam_modes<'py>(
             .iter()
             .map(|w| w / (2.0 * PI))
             .collect();
-        let nodes = beam.n_elements + 1;
-        let x: Vec<f64> = (0..nodes)
-            .map(|j| beam.length * j as f64 / beam.n_elements as f64)
+        let columns: Vec<Vec<f64>> = (0..k).map(|c| modes.elastic_deflection(c)).collect();
+        let shapes: Vec<Vec<f64>> = (0..=beam.n_elements)
+            .map(|j| columns.iter().map(|col| col[j]).collect())
             .collect();
-        let shapes: Vec<Vec<f64>> = (0..nodes)
-            .map(|j| (0..k).map(|c| modes.shapes[(2 * j, c + 2)]).collect())
-            .collect();
-        let t = beam.translation();
-        let total_mass = t.dot(&(beam.mass_matrix() * &t));
         let d = PyDict::new(py);
         d.set_item("frequencies_hz", PyArray1::from_vec(py, freqs))?;
         d.set_item(
             "rigid_eigenvalues",
             PyArray1::from_vec(py, modes.rigid_eigenvalues().to_vec()),
         )?;
-        d.set_item("x", PyArray1::from_vec(py, x))?;
+        d.set_item("x", PyArray1::from_vec(py, beam.node_positions()))?;
         d.set_item("shapes", PyArray2::from_vec2(py, &shapes)?)?;
-        d.set_item("total_mass", total_mass)?;
+        d.set_item("total_mass", beam.total_mass())?;
         d.set_item("flexibility", moment_modes.flexibility)?;
         d.set_item("residual_flexibility", moment_modes.residual_flexibility)?;
         d.set_item(
@@ -136,6 +131,7 @@ fn beam_response<'py>(
         d.set_item("n_steps", r.stats.n_steps)?;
         d.set_item("n_rejected", r.stats.n_rejected)?;
         d.set_item("n_rhs", r.stats.n_rhs)?;
+        d.set_item("solver", solver_dict(py, &m)?)?;
         Ok(d)
     })
 }

@@ -86,7 +86,7 @@ impl EnsemblePool {
 
     /// Runs one sample per row of `panels`; returns the metrics as columns. `lockstep`: several
     /// samples per thread in SIMD lanes (the same rows, bit for bit, as one at a time).
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=0.3490658503988659, hybrid=None, cancel=None, lockstep=true))]
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=crate::dynamics::VALIDITY_LIMIT, hybrid=None, cancel=None, lockstep=true))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,

@@ -95,20 +95,6 @@ fn stability_map<'py>(
     })
 }
 
-/// The fields of the Sec. 4.2 analysis, in the order of [`LinearThermal`].
-const LINEAR_FIELDS: [&str; 10] = [
-    "p",
-    "q",
-    "r",
-    "s",
-    "omega",
-    "omega_n",
-    "T_star",
-    "emissivity",
-    "theta_star",
-    "hinge_inertia",
-];
-
 /// The closed-form linear analysis of paper Sec. 4.2: its coefficients and what follows.
 #[pyfunction]
 #[pyo3(signature = (panel, flux=1.0, omega=None, t_star=None))]
@@ -122,19 +108,7 @@ fn linear_thermal<'py>(
     shield(|| {
         let lt = LinearThermal::new(&panel_from(panel)?, flux, omega, t_star)?;
         let d = PyDict::new(py);
-        let values = [
-            lt.p,
-            lt.q,
-            lt.r,
-            lt.s,
-            lt.omega,
-            lt.omega_n,
-            lt.t_star,
-            lt.emissivity,
-            lt.theta_star,
-            lt.hinge_inertia,
-        ];
-        for (name, v) in LINEAR_FIELDS.iter().zip(values) {
+        for (name, v) in LinearThermal::FIELDS.iter().zip(lt.values()) {
             d.set_item(name, v)?;
         }
         d.set_item("amplitude", lt.amplitude())?;
@@ -160,24 +134,13 @@ fn linear_delta_t<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     shield(|| {
         let mut v = [0.0; 10];
-        for (slot, name) in v.iter_mut().zip(LINEAR_FIELDS) {
+        for (slot, name) in v.iter_mut().zip(LinearThermal::FIELDS) {
             *slot = fields
                 .get_item(name)?
                 .ok_or_else(|| crate::Error::invalid("fields", name, "is missing"))?
                 .extract()?;
         }
-        let lt = LinearThermal {
-            p: v[0],
-            q: v[1],
-            r: v[2],
-            s: v[3],
-            omega: v[4],
-            omega_n: v[5],
-            t_star: v[6],
-            emissivity: v[7],
-            theta_star: v[8],
-            hinge_inertia: v[9],
-        };
+        let lt = LinearThermal::from_values(v);
         let out: Vec<f64> = t
             .as_array()
             .iter()
@@ -188,6 +151,7 @@ fn linear_delta_t<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("LINEAR_FIELDS", LinearThermal::FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(flutter, m)?)?;
     m.add_function(wrap_pyfunction!(linear_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(linear_delta_t, m)?)?;

@@ -73,6 +73,14 @@ fn panel_dict<'py>(py: Python<'py>, p: &crate::Panel) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+/// Validates a solver mapping {method, rtol, atol, dt, max_step, max_steps} and returns it as the
+/// engine reads it: `tj.SolverSettings` is checked here, by the same code that checks every run.
+#[pyfunction]
+fn check_solver<'py>(py: Python<'py>, solver: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
+    let m = solver_from(solver)?;
+    convert::solver_dict(py, &m)
+}
+
 /// Validates a panel given as a mapping of its parameters.
 #[pyfunction]
 fn validate_panel(panel: &Bound<'_, PyDict>) -> PyResult<()> {
@@ -98,6 +106,29 @@ fn steady_state(panel: &Bound<'_, PyDict>, coupled: bool, flux: f64) -> PyResult
         };
         let eq = equilibrium(&p, coupling, flux)?;
         Ok((eq.t_front, eq.t_back, eq.theta))
+    })
+}
+
+/// The default start of a run beginning at `t0`: the sunlit equilibrium at that time's solar
+/// flux, at rest, as the state (T_f, T_b, θ, θ̇).
+#[pyfunction]
+fn start_state(
+    panel: &Bound<'_, PyDict>,
+    orbit: &Bound<'_, PyDict>,
+    t0: f64,
+    coupled: bool,
+) -> PyResult<Vec<f64>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        crate::Orbit::check_time(t0)?;
+        let coupling = if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        };
+        let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
+        Ok(eq.state().as_slice().to_vec())
     })
 }
 
@@ -194,6 +225,27 @@ fn moment<'py>(
     })
 }
 
+type Arrays2<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// Positions (x, y), m, of the point at `zeta` along one half of the hinge model at each angle.
+#[pyfunction]
+fn hinge_points<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    zeta: f64,
+    theta: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Arrays2<'py>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let (x, y): (Vec<f64>, Vec<f64>) = theta
+            .as_array()
+            .iter()
+            .map(|&th| crate::dynamics::hinge_point(&p, zeta, th))
+            .unzip();
+        Ok((array(py, x), array(py, y)))
+    })
+}
+
 /// Energy of the hinge in a constant moment field (conserved when c_d = 0).
 #[pyfunction]
 fn energy<'py>(
@@ -259,8 +311,9 @@ fn simulate<'py>(
     })
 }
 
-/// Runs a coupled system from `y0` (default: its steady state at t0's flux) and returns every
-/// state component under its model's name, the thermal moment and the illumination.
+/// Runs a coupled system (or a thermal model alone) from `y0` (default: its steady state at t0's
+/// flux) and returns every state component under its model's name, the thermal moment and the
+/// illumination.
 fn run_coupled<'py, T, S, D>(
     py: Python<'py>,
     mut sys: Coupled<T, S, D>,
@@ -319,21 +372,8 @@ fn simulate_thermal<'py>(
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
         let thermal = crate::thermal::model(&p, layers)?;
-        let names = thermal.names();
-        let dim = Dyn(thermal.size());
-        let y_start = match y0 {
-            Some(v) => state(&v, dim)?,
-            None => crate::steady::thermal_start(&thermal, o.flux_scale(t0))?,
-        };
-        let traj = py.detach(|| {
-            let mut sys = Coupled::thermal_only(thermal, o);
-            run(&mut sys, &m, (t0, t1), y_start, &out)
-        })?;
-        let d = run_info(py, &traj)?;
-        for (i, name) in names.iter().enumerate() {
-            d.set_item(name, array(py, column(&traj, i)))?;
-        }
-        Ok(d)
+        let sys = Coupled::thermal_only(thermal, o);
+        run_coupled(py, sys, &m, (t0, t1), y0, &out)
     })
 }
 
@@ -410,15 +450,19 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CASE_A_PANEL", panel_dict(m.py(), &crate::Panel::case_a())?)?;
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
     m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
+    m.add("VALIDITY_LIMIT", crate::dynamics::VALIDITY_LIMIT)?;
+    m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(steady_state, m)?)?;
+    m.add_function(wrap_pyfunction!(start_state, m)?)?;
     m.add_function(wrap_pyfunction!(stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(derived, m)?)?;
     m.add_function(wrap_pyfunction!(shadow_intervals, m)?)?;
     m.add_function(wrap_pyfunction!(illumination, m)?)?;
     m.add_function(wrap_pyfunction!(moment, m)?)?;
     m.add_function(wrap_pyfunction!(energy, m)?)?;
+    m.add_function(wrap_pyfunction!(hinge_points, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_hinge, m)?)?;
