@@ -33,6 +33,8 @@ pub(crate) trait Lanes: Num {
     fn max(self, o: Self) -> Self;
     /// `a` in the lanes where `take` holds, else `self`.
     fn or_where(self, take: [bool; LANES], a: Self) -> Self;
+    /// Whether |x| > bound in any lane.
+    fn any_abs_above(self, bound: f64) -> bool;
 }
 
 /// [`Lanes`] written lane by lane, for any processor (the compiler vectorises what it can).
@@ -74,6 +76,10 @@ impl Lanes for Portable {
                 self.0[l]
             }
         }))
+    }
+    #[inline(always)]
+    fn any_abs_above(self, bound: f64) -> bool {
+        self.0.iter().any(|x| x.abs() > bound)
     }
 }
 
@@ -224,6 +230,14 @@ mod avx {
                 let mask = _mm256_setr_pd(sign(0), sign(1), sign(2), sign(3));
                 _mm256_blendv_pd(self.get(), a.get(), mask)
             })
+        }
+        #[inline(always)]
+        fn any_abs_above(self, bound: f64) -> bool {
+            // SAFETY: see the type's comment.
+            unsafe {
+                let above = _mm256_cmp_pd(self.abs().get(), _mm256_set1_pd(bound), _CMP_GT_OQ);
+                _mm256_movemask_pd(above) != 0
+            }
         }
     }
 

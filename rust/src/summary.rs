@@ -165,6 +165,16 @@ pub fn resolve_hinge(method: &Method, panel: &Panel, steps_per_period: f64) -> M
     }
 }
 
+/// A span (from, to) of one orbit that holds no window edge, and whether it lies in the window
+/// after entry and after exit.
+#[derive(Debug, Clone, Copy)]
+struct Calm {
+    from: f64,
+    to: f64,
+    in_entry: bool,
+    in_exit: bool,
+}
+
 /// Builds the per-orbit summaries from what the propagator reports: points of the solution
 /// (the integrators' dense output) or bands [θ_lo, θ_hi] that hold it (the hybrid propagator's
 /// oscillation envelopes and exactly propagated arcs).
@@ -181,6 +191,9 @@ pub(crate) struct Collector<V> {
     pub(crate) crossing: Option<LimitCrossing>,
     /// The last step's end as read: (t, dynamic part), the next step's start.
     pub(crate) end: (f64, f64),
+    /// Where the next steps' points are known to lie inside one orbit and on one side of each
+    /// window's edges.
+    calm: Calm,
     /// The orbit's eclipses, searched a stretch of orbits at a time.
     eclipses: EclipseTable,
 }
@@ -223,6 +236,12 @@ impl<V: SummaryView> Collector<V> {
             duration: 0.0,
             crossing: None,
             end: (f64::NAN, 0.0),
+            calm: Calm {
+                from: f64::NAN,
+                to: f64::NAN,
+                in_entry: false,
+                in_exit: false,
+            },
             eclipses: EclipseTable::new(orbit),
         };
         collector.current = collector.open(first_index)?;
@@ -288,44 +307,56 @@ impl<V: SummaryView> Collector<V> {
 
     /// Points of one step, in time order, each standing for the interval dt before it with its
     /// share `sq` of ∫(dynamic)²: the same as [`Collector::record`] of each, taken together when
-    /// the step lies within one orbit, does not cross a window's edge and stays within the limit
-    /// (nearly every step).
+    /// the points lie inside the calm span (nearly every step) and within the limit.
     pub(crate) fn read_points(&mut self, points: &[Point], dt: f64) -> Result<()> {
         let (first, last) = (points[0].t, points[points.len() - 1].t);
-        let s = &self.current;
-        let w = self.options.window;
-        // Whether the window from `start` holds every point (Some(true)), none (Some(false)),
-        // or some (None).
-        let holds = |start: f64| {
-            if start.is_nan() || last < start || first > start + w {
-                Some(false)
-            } else if first >= start && last <= start + w {
-                Some(true)
-            } else {
-                None
-            }
-        };
-        if let (true, Some(entry), Some(exit)) =
-            (last <= s.t_end, holds(s.t_entry), holds(s.t_exit))
-        {
-            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            let (mut peak, mut sq) = (0.0f64, 0.0);
-            for p in points {
-                lo = lo.min(p.theta);
-                hi = hi.max(p.theta);
-                peak = peak.max(p.dynamic.abs());
+        let calm = self.calm;
+        if first > calm.from && last < calm.to {
+            // The points are finite (the integrator accepts only finite states).
+            let (mut lo, mut hi) = (points[0].theta, points[0].theta);
+            let (mut peak, mut sq) = (points[0].dynamic.abs(), points[0].sq);
+            for p in &points[1..] {
+                lo = if p.theta < lo { p.theta } else { lo };
+                hi = if p.theta > hi { p.theta } else { hi };
+                let d = p.dynamic.abs();
+                peak = if d > peak { d } else { peak };
                 sq += p.sq;
             }
             let limit = self.options.theta_limit;
             if self.crossing.is_some() || (hi <= limit && lo >= -limit) {
-                self.take(lo, hi, peak, sq, dt * points.len() as f64, entry, exit);
+                let span = dt * points.len() as f64;
+                self.take(lo, hi, peak, sq, span, calm.in_entry, calm.in_exit);
                 return Ok(());
             }
         }
         for p in points {
             self.record(p.t, p.theta, p.theta, p.dynamic.abs(), p.sq, dt)?;
         }
+        self.calm = self.calm_around(last);
         Ok(())
+    }
+
+    /// The span of the current orbit around t between the edges of its windows (and its end),
+    /// where being inside a window or not cannot change.
+    fn calm_around(&self, t: f64) -> Calm {
+        let s = &self.current;
+        let w = self.options.window;
+        let (mut from, mut to) = (f64::NEG_INFINITY, s.t_end);
+        for edge in [s.t_entry, s.t_entry + w, s.t_exit, s.t_exit + w] {
+            if edge <= t && edge > from {
+                from = edge;
+            } else if edge > t && edge < to {
+                to = edge;
+            }
+        }
+        // Points strictly inside (from, to) are in a window if the whole span is.
+        let inside = |start: f64| from >= start && to <= start + w;
+        Calm {
+            from,
+            to,
+            in_entry: inside(s.t_entry),
+            in_exit: inside(s.t_exit),
+        }
     }
 
     /// Adds to the current orbit: θ within [lo, hi], the dynamic part's magnitude at most

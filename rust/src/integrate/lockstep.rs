@@ -234,10 +234,9 @@ fn rhs_lanes_of<V: Lanes>(
     if !matches!((coupling, model), (Coupling::Frozen, HingeModel::Linear)) {
         // `sin_cos`: the polynomials in every lane, the library for a lane beyond π/4.
         (sin, cos) = sin_cos_kernel(th);
-        let far = th.lanes().map(|a| a.abs() > FRAC_PI_4);
-        if far.iter().any(|&f| f) {
+        if th.any_abs_above(FRAC_PI_4) {
             for l in 0..LANES {
-                if far[l] {
+                if th.lanes()[l].abs() > FRAC_PI_4 {
                     (sin.lanes_mut()[l], cos.lanes_mut()[l]) = th.lanes()[l].sin_cos();
                 }
             }
