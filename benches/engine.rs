@@ -14,9 +14,9 @@ use std::hint::black_box;
 use std::time::Instant;
 use thermojitter::cancel::Cancel;
 use thermojitter::dynamics::HingeModel;
-use thermojitter::ensemble::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::integrate::dopri5;
-use thermojitter::integrate::{solve, Method, OdeSystem, Sampler, StepCounter, Tolerances};
+use thermojitter::integrate::{solve, Method, OdeSystem, Recorder, StepCounter, Tolerances};
+use thermojitter::montecarlo::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::steady::equilibrium;
 use thermojitter::system::{Coupled, Coupling};
 use thermojitter::{Orbit, Panel};
@@ -114,31 +114,31 @@ fn main() {
         stats.n_steps
     });
     orbit_run("orbit-end", "sampled at the end", &mut || {
-        let mut sampler = Sampler::new(vec![orbit.period]);
+        let mut recorder = Recorder::new(vec![orbit.period]);
         let (stats, _) = solve(
             &mut sys,
             &method,
             0.0,
             black_box(y0),
             orbit.period,
-            &mut sampler,
+            &mut recorder,
         )
         .expect("orbit");
-        black_box(&sampler.y);
+        black_box(&recorder.y);
         stats.n_steps
     });
     orbit_run("orbit-every", "sampled every 0.5 s", &mut || {
-        let mut sampler = Sampler::every(0.0, orbit.period, 0.5);
+        let mut recorder = Recorder::every(0.0, orbit.period, 0.5);
         let (stats, _) = solve(
             &mut sys,
             &method,
             0.0,
             black_box(y0),
             orbit.period,
-            &mut sampler,
+            &mut recorder,
         )
         .expect("orbit");
-        black_box(&sampler.y);
+        black_box(&recorder.y);
         stats.n_steps
     });
 

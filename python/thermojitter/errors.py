@@ -16,8 +16,10 @@ This module imports nothing from the engine: the engine's binding layer builds i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
+from collections.abc import Collection, Mapping
 from typing import Any
 
 import numpy as np
@@ -146,3 +148,24 @@ def real_array(name: str, value: Any, *, finite_only: bool = True) -> np.ndarray
         bad = out[~np.isfinite(out)][0]
         raise ParameterError(name, float(bad), "every value must be finite")
     return out
+
+
+def check_fields(
+    obj: Any,
+    *,
+    flags: Collection[str] = (),
+    choices: Mapping[str, tuple[str, ...]] | None = None,
+) -> None:
+    """Checks the type of every field of the frozen dataclass ``obj`` and keeps the plain value:
+    a bool for the names in ``flags``, one of ``choices[name]`` for those, a real number for
+    the others (the engine then checks the ranges)."""
+    choices = choices or {}
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if f.name in flags:
+            value = flag(f.name, value)
+        elif f.name in choices:
+            value = choice(f.name, value, choices[f.name])
+        else:
+            value = real(f.name, value)
+        object.__setattr__(obj, f.name, value)

@@ -59,7 +59,6 @@ MAX_LEO_ALTITUDE = 1e9
 
 ShadowModel = Literal["none", "cylindrical", "penumbra"]
 _SHADOWS = ("none", "cylindrical", "penumbra")
-_FLOATS = ("radius", "earth_radius", "period", "phase0", "epoch_day")
 _BOOLS = ("season", "eccentric_sun")
 
 DateLike = str | _dt.date | float | int
@@ -125,16 +124,7 @@ class Orbit:
     """Day of the year at t = 0 (days since 1 January 00:00 UTC)."""
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name in _FLOATS:
-                object.__setattr__(self, f.name, checks.real(f.name, value))
-            elif f.name in _BOOLS:
-                if not isinstance(value, (bool, np.bool_)):
-                    raise TypeError(f"{f.name} must be a bool, not {type(value).__name__}")
-                object.__setattr__(self, f.name, bool(value))
-            elif f.name == "shadow":
-                checks.choice("shadow", value, _SHADOWS)
+        checks.check_fields(self, flags=_BOOLS, choices={"shadow": _SHADOWS})
         _core.validate_orbit(self.as_dict())
 
     @classmethod

@@ -94,8 +94,7 @@ class Panel:
     """χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3)."""
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            object.__setattr__(self, f.name, checks.real(f.name, getattr(self, f.name)))
+        checks.check_fields(self)
         _core.validate_panel(self.as_dict())
 
     @classmethod

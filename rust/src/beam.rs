@@ -16,7 +16,7 @@
 //! correction), so a slowly varying moment gives the exact static deflection.
 
 use crate::error::{require_finite, require_non_negative, Error, Result};
-use crate::integrate::{solve, Const, Method, OdeSystem, Sampler, Stats};
+use crate::integrate::{solve, Const, Method, OdeSystem, Recorder, Stats};
 use crate::params::{beam_first_angular_frequency, Panel};
 use crate::simulate::Output;
 use crate::system::MomentHistory;
@@ -412,16 +412,16 @@ pub fn respond(
     let modes = beam.end_moment_modes()?;
     let mut system = ModalBeam::new(&modes, damping_ratio, moment);
     let y0 = system.static_state(system.moment.at(t0));
-    let mut sampler = Sampler::<Const<BEAM_STATE>>::new(times);
-    let (stats, _) = solve(&mut system, method, t0, y0, t1, &mut sampler)?;
+    let mut recorder = Recorder::<Const<BEAM_STATE>>::new(times);
+    let (stats, _) = solve(&mut system, method, t0, y0, t1, &mut recorder)?;
     let residual_flex = if residual {
         modes.residual_flexibility
     } else {
         0.0
     };
-    let mut eta = Vec::with_capacity(sampler.t.len());
-    let mut theta_f = Vec::with_capacity(sampler.t.len());
-    for (t, y) in sampler.t.iter().zip(&sampler.y) {
+    let mut eta = Vec::with_capacity(recorder.t.len());
+    let mut theta_f = Vec::with_capacity(recorder.t.len());
+    for (t, y) in recorder.t.iter().zip(&recorder.y) {
         let mut e = residual_flex * system.moment.at(*t);
         for (i, (_, _, h)) in modes.kept.iter().enumerate() {
             e += h * y[i];
@@ -437,7 +437,7 @@ pub fn respond(
         theta_f.push(s.asin());
     }
     Ok(BeamResponse {
-        t: sampler.t,
+        t: recorder.t,
         eta,
         theta_f,
         stats,

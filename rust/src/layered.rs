@@ -723,7 +723,7 @@ impl LayeredView {
     }
 }
 
-impl crate::summary::SummaryView for LayeredView {
+impl crate::longrun::SummaryView for LayeredView {
     fn theta_eq(&self, flux: f64) -> Result<f64> {
         Ok(equilibrium(&self.panel, &self.system.conduction, self.coupling, flux)?.theta)
     }
@@ -740,7 +740,7 @@ impl crate::summary::SummaryView for LayeredView {
     }
 }
 
-/// Per-orbit summaries of the N-node system (as [`crate::summary::run_orbits`]), from `y0` =
+/// Per-orbit summaries of the N-node system (as [`crate::longrun::run_orbits`]), from `y0` =
 /// (node temperatures, θ, θ̇); the end state is returned in the same form.
 #[allow(clippy::too_many_arguments)]
 pub fn run_orbits(
@@ -754,7 +754,7 @@ pub fn run_orbits(
     first_index: u64,
     n_orbits: u64,
     y0: &[f64],
-    options: crate::summary::SummaryOptions,
+    options: crate::longrun::SummaryOptions,
     cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredSummaries> {
     let n = conduction.nodes();
@@ -795,17 +795,17 @@ type SummaryArgs<'a> = (
     f64,
     u64,
     u64,
-    crate::summary::SummaryOptions,
+    crate::longrun::SummaryOptions,
     &'a crate::cancel::Cancel,
 );
 
 /// Per-orbit summaries of the N-node system, the end state as a plain vector.
 pub struct LayeredSummaries {
-    pub summaries: Vec<crate::summary::OrbitSummary>,
+    pub summaries: Vec<crate::longrun::OrbitSummary>,
     pub stats: crate::integrate::Stats,
     /// Node temperatures, θ, θ̇.
     pub y_end: Vec<f64>,
-    pub crossing: Option<crate::summary::LimitCrossing>,
+    pub crossing: Option<crate::longrun::LimitCrossing>,
 }
 
 fn summarised_run<D: Dim, S: OdeSystem<D>>(
@@ -818,7 +818,7 @@ where
     DefaultAllocator: Allocator<D>,
 {
     let (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel) = args;
-    let run = crate::summary::run_summarised(
+    let run = crate::longrun::run_summarised(
         system,
         view,
         panel,
@@ -1457,7 +1457,7 @@ mod tests {
         // sunlit and its eclipse steady states has a jitter RMS near zero, not the size of the
         // angle (the aluminium boom: every non-uniform mode is fast).
         use crate::integrate::{Method, Tolerances};
-        use crate::summary::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
+        use crate::longrun::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
         let (_, p, lam) = examples().pop().unwrap();
         let p = Panel { damping: 50.0, ..p };
         let c = Conduction::new(&p, &lam, 20).unwrap();

@@ -9,11 +9,11 @@
 use crate::dynamics::HingeModel;
 use crate::flutter::{analyse, critical_damping};
 use crate::integrate::{Method, Tolerances};
+use crate::longrun::{run_orbits, SummaryOptions, STEPS_PER_HINGE_PERIOD};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::simulate::{run, Output};
 use crate::steady::equilibrium;
-use crate::summary::{run_orbits, SummaryOptions, STEPS_PER_HINGE_PERIOD};
 use crate::system::{state, Coupled, Coupling};
 
 /// The penumbral year orbit: 1 October, inside the autumn eclipse season.

@@ -1,7 +1,7 @@
 //! High-level runs: integrate a system over a span and keep its state at the requested times.
 
 use crate::error::{Error, Result};
-use crate::integrate::{check_span, output, solve, Method, OdeSystem, Sampler, State, Stats};
+use crate::integrate::{check_span, output, solve, Method, OdeSystem, Recorder, State, Stats};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim};
 
@@ -95,11 +95,11 @@ where
 {
     let (t0, t1) = t_span;
     check_span(t0, t1)?;
-    let mut sampler = Sampler::new(output.sample_times(t0, t1)?);
-    let (stats, y_end) = solve(system, method, t0, y0, t1, &mut sampler)?;
+    let mut recorder = Recorder::new(output.sample_times(t0, t1)?);
+    let (stats, y_end) = solve(system, method, t0, y0, t1, &mut recorder)?;
     Ok(Trajectory {
-        t: sampler.t,
-        y: sampler.y,
+        t: recorder.t,
+        y: recorder.y,
         stats,
         y_end,
         method: *method,

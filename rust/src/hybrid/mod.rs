@@ -1,5 +1,5 @@
 //! The hybrid long-run propagator: the same per-orbit summaries as the hinge-resolved integration
-//! of [`crate::summary::run_orbits`], at a small fraction of the cost.
+//! of [`crate::longrun::run_orbits`], at a small fraction of the cost.
 //!
 //! Three regimes, chosen as the run goes:
 //!
@@ -11,7 +11,7 @@
 //!   non-linear model, integrated by the exponential Rosenbrock method [`exprb`], whose step is set
 //!   by the slow thermal non-linearity rather than the hinge period.
 //! - **Full integration** (the fallback): Dormand–Prince with the step capped at T_n/40, as
-//!   [`crate::summary::run_orbits`], for an orbit at a time, where the oscillation is too large for
+//!   [`crate::longrun::run_orbits`], for an orbit at a time, where the oscillation is too large for
 //!   the linearisation or the modal decomposition is ill-conditioned.
 //!
 //! The switch back to linear arcs is guarded by a measured criterion: the non-linear remainder
@@ -28,13 +28,13 @@ use crate::cancel::Cancel;
 use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::{require_positive, Error, Result};
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
-use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
-use crate::params::Panel;
-use crate::steady::equilibrium;
-use crate::summary::{
+use crate::longrun::{
     resolve_hinge, Collector, OrbitRun, SummaryObserver, SummaryOptions, TwoLayerView,
     STEPS_PER_HINGE_PERIOD,
 };
+use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
+use crate::params::Panel;
+use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
 use jacobian::Linearisation;
@@ -651,8 +651,8 @@ mod tests {
     use super::*;
     use crate::flutter::{analyse, critical_damping};
     use crate::integrate::Tolerances;
+    use crate::longrun::{run_orbits, OrbitSummary};
     use crate::orbit::Shadow;
-    use crate::summary::{run_orbits, OrbitSummary};
 
     fn options() -> SummaryOptions {
         SummaryOptions {

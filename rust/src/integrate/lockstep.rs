@@ -697,14 +697,14 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::Sampler;
+    use crate::integrate::Recorder;
     use crate::orbit::Orbit;
     use crate::params::Panel;
     use crate::steady::equilibrium;
     use nalgebra::U4;
 
     /// A run's samples, with its index.
-    struct Tagged(usize, Sampler<U4>);
+    struct Tagged(usize, Recorder<U4>);
 
     impl Observer<U4> for Tagged {
         fn on_step(&mut self, step: &DenseStep<U4>) -> std::ops::ControlFlow<()> {
@@ -744,7 +744,7 @@ mod tests {
                     t0: 0.0,
                     t1: orbit.period,
                     y0: Vector4::new(eq.t_front, eq.t_back, eq.theta + 0.15 * k as f64, 0.0),
-                    observer: Tagged(k, Sampler::every(0.0, orbit.period, orbit.period / 200.0)),
+                    observer: Tagged(k, Recorder::every(0.0, orbit.period, orbit.period / 200.0)),
                 }
             })
             .collect()
@@ -772,15 +772,15 @@ mod tests {
         solve_lockstep(
             kernel,
             || queue.next(),
-            |Tagged(k, sampler), outcome| {
+            |Tagged(k, recorder), outcome| {
                 let (stats, y_end) = outcome.unwrap();
-                out[k] = Some(bits(&sampler, &y_end, stats));
+                out[k] = Some(bits(&recorder, &y_end, stats));
             },
         );
         out.into_iter().map(Option::unwrap).collect()
     }
 
-    fn bits(s: &Sampler<U4>, y: &Vector4<f64>, stats: Stats) -> Run {
+    fn bits(s: &Recorder<U4>, y: &Vector4<f64>, stats: Stats) -> Run {
         let samples = s.y.iter().flat_map(|v| v.iter()).map(|x| x.to_bits());
         let end = y.iter().map(|x| x.to_bits()).collect();
         (samples.collect(), end, stats)

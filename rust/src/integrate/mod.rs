@@ -19,7 +19,7 @@ use std::cell::OnceCell;
 use std::ops::ControlFlow;
 
 pub use nalgebra::{Const, Dyn};
-pub use output::{Sampler, StepCounter};
+pub use output::{Recorder, StepCounter};
 
 /// A state vector of dimension `D`: `Const<N>` (N known at compile time) or `Dyn`.
 pub type State<D> = OVector<f64, D>;

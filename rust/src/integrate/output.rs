@@ -17,9 +17,10 @@ pub fn every(t0: f64, t1: f64, dt: f64) -> Vec<f64> {
     times
 }
 
-/// Keeps the state at requested times (sorted), interpolated with the step's dense output.
+/// Records the state at requested times (sorted), interpolated with the step's dense output.
+/// (The Monte Carlo design's "sampler" is another thing: how panels are drawn.)
 #[derive(Debug, Clone)]
-pub struct Sampler<D: Dim>
+pub struct Recorder<D: Dim>
 where
     DefaultAllocator: Allocator<D>,
 {
@@ -29,14 +30,14 @@ where
     pub y: Vec<State<D>>,
 }
 
-impl<D: Dim> Sampler<D>
+impl<D: Dim> Recorder<D>
 where
     DefaultAllocator: Allocator<D>,
 {
     /// `times` must be sorted; times outside the integrated span are never reached.
     pub fn new(times: Vec<f64>) -> Self {
         let n = times.len();
-        Sampler {
+        Recorder {
             times,
             next: 0,
             t: Vec::with_capacity(n),
@@ -73,7 +74,7 @@ where
     }
 }
 
-impl<D: Dim> Observer<D> for Sampler<D>
+impl<D: Dim> Observer<D> for Recorder<D>
 where
     DefaultAllocator: Allocator<D>,
 {

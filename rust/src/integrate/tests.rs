@@ -116,21 +116,21 @@ fn dense_output_is_fourth_order_accurate() {
             atol: rtol * 1e-2,
             ..Default::default()
         };
-        let mut sampler = Sampler::new(times.clone());
+        let mut recorder = Recorder::new(times.clone());
         solve(
             &mut sys,
             &Method::Dopri5(tol),
             0.0,
             exact_free(0.0),
             times[1000],
-            &mut sampler,
+            &mut recorder,
         )
         .unwrap();
-        assert_eq!(sampler.t.len(), times.len());
-        let e = sampler
+        assert_eq!(recorder.t.len(), times.len());
+        let e = recorder
             .t
             .iter()
-            .zip(&sampler.y)
+            .zip(&recorder.y)
             .map(|(t, y)| (y - exact_free(*t)).amax())
             .fold(0.0, f64::max);
         max_err.push(e);
@@ -328,9 +328,9 @@ fn a_run_time_size_gives_the_same_bits_as_a_fixed_one() {
             forcing_on_segment: 0.0,
             jump_at: Some(1.0),
         };
-        let mut fixed = Sampler::new(times.clone());
+        let mut fixed = Recorder::new(times.clone());
         let (s1, y1) = solve(&mut jump(), &method, 0.0, exact_free(0.0), 2.8, &mut fixed).unwrap();
-        let mut dynamic = Sampler::new(times.clone());
+        let mut dynamic = Recorder::new(times.clone());
         let y0 = State::<Dyn>::from_column_slice(exact_free(0.0).as_slice());
         let mut sys = DynOscillator(jump());
         let (s2, y2) = solve(&mut sys, &method, 0.0, y0, 2.8, &mut dynamic).unwrap();

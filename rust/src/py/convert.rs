@@ -6,6 +6,7 @@ use crate::integrate::State;
 use crate::integrate::{Method, Tolerances};
 use crate::orbit::Shadow;
 use crate::simulate::Output;
+use crate::system::Coupling;
 use crate::{Orbit, Panel};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, U1};
@@ -62,7 +63,7 @@ pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
 }
 
 /// An optional entry of a mapping of type T, named in any error.
-fn optional_item<'py, T: FromPyObjectOwned<'py>>(
+pub(super) fn optional_item<'py, T: FromPyObjectOwned<'py>>(
     d: &Bound<'py, PyDict>,
     key: &str,
     kind: &str,
@@ -74,6 +75,15 @@ fn optional_item<'py, T: FromPyObjectOwned<'py>>(
             .map(Some)
             .map_err(|_| type_error(key, kind, &v)),
     }
+}
+
+/// A required entry of a mapping, of type `T` (`kind` says which in the error).
+pub(super) fn required_item<'py, T: FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    kind: &str,
+) -> PyResult<T> {
+    optional_item(d, key, kind)?.ok_or_else(|| invalid(key, "missing", "is required"))
 }
 
 /// An orbit from a mapping: radius, earth_radius, period and phase0 are required; shadow
@@ -100,6 +110,15 @@ pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
     };
     o.validate()?;
     Ok(o)
+}
+
+/// The coupling of a `coupled` flag: the projected area follows θ (two-way), or is frozen.
+pub fn coupling(coupled: bool) -> Coupling {
+    if coupled {
+        Coupling::ProjectedArea
+    } else {
+        Coupling::Frozen
+    }
 }
 
 pub fn hinge_model(name: &str) -> PyResult<HingeModel> {
@@ -154,14 +173,12 @@ pub fn method(
 /// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
 /// run function receives it.
 pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
-    let name: String = optional_item(d, "method", "a string")?
-        .ok_or_else(|| invalid("method", "missing", "is required"))?;
+    let name: String = required_item(d, "method", "a string")?;
     let dt = match d.get_item("dt")? {
         Some(v) if !v.is_none() => Some(float_item(d, "dt")?),
         _ => None,
     };
-    let max_steps: u64 = optional_item(d, "max_steps", "an integer >= 1")?
-        .ok_or_else(|| invalid("max_steps", "missing", "is required"))?;
+    let max_steps: u64 = required_item(d, "max_steps", "an integer >= 1")?;
     method(
         &name,
         float_item(d, "rtol")?,

@@ -1,12 +1,11 @@
 //! Bindings of the distributed panel: its settings, modes, and flutter analysis.
 
-use super::convert::{orbit_from, output, panel_from, solver_from};
+use super::convert::{coupling, orbit_from, output, panel_from, required_item, solver_from};
 use super::error::{invalid, shield};
 use crate::distributed::{DistributedPanel, Settings, Support};
 use crate::flutter::check_flux;
-use crate::system::Coupling;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::f64::consts::PI;
@@ -23,33 +22,13 @@ pub(super) fn model_from(
     settings: &Bound<'_, PyDict>,
 ) -> PyResult<DistributedPanel> {
     let p = panel_from(panel)?;
-    let item = |key: &str| -> PyResult<Bound<'_, PyAny>> {
-        settings
-            .get_item(key)?
-            .ok_or_else(|| PyValueError::new_err(format!("{key} is missing")))
-    };
-    let typed = |key: &str, kind: &str| PyTypeError::new_err(format!("{key} must be {kind}"));
-    let support: String = item("support")?
-        .extract()
-        .map_err(|_| typed("support", "a string"))?;
-    let elements: i64 = item("elements")?
-        .extract()
-        .map_err(|_| typed("elements", "an integer"))?;
-    let modes: i64 = item("modes")?
-        .extract()
-        .map_err(|_| typed("modes", "an integer"))?;
-    let zeta: Option<f64> = item("damping_ratio")?
-        .extract()
-        .map_err(|_| typed("damping_ratio", "a number or None"))?;
-    let sun_angle: f64 = item("sun_angle")?
-        .extract()
-        .map_err(|_| typed("sun_angle", "a number"))?;
-    let coupled: bool = item("coupled")?
-        .extract()
-        .map_err(|_| typed("coupled", "a bool"))?;
-    let layers: i64 = item("layers")?
-        .extract()
-        .map_err(|_| typed("layers", "an integer"))?;
+    let support: String = required_item(settings, "support", "a string")?;
+    let elements: i64 = required_item(settings, "elements", "an integer")?;
+    let modes: i64 = required_item(settings, "modes", "an integer")?;
+    let zeta: Option<f64> = required_item(settings, "damping_ratio", "a number or None")?;
+    let sun_angle: f64 = required_item(settings, "sun_angle", "a number")?;
+    let coupled: bool = required_item(settings, "coupled", "a bool")?;
+    let layers: i64 = required_item(settings, "layers", "an integer")?;
     let layers = u32::try_from(layers)
         .map_err(|_| invalid("layers", layers, "must be a positive integer"))?;
     let defaults = Settings::new(&p);
@@ -60,11 +39,7 @@ pub(super) fn model_from(
         modes: count("modes", modes)?,
         damping_ratio: zeta.unwrap_or(defaults.damping_ratio),
         sun_angle,
-        coupling: if coupled {
-            Coupling::ProjectedArea
-        } else {
-            Coupling::Frozen
-        },
+        coupling: coupling(coupled),
     };
     DistributedPanel::new(&p, s).map_err(PyErr::from)
 }

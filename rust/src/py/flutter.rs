@@ -1,22 +1,13 @@
 //! Bindings of the flutter analysis.
 
-use super::convert::{hinge_model, panel_from};
+use super::convert::{coupling, hinge_model, panel_from};
 use super::error::shield;
 use crate::flutter::{analyse, check_flux, critical_damping};
 use crate::linear::LinearThermal;
 use crate::stability::Axis;
-use crate::system::Coupling;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-fn coupling(coupled: bool) -> Coupling {
-    if coupled {
-        Coupling::ProjectedArea
-    } else {
-        Coupling::Frozen
-    }
-}
 
 /// Eigen-analysis at the sunlit equilibrium; with `with_critical`, also the critical damping.
 #[pyfunction]

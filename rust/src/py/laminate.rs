@@ -1,7 +1,7 @@
 //! Bindings of the laminate layups and the N-node through-thickness model.
 
 use super::convert::{
-    float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
+    coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
 };
 use super::error::{invalid, shield};
 use crate::conduction::Conduction;
@@ -9,7 +9,6 @@ use crate::flutter::check_flux;
 use crate::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::layered;
 use crate::params::Panel;
-use crate::system::Coupling;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -86,14 +85,6 @@ pub fn conduction_from(
         Some(d) => Conduction::new(panel, &laminate_from(d)?, nodes)?,
         None => Conduction::homogeneous(panel, nodes)?,
     })
-}
-
-fn coupling(coupled: bool) -> Coupling {
-    if coupled {
-        Coupling::ProjectedArea
-    } else {
-        Coupling::Frozen
-    }
 }
 
 /// Checks one layer mapping (errors name the layer and field).

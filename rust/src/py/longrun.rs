@@ -1,4 +1,4 @@
-//! Bindings of summarised long runs.
+//! Bindings of the long runs (`crate::longrun`, and the hybrid propagator).
 
 use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
@@ -6,7 +6,7 @@ use super::error::shield;
 use super::laminate::conduction_from;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::layered;
-use crate::summary::{run_orbits_cancellable as run, OrbitSummary, SummaryOptions};
+use crate::longrun::{run_orbits_cancellable as run, OrbitSummary, SummaryOptions};
 use crate::system::Coupling;
 use nalgebra::U4;
 use numpy::PyArray1;
@@ -18,7 +18,7 @@ struct Summarised {
     summaries: Vec<OrbitSummary>,
     stats: crate::integrate::Stats,
     y_end: Vec<f64>,
-    crossing: Option<crate::summary::LimitCrossing>,
+    crossing: Option<crate::longrun::LimitCrossing>,
 }
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays).
@@ -121,7 +121,7 @@ fn run_orbits<'py>(
 /// The summaries of a run as columns, with its counters.
 fn summary_dict<'py>(py: Python<'py>, out: &Summarised) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let col = |f: fn(&crate::summary::OrbitSummary) -> f64| -> Vec<f64> {
+    let col = |f: fn(&crate::longrun::OrbitSummary) -> f64| -> Vec<f64> {
         out.summaries.iter().map(f).collect()
     };
     d.set_item(

@@ -5,11 +5,11 @@ mod beam;
 mod cancel;
 mod convert;
 mod distributed;
-mod ensemble;
 mod error;
 mod flutter;
 mod laminate;
 mod longrun;
+mod montecarlo;
 mod orbit;
 
 use crate::dynamics::hinge_energy;
@@ -18,9 +18,9 @@ use crate::integrate::State;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
 use crate::simulate::{run, Trajectory};
 use crate::steady::equilibrium;
-use crate::system::{Coupled, Coupling, DrivenHinge, MomentHistory};
+use crate::system::{Coupled, DrivenHinge, MomentHistory};
 use crate::thermal::ThermalModel;
-use convert::{hinge_model, orbit_from, output, panel_from, solver_from, state};
+use convert::{coupling, hinge_model, orbit_from, output, panel_from, solver_from, state};
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, Dyn, U2};
@@ -99,11 +99,7 @@ fn validate_orbit(orbit: &Bound<'_, PyDict>) -> PyResult<()> {
 fn steady_state(panel: &Bound<'_, PyDict>, coupled: bool, flux: f64) -> PyResult<(f64, f64, f64)> {
     shield(|| {
         let p = panel_from(panel)?;
-        let coupling = if coupled {
-            Coupling::ProjectedArea
-        } else {
-            Coupling::Frozen
-        };
+        let coupling = coupling(coupled);
         let eq = equilibrium(&p, coupling, flux)?;
         Ok((eq.t_front, eq.t_back, eq.theta))
     })
@@ -122,11 +118,7 @@ fn start_state(
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         crate::Orbit::check_time(t0)?;
-        let coupling = if coupled {
-            Coupling::ProjectedArea
-        } else {
-            Coupling::Frozen
-        };
+        let coupling = coupling(coupled);
         let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
         Ok(eq.state().as_slice().to_vec())
     })
@@ -174,34 +166,6 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
         d.set_item("flexural_stiffness", p.flexural_stiffness())?;
         d.set_item("matching_moment_scale", p.matching_moment_scale())?;
         Ok(d)
-    })
-}
-
-/// Shadow intervals of an orbit within [t0, t1].
-#[pyfunction]
-fn shadow_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
-    shield(|| {
-        let o = orbit_from(orbit)?;
-        o.check_span(t0, t1)?;
-        Ok(o.shadow_intervals(t0, t1))
-    })
-}
-
-/// Illumination s(t) at each time.
-#[pyfunction]
-fn illumination<'py>(
-    py: Python<'py>,
-    orbit: &Bound<'py, PyDict>,
-    t: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    shield(|| {
-        let o = orbit_from(orbit)?;
-        let t = t.as_array();
-        for &x in t.iter() {
-            crate::Orbit::check_time(x)?;
-        }
-        let s = t.iter().map(|&x| o.illumination(x)).collect();
-        Ok(array(py, s))
     })
 }
 
@@ -291,11 +255,7 @@ fn simulate<'py>(
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let hinge = hinge_model(model)?;
-        let coupling = if coupled {
-            Coupling::ProjectedArea
-        } else {
-            Coupling::Frozen
-        };
+        let coupling = coupling(coupled);
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
         if layers == 2 {
@@ -458,8 +418,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(start_state, m)?)?;
     m.add_function(wrap_pyfunction!(stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(derived, m)?)?;
-    m.add_function(wrap_pyfunction!(shadow_intervals, m)?)?;
-    m.add_function(wrap_pyfunction!(illumination, m)?)?;
     m.add_function(wrap_pyfunction!(moment, m)?)?;
     m.add_function(wrap_pyfunction!(energy, m)?)?;
     m.add_function(wrap_pyfunction!(hinge_points, m)?)?;
@@ -471,7 +429,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     beam::register(m)?;
     distributed::register(m)?;
     orbit::register(m)?;
-    ensemble::register(m)?;
+    montecarlo::register(m)?;
     cancel::register(m)?;
     laminate::register(m)?;
     Ok(())

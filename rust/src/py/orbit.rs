@@ -27,6 +27,16 @@ fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<Eclipse
     })
 }
 
+/// Shadow intervals of an orbit within [t0, t1].
+#[pyfunction]
+fn shadow_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
+    shield(|| {
+        let o = orbit_from(orbit)?;
+        o.check_span(t0, t1)?;
+        Ok(o.shadow_intervals(t0, t1))
+    })
+}
+
 /// Umbra intervals of an orbit within [t0, t1], clipped.
 #[pyfunction]
 fn umbra_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
@@ -60,6 +70,16 @@ fn map_times<'py>(
     }
     let v: Vec<f64> = t.iter().map(|&x| f(&o, x)).collect();
     Ok(PyArray1::from_vec(py, v))
+}
+
+/// Illumination s(t) at each time.
+#[pyfunction]
+fn illumination<'py>(
+    py: Python<'py>,
+    orbit: &Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    shield(|| map_times(py, orbit, t, Orbit::illumination))
 }
 
 /// Solar flux relative to 1 au at each time.
@@ -134,6 +154,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(eclipse_duration, m)?)?;
     m.add_function(wrap_pyfunction!(leo_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(eclipses, m)?)?;
+    m.add_function(wrap_pyfunction!(shadow_intervals, m)?)?;
+    m.add_function(wrap_pyfunction!(illumination, m)?)?;
     m.add_function(wrap_pyfunction!(umbra_intervals, m)?)?;
     m.add_function(wrap_pyfunction!(orbit_breakpoints, m)?)?;
     m.add_function(wrap_pyfunction!(flux_scale, m)?)?;

@@ -1,4 +1,5 @@
-//! Per-orbit summaries of long runs: memory grows with the number of orbits, not of steps.
+//! Long runs (`tj.simulate_orbits`, `python/thermojitter/longrun.py`): per-orbit summaries, so
+//! that memory grows with the number of orbits, not of steps.
 //!
 //! Each accepted step is read at two points of its dense output, the middle and the end, and at
 //! eight evenly spaced points where θ̇ changes sign within the step (an extreme of θ lies there).

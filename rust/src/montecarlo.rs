@@ -1,4 +1,5 @@
-//! Batches of independent panels (Monte Carlo samples, sweep points) run in parallel on rayon.
+//! Monte Carlo (`tj.monte_carlo`, `sweep`, `sensitivity`; `python/thermojitter/montecarlo.py`):
+//! batches of independent panels (samples, sweep points) run in parallel on rayon.
 //!
 //! Each sample is one panel integrated over a whole number of orbits from its sunlit equilibrium,
 //! plus the flutter analysis of that equilibrium, reduced to a few numbers. A sample is computed
@@ -12,13 +13,13 @@ use crate::flutter::{analyse, critical_damping};
 use crate::hybrid::{run_orbits_hybrid, HybridSettings};
 use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LANES};
 use crate::integrate::{DenseStep, Method, Observer};
-use crate::orbit::Orbit;
-use crate::params::Panel;
-use crate::steady::equilibrium;
-use crate::summary::{
+use crate::longrun::{
     finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, SummaryObserver,
     SummaryOptions, TwoLayerView,
 };
+use crate::orbit::Orbit;
+use crate::params::Panel;
+use crate::steady::equilibrium;
 use crate::system::Coupling;
 use nalgebra::{Vector4, U4};
 use rayon::prelude::*;
@@ -256,7 +257,7 @@ fn sample_head(
         // Without a threshold nothing is timed: a limit no angle reaches.
         theta_limit: s.threshold.unwrap_or(f64::MAX),
         stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
-        steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
+        steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
     };
     let head = SampleHead {
         theta_eq: flutter.equilibrium.theta,
@@ -434,7 +435,7 @@ pub fn run_batch_on(
 mod tests {
     use super::*;
     use crate::integrate::Tolerances;
-    use crate::summary::run_orbits;
+    use crate::longrun::run_orbits;
 
     fn settings() -> EnsembleSettings {
         EnsembleSettings {
@@ -576,7 +577,7 @@ mod tests {
                 window: 600.0,
                 theta_limit: 0.2,
                 stop_at_limit: false,
-                steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
+                steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
             },
         )
         .unwrap();
@@ -616,7 +617,7 @@ mod tests {
                 window: s.window,
                 theta_limit: f64::MAX,
                 stop_at_limit: false,
-                steps_per_period: crate::summary::STEPS_PER_HINGE_PERIOD,
+                steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
             },
             &HybridSettings::default(),
             &Cancel::new(),

@@ -1,12 +1,13 @@
-//! Bindings of batched runs: a rayon pool of its own, and the check of a design up front.
+//! Bindings of the Monte Carlo batches (`crate::montecarlo`): a rayon pool of its own
+//! (`_core.EnsemblePool`, the name the Python side has always used), and the check of a design
+//! up front.
 
 use super::cancel::{token, CancelToken};
-use super::convert::{hinge_model, orbit_from, solver_from};
+use super::convert::{coupling, hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use super::longrun::hybrid_from;
-use crate::ensemble::{pool, run_batch_on, EnsembleSettings, Path, SampleMetrics};
-use crate::system::Coupling;
+use crate::montecarlo::{pool, run_batch_on, EnsembleSettings, Path, SampleMetrics};
 use crate::Panel;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -116,11 +117,7 @@ impl EnsemblePool {
             let settings = EnsembleSettings {
                 orbit: orbit_from(orbit)?,
                 model: hinge_model(model)?,
-                coupling: if coupled {
-                    Coupling::ProjectedArea
-                } else {
-                    Coupling::Frozen
-                },
+                coupling: coupling(coupled),
                 method: solver_from(solver)?,
                 n_orbits,
                 window,
