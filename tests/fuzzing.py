@@ -4,12 +4,13 @@ short run in CI) and benches/fuzz.py (a long run that prints the count of each o
 Each example is a known-good call of one entry point with one to three of its arguments replaced
 by a hostile value (NaN, ±inf, 0, negatives, 1e±300, integers too large for a float, bools, None,
 strings, wrong shapes, reversed spans). It runs in a worker process under a watchdog, so that a
-crash (the process dies) or a hang (no answer within the time limit) is counted, not fatal.
+crash (the process dies) or a hang (no answer within the CPU-time limit, see ``Runner``) is
+counted, not fatal.
 
 Outcomes:
 
 - ``ok``: a result whose every number is finite (NaN only where documented: no eclipse, no umbra,
-  a failed Monte Carlo sample with its error);
+  a failed Monte Carlo sample with its error; +inf only for ``max_step``, "no cap");
 - ``refused_named``: ValueError/TypeError naming the parameter (a ``ParameterError``'s
   ``.parameter``, or the argument's name in the message); ``refused_unnamed`` otherwise;
 - ``runtime_error``: IntegrationError or ConvergenceError (a clear error from the engine);
@@ -22,6 +23,8 @@ from __future__ import annotations
 
 import math
 import multiprocessing as mp
+import os
+import time
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -293,6 +296,10 @@ NAN_ALLOWED = {
 }  # fmt: skip
 
 
+# Settings echoed in a result where +inf is the documented value "no cap" (max_step).
+INF_ALLOWED = {"max_step"}
+
+
 def _non_finite(value: Any, name: str = "") -> str | None:
     """The name of a non-finite number in a result, or None."""
     if name in NAN_ALLOWED:
@@ -300,6 +307,8 @@ def _non_finite(value: Any, name: str = "") -> str | None:
     if isinstance(value, (bool, np.bool_, str, bytes)) or value is None:
         return None
     if isinstance(value, (float, int, np.number)):
+        if name in INF_ALLOWED and value == math.inf:
+            return None
         return None if np.isfinite(value) else name or "value"
     if isinstance(value, np.ndarray):
         if value.dtype.kind in "fc" and not np.all(np.isfinite(value)):
@@ -335,6 +344,26 @@ def _non_finite(value: Any, name: str = "") -> str | None:
     return None
 
 
+def _eclipse_rows(rows: Any) -> str | None:
+    """``Orbit.eclipses`` rows (deepest point, first contact, last contact, umbra entry, umbra
+    exit): the first three finite; the umbra pair NaN together (documented: a penumbral eclipse
+    has no umbra) or finite inside the contacts."""
+    rows = np.asarray(rows, dtype=float)
+    if rows.ndim != 2 or rows.shape[1] != 5:
+        return f"eclipses of shape {rows.shape}"
+    if not np.all(np.isfinite(rows[:, :3])):
+        return "eclipses[:, :3]"
+    umbra = rows[:, 3:]
+    none = np.isnan(umbra).all(axis=1)
+    inside = np.isfinite(umbra).all(axis=1)
+    inside &= (
+        (rows[:, 1] <= umbra[:, 0]) & (umbra[:, 0] <= umbra[:, 1]) & (umbra[:, 1] <= rows[:, 2])
+    )
+    if not np.all(none | inside):
+        return "eclipses[:, 3:]"
+    return None
+
+
 def classify(example: Example) -> tuple[str, str]:
     """Runs one example here and returns (outcome, detail)."""
     import thermojitter as tj
@@ -361,7 +390,7 @@ def classify(example: Example) -> tuple[str, str]:
         if type(exc).__name__ == "PanicException":
             return "panic", str(exc)[:200]
         raise
-    bad = _non_finite(result)
+    bad = _eclipse_rows(result) if example.target == "eclipses" else _non_finite(result)
     if bad:
         return "silent_nan", f"{bad} is not finite"
     return "ok", ""
@@ -378,15 +407,35 @@ def _worker(conn: Any) -> None:
         conn.send(classify(example))
 
 
+def _cpu_seconds(pid: int) -> float | None:
+    """CPU time (user + system, every thread) the process ``pid`` has used, s; None where /proc
+    cannot tell."""
+    try:
+        fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()  # noqa: SIM115
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
+
+
 class Runner:
     """Runs examples in a worker process, one at a time, with a watchdog: a worker that dies
-    (abort) or does not answer in ``limit`` s (hang) is counted and replaced."""
+    (abort) or does not answer (hang) is counted and replaced.
 
-    def __init__(self, limit: float = 20.0) -> None:
+    A hang is judged by the CPU time the worker spends on the call (every thread), not by the
+    clock: other jobs share the machine, and a call that waits for a core is not hanging. A call
+    is a hang once it has used ``limit`` s of CPU, or (a worker stuck without computing, or where
+    the CPU time is unknown) ``wall_factor`` × ``limit`` s of wall time. ``last_cpu`` and
+    ``last_wall`` hold the last call's figures.
+    """
+
+    def __init__(self, limit: float = 20.0, wall_factor: float = 6.0) -> None:
         self.limit = limit
+        self.wall_limit = wall_factor * limit
         self.ctx = mp.get_context("spawn")
         self.proc: Any = None
         self.conn: Any = None
+        self.last_cpu = 0.0
+        self.last_wall = 0.0
 
     def _start(self) -> None:
         parent, child = self.ctx.Pipe()
@@ -402,7 +451,25 @@ class Runner:
         except (BrokenPipeError, OSError):
             self._start()
             self.conn.send(example)
-        if self.conn.poll(self.limit):
+        cpu0 = _cpu_seconds(self.proc.pid) or 0.0
+        start = time.monotonic()
+        answered = False
+        while True:
+            if self.conn.poll(0.05):
+                answered = True
+                break
+            cpu = _cpu_seconds(self.proc.pid)
+            self.last_cpu = (cpu - cpu0) if cpu is not None else 0.0
+            self.last_wall = time.monotonic() - start
+            if not self.proc.is_alive() or self.last_cpu > self.limit:
+                break
+            if self.last_wall > self.wall_limit or (cpu is None and self.last_wall > self.limit):
+                break
+        cpu = _cpu_seconds(self.proc.pid)
+        if cpu is not None:
+            self.last_cpu = cpu - cpu0
+        self.last_wall = time.monotonic() - start
+        if answered:
             try:
                 return self.conn.recv()  # type: ignore[no-any-return]
             except EOFError:
@@ -411,7 +478,10 @@ class Runner:
             self.proc.kill()
             self.proc.join()
             self.proc = None
-            return "hang", f"no answer within {self.limit} s"
+            return "hang", (
+                f"no answer after {self.last_cpu:.1f} s of CPU ({self.last_wall:.1f} s wall); "
+                f"limits {self.limit:g} s CPU, {self.wall_limit:g} s wall"
+            )
         code = self.proc.exitcode
         self.proc = None
         return "abort", f"worker died (exit code {code})"

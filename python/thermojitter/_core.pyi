@@ -8,6 +8,7 @@ from numpy.typing import NDArray
 _F = NDArray[np.float64]
 
 __all__ = [
+    "least_steps",
     "leo_orbit",
     "eclipse_duration",
     "SIDEREAL_DAY",
@@ -23,6 +24,7 @@ __all__ = [
     "EnsemblePool",
     "IntegrationError",
     "LAYER_FIELDS",
+    "MAX_THREADS",
     "LINEAR_FIELDS",
     "MAX_TIME",
     "PANEL_FIELDS",
@@ -91,6 +93,7 @@ PERIHELION_DAY: float
 GEO_EQUINOX_ORBIT: dict[str, Any]
 CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
+MAX_THREADS: int
 MAX_TIME: float
 VALIDITY_LIMIT: float
 
@@ -278,6 +281,9 @@ def stability_map(
 
 # --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
 def check_panels(panels: _F) -> list[tuple[int, str, str]]: ...
+def least_steps(
+    panels: _F, solver: dict[str, Any], span: float, steps_per_period: float | None = None
+) -> _F: ...
 
 @final
 class EnsemblePool:

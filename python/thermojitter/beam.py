@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter.checkpoint import write_bytes_atomic
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
@@ -562,9 +563,10 @@ def write_beam_comparison(
 
         result["distributed"] = hinge_vs_distributed(out_dir=out)
         report += "\n" + hinge_vs_distributed_markdown(result["distributed"])
+    # Atomic: a failed write (a full disk) leaves no partial file.
     path = Path(out) / "beam_summary.json"
-    path.write_text(json.dumps(result, indent=2))
-    (Path(out) / "beam_report.md").write_text(report)
+    write_bytes_atomic(path, json.dumps(result, indent=2).encode())
+    write_bytes_atomic(Path(out) / "beam_report.md", report.encode())
     for name, case in result["cases"].items():
         print(
             f"{name:17s} K_el = {case['hinge_stiffness']:8.1f} N m/rad  chi = "

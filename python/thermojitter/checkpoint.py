@@ -56,7 +56,7 @@ def digest(value: Any) -> str:
 def write_atomic(path: str | os.PathLike[str], write: Callable[[BinaryIO], object]) -> None:
     """Writes ``path`` through ``write(file)`` at a temporary name in the same folder, flushes
     it to disk and renames it over ``path``. On any failure the temporary file is removed and
-    ``path`` is left as it was; the error is raised again."""
+    ``path`` is left as it was; the error is raised again (an ``OSError`` naming ``path``)."""
     target = Path(path)
     fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     tmp = Path(name)
@@ -66,9 +66,11 @@ def write_atomic(path: str | os.PathLike[str], write: Callable[[BinaryIO], objec
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             tmp.unlink()
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(target)  # a failed fsync or write names no file otherwise
         raise
     _sync_folder(target.parent)
 

@@ -39,7 +39,7 @@ class ParameterError(ValueError):
         self.value = value
         self.allowed = allowed
         if message is None:
-            message = f"{parameter} = {value!r} is invalid"
+            message = f"{parameter} = {_shown(value)} is invalid"
             if allowed:
                 message += f": {allowed}"
         super().__init__(message)
@@ -47,6 +47,13 @@ class ParameterError(ValueError):
     def __reduce__(self) -> tuple[Any, ...]:
         # Crosses process boundaries (Monte Carlo workers) with its attributes.
         return (type(self), (self.parameter, self.value, self.allowed, str(self)))
+
+
+def _shown(value: Any) -> str:
+    """``value`` as a message shows it: a repr of hundreds of characters (an integer of 400
+    digits) is cut, saying how long it was."""
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:24]}… ({len(text)} characters)"
 
 
 class InternalError(RuntimeError):

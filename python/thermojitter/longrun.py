@@ -105,6 +105,35 @@ class OrbitSummaries:
         return pd.DataFrame(self.columns).set_index("index")
 
 
+def orbit_count(name: str, value: Any, orbit: Orbit, t_start: float = 0.0) -> int:
+    """A whole number of orbits >= 1 that a run starting at ``t_start`` can reach (|t| at most
+    the engine's MAX_TIME), checked before any product that would overflow a float."""
+    n = checks.integer(name, value, 1)
+    most = (_core.MAX_TIME - abs(t_start)) / orbit.period
+    if n > most:  # exact for any int, even 10**400
+        raise checks.ParameterError(
+            name,
+            value,
+            f"must be <= {most:.4g}: a run may reach at most t = {_core.MAX_TIME:g} s "
+            f"(about {_core.MAX_TIME / 3.15576e7:.0f} years)",
+        )
+    return n
+
+
+def refuse_beyond_budget(name: str, value: Any, least: float, max_steps: int, what: str) -> None:
+    """A ParameterError naming ``name`` when a request needs, at the least, more integrator steps
+    than its budget ``max_steps``: known before any work, rather than found minutes into it.
+    ``what`` says where the steps come from."""
+    if least > max_steps:
+        raise checks.ParameterError(
+            name,
+            value,
+            f"needs at least {least:.3g} integrator steps ({what}), more than max_steps = "
+            f"{max_steps}: use method='hybrid' (sunlit arcs without steps), a shorter span, "
+            "or a larger max_steps",
+        )
+
+
 def _empty_columns() -> dict[str, list[Any]]:
     return {name: [] for name in SUMMARY_FIELDS}
 
@@ -234,6 +263,9 @@ def simulate_orbits(
       (polled between chunks, for callers that handle SIGINT and report it themselves), silently.
     - ``progress``: a tqdm bar on stderr with the remaining time (in Jupyter a widget; also when
       stderr is not a terminal); ``None``: only when stderr is a terminal; ``False``: none.
+    - ``max_steps``: the step budget of the whole run, every orbit together. A run whose least
+      cost (known up front for rk45 with its step cap, and rk4) exceeds it is refused before it
+      starts, naming ``n_orbits``; one that reaches it raises ``IntegrationError``.
     - ``method``: ``"hybrid"`` (default) propagates the sunlit arcs exactly in the linearised
       system's modal form and integrates only the shadow crossings and their thermal recovery
       with the full non-linear model (an exponential integrator), falling back on the
@@ -268,15 +300,8 @@ def simulate_orbits(
         checks.flag("progress", progress)
     if stop is not None and not callable(stop):
         raise TypeError(f"stop must be callable, not {type(stop).__name__}")
-    t_end = t_start + n_orbits * orbit.period
-    if not abs(t_end) <= _core.MAX_TIME:
-        # Each chunk is checked by the engine; the whole run is checked here, before any work.
-        raise checks.ParameterError(
-            "n_orbits",
-            n_orbits,
-            f"reaches t = {t_end:.4g} s; a run may reach at most {_core.MAX_TIME:g} s "
-            f"({_core.MAX_TIME / orbit.period:.4g} orbits of this one)",
-        )
+    # Each chunk is checked by the engine; the whole run is checked here, before any work.
+    n_orbits = orbit_count("n_orbits", n_orbits, orbit, t_start)
     method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
     nodes = None if layers is None else check_layers(layers)
     if nodes is not None and method == "hybrid":
@@ -345,6 +370,19 @@ def simulate_orbits(
         core_args["layup"] = layup_dict(panel)
         core_args["nodes"] = nodes
 
+    budget = int(core_args["solver"]["max_steps"])  # for the whole run, every orbit together
+    if method != "hybrid":
+        row = np.array([[panel.as_dict()[f] for f in _core.PANEL_FIELDS]])
+        least = float(
+            _core.least_steps(row, core_args["solver"], orbit.period, steps_per_period)[0]
+        )
+        cap = (
+            "a fixed step dt" if method == "rk4" else f"the step capped at T_n/{steps_per_period:g}"
+        )
+        refuse_beyond_budget(
+            "n_orbits", n_orbits, least * n_orbits, budget, f"{least:.3g} per orbit with {cap}"
+        )
+
     columns = _empty_columns()
     y = [float(v) for v in y0]
     next_index = 0
@@ -396,6 +434,12 @@ def simulate_orbits(
                 next_index = int(columns["index"][-1]) + 1
             else:
                 next_index += count
+            if counters["n_steps"] >= budget and next_index < n_orbits and not stopped:
+                raise _core.IntegrationError(
+                    f"max_steps = {budget} reached after {next_index} of {n_orbits} orbits "
+                    f"({counters['n_steps']} steps; the budget holds for the whole run): pass "
+                    "a larger max_steps or fewer orbits"
+                )
             if bar is not None:
                 bar.update(count)
             if path is not None and time.monotonic() - last_save > checkpoint_every:

@@ -35,7 +35,7 @@ from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
-from thermojitter.longrun import DEFAULT_THETA_LIMIT
+from thermojitter.longrun import DEFAULT_THETA_LIMIT, orbit_count, refuse_beyond_budget
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import progress_bar, report_interrupted
@@ -290,8 +290,7 @@ def _options(
     stop_at_threshold: bool,
 ) -> dict[str, Any]:
     """The keyword arguments of EnsemblePool.run shared by every chunk (plain data)."""
-    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
-        raise ValueError(f"horizon = {horizon!r} is invalid: must be a whole number of orbits >= 1")
+    horizon = orbit_count("horizon", horizon, orbit)
     if threshold is not None and not (math.isfinite(threshold) and threshold > 0):
         raise ValueError(f"threshold = {threshold!r} is invalid: must be a finite angle > 0 (rad)")
     if not (isinstance(window, (int, float)) and math.isfinite(window) and window > 0):
@@ -316,7 +315,8 @@ def _default_method(method: str | None, orbit: Orbit, horizon: Any) -> str:
     """``None``: the hybrid propagator over a month or more, the hinge-resolved rk45 below."""
     if method is not None:
         return method
-    long = isinstance(horizon, (int, np.integer)) and horizon * orbit.period >= 30 * 86400.0
+    # horizon is compared, not multiplied: an int too large for a float is refused later.
+    long = isinstance(horizon, (int, np.integer)) and horizon >= 30 * 86400.0 / orbit.period
     return "hybrid" if long else "rk45"
 
 
@@ -584,6 +584,28 @@ def _frame(
     return frame
 
 
+def _refuse_beyond_budget(
+    matrix: NDArray[np.float64], options: dict[str, Any], settings: dict[str, Any]
+) -> None:
+    """Refuses, before any work, a design whose samples together need more integrator steps than
+    ``max_steps`` (the study's budget; each sample also stops at it): a sample that needs more
+    names ``horizon``, a design that does names its size. The hybrid's least cost is not known
+    up front (its sunlit arcs take no step); each of its samples stops at the budget."""
+    if options["hybrid"] is not None:
+        return
+    solver = options["solver"]
+    period = float(options["orbit"]["period"])
+    least = _core.least_steps(matrix, solver, options["n_orbits"] * period)
+    budget = int(solver["max_steps"])
+    horizon = options["n_orbits"]
+    per = f"{least.max() / horizon:.3g} per orbit of the slowest sample"
+    refuse_beyond_budget("horizon", horizon, float(least.max()), budget, per)
+    size = "grid" if settings["study"] == "sweep" else "n"
+    what = f"{len(matrix)} samples of {horizon} orbits, {per}"
+    value = settings.get(size, len(matrix)) if size == "n" else f"{len(matrix)} panels"
+    refuse_beyond_budget(size, value, float(least.sum()), budget, what)
+
+
 def _run_design(
     names: Sequence[str],
     values: NDArray[np.float64],
@@ -599,10 +621,9 @@ def _run_design(
 ) -> Any:
     n = len(matrix)
     checks.flag("progress", progress)
-    if threads is not None and (
-        isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1
-    ):
-        raise ValueError(f"threads = {threads!r} is invalid: must be an integer >= 1 or None")
+    if threads is not None:
+        threads = checks.integer("threads", threads, 1, _core.MAX_THREADS)
+    _refuse_beyond_budget(matrix, options, settings)
     if chunk_size is None:
         chunk_size = _default_chunk_size(n)
     elif isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
@@ -694,10 +715,13 @@ def _check_seed(seed: Any, checkpoint: Any) -> int:
     return int(seed)
 
 
+MAX_SAMPLES = 10**7
+"""Most samples of one study: its design is held in memory (about 140 bytes a sample, over a
+gigabyte at the limit), and so many runs of even one orbit take CPU-days."""
+
+
 def _check_n(n: Any, least: int = 1) -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < least:
-        raise ValueError(f"n = {n!r} is invalid: must be an integer >= {least}")
-    return int(n)
+    return checks.integer("n", n, least, MAX_SAMPLES)
 
 
 def _sampled(
@@ -776,7 +800,11 @@ def monte_carlo(
       for horizons of a month or more, rk45 below.
     - ``threshold`` (rad): time the first abs(θ) above it (``t_threshold``); with
       ``stop_at_threshold`` a sample stops there.
-    - ``threads``: rayon threads on this machine (default: one per core). ``backend``: None (this
+    - ``max_steps``: the study's step budget, every sample together (each sample also stops at
+      it). A design whose least cost, known up front for rk45 with its step cap and rk4, exceeds
+      it is refused before it starts, naming ``horizon`` or ``n``.
+    - ``threads``: rayon threads on this machine (default: one per core, at most
+      ``MAX_THREADS``). ``backend``: None (this
       machine), ``"dask"`` (a new LocalCluster), a scheduler address or a ``distributed.Client``;
       each worker then runs chunks on as many rayon threads as it has threads.
     - ``checkpoint``: a directory; finished chunks (``chunk_size`` samples, default depending on n
@@ -863,6 +891,9 @@ def sweep(
         window, threshold, stop_at_threshold,
     )  # fmt: skip
     names = list(grid)
+    size = math.prod(len(a) for a in axes)
+    if size > MAX_SAMPLES:
+        raise ParameterError("grid", f"{size} panels", f"must hold at most {MAX_SAMPLES} panels")
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
     matrix = _panel_matrix(panel, names, values)
     _refuse_invalid(matrix, "")

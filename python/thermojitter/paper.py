@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import _core, plots, solver
+from thermojitter.checkpoint import write_bytes_atomic
 from thermojitter.flutter import linear_thermal_response
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
@@ -763,9 +764,8 @@ def _jsonable(value: Any) -> Any:
 
 
 def _write_json(path: Path, data: dict[str, Any]) -> None:
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(_jsonable(data), indent=2, ensure_ascii=False) + "\n")
-    tmp.replace(path)
+    text = json.dumps(_jsonable(data), indent=2, ensure_ascii=False) + "\n"
+    write_bytes_atomic(path, text.encode())
 
 
 def _report(
@@ -875,5 +875,5 @@ def run_paper(
     summary["wall_time_s"] = round(time.perf_counter() - started, 2)
     summary["python"] = platform.python_version()
     _write_json(folder / "summary.json", summary)
-    (folder / "report.md").write_text(_report(ctx, results, summary))
+    write_bytes_atomic(folder / "report.md", _report(ctx, results, summary).encode())
     return summary

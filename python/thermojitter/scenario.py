@@ -29,11 +29,12 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
+from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.solver import ATOL, RTOL, SolverSettings
+from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -97,13 +98,21 @@ class SimulationSettings:
     layers: int | None = None
     """Nodes through the thickness of the N-node model (one homogeneous layer for a [panel]);
     None: the two-layer model."""
+    max_steps: int = MAX_STEPS
+    """The run's step budget (every orbit together with keep = "orbits")."""
 
     @property
     def solver(self) -> SolverSettings:
         """The integrator settings of ``method`` (rk45 for the hybrid propagator's fallback),
         ``rtol``, ``atol`` and ``dt``, checked by the engine when a run asks for them."""
         method = "rk45" if self.method == "hybrid" else self.method
-        return SolverSettings(method, self.rtol, self.atol, self.dt)  # type: ignore[arg-type]
+        return SolverSettings(
+            method,  # type: ignore[arg-type]
+            self.rtol,
+            self.atol,
+            self.dt,
+            max_steps=self.max_steps,
+        )
 
     def span(self, orbit: Orbit) -> tuple[float, float]:
         """(t0, t1) in s: t_end if given, else t_start + orbits · period (one orbit by default)."""
@@ -140,7 +149,10 @@ class Scenario:
 def _real(path: Path, key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ScenarioError(path, key, f"must be a number, not {_toml_type(value)} {value!r}")
-    number = float(value)
+    try:
+        number = checks.real(key, value)
+    except ParameterError as exc:  # an integer too large for a float
+        raise ScenarioError(path, key, str(exc.allowed)) from None
     if not math.isfinite(number):
         raise ScenarioError(path, key, f"must be finite, not {value!r}")
     return number
@@ -282,6 +294,10 @@ def _simulation(path: Path, table: dict[str, Any]) -> SimulationSettings:
             out[key] = _choice(path, s + key, value, ON_LIMIT)
         elif key in ("t_start", "t_end"):
             out[key] = _real(path, s + key, value)
+        elif key == "max_steps":
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ScenarioError(path, s + key, f"must be an integer >= 1, not {value!r}")
+            out[key] = value
         elif key == "layers":
             if isinstance(value, bool) or not isinstance(value, int) or value < 2:
                 raise ScenarioError(

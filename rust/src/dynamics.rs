@@ -346,6 +346,30 @@ pub fn hinge_energy(
     kinetic + 0.5 * panel.hinge_stiffness * theta * theta - moment * theta
 }
 
+/// [`hinge_energy`] of a state given by a caller: θ within the hinge model's range, a moment
+/// whose static angle is too, and a rate whose kinetic energy is a number (a rate of 1e160
+/// rad/s would give inf).
+pub fn checked_hinge_energy(
+    panel: &Panel,
+    model: HingeModel,
+    theta: f64,
+    theta_dot: f64,
+    moment: f64,
+) -> Result<f64> {
+    check_hinge_angle("theta", theta)?;
+    check_moment(panel, moment)?;
+    let energy = hinge_energy(panel, model, theta, theta_dot, moment);
+    if energy.is_finite() {
+        Ok(energy)
+    } else {
+        Err(Error::invalid(
+            "theta_dot",
+            theta_dot,
+            "must be finite, with a kinetic energy within a float's range",
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -440,5 +464,26 @@ mod tests {
             let rate = de_dth * om + de_dom * acc;
             assert!(rate.abs() < 1e-5 * (de_dth * om).abs(), "{model:?}: {rate}");
         }
+    }
+
+    #[test]
+    fn checked_hinge_energy_refuses_states_beyond_the_model_and_agrees_within() {
+        let p = Panel::paper();
+        let m = HingeModel::Nonlinear;
+        let name = |r: Result<f64>| match r {
+            Err(Error::InvalidParameter { name, .. }) => name,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            name(checked_hinge_energy(&p, m, 1e300, 0.0, 400.0)),
+            "theta"
+        );
+        assert_eq!(
+            name(checked_hinge_energy(&p, m, 0.1, 1e200, 400.0)),
+            "theta_dot"
+        );
+        assert_eq!(name(checked_hinge_energy(&p, m, 0.1, 0.0, 1e300)), "moment");
+        let e = checked_hinge_energy(&p, m, 0.1, 0.02, 400.0).unwrap();
+        assert_eq!(e, hinge_energy(&p, m, 0.1, 0.02, 400.0));
     }
 }

@@ -364,8 +364,19 @@ fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> 
         .collect()
 }
 
+/// Most worker threads a pool may have: more than any machine's cores, few enough that a typo
+/// (or 2**63) does not spawn threads until the operating system refuses.
+pub const MAX_THREADS: usize = 1024;
+
 /// A rayon pool of its own with `threads` workers (0: rayon's default, one per core).
 pub fn pool(threads: usize) -> Result<ThreadPool> {
+    if threads > MAX_THREADS {
+        return Err(Error::invalid(
+            "threads",
+            threads,
+            &format!("must be in [1, {MAX_THREADS}] (or None for one per core)"),
+        ));
+    }
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -705,5 +716,43 @@ mod tests {
         // Cancelled before it starts: nothing runs.
         let e = run_batch(&pool(1).unwrap(), &panels(), &settings(), &cancel).unwrap_err();
         assert_eq!(e, Error::Cancelled);
+    }
+
+    #[test]
+    fn pools_beyond_the_thread_limit_are_refused_before_any_thread_starts() {
+        for threads in [MAX_THREADS + 1, usize::MAX] {
+            let err = pool(threads).expect_err("refused");
+            assert!(err.to_string().starts_with("threads = "), "{err}");
+            assert!(err.to_string().contains(&MAX_THREADS.to_string()), "{err}");
+        }
+    }
+
+    #[test]
+    fn a_hybrid_sample_stops_at_its_budget_every_step_counted() {
+        // On a low orbit the hybrid falls back on the full integration every orbit; each
+        // stretch used to get the whole budget, so the run took that many steps per orbit.
+        // A budget of a few orbits' steps, each stretch well within it.
+        let budget = 100_000;
+        let s = EnsembleSettings {
+            n_orbits: 50,
+            hybrid: Some(HybridSettings::default()),
+            method: Method::Dopri5(Tolerances {
+                rtol: 1e-6,
+                atol: 1e-8,
+                max_steps: budget,
+                ..Tolerances::default()
+            }),
+            ..settings()
+        };
+        let err = run_sample(&Panel::paper(), &s, &Cancel::new()).expect_err("budget");
+        assert!(
+            err.to_string().contains("max_steps = 100000 reached"),
+            "{err}"
+        );
+        // A few orbits in, not after the 50 (~30,000 steps an orbit here).
+        let Error::Integration { t, .. } = err else {
+            panic!("{err}")
+        };
+        assert!(t < 6.0 * s.orbit.period, "stopped at t = {t}");
     }
 }

@@ -65,6 +65,11 @@ fn rest_state<S: StructuralModel>(structure: &S, positions: &[f64]) -> Vec<f64> 
     q
 }
 
+/// Flux factors a steady state is sought for: from far beyond the planets (1e-6, at 1000 au) to
+/// 100 (0.1 au, well inside Mercury's orbit). Beyond them a panel's temperatures underflow or
+/// soar to thousands of kelvin, and Newton fails without saying why.
+pub const FLUX_RANGE: (f64, f64) = (1e-6, 100.0);
+
 /// The steady state of `thermal` coupled to `structure` under constant flux factor `flux`:
 /// (temperatures, positions), velocities being zero. Newton from the isothermal plate's
 /// temperature and the unloaded shape, with a forward-difference Jacobian.
@@ -78,8 +83,13 @@ where
     T: ThermalModel + ?Sized,
     S: StructuralModel,
 {
-    if !(flux.is_finite() && flux > 0.0) {
-        return Err(Error::invalid("flux", flux, "must be finite and > 0"));
+    let (low, high) = FLUX_RANGE;
+    if !(low..=high).contains(&flux) {
+        return Err(Error::invalid(
+            "flux",
+            flux,
+            &format!("must be in [{low:e}, {high}] (the solar flux over its value at 1 au)"),
+        ));
     }
     let n = thermal.size();
     let m = n + structure.positions();
@@ -203,6 +213,23 @@ mod tests {
                 .steady_state(flux)
                 .unwrap();
             assert!((y[0] - exact).abs() <= 1e-13 * exact, "{} vs {exact}", y[0]);
+        }
+    }
+
+    #[test]
+    fn flux_factors_outside_the_range_are_named() {
+        let p = Panel::paper();
+        for flux in [0.0, 5e-324, 0.9e-6, 100.1, 1e12, f64::NAN, f64::INFINITY] {
+            match equilibrium(&p, Coupling::ProjectedArea, flux) {
+                Err(crate::Error::InvalidParameter { name, .. }) => assert_eq!(name, "flux"),
+                other => panic!("flux {flux}: {other:?}"),
+            }
+        }
+        for flux in [FLUX_RANGE.0, 0.0111, 1.0, 10.6] {
+            assert!(
+                equilibrium(&p, Coupling::ProjectedArea, flux).is_ok(),
+                "flux {flux}"
+            );
         }
     }
 }

@@ -33,7 +33,7 @@ from thermojitter.scenario import ScenarioError, load_scenario
 
 SETTING_KEYS = ("n", "seed", "sampler", "truncate")
 """Keys of [montecarlo] that set the design."""
-RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window")
+RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window", "max_steps")
 
 
 def read_scenario(path: str | Path) -> dict[str, Any]:

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_dir, write_output
+from thermojitter.errors import ParameterError
 from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.scenario import Scenario, ScenarioError, load_scenario
 
@@ -55,7 +56,7 @@ def scenario_keys_help() -> str:
                 "method = rk45 | rk4 (dt = step, s); dt_out = output interval, s; keep = "
                 '"samples" | "orbits" (one summary row per orbit, resumable, with '
                 'theta_limit_deg and on_limit = "stop" | "flag"); layers = nodes through '
-                "the thickness (the N-node model)",
+                "the thickness (the N-node model); max_steps = the run's step budget",
             ),
             table("output", ["format", "plots"], 'format = "csv" | "parquet"; plots = true'),
         ]
@@ -190,32 +191,40 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         raise ScenarioError(
             scenario.source, "simulation", f"keep = 'orbits' needs whole orbits; the span is {n:g}"
         )
+    span_key = "simulation." + next(
+        (k for k in ("years", "orbits", "t_end") if getattr(sim, k) is not None), "orbits"
+    )
     if n_orbits > MAX_ORBITS:
-        key = next(k for k in ("years", "orbits", "t_end") if getattr(sim, k) is not None)
         raise ScenarioError(
             scenario.source,
-            f"simulation.{key}",
+            span_key,
             f"the span covers {n:.3g} orbits, more than {MAX_ORBITS:.0e}: shorten it",
         )
     fmt = args.format or scenario.output.format
     check_writer(fmt)
     started = time.perf_counter()
-    runs = simulate_orbits(
-        scenario.panel,
-        scenario.orbit,
-        n_orbits,
-        t_start=sim.t_start,
-        model=sim.model,  # type: ignore[arg-type]
-        coupled=sim.coupled,
-        method=sim.method,  # type: ignore[arg-type]
-        solver=sim.solver,
-        theta_limit=math.radians(sim.theta_limit_deg),
-        on_limit=sim.on_limit,  # type: ignore[arg-type]
-        layers=sim.layers,
-        checkpoint=out / "checkpoint.json",
-        progress=not args.no_progress,
-        stop=STOP,
-    )
+    try:
+        runs = simulate_orbits(
+            scenario.panel,
+            scenario.orbit,
+            n_orbits,
+            t_start=sim.t_start,
+            model=sim.model,  # type: ignore[arg-type]
+            coupled=sim.coupled,
+            method=sim.method,  # type: ignore[arg-type]
+            solver=sim.solver,
+            theta_limit=math.radians(sim.theta_limit_deg),
+            on_limit=sim.on_limit,  # type: ignore[arg-type]
+            layers=sim.layers,
+            checkpoint=out / "checkpoint.json",
+            progress=not args.no_progress,
+            stop=STOP,
+        )
+    except ParameterError as exc:
+        if exc.parameter != "n_orbits":
+            raise
+        # The span is the scenario's key (a budget refusal, said in its own words).
+        raise ScenarioError(scenario.source, span_key, f"{n_orbits} orbits {exc.allowed}") from None
     written = [write_series(out / "orbits", dict(runs.columns), fmt).name]
     if scenario.output.plots and not args.no_plots and len(runs) > 1 and not runs.interrupted:
         from thermojitter.plots import orbit_summary_figure

@@ -385,6 +385,7 @@ impl Driver<'_> {
         let mut fallback = false;
         while self.t < self.t_end && !self.stopped() {
             self.obs.cancel.check()?;
+            self.check_budget()?;
             let horizon = (self.t + self.orbit.period).min(self.t_end);
             let eclipses = self.eclipses.overlapping(self.t, horizon).to_vec();
             if fallback {
@@ -415,6 +416,20 @@ impl Driver<'_> {
                 }
             }
             fallback = self.exponential(horizon, &eclipses)?;
+        }
+        Ok(())
+    }
+
+    /// The fallback's step budget holds for the whole run, every kind of step counted: each
+    /// fallback stretch alone stops at it, and without this check a run with one stretch per
+    /// orbit could take that many steps per orbit.
+    fn check_budget(&self) -> Result<()> {
+        let budget = self.fallback.max_steps();
+        if self.stats.n_steps + self.stats.n_rejected >= budget {
+            return Err(Error::Integration {
+                t: self.t,
+                reason: format!("max_steps = {budget} reached"),
+            });
         }
         Ok(())
     }

@@ -229,6 +229,24 @@ impl Default for Tolerances {
 }
 
 impl Method {
+    /// The fewest steps this method can take over `span` s, known before any work: the fixed
+    /// step's count, or the span over the adaptive step's cap (error control may take more,
+    /// never fewer; 0 without a cap).
+    pub fn least_steps(&self, span: f64) -> f64 {
+        match self {
+            Method::Rk4 { dt } => (span / dt).ceil(),
+            Method::Dopri5(tol) => span / tol.max_step,
+        }
+    }
+
+    /// The most steps (accepted + rejected) a run may take.
+    pub fn max_steps(&self) -> u64 {
+        match self {
+            Method::Rk4 { .. } => MAX_FIXED_STEPS as u64,
+            Method::Dopri5(tol) => tol.max_steps,
+        }
+    }
+
     pub fn validate(&self) -> Result<()> {
         match self {
             Method::Rk4 { dt } => require_positive("dt", *dt),

@@ -342,3 +342,18 @@ fn a_run_time_size_gives_the_same_bits_as_a_fixed_one() {
         }
     }
 }
+
+#[test]
+fn least_steps_is_the_fixed_count_or_the_span_over_the_cap() {
+    assert_eq!(Method::Rk4 { dt: 0.3 }.least_steps(3.0), 10.0);
+    assert_eq!(Method::Rk4 { dt: 0.4 }.least_steps(3.0), 8.0);
+    let capped = Tolerances {
+        max_step: 0.2,
+        ..Tolerances::default()
+    };
+    assert_eq!(Method::Dopri5(capped).least_steps(100.0), 500.0);
+    // Error control alone has no lower bound known up front.
+    assert_eq!(Method::Dopri5(Tolerances::default()).least_steps(1e6), 0.0);
+    assert_eq!(Method::Dopri5(capped).max_steps(), 500_000_000);
+    assert_eq!(Method::Rk4 { dt: 1.0 }.max_steps(), MAX_FIXED_STEPS as u64);
+}

@@ -12,7 +12,7 @@ mod longrun;
 mod montecarlo;
 mod orbit;
 
-use crate::dynamics::hinge_energy;
+use crate::dynamics::checked_hinge_energy;
 use crate::dynamics::{thermal_moment, Hinge, StructuralModel};
 use crate::integrate::State;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
@@ -227,8 +227,8 @@ fn energy<'py>(
             .as_array()
             .iter()
             .zip(theta_dot.as_array().iter())
-            .map(|(&a, &b)| hinge_energy(&p, m, a, b, moment))
-            .collect();
+            .map(|(&a, &b)| checked_hinge_energy(&p, m, a, b, moment))
+            .collect::<crate::Result<Vec<f64>>>()?;
         Ok(array(py, e))
     })
 }
@@ -410,6 +410,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CASE_A_PANEL", panel_dict(m.py(), &crate::Panel::case_a())?)?;
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
     m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
+    m.add("MAX_THREADS", crate::montecarlo::MAX_THREADS)?;
     m.add("VALIDITY_LIMIT", crate::dynamics::VALIDITY_LIMIT)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;

@@ -7,6 +7,7 @@ use super::convert::{coupling, hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use super::longrun::hybrid_from;
+use crate::longrun::{resolve_hinge, STEPS_PER_HINGE_PERIOD};
 use crate::montecarlo::{pool, run_batch_on, EnsembleSettings, Path, SampleMetrics};
 use crate::Panel;
 use numpy::{PyArray1, PyReadonlyArray2};
@@ -34,6 +35,29 @@ fn panels_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Panel>> {
             Ok(p)
         })
         .collect()
+}
+
+/// The fewest integrator steps a run of `span` s of each row of `panels` takes, with the step
+/// capped at T_n / `steps_per_period` as long runs do (0: no cap; None: the ensembles' cap):
+/// known before any work, so that a request beyond its step budget is refused up front.
+#[pyfunction]
+#[pyo3(signature = (panels, solver, span, steps_per_period=None))]
+fn least_steps<'py>(
+    py: Python<'py>,
+    panels: PyReadonlyArray2<'py, f64>,
+    solver: &Bound<'py, PyDict>,
+    span: f64,
+    steps_per_period: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    shield(|| {
+        let method = solver_from(solver)?;
+        let cap = steps_per_period.unwrap_or(STEPS_PER_HINGE_PERIOD);
+        let least = panels_from(&panels)?
+            .iter()
+            .map(|p| resolve_hinge(&method, p, cap).least_steps(span))
+            .collect();
+        Ok(PyArray1::from_vec(py, least))
+    })
 }
 
 /// Every row that the panel validation refuses, as (row, parameter, message).
@@ -181,5 +205,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<EnsemblePool>()?;
     m.add_function(wrap_pyfunction!(cpu_info, m)?)?;
     m.add_function(wrap_pyfunction!(check_panels, m)?)?;
+    m.add_function(wrap_pyfunction!(least_steps, m)?)?;
     Ok(())
 }
