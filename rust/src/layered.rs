@@ -726,19 +726,7 @@ pub fn simulate(
     let n = conduction.nodes();
     let start: Vec<f64> = match y0 {
         Some(v) => {
-            if v.len() != n + 2 {
-                return Err(Error::invalid(
-                    "y0",
-                    format!("{} components", v.len()),
-                    &format!(
-                        "must hold the {n} node temperatures, θ and θ̇ ({} values)",
-                        n + 2
-                    ),
-                ));
-            }
-            if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-                return Err(Error::invalid("y0", x, "every component must be finite"));
-            }
+            check_start(v, n)?;
             v.to_vec()
         }
         None => {
@@ -1009,7 +997,7 @@ pub fn equilibrium(
     }
     x[n] = c.moment(&profile) / k_el;
     let k = c.conduction_matrix();
-    for _ in 0..100 {
+    let residual_and_jacobian = |x: &DVector<f64>| {
         let th = x[n];
         let (area, d_area) = match coupling {
             Coupling::ProjectedArea => (th.cos(), -th.sin()),
@@ -1034,38 +1022,27 @@ pub fn equilibrium(
             jac[(n, i)] = c.moment_weight[i] / k_el;
         }
         jac[(n, n)] = -1.0;
-        let dx = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
+        (f, jac)
+    };
+    let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
+        (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]) && dx[n].abs() < 1e-14
+    };
+    let x = crate::steady::newton("steady state", x, n, residual_and_jacobian, settled)?;
+    if x[n].abs() >= std::f64::consts::FRAC_PI_2 {
+        return Err(Error::NoConvergence {
             what: "steady state".into(),
-            reason: "singular Jacobian".into(),
-        })?;
-        let mut lambda = 1.0;
-        while (0..n).any(|i| x[i] + lambda * dx[i] <= 0.0) {
-            lambda *= 0.5;
-        }
-        x += &dx * lambda;
-        let small_t = (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]);
-        if small_t && dx[n].abs() < 1e-14 {
-            if x[n].abs() >= std::f64::consts::FRAC_PI_2 {
-                return Err(Error::NoConvergence {
-                    what: "steady state".into(),
-                    reason: format!(
-                        "hinge angle {} rad is beyond 90°: the panel is far too soft",
-                        x[n]
-                    ),
-                });
-            }
-            let temperatures: Vec<f64> = x.rows(0, n).iter().copied().collect();
-            let moment = c.moment(&temperatures);
-            return Ok(LayeredEquilibrium {
-                temperatures,
-                theta: x[n],
-                moment,
-            });
-        }
+            reason: format!(
+                "hinge angle {} rad is beyond 90°: the panel is far too soft",
+                x[n]
+            ),
+        });
     }
-    Err(Error::NoConvergence {
-        what: "steady state".into(),
-        reason: "Newton did not converge in 100 iterations".into(),
+    let temperatures: Vec<f64> = x.rows(0, n).iter().copied().collect();
+    let moment = c.moment(&temperatures);
+    Ok(LayeredEquilibrium {
+        temperatures,
+        theta: x[n],
+        moment,
     })
 }
 
@@ -1153,23 +1130,17 @@ fn growth(
 ) -> Result<(f64, f64, Vec<nalgebra::Complex<f64>>)> {
     let n = c.nodes();
     let jac = jacobian(panel, c, model, coupling, flux, eq);
-    // Balance kelvin rows against radian rows (a diagonal similarity keeps the eigenvalues).
+    // Balance kelvin rows against radian rows.
     let tmax = eq.temperatures.iter().fold(1.0_f64, |a, &b| a.max(b));
     let mut scale = vec![1.0; n + 2];
     scale[n] = 1.0 / tmax;
     scale[n + 1] = panel.natural_angular_frequency() / tmax;
-    let balanced = DMatrix::from_fn(n + 2, n + 2, |i, j| jac[(i, j)] * scale[j] / scale[i]);
-    let ev = balanced.complex_eigenvalues();
-    if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
-        return Err(Error::NoConvergence {
-            what: "eigenvalues".into(),
-            reason: "non-finite result".into(),
-        });
-    }
-    let mut ev: Vec<_> = ev.iter().copied().collect();
-    ev.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
-    let omega = ev.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
-    Ok((ev[0].re, omega / (2.0 * std::f64::consts::PI), ev))
+    let spectrum = crate::flutter::Spectrum::of(&jac, &scale)?;
+    Ok((
+        spectrum.growth_rate,
+        spectrum.frequency_hz,
+        spectrum.eigenvalues,
+    ))
 }
 
 /// The damping c_d (N m s/rad) at which the growth rate crosses zero (bisection); 0 when the
@@ -1190,36 +1161,10 @@ pub fn critical_damping(
         };
         Ok(growth(&p, c, model, coupling, flux, &eq)?.0)
     };
-    if rate(0.0)? < 0.0 {
-        return Ok(0.0);
-    }
-    let mut hi = panel
+    let start = panel
         .damping
         .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
-    let mut tries = 0;
-    while rate(hi)? >= 0.0 {
-        hi *= 2.0;
-        tries += 1;
-        if tries > 200 {
-            return Err(Error::NoConvergence {
-                what: "critical damping".into(),
-                reason: "no stabilising damping found".into(),
-            });
-        }
-    }
-    let mut lo = 0.0;
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if rate(mid)? >= 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= 1e-12 * hi {
-            break;
-        }
-    }
-    Ok(0.5 * (lo + hi))
+    crate::flutter::critical_value(rate, start, 1e-12)
 }
 
 #[cfg(test)]
