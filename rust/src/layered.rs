@@ -1609,6 +1609,70 @@ mod tests {
         }
     }
 
+    /// Physics review of the node count: the plain paper panel's c_d* is 2.16 with two nodes
+    /// and about 5.6 with many. Not a bug: (1) with two nodes the N-node model is eq. 2 and its
+    /// c_d* is the two-layer one, which the Sec. 4.2 closed form approximates; (2) as the nodes
+    /// double, c_d* converges (second order in the element size) to the continuum's; (3) the
+    /// two lumped nodes relax the gradient at 4 K/(m c), the continuum slab at π² K/(m c) (its
+    /// first odd conduction mode), so at the hinge frequency the gradient answers the swinging
+    /// flux with another lag, and another thermal pumping.
+    #[test]
+    fn critical_damping_converges_with_the_nodes_and_two_nodes_are_the_two_layer_model() {
+        let p = Panel::paper();
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let cd = |nodes: usize| {
+            let c = Conduction::homogeneous(&p, nodes).unwrap();
+            critical_damping(&p, &c, model, coupling, 1.0).unwrap()
+        };
+        // (1) Two nodes: the two-layer model's c_d* (to the bisection's tolerance).
+        let two = crate::flutter::critical_damping(&p, model, coupling, 1.0).unwrap();
+        assert!((cd(2) / two - 1.0).abs() < 1e-10, "{} vs {two}", cd(2));
+        // ... which the closed form of Sec. 4.2 approximates on a panel with ε_f = ε_b (the
+        // form it assumes; linear hinge, first order in the pumping).
+        let equal = Panel {
+            emissivity_front: 0.55,
+            emissivity_back: 0.55,
+            ..p
+        };
+        let c2 = Conduction::homogeneous(&equal, 2).unwrap();
+        let exact = critical_damping(&equal, &c2, HingeModel::Linear, coupling, 1.0).unwrap();
+        let closed = crate::linear::LinearThermal::new(&equal, 1.0, None, None)
+            .unwrap()
+            .critical_damping_estimate();
+        println!("ε_f = ε_b: c_d* two nodes {exact:.5}, Sec. 4.2 closed form {closed:.5}");
+        assert!((closed / exact - 1.0).abs() < 1e-3, "{closed} vs {exact}");
+        // (2) Convergence as the elements double (nodes 2^k + 1).
+        let values: Vec<f64> = [3, 5, 9, 17, 33, 65].iter().map(|&n| cd(n)).collect();
+        let changes: Vec<f64> = values.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+        let orders: Vec<f64> = changes.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        let doubling: Vec<f64> = [4, 8, 16, 32, 64].iter().map(|&n| cd(n)).collect();
+        println!(
+            "c_d* at 3..65 nodes {values:?}, changes {changes:?}, observed orders {orders:?}; \
+             at 4, 8, 16, 32, 64 nodes {doubling:?}"
+        );
+        for &o in &orders[2..] {
+            assert!(o > 1.7, "observed order {o}: {orders:?}");
+        }
+        let limit = values[5] + changes[4] / 3.0; // Richardson, second order
+        assert!((values[5] / limit - 1.0).abs() < 1e-3, "{values:?}");
+        assert!((doubling[4] / limit - 1.0).abs() < 1e-3, "{doubling:?}");
+        assert!(limit > 2.0 * two, "{limit} vs {two}");
+        // (3) The gradient's relaxation: 4 K/(m c) for two lumped nodes, π² K/(m c) for the
+        // continuum, which the first odd conduction mode approaches at second order.
+        let unit = p.conductance / p.heat_capacity();
+        let first = |nodes: usize| Conduction::homogeneous(&p, nodes).unwrap().modes().rates[1];
+        assert!((first(2) / (4.0 * unit) - 1.0).abs() < 1e-12);
+        let pi2 = std::f64::consts::PI.powi(2) * unit;
+        let errors: Vec<f64> = [9, 17, 33, 65]
+            .iter()
+            .map(|&n| (first(n) / pi2 - 1.0).abs())
+            .collect();
+        println!("first odd mode against π² K/(m c) at 9..65 nodes: {errors:?}");
+        for w in errors.windows(2) {
+            assert!(((w[0] / w[1]).log2() - 2.0).abs() < 0.1, "{errors:?}");
+        }
+    }
+
     /// One GEO orbit of the example `LAMINATE_PANEL` (wing or boom) with `LAMINATE_NODES` nodes
     /// (2: the two-layer model on the same panel), for instruction counts under callgrind:
     /// `LAMINATE_PANEL=wing LAMINATE_NODES=20 valgrind --tool=callgrind <test binary>
