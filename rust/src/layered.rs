@@ -840,6 +840,9 @@ impl crate::longrun::SummaryView for LayeredView {
             self.system.moment_of(flux, y) / self.panel.hinge_stiffness,
         )
     }
+    fn rate(&self, y: &[f64]) -> f64 {
+        y[self.system.thermal_size() + 1]
+    }
 }
 
 /// Per-orbit summaries of the N-node system (as [`crate::longrun::run_orbits`]), from `y0` =
