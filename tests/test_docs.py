@@ -76,5 +76,10 @@ def test_every_scenario_key_is_documented() -> None:
     for key in common:
         assert f"| `{key}` |" in reference, key
         assert re.search(rf"\b{key}\b", run_help), key
+    from thermojitter.scenario import LAMINATE_KEYS, LAYER_KEYS
+
+    for key in (*LAMINATE_KEYS, "layers", *LAYER_KEYS):
+        assert f"| `{key}` |" in reference, key
+        assert re.search(rf"\b{key}\b", run_help), key
     for key in (*FLUTTER_KEYS, *SETTING_KEYS, *RUN_KEYS):
         assert f"| `{key}` |" in reference, key

@@ -126,6 +126,36 @@ def test_node_temperatures_over_time_and_depth() -> None:
     )
 
 
+def test_node_temperatures_in_pandas_name_node_and_layer() -> None:
+    pd = pytest.importorskip("pandas")
+    p = tj.Panel.from_laminate(wing(), length=20.0)
+    sol = tj.simulate(p, GEO, (0.0, 600.0), layers=12, dt_out=60.0)
+    frame = sol.to_pandas()
+    assert isinstance(frame, pd.DataFrame)
+    names = [c for c in frame.columns if c.startswith("T_node")]
+    assert names == list(sol.node_columns) and len(names) == 12
+    # Faces, interfaces and interior nodes each say where they are.
+    assert names[0] == "T_node00 (front, kapton)"
+    assert names[-1] == "T_node11 (back, cfrp_m55j_qi)"
+    interfaces = [n for n in names if "|" in n]
+    assert [n.split(" ", 1)[1] for n in interfaces] == [
+        "(kapton|cfrp_m55j_qi)",
+        "(cfrp_m55j_qi|aluminium_honeycomb)",
+        "(aluminium_honeycomb|cfrp_m55j_qi)",
+    ]
+    assert sol.T_nodes is not None and sol.depth is not None
+    for k, name in enumerate(names):
+        assert np.array_equal(frame[name].to_numpy(), sol.T_nodes[:, k])
+    assert frame.attrs["depth"] == pytest.approx(list(sol.depth), abs=0.0)
+    # The interface nodes sit at the layers' boundaries.
+    bounds = np.cumsum([layer.thickness for layer in wing().layers])[:-1]
+    at = [sol.depth[k] for k, n in enumerate(names) if "|" in n]
+    assert at == pytest.approx(list(bounds), rel=1e-12)
+    # Without layers=N: the plain columns only.
+    plain = tj.simulate(p, GEO, (0.0, 600.0), dt_out=60.0).to_pandas()
+    assert not [c for c in plain.columns if c.startswith("T_node")]
+
+
 def test_layers_is_checked() -> None:
     p = tj.Panel.from_laminate(wing(), length=20.0)
     with pytest.raises(ValueError, match="layers"):

@@ -306,6 +306,8 @@ class EnsemblePool:
         hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
         lockstep: bool = True,
+        layup: dict[str, Any] | None = None,
+        nodes: int | None = None,
     ) -> dict[str, Any]: ...
 
 # --- laminates and the N-node model -------------------------------------------------------------

@@ -37,9 +37,9 @@ from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT, orbit_count, refuse_beyond_budget
 from thermojitter.orbit import Orbit
-from thermojitter.panel import Panel
+from thermojitter.panel import LAYUP_FIELDS, Panel
 from thermojitter.progress import progress_bar, report_interrupted
-from thermojitter.simulate import check_inputs
+from thermojitter.simulate import check_inputs, check_layers, layup_dict
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 Sampler = Literal["random", "lhs", "sobol"]
@@ -309,6 +309,32 @@ def _options(
         "validity_limit": DEFAULT_THETA_LIMIT,
         "hybrid": {} if hybrid else None,
     }
+
+
+def _with_layers(
+    options: dict[str, Any], panel: Panel, layers: Any, names: Sequence[str]
+) -> dict[str, Any]:
+    """The run options with the N-node through-thickness model (``layers`` nodes) on the
+    panel's layup, or on each sample's panel as one homogeneous layer for a plain panel.
+
+    The N-node model is integrated in full: the hybrid propagator (two-layer only) gives way to
+    its rk45 fallback, as in ``simulate_orbits``. On a laminate panel the fields its layup
+    decides cannot be varied (the N-node model takes them from the layers)."""
+    if layers is None:
+        return options
+    nodes = check_layers(layers)
+    if panel.layup is not None:
+        fixed = [name for name in names if name in LAYUP_FIELDS]
+        if fixed:
+            raise ParameterError(
+                f"vary.{fixed[0]}",
+                fixed[0],
+                message=(
+                    f"{fixed[0]} of a laminate panel follows from its layup, which layers={nodes} "
+                    "integrates layer by layer: vary a plain panel, or run one study per laminate"
+                ),
+            )
+    return {**options, "hybrid": None, "nodes": nodes, "layup": layup_dict(panel)}
 
 
 def _default_method(method: str | None, orbit: Orbit, horizon: Any) -> str:
@@ -780,6 +806,7 @@ def monte_carlo(
     window: float = 600.0,
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
+    layers: int | None = None,
 ) -> Any:
     """Runs ``n`` panels drawn around ``panel`` and returns a pandas DataFrame, one row a sample:
     the sampled parameters, then the metrics (see ``METRICS``).
@@ -814,6 +841,11 @@ def monte_carlo(
 
     - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
       and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback).
+    - ``layers``: N runs every sample with the N-node through-thickness model (as
+      ``simulate_orbits(..., layers=N)``): on the layup of a panel made by
+      :meth:`Panel.from_laminate` (whose layup-decided fields cannot be varied then), or on each
+      sample's panel as one homogeneous layer. The N-node model is integrated in full (rk45 in
+      place of the hybrid propagator). A sample is the single run of its panel.
 
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
@@ -829,6 +861,7 @@ def monte_carlo(
                           atol=atol, dt=dt, max_steps=max_steps),
         window, threshold, stop_at_threshold,
     )  # fmt: skip
+    options = _with_layers(options, panel, layers, list(vary))
     u = _unit_design(sampler, n, len(vary), seed)
     names, values, matrix = _sampled(panel, vary, u, bool(truncate))
     settings = {
@@ -870,10 +903,11 @@ def sweep(
     window: float = 600.0,
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
+    layers: int | None = None,
 ) -> Any:
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
-    arguments are the same."""
+    arguments (``layers`` too) are the same."""
     check_inputs(panel, orbit)
     if not isinstance(grid, Mapping) or not grid:
         raise ValueError("grid must be a non-empty mapping of panel parameter names to values")
@@ -894,6 +928,7 @@ def sweep(
     size = math.prod(len(a) for a in axes)
     if size > MAX_SAMPLES:
         raise ParameterError("grid", f"{size} panels", f"must hold at most {MAX_SAMPLES} panels")
+    options = _with_layers(options, panel, layers, names)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
     matrix = _panel_matrix(panel, names, values)
     _refuse_invalid(matrix, "")
@@ -947,14 +982,15 @@ def sensitivity(
     window: float = 600.0,
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
+    layers: int | None = None,
 ) -> SensitivityResult:
     """Sobol sensitivity indices of one metric to the parameters in ``vary`` (needs SALib:
     ``pip install 'thermojitter[sensitivity]'``).
 
     Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design (best with n
     a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
-    arguments these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` per parameter
-    (first-order and total indices, 95 % confidence half-widths).
+    arguments (``layers`` too) these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``,
+    ``ST_conf`` per parameter (first-order and total indices, 95 % confidence half-widths).
     """
     try:
         from SALib.analyze import sobol as sobol_analyze
@@ -978,6 +1014,7 @@ def sensitivity(
         window, threshold, stop_at_threshold,
     )  # fmt: skip
     names = list(vary)
+    options = _with_layers(options, panel, layers, names)
     problem = {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # n not a power of 2

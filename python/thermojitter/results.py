@@ -108,13 +108,43 @@ class Solution(_Run):
     """With ``layers=N``: the temperature of every node (time × node), K."""
     depth: Array | None = None
     """With ``layers=N``: each node's depth below the front face, m."""
+    node_labels: tuple[str, ...] | None = None
+    """With ``layers=N``: where each node sits: ``"front, L"``/``"back, L"`` on the faces of
+    layers L, ``"L|M"`` on the interface of layers L and M, ``"L"`` inside layer L (a plain
+    panel's one layer is ``"panel"``)."""
+
+    @property
+    def node_columns(self) -> tuple[str, ...]:
+        """The ``to_pandas()`` column of each node's temperature: ``"T_node07 (honeycomb)"``
+        (node index, front first, and where it sits, see ``node_labels``); empty without
+        ``layers=N``."""
+        if self.T_nodes is None or self.node_labels is None:
+            return ()
+        width = len(str(len(self.node_labels) - 1))
+        return tuple(f"T_node{i:0{width}d} ({label})" for i, label in enumerate(self.node_labels))
+
+    def to_pandas(self) -> Any:
+        """A pandas DataFrame indexed by time (s); needs pandas. With ``layers=N`` it has a
+        column per node after the others (``node_columns``), and ``frame.attrs["depth"]`` gives
+        each node's depth below the front face, m."""
+        frame = super().to_pandas()
+        names = self.node_columns
+        if names and self.T_nodes is not None:
+            import pandas as pd
+
+            nodes = pd.DataFrame(np.asarray(self.T_nodes), index=frame.index, columns=list(names))
+            frame = pd.concat([frame, nodes], axis=1)
+            frame.attrs["depth"] = [float(v) for v in np.asarray(self.depth)]
+        return frame
 
     def to_xarray(self) -> Any:
         """An xarray Dataset over t (s); with ``layers=N`` also ``T_nodes`` over (t, node),
-        with the node depth (m) as a coordinate."""
+        with the node depth (m) and label (``node_labels``) as coordinates."""
         ds = super().to_xarray()
         if self.T_nodes is not None and self.depth is not None:
             ds = ds.assign_coords(depth=("node", np.asarray(self.depth)))
+            if self.node_labels is not None:
+                ds = ds.assign_coords(label=("node", list(self.node_labels)))
             ds["T_nodes"] = (("t", "node"), np.asarray(self.T_nodes))
         return ds
 

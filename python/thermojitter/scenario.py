@@ -1,9 +1,18 @@
 """Scenario files: one simulation described in TOML, checked key by key.
 
-A scenario has four tables, each optional::
+A scenario has these tables, each optional::
 
     [panel]        # any Panel field (SI); missing ones take the Table 1 values
     mass_per_length = 5.51
+
+    [laminate]     # a layup: the panel is then Panel.from_laminate of it, and [panel] may
+    emissivity_front = 0.8   # give only length, width, hinge_stiffness, damping,
+    emissivity_back = 0.8    # solar_constant and moment_scale
+    absorptivity = 0.9
+
+    [[laminate.layers]]      # front first: a library material and its thickness, or the six
+    material = "kapton"      # properties of Layer (a material's values may be overridden)
+    thickness = 50e-6
 
     [orbit]        # preset = "geo_equinox" and/or any Orbit field
     preset = "geo_equinox"
@@ -30,10 +39,12 @@ from pathlib import Path
 from typing import Any
 
 from thermojitter import errors as checks
+from thermojitter import materials
 from thermojitter.errors import ParameterError
+from thermojitter.laminate import Laminate, Layer
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
 from thermojitter.orbit import Orbit
-from thermojitter.panel import Panel
+from thermojitter.panel import LAYUP_FIELDS, Panel
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 if sys.version_info >= (3, 11):
@@ -237,6 +248,107 @@ def _panel(path: Path, table: dict[str, Any]) -> Panel:
     return _validated(path, "panel", Panel, {}, values)  # type: ignore[no-any-return]
 
 
+LAYER_KEYS = ("material", "name", *(f.name for f in fields(Layer) if f.name != "name"))
+"""Keys of a [[laminate.layers]] entry: a library material and/or the properties of a Layer."""
+LAMINATE_KEYS = tuple(f.name for f in fields(Laminate) if f.name != "layers")
+"""Keys of [laminate] besides its layers."""
+LAMINATE_PANEL_KEYS = tuple(
+    k for k in Panel.field_names() if k not in LAYUP_FIELDS and k not in LAMINATE_KEYS
+) + ("width",)
+"""The [panel] keys a scenario with a [laminate] may give (Panel.from_laminate's arguments)."""
+
+
+def _layer(path: Path, index: int, entry: Any) -> Layer:
+    """One [[laminate.layers]] entry; errors name laminate.layers[i].key and the layer."""
+    where = f"laminate.layers[{index}]"
+    if not isinstance(entry, dict):
+        raise ScenarioError(path, where, f"must be a table, not {_toml_type(entry)}")
+    named = entry.get("name", entry.get("material"))
+    label = where + (f" ('{named}')" if isinstance(named, str) else "")
+    for key in entry:
+        if key not in LAYER_KEYS:
+            raise ScenarioError(
+                path, f"{label}.{key}", f"unknown key (allowed: {', '.join(LAYER_KEYS)})"
+            )
+    values: dict[str, Any] = {}
+    if "material" in entry:
+        key = entry["material"]
+        if not isinstance(key, str) or key not in materials.LIBRARY:
+            raise ScenarioError(
+                path,
+                f"{label}.material",
+                f"must be one of {', '.join(repr(k) for k in materials.LIBRARY)}, not {key!r}",
+            )
+        # The material's properties, named after it; the entry's own keys override them.
+        values = materials.LIBRARY[key].layer(1.0).as_dict()
+        del values["thickness"]
+    if "name" in entry:
+        if not isinstance(entry["name"], str):
+            raise ScenarioError(path, f"{label}.name", f"must be a string, not {entry['name']!r}")
+        values["name"] = entry["name"]
+    for key, value in entry.items():
+        if key not in ("material", "name"):
+            values[key] = _real(path, f"{label}.{key}", value)
+    missing = [f.name for f in fields(Layer) if f.name != "name" and f.name not in values]
+    if missing:
+        raise ScenarioError(
+            path,
+            f"{label}.{missing[0]}",
+            "is required (give material = a library key, or every property of the layer)",
+        )
+    # The engine checks the layer and names the property it refuses.
+    try:
+        return Layer(**values)
+    except ParameterError as exc:
+        # "layer 'core': density = -50 is invalid: ..." → "= -50 is invalid: ..." under the key
+        # of the property the engine names.
+        field_name = exc.parameter.rsplit(": ", 1)[-1]
+        reason = str(exc).split(f"{field_name} ", 1)[-1]
+        raise ScenarioError(path, f"{label}.{field_name}", reason) from None
+    except (ValueError, TypeError) as exc:
+        raise ScenarioError(path, label, str(exc)) from None
+
+
+def _laminate(path: Path, table: dict[str, Any]) -> Laminate:
+    """[laminate] with its [[laminate.layers]] (front first)."""
+    _reject_unknown(path, "laminate", table, {"layers", *LAMINATE_KEYS})
+    entries = table.get("layers")
+    if not isinstance(entries, list) or not entries:
+        raise ScenarioError(
+            path, "laminate.layers", "at least one [[laminate.layers]] table is required"
+        )
+    layers = tuple(_layer(path, i, entry) for i, entry in enumerate(entries))
+    missing = [k for k in ("emissivity_front", "emissivity_back", "absorptivity") if k not in table]
+    if missing:
+        raise ScenarioError(path, f"laminate.{missing[0]}", "is required")
+    values = {k: _real(path, f"laminate.{k}", v) for k, v in table.items() if k != "layers"}
+    try:
+        return Laminate(layers, **values)
+    except ParameterError as exc:
+        # The engine names the surface property or "layers" (the stack as a whole).
+        key = f"laminate.{exc.parameter}"
+        reason = str(exc).split(f"{exc.parameter} ", 1)[-1]
+        raise ScenarioError(path, key, reason) from None
+    except (ValueError, TypeError) as exc:
+        raise ScenarioError(path, "laminate", str(exc)) from None
+
+
+def _laminate_panel(path: Path, panel: dict[str, Any], laminate: Laminate) -> Panel:
+    """Panel.from_laminate of the layup with the [panel] keys it takes."""
+    for key in panel:
+        if key not in LAMINATE_PANEL_KEYS:
+            raise ScenarioError(
+                path,
+                f"panel.{key}",
+                "follows from [laminate] (give it there, or remove [laminate]); with a "
+                f"[laminate], [panel] takes {', '.join(LAMINATE_PANEL_KEYS)}",
+            )
+    values = {key: _real(path, f"panel.{key}", value) for key, value in panel.items()}
+    return _validated(  # type: ignore[no-any-return]
+        path, "panel", lambda **kw: Panel.from_laminate(laminate, **kw), {}, values
+    )
+
+
 def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
     """[orbit]: a preset (with its own arguments: start_date for geo_year, altitude for leo)
     and/or any Orbit field."""
@@ -342,14 +454,19 @@ def parse_scenario(
     ``extra_sections`` names further tables the caller accepts; they are returned unchecked in
     ``Scenario.extra`` (absent ones as empty tables)."""
     where = Path(path)
-    sections = {"panel", "orbit", "simulation", "output", *extra_sections}
+    sections = {"panel", "laminate", "orbit", "simulation", "output", *extra_sections}
     for key in data:
         if key not in sections:
             raise ScenarioError(
                 where, key, f"unknown table (allowed: {', '.join(sorted(sections))})"
             )
+    if "laminate" in data:
+        layup = _laminate(where, _table(where, data, "laminate"))
+        panel = _laminate_panel(where, _table(where, data, "panel"), layup)
+    else:
+        panel = _panel(where, _table(where, data, "panel"))
     return Scenario(
-        panel=_panel(where, _table(where, data, "panel")),
+        panel=panel,
         orbit=_orbit(where, _table(where, data, "orbit")),
         simulation=_simulation(where, _table(where, data, "simulation")),
         output=_output(where, _table(where, data, "output")),

@@ -204,6 +204,7 @@ def simulate(
             y_end=raw["y_end"],
             T_nodes=temps,
             depth=raw["depth"],
+            node_labels=tuple(raw["node_labels"]),
         )
     raw = _core.simulate(
         panel.as_dict(),

@@ -11,6 +11,7 @@ keywords or ``solver=SolverSettings(...)``, and its result reports the settings 
 from __future__ import annotations
 
 import dataclasses
+import functools
 from typing import Any, Literal
 
 from thermojitter import _core
@@ -53,11 +54,13 @@ class SolverSettings:
         }
         for name, value in checked.items():
             object.__setattr__(self, name, value)
+        # Kept as made (the object is immutable): every run passes them to the engine.
+        object.__setattr__(self, "_items", tuple(checked.items()))
         _core.check_solver(self.as_dict())
 
     def as_dict(self) -> dict[str, Any]:
         """The settings as the engine takes them (a plain mapping)."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        return dict(self._items)  # type: ignore[attr-defined]
 
     def replace(self, **changes: Any) -> SolverSettings:
         """A validated copy with ``changes``."""
@@ -71,7 +74,15 @@ class SolverSettings:
         silently ignored."""
         given = {k: v for k, v in keywords.items() if not (k == "method" and v is None)}
         if solver is None:
-            return cls(**given)
+            # Runs repeat the same few settings: each distinct set is checked once. The key holds
+            # each value's type, so True is not taken for 1.
+            key = tuple((k, type(v), v) for k, v in given.items())
+            try:
+                return _checked(key)
+            except TypeError as exc:
+                if "unhashable" not in str(exc):
+                    raise
+                return cls(**given)
         if not isinstance(solver, SolverSettings):
             raise TypeError(
                 f"solver must be a thermojitter.SolverSettings, not {checks.type_name(solver)}"
@@ -83,3 +94,10 @@ class SolverSettings:
                 "solver", solver, f"give solver= or {', '.join(clash)}, not both"
             )
         return solver
+
+
+@functools.lru_cache(maxsize=64)
+def _checked(key: tuple[tuple[str, type, Any], ...]) -> SolverSettings:
+    """The settings of ``key`` ((name, type, value) triples), checked once (a refused set is not
+    cached: its error is raised again on every call)."""
+    return SolverSettings(**{name: value for name, _, value in key})

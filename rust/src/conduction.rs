@@ -51,6 +51,8 @@ pub struct Conduction {
     pub radiation_back: f64,
     /// Index of the layer of each element.
     pub element_layer: Vec<usize>,
+    /// The name of each layer of the layup.
+    pub layer_names: Vec<String>,
     /// Built by [`Conduction::homogeneous`] with two nodes: eq. 2 itself, whose steady state is
     /// [`crate::steady::equilibrium`]'s.
     pub two_layer: bool,
@@ -143,6 +145,7 @@ impl Conduction {
             radiation_front: STEFAN_BOLTZMANN * panel.emissivity_front,
             radiation_back: STEFAN_BOLTZMANN * panel.emissivity_back,
             element_layer,
+            layer_names: laminate.layers.iter().map(|l| l.name.clone()).collect(),
             two_layer: false,
         })
     }
@@ -188,6 +191,26 @@ impl Conduction {
 
     pub fn nodes(&self) -> usize {
         self.capacity.len()
+    }
+
+    /// Where each node sits, front to back: "front, L" and "back, L" for the face nodes of
+    /// layers L, "L|M" for a node on the interface of layers L and M, and "L" inside layer L.
+    pub fn node_labels(&self) -> Vec<String> {
+        let n = self.nodes();
+        let name = |e: usize| self.layer_names[self.element_layer[e]].as_str();
+        (0..n)
+            .map(|i| {
+                if i == 0 {
+                    format!("front, {}", name(0))
+                } else if i + 1 == n {
+                    format!("back, {}", name(n - 2))
+                } else if self.element_layer[i - 1] != self.element_layer[i] {
+                    format!("{}|{}", name(i - 1), name(i))
+                } else {
+                    name(i).to_string()
+                }
+            })
+            .collect()
     }
 
     /// Total heat capacity per unit area, J/(m² K).
@@ -443,6 +466,16 @@ mod tests {
         assert!((c.depth[19] - lam.thickness()).abs() < 1e-18);
         assert!(Conduction::new(&panel(), &lam, 4).is_err());
         assert!(Conduction::new(&panel(), &lam, 5).is_ok());
+        // One node per layer boundary, labelled with both layers; faces with theirs.
+        let labels = c.node_labels();
+        assert_eq!(labels[0], format!("front, {}", lam.layers[0].name));
+        assert_eq!(labels[19], format!("back, {}", lam.layers[3].name));
+        let interfaces: Vec<&String> = labels.iter().filter(|l| l.contains('|')).collect();
+        assert_eq!(interfaces.len(), 3, "{labels:?}");
+        assert_eq!(
+            interfaces[1],
+            &format!("{}|{}", lam.layers[1].name, lam.layers[2].name)
+        );
     }
 
     #[test]

@@ -252,13 +252,7 @@ fn sample_head(
     let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
     let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
     let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-    let options = SummaryOptions {
-        window: s.window,
-        // Without a threshold nothing is timed: a limit no angle reaches.
-        theta_limit: s.threshold.unwrap_or(f64::MAX),
-        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
-        steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
-    };
+    let options = summary_options(s);
     let head = SampleHead {
         theta_eq: flutter.equilibrium.theta,
         growth_rate: flutter.growth_rate,
@@ -266,6 +260,114 @@ fn sample_head(
         critical_damping: critical,
     };
     Ok((head, y0, options))
+}
+
+/// The per-orbit summaries every sample of a batch takes.
+fn summary_options(s: &EnsembleSettings) -> SummaryOptions {
+    SummaryOptions {
+        window: s.window,
+        // Without a threshold nothing is timed: a limit no angle reaches.
+        theta_limit: s.threshold.unwrap_or(f64::MAX),
+        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
+        steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
+    }
+}
+
+/// The N-node through-thickness model of every sample of a batch: `nodes` nodes through the
+/// thickness of `layup`, or of each sample's panel as one homogeneous layer when `layup` is None
+/// (see [`crate::conduction::Conduction::homogeneous`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layers {
+    pub layup: Option<crate::laminate::Laminate>,
+    pub nodes: usize,
+}
+
+/// One sample with the N-node model: the N-node flutter analysis and the summarised N-node run
+/// of `panel` from its sunlit equilibrium, the same computations as a single run of it
+/// (`layered::analyse`, `layered::critical_damping`, `layered::run_orbits`).
+pub fn run_sample_layered(
+    panel: &Panel,
+    settings: &EnsembleSettings,
+    layers: &Layers,
+    cancel: &Cancel,
+) -> Result<SampleMetrics> {
+    use crate::layered;
+    cancel.check()?;
+    panel.validate()?;
+    let s = settings;
+    if s.hybrid.is_some() {
+        return Err(Error::invalid(
+            "method",
+            "hybrid",
+            "covers the two-layer model only; N-node samples are integrated in full (rk45 or rk4)",
+        ));
+    }
+    let c = match &layers.layup {
+        Some(l) => crate::conduction::Conduction::new(panel, l, layers.nodes)?,
+        None => crate::conduction::Conduction::homogeneous(panel, layers.nodes)?,
+    };
+    let flutter = layered::analyse(panel, &c, s.model, s.coupling, 1.0)?;
+    let critical = layered::critical_damping(panel, &c, s.model, s.coupling, 1.0)?;
+    let eq = layered::equilibrium(panel, &c, s.coupling, s.orbit.flux_scale(0.0))?;
+    let mut y0 = eq.temperatures;
+    y0.extend([eq.theta, 0.0]);
+    let head = SampleHead {
+        theta_eq: flutter.equilibrium.theta,
+        growth_rate: flutter.growth_rate,
+        frequency_hz: flutter.frequency_hz,
+        critical_damping: critical,
+    };
+    let out = layered::run_orbits(
+        panel,
+        c,
+        &s.orbit,
+        s.model,
+        s.coupling,
+        &s.method,
+        0.0,
+        0,
+        s.n_orbits,
+        &y0,
+        summary_options(s),
+        cancel,
+    )?;
+    let n = out.y_end.len();
+    let run = OrbitRun {
+        summaries: out.summaries,
+        stats: out.stats,
+        // The metrics read the summaries only; the faces stand for the thermal state.
+        y_end: Vector4::new(
+            out.y_end[0],
+            out.y_end[n - 3],
+            out.y_end[n - 2],
+            out.y_end[n - 1],
+        ),
+        crossing: out.crossing,
+    };
+    Ok(sample_metrics(&head, settings, &run, run.stats.t_end))
+}
+
+/// [`run_batch`] with the N-node model (one sample at a time per thread).
+pub fn run_batch_layered(
+    pool: &ThreadPool,
+    panels: &[Panel],
+    settings: &EnsembleSettings,
+    layers: &Layers,
+    cancel: &Cancel,
+) -> Result<Vec<SampleMetrics>> {
+    settings.validate()?;
+    let out = pool.install(|| {
+        panels
+            .par_iter()
+            .with_max_len(1)
+            .map(|p| {
+                run_sample_layered(p, settings, layers, cancel)
+                    .unwrap_or_else(SampleMetrics::failed)
+            })
+            .collect()
+    });
+    cancel.check()?;
+    Ok(out)
 }
 
 /// A sample's metrics from its head and its run.

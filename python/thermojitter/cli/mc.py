@@ -33,7 +33,17 @@ from thermojitter.scenario import ScenarioError, load_scenario
 
 SETTING_KEYS = ("n", "seed", "sampler", "truncate")
 """Keys of [montecarlo] that set the design."""
-RUN_KEYS = ("horizon", "threshold", "rtol", "atol", "model", "coupled", "window", "max_steps")
+RUN_KEYS = (
+    "horizon",
+    "threshold",
+    "rtol",
+    "atol",
+    "model",
+    "coupled",
+    "window",
+    "max_steps",
+    "layers",
+)
 
 
 def read_scenario(path: str | Path) -> dict[str, Any]:
@@ -48,6 +58,15 @@ def read_scenario(path: str | Path) -> dict[str, Any]:
     extra = sorted(set(settings) - allowed)
     if extra:
         raise ScenarioError(path, f"montecarlo.{extra[0]}", "unknown key")
+    layers = settings.get("layers")
+    if layers is not None and (
+        isinstance(layers, bool) or not isinstance(layers, int) or layers < 2
+    ):
+        raise ScenarioError(
+            path,
+            "montecarlo.layers",
+            f"must be an integer >= 2 (nodes through the thickness), not {layers!r}",
+        )
     return {"panel": scenario.panel, "orbit": scenario.orbit, "vary": vary, "settings": settings}
 
 

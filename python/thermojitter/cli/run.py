@@ -16,7 +16,14 @@ import numpy as np
 from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_dir, write_output
 from thermojitter.errors import ParameterError
 from thermojitter.progress import progress_bar, report_interrupted
-from thermojitter.scenario import Scenario, ScenarioError, load_scenario
+from thermojitter.scenario import (
+    LAMINATE_KEYS,
+    LAMINATE_PANEL_KEYS,
+    LAYER_KEYS,
+    Scenario,
+    ScenarioError,
+    load_scenario,
+)
 
 MAX_ROWS = 20_000_000
 """Largest time series ``run`` will keep (rows); more asks for a larger dt_out."""
@@ -43,6 +50,15 @@ def scenario_keys_help() -> str:
     return "\n".join(
         [
             table("panel", list(_core.PANEL_FIELDS), "SI units, Table 1 for the rest"),
+            table(
+                "laminate",
+                [*LAMINATE_KEYS, "layers"],
+                "a layup in place of a plain panel ([panel] then gives only "
+                + ", ".join(LAMINATE_PANEL_KEYS)
+                + "); each [[laminate.layers]], front first, has "
+                + ", ".join(LAYER_KEYS)
+                + " (material = a tj.materials key, or every property)",
+            ),
             table(
                 "orbit",
                 ["preset", "start_date", "altitude", *(f.name for f in fields(Orbit))],
@@ -103,6 +119,7 @@ def simulate_scenario(
     pieces: list[dict[str, np.ndarray]] = []
     counters = {"n_steps": 0, "n_rejected": 0, "n_rhs": 0}
     chunks = _chunks(t0, t1, scenario.orbit.period)
+    node_names: tuple[str, ...] = ()
     y0: Any = None
     interrupted = False
     bar: Any = None
@@ -126,7 +143,12 @@ def simulate_scenario(
             )
             # the sample at b starts the next orbit's piece; only the last piece keeps its end
             keep = slice(None) if last else slice(0, len(inside))
-            pieces.append({"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in COLUMNS}})
+            piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in COLUMNS}}
+            # With layers = N: a column per node, named as in Solution.to_pandas().
+            node_names = sol.node_columns
+            if sol.T_nodes is not None:
+                piece.update({n: sol.T_nodes[keep, k] for k, n in enumerate(node_names)})
+            pieces.append(piece)
             for key in counters:
                 counters[key] += int(getattr(sol, key))
             y0 = [float(v) for v in sol.y_end]
@@ -139,7 +161,7 @@ def simulate_scenario(
     finally:
         if bar is not None:
             bar.close()
-    names = ("t", *COLUMNS)
+    names = ("t", *COLUMNS, *(node_names if pieces else ()))
     columns = {
         name: np.concatenate([p[name] for p in pieces]) if pieces else np.empty(0) for name in names
     }

@@ -44,6 +44,13 @@ pub(super) fn model_from(
     DistributedPanel::new(&p, s).map_err(PyErr::from)
 }
 
+/// The kept modes' frequencies (Hz) and the damping ratio in use, into `d`.
+fn modal_info<'py>(py: Python<'py>, m: &DistributedPanel, d: &Bound<'py, PyDict>) -> PyResult<()> {
+    let hz: Vec<f64> = m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect();
+    d.set_item("frequencies_hz", PyArray1::from_vec(py, hz))?;
+    d.set_item("damping_ratio", m.settings.damping_ratio)
+}
+
 /// What the model is: node and element positions, kept frequencies, the damping ratio in use,
 /// the defaults, and the mesh's first elastic frequency.
 #[pyfunction]
@@ -58,14 +65,7 @@ fn distributed_info<'py>(
         let d = PyDict::new(py);
         d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
         d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
-        d.set_item(
-            "frequencies_hz",
-            PyArray1::from_vec(
-                py,
-                m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect(),
-            ),
-        )?;
-        d.set_item("damping_ratio", m.settings.damping_ratio)?;
+        modal_info(py, &m, &d)?;
         d.set_item("arm", mesh.arm())?;
         d.set_item("elastic_modes", mesh.elastic_modes())?;
         Ok(d)
@@ -209,14 +209,7 @@ fn simulate_distributed<'py>(
         d.set_item("n_steps", r.stats.n_steps)?;
         d.set_item("n_rejected", r.stats.n_rejected)?;
         d.set_item("n_rhs", r.stats.n_rhs)?;
-        d.set_item(
-            "frequencies_hz",
-            PyArray1::from_vec(
-                py,
-                m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect(),
-            ),
-        )?;
-        d.set_item("damping_ratio", m.settings.damping_ratio)?;
+        modal_info(py, &m, &d)?;
         Ok(d)
     })
 }

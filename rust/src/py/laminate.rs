@@ -276,6 +276,7 @@ fn simulate_layers<'py>(
         let out = output(t_eval, dt_out, t0, t1)?;
         let c = conduction_from(&p, layup, nodes)?;
         let depth = c.depth.clone();
+        let labels = c.node_labels();
         let k = coupling(coupled);
         let run = py
             .detach(|| layered::simulate(&p, c, &o, hinge, k, &m, (t0, t1), y0.as_deref(), &out))?;
@@ -286,6 +287,7 @@ fn simulate_layers<'py>(
         d.set_item("t", PyArray1::from_vec(py, run.t))?;
         d.set_item("T_nodes", temps)?;
         d.set_item("depth", PyArray1::from_vec(py, depth))?;
+        d.set_item("node_labels", labels)?;
         d.set_item("theta", PyArray1::from_vec(py, run.theta))?;
         d.set_item("theta_dot", PyArray1::from_vec(py, run.theta_dot))?;
         d.set_item("thermal_moment", PyArray1::from_vec(py, run.moment))?;

@@ -6,9 +6,12 @@ use super::cancel::{token, CancelToken};
 use super::convert::{coupling, hinge_model, orbit_from, solver_from};
 use super::error::invalid;
 use super::error::shield;
+use super::laminate::laminate_from;
 use super::longrun::hybrid_from;
 use crate::longrun::{resolve_hinge, STEPS_PER_HINGE_PERIOD};
-use crate::montecarlo::{pool, run_batch_on, EnsembleSettings, Path, SampleMetrics};
+use crate::montecarlo::{
+    pool, run_batch_layered, run_batch_on, EnsembleSettings, Layers, Path, SampleMetrics,
+};
 use crate::Panel;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -111,7 +114,9 @@ impl EnsemblePool {
 
     /// Runs one sample per row of `panels`; returns the metrics as columns. `lockstep`: several
     /// samples per thread in SIMD lanes (the same rows, bit for bit, as one at a time).
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=crate::dynamics::VALIDITY_LIMIT, hybrid=None, cancel=None, lockstep=true))]
+    /// `nodes`: the N-node through-thickness model with that many nodes, on `layup` (a laminate
+    /// mapping) or, without one, on each sample's panel as one homogeneous layer.
+    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=crate::dynamics::VALIDITY_LIMIT, hybrid=None, cancel=None, lockstep=true, layup=None, nodes=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -129,6 +134,8 @@ impl EnsemblePool {
         hybrid: Option<&Bound<'py, PyDict>>,
         cancel: Option<&Bound<'py, CancelToken>>,
         lockstep: bool,
+        layup: Option<&Bound<'py, PyDict>>,
+        nodes: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let cancel = token(cancel);
         let path = if lockstep {
@@ -151,7 +158,18 @@ impl EnsemblePool {
                 hybrid: hybrid.map(hybrid_from).transpose()?,
             };
             let pool = &self.pool;
-            let out = py.detach(|| run_batch_on(pool, &ps, &settings, &cancel, path))?;
+            // `nodes`: the N-node model on `layup` (None: each sample's panel as one layer).
+            let layers = match nodes {
+                Some(nodes) => Some(Layers {
+                    layup: layup.map(laminate_from).transpose()?,
+                    nodes,
+                }),
+                None => None,
+            };
+            let out = py.detach(|| match &layers {
+                Some(l) => run_batch_layered(pool, &ps, &settings, l, &cancel),
+                None => run_batch_on(pool, &ps, &settings, &cancel, path),
+            })?;
             let d = PyDict::new(py);
             let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };
             for (name, values) in [
