@@ -390,8 +390,40 @@ impl Orbit {
         match self.shadow {
             Shadow::None => Vec::new(),
             Shadow::Cylindrical if !self.season => self.equinox_cylinder_eclipses(t0, t1),
-            _ => self.searched_eclipses(t0, t1),
+            _ => self.searched_eclipses(t0, t1, true),
         }
+    }
+
+    /// Whether the passage behind the Earth within `quarter` of c can hold an eclipse. The
+    /// satellite, in the equatorial plane, is at least |δ| from the anti-Sun direction, and the
+    /// separation of the Sun's and the Earth's centres seen from it grows with that angle and with
+    /// the Sun's distance; the Sun's angular radius is largest at the least distance. Out of the
+    /// eclipse seasons this rules a passage out without a search.
+    fn may_eclipse(&self, c: f64, quarter: f64) -> bool {
+        // |δ| is monotonic over half a day except at a solstice, far from any eclipse; the
+        // margin covers its curvature (1e-6 rad) many times over.
+        let least = [c - quarter, c, c + quarter]
+            .iter()
+            .map(|&t| self.declination(t).abs())
+            .fold(f64::INFINITY, f64::min)
+            - 1e-4;
+        if least <= 0.0 {
+            return true;
+        }
+        let (sep, rho_s) = match self.shadow {
+            Shadow::Penumbra => {
+                let nearest = if self.eccentric_sun {
+                    1.0 - EARTH_ECCENTRICITY
+                } else {
+                    1.0
+                };
+                let (d, r) = (AU * nearest, self.radius);
+                let (sp, cp) = least.sin_cos();
+                ((d * sp).atan2(r + d * cp), (SUN_RADIUS / (d - r)).asin())
+            }
+            _ => (least, 0.0),
+        };
+        sep - self.earth_angular_radius() - rho_s < 0.0
     }
 
     /// Closed form for the cylinder with the Sun fixed in the orbit plane.
@@ -420,7 +452,8 @@ impl Orbit {
 
     /// Eclipses found numerically around each passage behind the Earth: the deepest point by
     /// golden-section search, the contacts by bisection (each side is monotonic).
-    fn searched_eclipses(&self, t0: f64, t1: f64) -> Vec<Eclipse> {
+    /// `prefilter`: skip the passages [`Orbit::may_eclipse`] rules out (off only to test it).
+    fn searched_eclipses(&self, t0: f64, t1: f64, prefilter: bool) -> Vec<Eclipse> {
         let quarter = 0.25 * self.synodic_period();
         let rho_e = self.earth_angular_radius();
         let outer = |t: f64| {
@@ -439,7 +472,7 @@ impl Orbit {
             if c - quarter >= t1 {
                 break;
             }
-            if c + quarter <= t0 {
+            if c + quarter <= t0 || (prefilter && !self.may_eclipse(c, quarter)) {
                 continue;
             }
             let deepest = golden_min(outer, c - 0.5 * quarter, c + 0.5 * quarter);
@@ -719,6 +752,37 @@ mod tests {
         let jan = Orbit::geo_year(PERIHELION_DAY);
         assert!((jan.flux_scale(0.0) - 1.0 / (1.0 - EARTH_ECCENTRICITY).powi(2)).abs() < 1e-12);
         assert_eq!(Orbit::geo_equinox().flux_scale(1e7), 1.0);
+    }
+
+    #[test]
+    fn passages_ruled_out_without_a_search_hold_no_eclipse() {
+        // A year of each kind of searched shadow, with and without the test before the search;
+        // and the test does rule out most passages (out of the seasons).
+        for orbit in [
+            Orbit::geo_year(0.0),
+            Orbit {
+                shadow: Shadow::Cylindrical,
+                ..Orbit::geo_year(0.0)
+            },
+            Orbit {
+                eccentric_sun: false,
+                ..Orbit::geo_year(200.0)
+            },
+        ] {
+            let year = YEAR_DAYS * DAY;
+            let searched = orbit.searched_eclipses(0.0, year, false);
+            assert_eq!(orbit.searched_eclipses(0.0, year, true), searched);
+            assert!(
+                searched.len() > 60 && searched.len() < 200,
+                "{}",
+                searched.len()
+            );
+            let quarter = 0.25 * orbit.synodic_period();
+            let ruled_out = (0..366)
+                .filter(|&k| !orbit.may_eclipse(orbit.shadow_centre(k as f64), quarter))
+                .count();
+            assert!(ruled_out > 150, "{ruled_out}");
+        }
     }
 
     #[test]

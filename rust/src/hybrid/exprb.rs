@@ -42,20 +42,21 @@ pub struct ExpStep {
 }
 
 /// ∂f/∂t through the illumination (s(t) in a penumbra, the Sun's distance) inside the segment
-/// [a, b], by a one-sided difference that stays inside it.
+/// [a, b], by a one-sided difference that stays inside it; `flux` is the flux at t.
 fn time_derivative(
     system: &Coupled,
     lin: &Linearisation,
     t: f64,
+    flux: f64,
     y: &Vector4<f64>,
     a: f64,
     b: f64,
 ) -> Vector4<f64> {
     let delta = 1e-2_f64.min(0.5 * (b - a));
     let dflux = if t + delta <= b {
-        (system.flux_at(t + delta) - system.flux_at(t)) / delta
+        (system.flux_at(t + delta) - flux) / delta
     } else {
-        (system.flux_at(t) - system.flux_at((t - delta).max(a))) / delta
+        (flux - system.flux_at((t - delta).max(a))) / delta
     };
     lin.flux_sensitivity(y) * dflux
 }
@@ -77,13 +78,15 @@ pub fn segment(
     mut on_step: impl FnMut(&ExpStep) -> Result<bool>,
 ) -> Result<(u64, u64, bool)> {
     let (mut accepted, mut rejected) = (0u64, 0u64);
-    let mut f0 = system.rhs_at_flux(system.flux_at(*t), y);
+    // The flux at the step's start, carried from the end of the last one (s(t) is costly in a
+    // penumbra).
+    let mut flux = system.flux_at(*t);
+    let mut f0 = system.rhs_at_flux(flux, y);
     while *t < b {
         let t0 = *t;
         let y0 = *y;
-        let flux = system.flux_at(t0);
         let jac = lin.jacobian(flux, &y0);
-        let v = time_derivative(system, lin, t0, &y0, a, b);
+        let v = time_derivative(system, lin, t0, flux, &y0, a, b);
         let mut rejected_here = false;
         loop {
             let step = h.min(tol.max_step).min(b - t0);
@@ -101,7 +104,8 @@ pub fn segment(
             let [_, phi1, phi2, phi3] = phi_matrices(&(jac * hs));
             let du = phi1 * (f0 * hs) + phi2 * (v * (hs * hs));
             let u_mid = y0 + du;
-            let f_mid = system.rhs_at_flux(system.flux_at(t1), &u_mid);
+            let flux1 = system.flux_at(t1);
+            let f_mid = system.rhs_at_flux(flux1, &u_mid);
             // g(t1, U) − g(t0, u) with g(t, u) = f(t, u) − J u − v t.
             let d = f_mid - f0 - jac * du - v * hs;
             let corr = phi3 * (d * (2.0 * hs));
@@ -130,7 +134,8 @@ pub fn segment(
                 if t1 < b || hs >= *h {
                     *h = hs * factor;
                 }
-                let f1 = system.rhs_at_flux(system.flux_at(t1), &y1);
+                let f1 = system.rhs_at_flux(flux1, &y1);
+                flux = flux1;
                 accepted += 1;
                 *t = t1;
                 *y = y1;

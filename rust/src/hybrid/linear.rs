@@ -226,6 +226,31 @@ impl Signal {
         (lo, hi)
     }
 
+    /// sign × smooth part + envelope at GRID + 1 evenly spaced points of [t0, t1]: each
+    /// exponential advanced by its factor over one interval (rounding of 1e-14 at most, ample
+    /// to locate the largest).
+    fn bound_on_grid(&self, sign: f64, t0: f64, t1: f64) -> [f64; GRID + 1] {
+        let dx = (t1 - t0) / GRID as f64;
+        let mut values = [0.0; GRID + 1];
+        for (i, v) in values.iter_mut().enumerate() {
+            *v = sign * (self.q0 + self.q1 * (t0 + i as f64 * dx));
+        }
+        for k in 0..4 {
+            let l = self.lambda[k];
+            let (mut term, step) = ((l.re * t0).exp(), (l.re * dx).exp());
+            let weight = if l.im != 0.0 {
+                self.a[k].norm()
+            } else {
+                sign * self.a[k].re
+            };
+            for v in values.iter_mut() {
+                *v += weight * term;
+                term *= step;
+            }
+        }
+        values
+    }
+
     /// max over [t0, t1] of sign × signal.
     ///
     /// The hinge's pair of modes makes the oscillation 2|a| e^{στ} cos(ωτ + arg a), so sign × signal
@@ -243,14 +268,15 @@ impl Signal {
         let oscillating = (0..4)
             .filter(|&k| self.lambda[k].im > 0.0)
             .max_by(|&i, &j| self.a[i].norm().total_cmp(&self.a[j].norm()));
+        let grid = self.bound_on_grid(sign, t0, t1);
         let Some(k) = oscillating else {
-            let t_star = grid_max(&bound, t0, t1, 64, 0.0);
+            let t_star = grid_max(&bound, t0, t1, &grid, 0.0);
             return value(t0).max(value(t1)).max(value(t_star));
         };
         let omega = self.lambda[k].im;
         let period = 2.0 * std::f64::consts::PI / omega;
         // The signal's peaks are searched a period either side: an eighth of one will do here.
-        let t_star = grid_max(&bound, t0, t1, 64, 0.125 * period);
+        let t_star = grid_max(&bound, t0, t1, &grid, 0.125 * period);
         let ends = value(t0).max(value(t1)).max(value(t_star));
         let (a, b) = ((t_star - period).max(t0), (t_star + period).min(t1));
         let shift = self.a[k].arg()
@@ -308,19 +334,22 @@ impl Signal {
     }
 }
 
-/// The maximiser of f over [a, b] on an n-interval grid, refined by golden section between the
-/// best point's neighbours (until the bracket is narrower than `width`, at most 40 times).
-fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, n: usize, width: f64) -> f64 {
+/// Intervals of the grid on which the envelopes' largest value is located.
+const GRID: usize = 64;
+
+/// The maximiser of f over [a, b] from its values on an evenly spaced grid (`values`, ends
+/// included), refined by golden section between the best point's neighbours (until the bracket
+/// is narrower than `width`, at most 40 times).
+fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, values: &[f64], width: f64) -> f64 {
     if b <= a {
         return a;
     }
+    let n = values.len() - 1;
     let dx = (b - a) / n as f64;
-    let (mut best, mut best_v) = (a, f(a));
-    for i in 1..=n {
-        let x = if i == n { b } else { a + i as f64 * dx };
-        let v = f(x);
+    let (mut best, mut best_v) = (a, values[0]);
+    for (i, &v) in values.iter().enumerate().skip(1) {
         if v > best_v {
-            best = x;
+            best = if i == n { b } else { a + i as f64 * dx };
             best_v = v;
         }
     }

@@ -34,12 +34,13 @@ use crate::longrun::{
 };
 use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::params::Panel;
-use crate::steady::equilibrium;
+use crate::steady::{equilibrium, newton};
 use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
 use jacobian::Linearisation;
 use linear::Arc;
-use nalgebra::{Vector4, U4};
+use nalgebra::{DMatrix, DVector, Vector4, U4};
+use std::cell::Cell;
 use std::ops::ControlFlow;
 
 /// Settings of the hybrid propagator.
@@ -226,6 +227,7 @@ pub fn run_orbits_hybrid(
             system: Coupled::new(*panel, *orbit, model, coupling),
             lin: Linearisation::new(panel, model, coupling),
             theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
+            last: Cell::new(None),
         },
         scale: Vector4::new(1.0, 1.0, 1.0 / t_ref, wn / t_ref),
         eclipses: EclipseTable::new(orbit),
@@ -251,9 +253,9 @@ pub fn run_orbits_hybrid(
     Ok(out)
 }
 
-/// The tests that decide the regime: everything they need, copied out of the driver so that the
+/// The tests that decide the regime: everything they need, apart from the driver so that the
 /// fallback's observer can use them too.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Judge {
     panel: Panel,
     orbit: Orbit,
@@ -263,14 +265,51 @@ struct Judge {
     system: Coupled,
     lin: Linearisation,
     theta_per_kelvin: f64,
+    /// The last equilibrium and its flux: the next one, at a flux that has barely changed, is
+    /// found by Newton's method from it.
+    last: Cell<Option<(f64, Vector4<f64>)>>,
 }
 
 impl Judge {
     /// The sunlit equilibrium and Jacobian at the flux of time t.
     fn reference(&self, flux: f64) -> Result<(Vector4<f64>, nalgebra::Matrix4<f64>)> {
-        let eq = equilibrium(&self.panel, self.coupling, flux)?;
-        let y_ref = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+        let y_ref = match self.last.get() {
+            Some((f, y)) if f == flux => y,
+            Some((_, y)) => self.equilibrium_from(flux, &y)?,
+            None => equilibrium(&self.panel, self.coupling, flux)?.state(),
+        };
+        self.last.set(Some((flux, y_ref)));
         Ok((y_ref, self.lin.jacobian(flux, &y_ref)))
+    }
+
+    /// The equilibrium under `flux` by Newton's method from the state `start` at rest, with the
+    /// analytic Jacobian: the unknowns (T_f, T_b, θ), the equations dT_f/dt = dT_b/dt = θ̈ = 0.
+    fn equilibrium_from(&self, flux: f64, start: &Vector4<f64>) -> Result<Vector4<f64>> {
+        const ROWS: [usize; 3] = [0, 1, 3];
+        let state = |x: &DVector<f64>| Vector4::new(x[0], x[1], x[2], 0.0);
+        let system = |x: &DVector<f64>| {
+            let y = state(x);
+            let (f, jac) = (
+                self.system.rhs_at_flux(flux, &y),
+                self.lin.jacobian(flux, &y),
+            );
+            (
+                DVector::from_fn(3, |i, _| f[ROWS[i]]),
+                DMatrix::from_fn(3, 3, |i, j| jac[(ROWS[i], j)]),
+            )
+        };
+        // As steady::steady: temperatures to 1e-12 relative, the angle to 1e-14 rad.
+        let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
+            dx[0].abs() < 1e-12 * x[0] && dx[1].abs() < 1e-12 * x[1] && dx[2].abs() < 1e-14
+        };
+        let x0 = DVector::from_column_slice(&start.as_slice()[..3]);
+        Ok(state(&newton(
+            "sunlit equilibrium",
+            x0,
+            2,
+            system,
+            settled,
+        )?))
     }
 
     /// Amplitude of the hinge oscillation about the quasi-static deflection M_T/K_el, from the
@@ -319,7 +358,7 @@ impl Judge {
 /// (checked every `CHECK_EVERY` s of simulated time, in full Sun past the last shadow's window).
 struct FallbackObserver<'a, 'c> {
     inner: &'a mut SummaryObserver<'c, TwoLayerView>,
-    judge: Judge,
+    judge: &'a Judge,
     eclipses: &'a [Eclipse],
     window: f64,
     next_check: f64,
@@ -503,7 +542,7 @@ impl Driver<'_> {
         let window = self.judge_window();
         let mut watch = FallbackObserver {
             inner: &mut self.obs,
-            judge: self.judge,
+            judge: &self.judge,
             eclipses,
             window,
             next_check: self.t + CHECK_EVERY,
