@@ -61,7 +61,6 @@ __all__ = [
     "moment",
     "orbit_breakpoints",
     "run_orbits",
-    "run_orbits_hybrid",
     "shadow_intervals",
     "simulate",
     "simulate_distributed",
@@ -188,24 +187,7 @@ def run_orbits(
     cancel: CancelToken | None = None,
     layup: dict[str, Any] | None = None,
     nodes: int | None = None,
-) -> dict[str, Any]: ...
-def run_orbits_hybrid(
-    panel: dict[str, float],
-    orbit: dict[str, Any],
-    *,
-    model: str,
-    coupled: bool,
-    solver: dict[str, Any],
-    t_start: float,
-    first_index: int,
-    n_orbits: int,
-    y0: list[float],
-    window: float,
-    theta_limit: float,
-    stop_at_limit: bool,
-    steps_per_period: float,
-    hybrid: dict[str, float],
-    cancel: CancelToken | None = None,
+    hybrid: dict[str, float] | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---

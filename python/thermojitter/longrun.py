@@ -407,10 +407,9 @@ def simulate_orbits(
             # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same places.
             count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
             t0 = float(t_start) + next_index * orbit.period
-            run = _core.run_orbits_hybrid if method == "hybrid" else _core.run_orbits
             extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
             raw = engine.call(
-                run,
+                _core.run_orbits,
                 panel.as_dict(),
                 orbit.as_dict(),
                 t_start=t0,

@@ -21,9 +21,12 @@ struct Summarised {
     crossing: Option<crate::longrun::LimitCrossing>,
 }
 
-/// Integrates whole orbits and returns one summary per orbit (columns as arrays).
+/// Integrates whole orbits and returns one summary per orbit (columns as arrays): the two-layer
+/// model, or the N-node model (`nodes`, `layup`), or with `hybrid` (its settings) the hybrid
+/// propagator, whose fallback is the solver's full integration; a hybrid run adds how the
+/// simulated time was split between linear arcs, the exponential integrator and the fallback.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None))]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None, hybrid=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
@@ -43,6 +46,7 @@ fn run_orbits<'py>(
     cancel: Option<&Bound<'py, CancelToken>>,
     layup: Option<&Bound<'py, PyDict>>,
     nodes: Option<usize>,
+    hybrid: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cancel = token(cancel);
     shield(|| {
@@ -62,9 +66,18 @@ fn run_orbits<'py>(
             stop_at_limit,
             steps_per_period,
         };
-        let out = match nodes {
+        let settings = hybrid.map(hybrid_from).transpose()?;
+        let out = match (nodes, settings) {
+            (Some(_), Some(_)) => {
+                return Err(crate::Error::invalid(
+                    "hybrid",
+                    "settings",
+                    "the hybrid propagator covers the two-layer model: give nodes = None",
+                )
+                .into())
+            }
             // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            Some(n) => {
+            (Some(n), None) => {
                 let c = conduction_from(&p, layup, n)?;
                 let run = py.detach(|| {
                     layered::run_orbits(
@@ -89,7 +102,7 @@ fn run_orbits<'py>(
                     crossing: run.crossing,
                 }
             }
-            None => {
+            (None, None) => {
                 let y = state(&y0, U4)?;
                 let run = py.detach(|| {
                     run(
@@ -112,6 +125,43 @@ fn run_orbits<'py>(
                     y_end: run.y_end.as_slice().to_vec(),
                     crossing: run.crossing,
                 }
+            }
+            (None, Some(settings)) => {
+                let y = state(&y0, U4)?;
+                crate::dynamics::check_hinge_angle("y0[2]", y[2])?;
+                let out = py.detach(|| {
+                    run_hybrid(
+                        &p,
+                        &o,
+                        hinge,
+                        coupling,
+                        &m,
+                        t_start,
+                        first_index,
+                        n_orbits,
+                        y,
+                        options,
+                        &settings,
+                        &cancel,
+                    )
+                })?;
+                let run = out.run;
+                let d = summary_dict(
+                    py,
+                    &Summarised {
+                        summaries: run.summaries,
+                        stats: run.stats,
+                        y_end: run.y_end.as_slice().to_vec(),
+                        crossing: run.crossing,
+                    },
+                )?;
+                d.set_item("t_linear", out.t_linear)?;
+                d.set_item("t_exponential", out.t_exponential)?;
+                d.set_item("t_fallback", out.t_fallback)?;
+                d.set_item("n_arcs", out.n_arcs)?;
+                d.set_item("n_exp_steps", out.n_exp_steps)?;
+                d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+                return Ok(d);
             }
         };
         summary_dict(py, &out)
@@ -156,87 +206,6 @@ fn summary_dict<'py>(py: Python<'py>, out: &Summarised) -> PyResult<Bound<'py, P
     Ok(d)
 }
 
-/// Like `run_orbits`, with the hybrid propagator (the solver is the full integration it falls
-/// back to); adds how the simulated time was split between linear arcs, the exponential
-/// integrator and the fallback.
-#[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, hybrid, cancel=None))]
-#[allow(clippy::too_many_arguments)]
-fn run_orbits_hybrid<'py>(
-    py: Python<'py>,
-    panel: &Bound<'py, PyDict>,
-    orbit: &Bound<'py, PyDict>,
-    model: &str,
-    coupled: bool,
-    solver: &Bound<'py, PyDict>,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: Vec<f64>,
-    window: f64,
-    theta_limit: f64,
-    stop_at_limit: bool,
-    steps_per_period: f64,
-    hybrid: &Bound<'py, PyDict>,
-    cancel: Option<&Bound<'py, CancelToken>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
-        let p = panel_from(panel)?;
-        let o = orbit_from(orbit)?;
-        let hinge = hinge_model(model)?;
-        let coupling = if coupled {
-            Coupling::ProjectedArea
-        } else {
-            Coupling::Frozen
-        };
-        let m = solver_from(solver)?;
-        let y = state(&y0, U4)?;
-        crate::dynamics::check_hinge_angle("theta_limit", theta_limit)?;
-        crate::dynamics::check_hinge_angle("y0[2]", y[2])?;
-        let options = SummaryOptions {
-            window,
-            theta_limit,
-            stop_at_limit,
-            steps_per_period,
-        };
-        let settings = hybrid_from(hybrid)?;
-        let out = py.detach(|| {
-            run_hybrid(
-                &p,
-                &o,
-                hinge,
-                coupling,
-                &m,
-                t_start,
-                first_index,
-                n_orbits,
-                y,
-                options,
-                &settings,
-                &cancel,
-            )
-        })?;
-        let run = out.run;
-        let d = summary_dict(
-            py,
-            &Summarised {
-                summaries: run.summaries,
-                stats: run.stats,
-                y_end: run.y_end.as_slice().to_vec(),
-                crossing: run.crossing,
-            },
-        )?;
-        d.set_item("t_linear", out.t_linear)?;
-        d.set_item("t_exponential", out.t_exponential)?;
-        d.set_item("t_fallback", out.t_fallback)?;
-        d.set_item("n_arcs", out.n_arcs)?;
-        d.set_item("n_exp_steps", out.n_exp_steps)?;
-        d.set_item("n_fallback_steps", out.n_fallback_steps)?;
-        Ok(d)
-    })
-}
-
 /// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
 pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
     let mut s = HybridSettings::default();
@@ -264,6 +233,5 @@ pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_orbits, m)?)?;
-    m.add_function(wrap_pyfunction!(run_orbits_hybrid, m)?)?;
     Ok(())
 }
