@@ -293,33 +293,26 @@ impl Conduction {
         }
         let n = self.nodes();
         let t0 = (self.absorbed * flux / (self.radiation_front + self.radiation_back)).powf(0.25);
-        let mut t = DVector::from_element(n, t0);
         let k = self.conduction_matrix();
-        for _ in 0..100 {
+        let residual_and_jacobian = |t: &DVector<f64>| {
             let (qf, qb) = self.face_inputs(flux, t[0], t[n - 1]);
-            let mut f = -(&k * &t);
+            let mut f = -(&k * t);
             f[0] += qf;
             f[n - 1] += qb;
             let mut jac = -k.clone();
             jac[(0, 0)] -= 4.0 * self.radiation_front * t[0].powi(3);
             jac[(n - 1, n - 1)] -= 4.0 * self.radiation_back * t[n - 1].powi(3);
-            let dt = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
-                what: "steady profile".into(),
-                reason: "singular Jacobian".into(),
-            })?;
-            let mut lambda = 1.0;
-            while (0..n).any(|i| t[i] + lambda * dt[i] <= 0.0) {
-                lambda *= 0.5;
-            }
-            t += &dt * lambda;
-            if dt.amax() < 1e-12 * t.amax() {
-                return Ok(t.iter().copied().collect());
-            }
-        }
-        Err(Error::NoConvergence {
-            what: "steady profile".into(),
-            reason: "Newton did not converge in 100 iterations".into(),
-        })
+            (f, jac)
+        };
+        let settled = |t: &DVector<f64>, dt: &DVector<f64>| dt.amax() < 1e-12 * t.amax();
+        let t = crate::steady::newton(
+            "steady profile",
+            DVector::from_element(n, t0),
+            n,
+            residual_and_jacobian,
+            settled,
+        )?;
+        Ok(t.iter().copied().collect())
     }
 
     /// The conduction modes: K φ = λ C φ, φᵀ C φ = C_tot (so the first, uniform mode has unit

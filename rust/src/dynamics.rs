@@ -1,6 +1,7 @@
 //! Thermal bending moment and the one-degree-of-freedom hinge model (paper Sec. 3, eqs. 20, 28).
 
 use crate::error::{Error, Result};
+use crate::num::Num;
 use crate::params::Panel;
 
 /// Structural model of the hinge.
@@ -114,30 +115,32 @@ pub fn thermal_moment(panel: &Panel, t_front: f64, t_back: f64) -> f64 {
 /// The generalised moment on the hinge, M − c_d θ̇ − K_el θ, in the unit of its coefficients
 /// (N m, or per I_B when all three are divided by it).
 #[inline(always)]
-pub(crate) fn generalised_moment(
-    moment: f64,
-    damping: f64,
-    stiffness: f64,
-    theta: f64,
-    theta_dot: f64,
-) -> f64 {
+pub(crate) fn generalised_moment<T: Num>(
+    moment: T,
+    damping: T,
+    stiffness: T,
+    theta: T,
+    theta_dot: T,
+) -> T {
     moment - damping * theta_dot - stiffness * theta
 }
 
 /// θ̈ from the generalised moment over I_B, `forced`: eq. 28, or eq. 20 with 3/(2 m l³) = 1/I_B
 /// factored out. `sin`, `cos` are those of θ (unused by the linear model).
 #[inline(always)]
-pub(crate) fn angular_acceleration(
+pub(crate) fn angular_acceleration<T: Num>(
     model: HingeModel,
-    forced: f64,
-    theta_dot: f64,
-    sin: f64,
-    cos: f64,
-) -> f64 {
+    forced: T,
+    theta_dot: T,
+    sin: T,
+    cos: T,
+) -> T {
+    let three = T::from(3.0);
     match model {
         HingeModel::Linear => forced,
         HingeModel::Nonlinear => {
-            (forced - 3.0 * theta_dot * theta_dot * sin * cos) / (1.0 + 3.0 * sin * sin)
+            (forced - three * theta_dot * theta_dot * sin * cos)
+                / (T::from(1.0) + three * sin * sin)
         }
     }
 }
@@ -292,7 +295,7 @@ pub fn sin_cos(theta: f64) -> (f64, f64) {
 /// The polynomials of [`sin_cos`] alone, for |θ| ≤ π/4 (no branch, so that a loop over SIMD
 /// lanes vectorises; the caller handles the lanes beyond π/4).
 #[inline(always)]
-pub(crate) fn sin_cos_kernel(theta: f64) -> (f64, f64) {
+pub(crate) fn sin_cos_kernel<T: Num>(theta: T) -> (T, T) {
     const S: [f64; 6] = [
         -0.16666666666666632,
         0.00833333333332249,
@@ -309,13 +312,18 @@ pub(crate) fn sin_cos_kernel(theta: f64) -> (f64, f64) {
         2.087572321298175e-09,
         -1.1359647557788195e-11,
     ];
+    let [s0, s1, s2, s3, s4, s5] = S.map(T::from);
+    let [c0, c1, c2, c3, c4, c5] = C.map(T::from);
     let z = theta * theta;
     let w = z * z;
     let w2 = w * w;
     // Estrin's scheme: three independent pairs, then two levels.
-    let ps = (S[0] + z * S[1]) + w * (S[2] + z * S[3]) + w2 * (S[4] + z * S[5]);
-    let pc = (C[0] + z * C[1]) + w * (C[2] + z * C[3]) + w2 * (C[4] + z * C[5]);
-    (theta + theta * z * ps, 1.0 - (0.5 * z - w * pc))
+    let ps = (s0 + z * s1) + w * (s2 + z * s3) + w2 * (s4 + z * s5);
+    let pc = (c0 + z * c1) + w * (c2 + z * c3) + w2 * (c4 + z * c5);
+    (
+        theta + theta * z * ps,
+        T::from(1.0) - (T::from(0.5) * z - w * pc),
+    )
 }
 
 /// Mechanical energy of the hinge in a constant moment field, J: kinetic + spring − work of M.

@@ -20,6 +20,7 @@ pub mod layered;
 pub mod linear;
 pub mod longrun;
 pub mod montecarlo;
+mod num;
 pub mod orbit;
 pub mod params;
 pub mod simulate;

@@ -531,7 +531,39 @@ fn penumbral_year_orbit_is_unchanged() {
         trajectory(o, nl, pa, Method::Rk4 { dt: 2.0 }),
         &YEAR_RK4,
     );
-    check("SUMMARIES", summaries(), &SUMMARIES);
+    check_summaries(summaries(), &SUMMARIES);
+}
+
+/// The summaries were recorded when every step was read at four points; it is now read at two
+/// (eight around an extreme of θ), which moves the extremes by less than 1e-3 of the orbit's
+/// amplitude and the jitter's peak and RMS by less than 1e-3 of themselves (the bound of
+/// `summary::tests::two_reads_keep_the_peaks`). The integration (end state, steps), θ_eq and the
+/// eclipse times are unchanged to the bit.
+fn check_summaries(got: Vec<u64>, want: &[u64]) {
+    assert_eq!(got.len(), want.len(), "SUMMARIES: length");
+    let f = |b: u64| f64::from_bits(b);
+    // Per orbit: θ_eq, θ_max, θ_min, amplitude, jitter RMS, jitter peak, t_entry, t_exit,
+    // entry θ_min, exit θ_max, entry peak, exit peak.
+    for (k, (g, w)) in got.chunks(12).zip(want.chunks(12)).take(2).enumerate() {
+        let amplitude = f(w[3]);
+        for i in 0..12 {
+            let (a, b) = (f(g[i]), f(w[i]));
+            let limit = match i {
+                0 | 6 | 7 => 0.0,
+                4 | 5 => 1e-3 * b.abs(),
+                _ => 1e-3 * amplitude,
+            };
+            assert!(
+                (a - b).abs() <= limit,
+                "SUMMARIES orbit {k} field {i}: {a:e}, recorded {b:e}"
+            );
+        }
+    }
+    check(
+        "SUMMARIES (end state, steps)",
+        got[24..].to_vec(),
+        &want[24..],
+    );
 }
 
 #[test]

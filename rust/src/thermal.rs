@@ -9,6 +9,7 @@
 //! (K/s, the form the integrator's hot path uses, with no division left in it).
 
 use crate::error::{Error, Result};
+use crate::num::Num;
 use crate::params::Panel;
 use crate::STEFAN_BOLTZMANN;
 
@@ -213,15 +214,16 @@ impl ThermalModel for OneNode {
 
 /// Coefficients of eq. 2's two heat balances, in W/m² per unit of their variable, or divided by
 /// the layer's heat capacity (per second).
+/// `T` is f64, or one value per lane for several panels at once (`integrate::lockstep`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Balance {
+pub(crate) struct Balance<T = f64> {
     /// α C: absorbed per unit flux factor.
-    pub(crate) heating: f64,
+    pub(crate) heating: T,
     /// K: conducted per kelvin of T_f − T_b.
-    pub(crate) conduction: f64,
+    pub(crate) conduction: T,
     /// σ ε_f and σ ε_b: emitted per T⁴.
-    pub(crate) radiation_front: f64,
-    pub(crate) radiation_back: f64,
+    pub(crate) radiation_front: T,
+    pub(crate) radiation_back: T,
 }
 
 impl Balance {
@@ -233,10 +235,12 @@ impl Balance {
             radiation_back: self.radiation_back / capacity,
         }
     }
+}
 
+impl<T: Num> Balance<T> {
     /// Eq. 2: (front, back) = (α C flux − K (T_f − T_b) − σ ε_f T_f⁴, K (T_f − T_b) − σ ε_b T_b⁴).
     #[inline(always)]
-    pub(crate) fn flows(&self, flux: f64, t_front: f64, t_back: f64) -> (f64, f64) {
+    pub(crate) fn flows(&self, flux: T, t_front: T, t_back: T) -> (T, T) {
         let conducted = self.conduction * (t_front - t_back);
         let tf4 = (t_front * t_front) * (t_front * t_front);
         let tb4 = (t_back * t_back) * (t_back * t_back);

@@ -18,21 +18,21 @@
 //! ([`Kernel::detect`]). Both give the same bits.
 
 use super::dopri5::{
-    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY,
+    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
 };
 use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
 use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::error::{Error, Result};
+#[cfg(target_arch = "x86_64")]
+use crate::num::Avx;
+use crate::num::{Lanes, Portable};
 use crate::system::{Coupled, Coupling, LaneForm};
 use crate::thermal::Balance;
 use nalgebra::Vector4;
 use std::f64::consts::FRAC_PI_4;
 
 /// Runs advanced together on one core.
-pub const LANES: usize = 4;
-
-/// One value per lane.
-type V = [f64; LANES];
+pub const LANES: usize = crate::num::LANES;
 
 /// One run for a lane: integrate `system` from (`t0`, `y0`) to `t1` with Dormand–Prince at `tol`,
 /// telling `observer` of every accepted step.
@@ -89,7 +89,7 @@ where
             // SAFETY: the processor has AVX2 (checked just above).
             unsafe { drive_avx2(next, done) }
         }
-        _ => drive(next, done),
+        _ => drive::<Portable, O, N, F>(next, done),
     }
 }
 
@@ -101,19 +101,23 @@ where
     N: FnMut() -> Option<Job<O>>,
     F: FnMut(O, Result<(Stats, Vector4<f64>)>),
 {
-    drive(next, done)
+    drive::<Avx, O, N, F>(next, done)
 }
 
-/// The lanes' inputs to one trial step, lane by lane in each array.
+/// The lanes' inputs to one trial step, lane by lane in each value.
 #[derive(Clone, Copy)]
-struct Pack {
+struct Pack<V> {
     t: V,
     h: V,
+    /// The step's end as the lane's run has it (t + h, bit for bit).
+    t_new: V,
     y0: [V; 4],
     k1: [V; 4],
-    /// Each lane's coefficients: the balance (heating, conduction, radiation front and back),
-    /// then load per kelvin, damping and stiffness (see [`Coupled::lane_form`]).
-    coef: [V; 7],
+    /// Each lane's coefficients (see [`Coupled::lane_form`]).
+    balance: Balance<V>,
+    load_per_kelvin: V,
+    damping: V,
+    stiffness: V,
     atol: V,
     rtol: V,
     /// Illumination at the stage times t + c_i h (i = 2..5) and at t + h (stages 6 and 7).
@@ -121,56 +125,93 @@ struct Pack {
 }
 
 /// The lanes' results of one trial step.
-struct Trial {
+struct Trial<V> {
     y_new: [V; 4],
     /// The continuous extension's coefficients r2..r5 (r1 is y0).
     dense: [[V; 4]; 4],
     /// k7 = f(t + h, y_new), the next step's k1.
     k7: [V; 4],
+    /// The interpolant at the middle of the step ([`DenseStep::midpoint`]).
+    mid: [V; 4],
     /// The error norm squared (mean square of the weighted error).
     mean_square: V,
 }
 
-const ZERO: V = [0.0; LANES];
-
-impl Pack {
+impl<V: Lanes> Pack<V> {
     fn zeros() -> Self {
+        let zero = V::from(0.0);
         Pack {
-            t: ZERO,
-            h: ZERO,
-            y0: [ZERO; 4],
-            k1: [ZERO; 4],
-            coef: [ZERO; 7],
-            atol: ZERO,
-            rtol: ZERO,
-            flux: [ZERO; 5],
+            t: zero,
+            h: zero,
+            t_new: zero,
+            y0: [zero; 4],
+            k1: [zero; 4],
+            balance: Balance {
+                heating: zero,
+                conduction: zero,
+                radiation_front: zero,
+                radiation_back: zero,
+            },
+            load_per_kelvin: zero,
+            damping: zero,
+            stiffness: zero,
+            atol: zero,
+            rtol: zero,
+            flux: [zero; 5],
         }
     }
 
     /// Empties lane `l`: zeros keep its arithmetic finite and cheap.
     fn clear(&mut self, l: usize) {
-        self.t[l] = 0.0;
-        self.h[l] = 0.0;
+        let mut empty = Pack::zeros();
+        // A zero step would divide by zero in the midpoint: keep it finite.
+        empty.h = 1.0.into();
+        empty.t_new = 1.0.into();
+        self.set_lane(l, &empty);
+    }
+
+    /// Copies lane `l` of `from` into lane `l`.
+    fn set_lane(&mut self, l: usize, from: &Pack<V>) {
+        let put = |to: &mut V, from: &V| to.lanes_mut()[l] = from.lanes()[l];
+        put(&mut self.t, &from.t);
+        put(&mut self.h, &from.h);
+        put(&mut self.t_new, &from.t_new);
         for i in 0..4 {
-            self.y0[i][l] = 0.0;
-            self.k1[i][l] = 0.0;
+            put(&mut self.y0[i], &from.y0[i]);
+            put(&mut self.k1[i], &from.k1[i]);
         }
-        for c in &mut self.coef {
-            c[l] = 0.0;
-        }
-        self.atol[l] = 0.0;
-        self.rtol[l] = 0.0;
-        for f in &mut self.flux {
-            f[l] = 0.0;
+        put(&mut self.balance.heating, &from.balance.heating);
+        put(&mut self.balance.conduction, &from.balance.conduction);
+        put(
+            &mut self.balance.radiation_front,
+            &from.balance.radiation_front,
+        );
+        put(
+            &mut self.balance.radiation_back,
+            &from.balance.radiation_back,
+        );
+        put(&mut self.load_per_kelvin, &from.load_per_kelvin);
+        put(&mut self.damping, &from.damping);
+        put(&mut self.stiffness, &from.stiffness);
+        put(&mut self.atol, &from.atol);
+        put(&mut self.rtol, &from.rtol);
+        for j in 0..5 {
+            put(&mut self.flux[j], &from.flux[j]);
         }
     }
 }
 
 /// The coupled right-hand side in every lane: [`Coupled::rhs_at_flux`]'s arithmetic.
 #[inline(always)]
-fn rhs_lanes(model: HingeModel, coupling: Coupling, p: &Pack, flux: &V, y: &[V; 4]) -> [V; 4] {
-    // One loop per (model, coupling), each with its constants folded, so that the loops hold
-    // no branch and vectorise.
+fn rhs_lanes<V: Lanes>(
+    model: HingeModel,
+    coupling: Coupling,
+    p: &Pack<V>,
+    flux: V,
+    y: &[V; 4],
+) -> [V; 4] {
+    // One body per (model, coupling), each with its constants folded, so that it holds no
+    // branch.
     use {Coupling::*, HingeModel::*};
     match (model, coupling) {
         (Nonlinear, ProjectedArea) => rhs_lanes_of(Nonlinear, ProjectedArea, p, flux, y),
@@ -181,58 +222,46 @@ fn rhs_lanes(model: HingeModel, coupling: Coupling, p: &Pack, flux: &V, y: &[V; 
 }
 
 #[inline(always)]
-fn rhs_lanes_of(model: HingeModel, coupling: Coupling, p: &Pack, flux: &V, y: &[V; 4]) -> [V; 4] {
-    let (mut sin, mut cos) = (ZERO, [1.0; LANES]);
+fn rhs_lanes_of<V: Lanes>(
+    model: HingeModel,
+    coupling: Coupling,
+    p: &Pack<V>,
+    flux: V,
+    y: &[V; 4],
+) -> [V; 4] {
+    let [tf, tb, th, om] = *y;
+    let (mut sin, mut cos) = (V::from(0.0), V::from(1.0));
     if !matches!((coupling, model), (Coupling::Frozen, HingeModel::Linear)) {
         // `sin_cos`: the polynomials in every lane, the library for a lane beyond π/4.
-        let mut far = false;
-        for l in 0..LANES {
-            (sin[l], cos[l]) = sin_cos_kernel(y[2][l]);
-            far |= y[2][l].abs() > FRAC_PI_4;
-        }
-        if far {
+        (sin, cos) = sin_cos_kernel(th);
+        if th.any_abs_above(FRAC_PI_4) {
             for l in 0..LANES {
-                if y[2][l].abs() > FRAC_PI_4 {
-                    (sin[l], cos[l]) = y[2][l].sin_cos();
+                if th.lanes()[l].abs() > FRAC_PI_4 {
+                    (sin.lanes_mut()[l], cos.lanes_mut()[l]) = th.lanes()[l].sin_cos();
                 }
             }
         }
     }
-    // `Coupled::rhs_at_flux` of the two-layer plate on the hinge, lane by lane.
-    let mut out = [ZERO; 4];
-    for l in 0..LANES {
-        let balance = Balance {
-            heating: p.coef[0][l],
-            conduction: p.coef[1][l],
-            radiation_front: p.coef[2][l],
-            radiation_back: p.coef[3][l],
-        };
-        let (tf, tb, th, om) = (y[0][l], y[1][l], y[2][l], y[3][l]);
-        let load = p.coef[4][l] * (tf - tb);
-        let forced = generalised_moment(load, p.coef[5][l], p.coef[6][l], th, om);
-        let acc = angular_acceleration(model, forced, om, sin[l], cos[l]);
-        let area = match coupling {
-            Coupling::ProjectedArea => cos[l],
-            Coupling::Frozen => 1.0,
-        };
-        let (front, back) = balance.flows(flux[l] * area, tf, tb);
-        out[0][l] = front;
-        out[1][l] = back;
-        out[2][l] = om;
-        out[3][l] = acc;
-    }
-    out
+    // `Coupled::rhs_at_flux` of the two-layer plate on the hinge.
+    let load = p.load_per_kelvin * (tf - tb);
+    let forced = generalised_moment(load, p.damping, p.stiffness, th, om);
+    let acc = angular_acceleration(model, forced, om, sin, cos);
+    let area = match coupling {
+        Coupling::ProjectedArea => cos,
+        Coupling::Frozen => V::from(1.0),
+    };
+    let (front, back) = p.balance.flows(flux * area, tf, tb);
+    [front, back, om, acc]
 }
 
 /// y0 + Σ k_j (a_j h), summed in the order given (as nalgebra sums `y0 + k1 * x + k2 * y`).
 #[inline(always)]
-fn stage<const M: usize>(y0: &[V; 4], h: &V, terms: [(&[V; 4], f64); M]) -> [V; 4] {
+fn stage<V: Lanes, const M: usize>(y0: &[V; 4], h: V, terms: [(&[V; 4], f64); M]) -> [V; 4] {
     let mut out = *y0;
     for (k, a) in terms {
+        let ah = V::from(a) * h;
         for i in 0..4 {
-            for l in 0..LANES {
-                out[i][l] += k[i][l] * (a * h[l]);
-            }
+            out[i] = out[i] + k[i] * ah;
         }
     }
     out
@@ -241,17 +270,18 @@ fn stage<const M: usize>(y0: &[V; 4], h: &V, terms: [(&[V; 4], f64); M]) -> [V; 
 /// One Dormand–Prince trial step in every lane: [`dopri5::step`] and the error norm of
 /// [`dopri5`]'s segment loop, operation for operation.
 #[inline(always)]
-fn step_lanes(model: HingeModel, coupling: Coupling, p: &Pack) -> Trial {
-    let (y0, k1, h) = (&p.y0, &p.k1, &p.h);
-    let f = |flux: &V, y: &[V; 4]| rhs_lanes(model, coupling, p, flux, y);
-    let k2 = f(&p.flux[0], &stage(y0, h, [(k1, A21)]));
-    let k3 = f(&p.flux[1], &stage(y0, h, [(k1, A3[0]), (&k2, A3[1])]));
+fn step_lanes<V: Lanes>(model: HingeModel, coupling: Coupling, p: &Pack<V>) -> Trial<V> {
+    let zero = V::from(0.0);
+    let (y0, k1, h) = (&p.y0, &p.k1, p.h);
+    let f = |flux: V, y: &[V; 4]| rhs_lanes(model, coupling, p, flux, y);
+    let k2 = f(p.flux[0], &stage(y0, h, [(k1, A21)]));
+    let k3 = f(p.flux[1], &stage(y0, h, [(k1, A3[0]), (&k2, A3[1])]));
     let k4 = f(
-        &p.flux[2],
+        p.flux[2],
         &stage(y0, h, [(k1, A4[0]), (&k2, A4[1]), (&k3, A4[2])]),
     );
     let k5 = f(
-        &p.flux[3],
+        p.flux[3],
         &stage(
             y0,
             h,
@@ -259,7 +289,7 @@ fn step_lanes(model: HingeModel, coupling: Coupling, p: &Pack) -> Trial {
         ),
     );
     let k6 = f(
-        &p.flux[4],
+        p.flux[4],
         &stage(
             y0,
             h,
@@ -283,65 +313,69 @@ fn step_lanes(model: HingeModel, coupling: Coupling, p: &Pack) -> Trial {
             (&k6, B[5]),
         ],
     );
-    let k7 = f(&p.flux[4], &y_new);
+    let k7 = f(p.flux[4], &y_new);
     // err = Σ k_j ((b_j − b̂_j) h), starting from the first product (no y0 term).
     let weights = [
-        (k1, B[0] - B_HAT[0]),
         (&k3, B[2] - B_HAT[2]),
         (&k4, B[3] - B_HAT[3]),
         (&k5, B[4] - B_HAT[4]),
         (&k6, B[5] - B_HAT[5]),
         (&k7, B[6] - B_HAT[6]),
     ];
-    let mut err = [ZERO; 4];
-    for (j, (k, w)) in weights.into_iter().enumerate() {
+    let first = V::from(B[0] - B_HAT[0]) * h;
+    let mut err = k1.map(|k| k * first);
+    for (k, w) in weights {
+        let wh = V::from(w) * h;
         for i in 0..4 {
-            for l in 0..LANES {
-                let term = k[i][l] * (w * h[l]);
-                err[i][l] = if j == 0 { term } else { err[i][l] + term };
-            }
+            err[i] = err[i] + k[i] * wh;
         }
     }
     // The scaled error e_i = err_i / (atol + rtol max(|y0_i|, |y_new_i|)), and its mean square
     // summed as nalgebra's norm_squared sums a 4-vector: (e0² + e2²) + (e1² + e3²).
-    let mut e = [ZERO; 4];
+    let mut e = [zero; 4];
     for i in 0..4 {
-        for l in 0..LANES {
-            let weight = 1.0 / (p.atol[l] + y0[i][l].abs().max(y_new[i][l].abs()) * p.rtol[l]);
-            e[i][l] = err[i][l] * weight;
-        }
+        let weight = V::from(1.0) / (p.atol + y0[i].abs().max(y_new[i].abs()) * p.rtol);
+        e[i] = err[i] * weight;
     }
-    let mut mean_square = ZERO;
-    for l in 0..LANES {
-        let a = e[0][l] * e[0][l] + e[2][l] * e[2][l];
-        let b = e[1][l] * e[1][l] + e[3][l] * e[3][l];
-        mean_square[l] = (a + b) / 4.0;
-    }
+    let a = e[0] * e[0] + e[2] * e[2];
+    let b = e[1] * e[1] + e[3] * e[3];
+    let mean_square = (a + b) / V::from(4.0);
     // `dopri5::dense_coefficients`, computed for every lane (most trials are accepted and the
     // summary reads every step).
-    let mut dense = [[ZERO; 4]; 4];
+    let mut dense = [[zero; 4]; 4];
     for i in 0..4 {
-        for l in 0..LANES {
-            let diff = y_new[i][l] - y0[i][l];
-            let bspl = k1[i][l] * h[l] - diff;
-            let r4 = diff - k7[i][l] * h[l] - bspl;
-            let r5 = (k1[i][l] * DENSE[0]
-                + k3[i][l] * DENSE[2]
-                + k4[i][l] * DENSE[3]
-                + k5[i][l] * DENSE[4]
-                + k6[i][l] * DENSE[5]
-                + k7[i][l] * DENSE[6])
-                * h[l];
-            dense[0][i][l] = diff;
-            dense[1][i][l] = bspl;
-            dense[2][i][l] = r4;
-            dense[3][i][l] = r5;
-        }
+        let diff = y_new[i] - y0[i];
+        let bspl = k1[i] * h - diff;
+        let r4 = diff - k7[i] * h - bspl;
+        let r5 = (k1[i] * V::from(DENSE[0])
+            + k3[i] * V::from(DENSE[2])
+            + k4[i] * V::from(DENSE[3])
+            + k5[i] * V::from(DENSE[4])
+            + k6[i] * V::from(DENSE[5])
+            + k7[i] * V::from(DENSE[6]))
+            * h;
+        dense[0][i] = diff;
+        dense[1][i] = bspl;
+        dense[2][i] = r4;
+        dense[3][i] = r5;
+    }
+    // `DenseStep::midpoint`: the interpolant at t + h/2 as `DenseStep::eval` evaluates it
+    // (the summaries read every step there), or y_new where that time rounds onto the end.
+    let t_mid = p.t + V::from(0.5) * h;
+    let th = (t_mid - p.t) / h;
+    let th1 = V::from(1.0) - th;
+    let at_end: [bool; LANES] = std::array::from_fn(|l| t_mid.lanes()[l] == p.t_new.lanes()[l]);
+    let mut mid = [zero; 4];
+    for i in 0..4 {
+        let [r2, r3, r4, r5] = [dense[0][i], dense[1][i], dense[2][i], dense[3][i]];
+        let y = y0[i] + (r2 + (r3 + (r4 + r5 * th1) * th) * th1) * th;
+        mid[i] = y.or_where(at_end, y_new[i]);
     }
     Trial {
         y_new,
         dense,
         k7,
+        mid,
         mean_square,
     }
 }
@@ -463,7 +497,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
     }
 
     /// Chooses the trial step and loads the lane's inputs into `p`.
-    fn begin_trial(&mut self, p: &mut Pack, l: usize) -> Result<()> {
+    fn begin_trial<V: Lanes>(&mut self, p: &mut Pack<V>, l: usize) -> Result<()> {
         let t = self.t;
         if !self.rejected {
             self.min_step = 10.0 * (dopri5::next_up(t) - t);
@@ -484,74 +518,66 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
         };
         self.t_new = t_new;
         let h = t_new - t;
-        p.t[l] = t;
-        p.h[l] = h;
+        p.t.lanes_mut()[l] = t;
+        p.h.lanes_mut()[l] = h;
+        p.t_new.lanes_mut()[l] = t_new;
         for i in 0..4 {
-            p.y0[i][l] = self.y[i];
-            p.k1[i][l] = self.k1[i];
+            p.y0[i].lanes_mut()[l] = self.y[i];
+            p.k1[i].lanes_mut()[l] = self.k1[i];
         }
         if let Some(flux) = self.constant_flux {
             for f in &mut p.flux {
-                f[l] = flux;
+                f.lanes_mut()[l] = flux;
             }
         } else {
             for (j, c) in C[1..5].iter().enumerate() {
-                p.flux[j][l] = self.system.flux_at(t + c * h);
+                p.flux[j].lanes_mut()[l] = self.system.flux_at(t + c * h);
             }
-            p.flux[4][l] = self.system.flux_at(t_new);
+            p.flux[4].lanes_mut()[l] = self.system.flux_at(t_new);
         }
         Ok(())
     }
 
     /// Loads what stays fixed over the run into lane `l` of `p`.
-    fn load(&self, p: &mut Pack, l: usize) {
+    fn load<V: Lanes>(&self, p: &mut Pack<V>, l: usize) {
         let f = self.system.lane_form();
         let b = f.balance;
-        let coef = [
-            b.heating,
-            b.conduction,
-            b.radiation_front,
-            b.radiation_back,
-            f.load_per_kelvin,
-            f.damping,
-            f.stiffness,
-        ];
-        for (c, v) in p.coef.iter_mut().zip(coef) {
-            c[l] = v;
+        let to = &mut p.balance;
+        for (c, v) in [
+            (&mut to.heating, b.heating),
+            (&mut to.conduction, b.conduction),
+            (&mut to.radiation_front, b.radiation_front),
+            (&mut to.radiation_back, b.radiation_back),
+            (&mut p.load_per_kelvin, f.load_per_kelvin),
+            (&mut p.damping, f.damping),
+            (&mut p.stiffness, f.stiffness),
+            (&mut p.atol, self.tol.atol),
+            (&mut p.rtol, self.tol.rtol),
+        ] {
+            c.lanes_mut()[l] = v;
         }
-        p.atol[l] = self.tol.atol;
-        p.rtol[l] = self.tol.rtol;
     }
 
     /// Accepts or rejects the trial in lane `l` of `trial` (the tail of `dopri5::segment`'s
     /// loop); `Some` when the run has ended.
-    fn end_trial(&mut self, trial: &Trial, l: usize) -> Option<Outcome> {
+    fn end_trial<V: Lanes>(&mut self, trial: &Trial<V>, l: usize) -> Option<Outcome> {
         let (t, t_new) = (self.t, self.t_new);
         let h = t_new - t;
         self.stats.n_rhs += 6;
-        let mean_square = trial.mean_square[l];
-        let lane = |v: &[V; 4]| Vector4::new(v[0][l], v[1][l], v[2][l], v[3][l]);
+        let mean_square = trial.mean_square.lanes()[l];
+        let lane = |v: &[V; 4]| Vector4::from(v.map(|x| x.lanes()[l]));
         if mean_square < 1.0 {
-            let mut factor = if mean_square == 0.0 {
-                MAX_FACTOR
-            } else {
-                let grow = (mean_square as f32).powf(0.5 * ERROR_EXPONENT as f32);
-                MAX_FACTOR.min(SAFETY * f64::from(grow))
-            };
-            if self.rejected {
-                factor = factor.min(1.0);
-            }
             self.stats.n_steps += 1;
             let y0 = self.y;
             let y_new = lane(&trial.y_new);
             let [r2, r3, r4, r5] = &trial.dense;
             let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
             self.y = y_new;
-            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r);
+            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r, lane(&trial.mid));
             self.t = t_new;
             self.stats.t_end = t_new;
             self.k1 = lane(&trial.k7);
-            self.h_abs = (h * factor).min(self.tol.max_step);
+            self.h_abs = dopri5::next_step(h, mean_square, self.rejected, self.tol.max_step);
             self.rejected = false;
             if self.observer.on_step(&dense).is_break() {
                 self.stats.stopped = self.stats.t_end < self.t1;
@@ -588,14 +614,14 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
 
 /// The lockstep loop (compiled once per [`Kernel`]).
 #[inline(always)]
-fn drive<O, N, F>(mut next: N, mut done: F)
+fn drive<V: Lanes, O, N, F>(mut next: N, mut done: F)
 where
     O: Observer<nalgebra::U4>,
     N: FnMut() -> Option<Job<O>>,
     F: FnMut(O, Result<(Stats, Vector4<f64>)>),
 {
     let mut lanes: [Option<Lane<O>>; LANES] = std::array::from_fn(|_| None);
-    let mut pack = Pack::zeros();
+    let mut pack = Pack::<V>::zeros();
     let mut form: Option<(HingeModel, Coupling)> = None;
     let mut exhausted = false;
     loop {

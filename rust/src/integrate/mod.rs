@@ -64,6 +64,9 @@ where
     pub y1: State<D>,
     slopes: Slopes<D>,
     r: OnceCell<[State<D>; 5]>,
+    /// The interpolant at [`DenseStep::midpoint`]'s time, when the integrator computed it with
+    /// the step (the lockstep lanes do, four steps at once).
+    mid: Option<State<D>>,
 }
 
 /// The slopes an interpolant is built from.
@@ -100,6 +103,7 @@ where
             y1,
             slopes: Slopes::Hermite([f0, f1]),
             r: OnceCell::new(),
+            mid: None,
         }
     }
 
@@ -118,18 +122,20 @@ where
             y1,
             slopes: Slopes::Dopri5(slopes),
             r: OnceCell::new(),
+            mid: None,
         }
     }
 
-    /// A step whose interpolant's coefficients r1..r5 the caller has built (with
-    /// `dopri5::dense_coefficients`' arithmetic: the lockstep lanes build them for several steps at
-    /// once).
+    /// A step whose interpolant's coefficients r1..r5 and value `mid` at [`DenseStep::midpoint`]
+    /// the caller has built (with `dopri5::dense_coefficients`' and [`DenseStep::eval`]'s
+    /// arithmetic: the lockstep lanes build them for several steps at once).
     pub(crate) fn with_coefficients(
         t0: f64,
         t1: f64,
         y0: State<D>,
         y1: State<D>,
         r: [State<D>; 5],
+        mid: State<D>,
     ) -> Self {
         DenseStep {
             t0,
@@ -138,6 +144,7 @@ where
             y1,
             slopes: Slopes::Given,
             r: OnceCell::from(r),
+            mid: Some(mid),
         }
     }
 
@@ -154,6 +161,17 @@ where
             }
             Slopes::Dopri5(k) => dopri5::dense_coefficients(h, &self.y0, diff, k),
             Slopes::Given => unreachable!("the coefficients were given on construction"),
+        }
+    }
+
+    /// The middle of the step, t0 + h/2, and the interpolant there (the same bits as
+    /// [`DenseStep::eval`] at that time).
+    #[inline]
+    pub fn midpoint(&self) -> (f64, State<D>) {
+        let t = self.t0 + 0.5 * (self.t1 - self.t0);
+        match &self.mid {
+            Some(y) => (t, y.clone()),
+            None => (t, self.eval(t)),
         }
     }
 

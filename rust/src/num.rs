@@ -1,0 +1,245 @@
+//! Arithmetic written once for one value (`f64`) and for one value per SIMD lane ([`Lanes`]), so
+//! that the model's formulas have a single source and a lane computes exactly what the scalar
+//! code does, operation for operation (`integrate::lockstep`).
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// What the model's formulas need of a number: the four operations and constants.
+pub(crate) trait Num:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + From<f64>
+{
+}
+
+impl Num for f64 {}
+
+/// Values advanced side by side, one per lane.
+pub(crate) const LANES: usize = 4;
+
+/// One f64 per lane: what the lockstep kernel needs beyond [`Num`]. Every operation is the same
+/// IEEE operation in each lane, nothing fused or reordered, so each lane's bits are those of the
+/// scalar code.
+pub(crate) trait Lanes: Num {
+    fn lanes(&self) -> &[f64; LANES];
+    fn lanes_mut(&mut self) -> &mut [f64; LANES];
+    /// |x| in each lane.
+    fn abs(self) -> Self;
+    /// `f64::max` in each lane.
+    fn max(self, o: Self) -> Self;
+    /// `a` in the lanes where `take` holds, else `self`.
+    fn or_where(self, take: [bool; LANES], a: Self) -> Self;
+    /// Whether |x| > bound in any lane.
+    fn any_abs_above(self, bound: f64) -> bool;
+}
+
+/// [`Lanes`] written lane by lane, for any processor (the compiler vectorises what it can).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(32))]
+pub(crate) struct Portable(pub(crate) [f64; LANES]);
+
+impl Portable {
+    #[inline(always)]
+    fn map2(self, o: Portable, f: impl Fn(f64, f64) -> f64) -> Portable {
+        let (a, b) = (self.0, o.0);
+        Portable([f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2]), f(a[3], b[3])])
+    }
+}
+
+impl Lanes for Portable {
+    #[inline(always)]
+    fn lanes(&self) -> &[f64; LANES] {
+        &self.0
+    }
+    #[inline(always)]
+    fn lanes_mut(&mut self) -> &mut [f64; LANES] {
+        &mut self.0
+    }
+    #[inline(always)]
+    fn abs(self) -> Portable {
+        Portable(self.0.map(f64::abs))
+    }
+    #[inline(always)]
+    fn max(self, o: Portable) -> Portable {
+        self.map2(o, f64::max)
+    }
+    #[inline(always)]
+    fn or_where(self, take: [bool; LANES], a: Portable) -> Portable {
+        Portable(std::array::from_fn(|l| {
+            if take[l] {
+                a.0[l]
+            } else {
+                self.0[l]
+            }
+        }))
+    }
+    #[inline(always)]
+    fn any_abs_above(self, bound: f64) -> bool {
+        self.0.iter().any(|x| x.abs() > bound)
+    }
+}
+
+impl From<f64> for Portable {
+    #[inline(always)]
+    fn from(x: f64) -> Portable {
+        Portable([x; LANES])
+    }
+}
+
+impl Add for Portable {
+    type Output = Portable;
+    #[inline(always)]
+    fn add(self, o: Portable) -> Portable {
+        self.map2(o, |a, b| a + b)
+    }
+}
+
+impl Sub for Portable {
+    type Output = Portable;
+    #[inline(always)]
+    fn sub(self, o: Portable) -> Portable {
+        self.map2(o, |a, b| a - b)
+    }
+}
+
+impl Mul for Portable {
+    type Output = Portable;
+    #[inline(always)]
+    fn mul(self, o: Portable) -> Portable {
+        self.map2(o, |a, b| a * b)
+    }
+}
+
+impl Div for Portable {
+    type Output = Portable;
+    #[inline(always)]
+    fn div(self, o: Portable) -> Portable {
+        self.map2(o, |a, b| a / b)
+    }
+}
+
+impl Neg for Portable {
+    type Output = Portable;
+    #[inline(always)]
+    fn neg(self) -> Portable {
+        Portable(self.0.map(|a| -a))
+    }
+}
+
+impl Num for Portable {}
+
+/// [`Lanes`] as AVX instructions, one per operation. Values of this type are made only inside
+/// the lockstep kernel compiled for AVX2, which runs only once the processor is known to have it
+/// (`integrate::lockstep::Kernel`); its operations are inlined there. The lanes are kept in an
+/// array (no vector type crosses a function boundary compiled without AVX).
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx::Avx;
+
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{Lanes, Num, LANES};
+    use std::arch::x86_64::*;
+    use std::ops::{Add, Div, Mul, Neg, Sub};
+
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[repr(C, align(32))]
+    pub(crate) struct Avx(pub(crate) [f64; LANES]);
+
+    impl Avx {
+        #[inline(always)]
+        fn get(self) -> __m256d {
+            // SAFETY: see the type's comment (the processor has AVX); the array is aligned.
+            unsafe { _mm256_load_pd(self.0.as_ptr()) }
+        }
+        #[inline(always)]
+        fn put(v: __m256d) -> Avx {
+            let mut out = Avx([0.0; LANES]);
+            // SAFETY: as in `get`.
+            unsafe { _mm256_store_pd(out.0.as_mut_ptr(), v) };
+            out
+        }
+    }
+
+    macro_rules! binary {
+        ($trait:ident, $method:ident, $intrinsic:ident) => {
+            impl $trait for Avx {
+                type Output = Avx;
+                #[inline(always)]
+                fn $method(self, o: Avx) -> Avx {
+                    // SAFETY: see the type's comment.
+                    Avx::put(unsafe { $intrinsic(self.get(), o.get()) })
+                }
+            }
+        };
+    }
+    binary!(Add, add, _mm256_add_pd);
+    binary!(Sub, sub, _mm256_sub_pd);
+    binary!(Mul, mul, _mm256_mul_pd);
+    binary!(Div, div, _mm256_div_pd);
+
+    impl Neg for Avx {
+        type Output = Avx;
+        #[inline(always)]
+        fn neg(self) -> Avx {
+            // SAFETY: see the type's comment. Flipping the sign bit is IEEE negation.
+            Avx::put(unsafe { _mm256_xor_pd(self.get(), _mm256_set1_pd(-0.0)) })
+        }
+    }
+
+    impl From<f64> for Avx {
+        #[inline(always)]
+        fn from(x: f64) -> Avx {
+            Avx([x; LANES])
+        }
+    }
+
+    impl Lanes for Avx {
+        #[inline(always)]
+        fn lanes(&self) -> &[f64; LANES] {
+            &self.0
+        }
+        #[inline(always)]
+        fn lanes_mut(&mut self) -> &mut [f64; LANES] {
+            &mut self.0
+        }
+        #[inline(always)]
+        fn abs(self) -> Avx {
+            // SAFETY: see the type's comment. Clearing the sign bit is `f64::abs`.
+            Avx::put(unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.get()) })
+        }
+        #[inline(always)]
+        fn max(self, o: Avx) -> Avx {
+            // `vmaxpd` gives its second operand when either is NaN; `f64::max` gives the other
+            // operand when one is NaN: take `self` where `o` is NaN.
+            // SAFETY: see the type's comment.
+            Avx::put(unsafe {
+                let (a, b) = (self.get(), o.get());
+                let m = _mm256_max_pd(a, b);
+                _mm256_blendv_pd(m, a, _mm256_cmp_pd(b, b, _CMP_UNORD_Q))
+            })
+        }
+        #[inline(always)]
+        fn or_where(self, take: [bool; LANES], a: Avx) -> Avx {
+            let sign = |l: usize| if take[l] { -0.0 } else { 0.0 };
+            // SAFETY: see the type's comment. `blendv` picks by the mask's sign bit.
+            Avx::put(unsafe {
+                let mask = _mm256_setr_pd(sign(0), sign(1), sign(2), sign(3));
+                _mm256_blendv_pd(self.get(), a.get(), mask)
+            })
+        }
+        #[inline(always)]
+        fn any_abs_above(self, bound: f64) -> bool {
+            // SAFETY: see the type's comment.
+            unsafe {
+                let above = _mm256_cmp_pd(self.abs().get(), _mm256_set1_pd(bound), _CMP_GT_OQ);
+                _mm256_movemask_pd(above) != 0
+            }
+        }
+    }
+
+    impl Num for Avx {}
+}
