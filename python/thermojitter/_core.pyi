@@ -56,6 +56,7 @@ __all__ = [
     "linear_delta_t",
     "linear_thermal",
     "layered_flutter",
+    "layered_start_state",
     "layered_steady_state",
     "materials",
     "moment",
@@ -310,6 +311,14 @@ def layered_steady_state(
     coupled: bool = True,
     flux: float = 1.0,
 ) -> dict[str, Any]: ...
+def layered_start_state(
+    panel: dict[str, float],
+    layup: dict[str, Any] | None,
+    nodes: int,
+    orbit: dict[str, Any],
+    t0: float,
+    coupled: bool,
+) -> list[float]: ...
 def layered_flutter(
     panel: dict[str, float],
     layup: dict[str, Any] | None,

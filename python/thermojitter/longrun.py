@@ -328,11 +328,11 @@ def simulate_orbits(
         y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
     elif y0 is None:
         assert nodes is not None
-        flux = float(orbit.flux_scale(t_start)[0])
-        raw_eq = _core.layered_steady_state(
-            panel.as_dict(), layup_dict(panel), nodes, coupled, flux
+        y0 = tuple(
+            _core.layered_start_state(
+                panel.as_dict(), layup_dict(panel), nodes, orbit.as_dict(), t_start, coupled
+            )
         )
-        y0 = (*raw_eq["temperatures"], raw_eq["theta"], 0.0)
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_dict(),

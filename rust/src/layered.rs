@@ -1049,6 +1049,23 @@ pub fn equilibrium(
     })
 }
 
+/// The default start of a layered run beginning at `t0`: the sunlit equilibrium at that time's
+/// solar flux, at rest, as the state (node temperatures front first, θ, θ̇ = 0).
+pub fn start_state(
+    panel: &Panel,
+    c: &Conduction,
+    coupling: Coupling,
+    orbit: &Orbit,
+    t0: f64,
+) -> Result<Vec<f64>> {
+    Orbit::check_time(t0)?;
+    let eq = equilibrium(panel, c, coupling, orbit.flux_scale(t0))?;
+    let mut y = eq.temperatures;
+    y.push(eq.theta);
+    y.push(0.0);
+    Ok(y)
+}
+
 /// The analytic Jacobian of the nodal system (N node temperatures, θ, θ̇) at a steady state.
 pub fn jacobian(
     panel: &Panel,
@@ -1224,6 +1241,44 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn start_state_is_at_rest_in_the_equilibrium_at_the_start_dates_flux() {
+        let p = Panel::paper();
+        // The eccentric Sun: the flux is highest near perihelion (early January), lowest near
+        // aphelion (early July).
+        let orbit = Orbit::geo_year(0.0);
+        let (january, july) = (3.0 * 86400.0, 185.0 * 86400.0);
+        let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
+        let sys = Layered::new(
+            &p,
+            c.clone(),
+            HingeModel::Nonlinear,
+            Coupling::ProjectedArea,
+            f64::INFINITY,
+        )
+        .unwrap();
+        let mut fronts = Vec::new();
+        for t0 in [january, july] {
+            let y = start_state(&p, &c, Coupling::ProjectedArea, &orbit, t0).unwrap();
+            assert_eq!(y.len(), c.nodes() + 2);
+            assert_eq!(y[c.nodes() + 1], 0.0);
+            let mut dy = vec![0.0; y.len()];
+            sys.rhs_at_flux(orbit.flux_scale(t0), &y, &mut dy);
+            assert!(dy.iter().all(|v| v.abs() < 1e-9), "not at rest: {dy:?}");
+            fronts.push(y[0]);
+        }
+        assert!(fronts[0] > fronts[1] + 1.0, "January {fronts:?} vs July");
+        // Two nodes on a plain panel start where the two-layer run starts, to the bit.
+        let two = Conduction::homogeneous(&p, 2).unwrap();
+        for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+            let y = start_state(&p, &two, coupling, &orbit, july).unwrap();
+            let eq = crate::steady::equilibrium(&p, coupling, orbit.flux_scale(july)).unwrap();
+            assert_eq!(y, eq.state().as_slice());
+        }
+        let err = start_state(&p, &c, Coupling::ProjectedArea, &orbit, f64::NAN).unwrap_err();
+        assert!(matches!(err, Error::InvalidParameter { ref name, .. } if name == "t"));
     }
 
     #[test]
