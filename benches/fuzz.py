@@ -1,7 +1,7 @@
 """The long run of the fuzz harness (tests/fuzzing.py): N generated hostile calls of the public API
-and the scenario parser, each in a worker process under a watchdog (20 s of the worker's CPU
-time, or 6x that of wall time); prints the count of each
-outcome, the share of refusals that name the parameter, and every failure.
+and the scenario parser, and damaged scenario files and long-run checkpoints, each in a worker
+process under a watchdog (20 s of the worker's CPU time, or 6x that of wall time); prints the
+count of each outcome, the share of refusals that name the parameter, and every failure.
 
     python benches/fuzz.py --n 10000
 """

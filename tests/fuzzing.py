@@ -3,9 +3,10 @@ short run in CI) and benches/fuzz.py (a long run that prints the count of each o
 
 Each example is a known-good call of one entry point with one to three of its arguments replaced
 by a hostile value (NaN, ±inf, 0, negatives, 1e±300, integers too large for a float, bools, None,
-strings, wrong shapes, reversed spans). It runs in a worker process under a watchdog, so that a
-crash (the process dies) or a hang (no answer within the CPU-time limit, see ``Runner``) is
-counted, not fatal.
+strings, wrong shapes, reversed spans), or the bytes of a scenario file or of a long run's
+checkpoint, damaged (truncated, bit-flipped, a line dropped or repeated, a piece replaced). It
+runs in a worker process under a watchdog, so that a crash (the process dies) or a hang (no
+answer within the CPU-time limit, see ``Runner``) is counted, not fatal.
 
 Outcomes:
 
@@ -14,7 +15,8 @@ Outcomes:
 - ``refused_named``: ValueError/TypeError naming the parameter (a ``ParameterError``'s
   ``.parameter``, or the argument's name in the message); ``refused_unnamed`` otherwise;
 - ``runtime_error``: IntegrationError or ConvergenceError (a clear error from the engine);
-- failures: ``silent_nan`` (a non-finite number returned), ``internal_error`` (a panic caught at
+- failures: ``silent_nan`` (a non-finite number returned), ``wrong_result`` (a run resumed
+  from a damaged checkpoint that differs from the run itself), ``internal_error`` (a panic caught at
   the boundary), ``panic`` (a BaseException from the engine), ``other_exception`` (any other
   type), ``abort`` (the worker died), ``hang`` (past the time limit).
 """
@@ -33,7 +35,9 @@ from typing import Any
 import hypothesis.strategies as st
 import numpy as np
 
-FAILURES = ("silent_nan", "internal_error", "panic", "other_exception", "abort", "hang")
+FAILURES = (
+    "silent_nan", "wrong_result", "internal_error", "panic", "other_exception", "abort", "hang",
+)  # fmt: skip
 OUTCOMES = ("ok", "refused_named", "refused_unnamed", "runtime_error", *FAILURES)
 
 # Hostile values, and values that are fine, to mix into good calls.
@@ -209,6 +213,7 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
                 "threads": 1,
                 "progress": False,
                 **fast,
+                **budget,
             },
         ),
         "sweep": (
@@ -220,6 +225,7 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
                 "threads": 1,
                 "progress": False,
                 **fast,
+                **budget,
             },
         ),
         "scenario": (
@@ -231,7 +237,111 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
                 "output": {"format": "csv"},
             },
         ),
+        # Damaged files: the bytes of a good one, mutated (see ``damaged``).
+        "scenario file": (_scenario_file, {"text": SCENARIO_TEXT}),
+        "checkpoint": (_resume, {"text": b""}),
     }
+
+
+SCENARIO_TEXT = b"""# a scenario file
+[panel]
+damping = 3.0
+length = 50.0
+
+[orbit]
+preset = "leo"
+altitude = 540e3
+
+[simulation]
+t_end = 600.0
+rtol = 1e-8
+keep = "samples"
+
+[output]
+format = "csv"
+plots = false
+"""
+
+# Byte strings spliced into a file: TOML and JSON syntax, hostile numbers, bad encodings.
+TOKENS = [
+    b"", b"nan", b"inf", b"-inf", b"-1", b"0", b"1e400", b"9" * 400, b'"x"', b"[]", b"{}",
+    b"true", b"null", b"=", b"[panel]", b"[[orbit]]", b"\n", b"\x00", b"\xff\xfe", b'"', b",",
+    b"}", b"]", b"damping = ", b'"content"', b'"checksum": "0"', b"1.0000000000000002",
+]  # fmt: skip
+
+
+def damaged(base: bytes) -> st.SearchStrategy[bytes]:
+    """``base`` truncated, with a bit flipped, a line removed or repeated, or a piece replaced
+    by a token."""
+    n = len(base)
+    lines = base.split(b"\n")
+
+    def flip(i: int, bit: int) -> bytes:
+        return base[:i] + bytes([base[i] ^ (1 << bit)]) + base[i + 1 :]
+
+    def splice(i: int, width: int, token: bytes) -> bytes:
+        return base[:i] + token + base[i + width :]
+
+    def line(j: int, repeat: bool) -> bytes:
+        kept = lines[: j + 1] + lines[j:] if repeat else lines[:j] + lines[j + 1 :]
+        return b"\n".join(kept)
+
+    return st.one_of(
+        st.integers(0, n - 1).map(lambda k: base[:k]),
+        st.builds(flip, st.integers(0, n - 1), st.integers(0, 7)),
+        st.builds(splice, st.integers(0, n), st.integers(0, 24), st.sampled_from(TOKENS)),
+        st.builds(line, st.integers(0, len(lines) - 1), st.booleans()),
+    )
+
+
+def _scenario_file(text: bytes) -> Any:
+    import tempfile
+    from pathlib import Path
+
+    from thermojitter.scenario import load_scenario
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "fuzz.toml"
+        path.write_bytes(text)
+        return load_scenario(path)
+
+
+_RESUME: dict[str, Any] = {}
+
+
+def _resume_call() -> tuple[Any, dict[str, Any]]:
+    """The long run whose checkpoint the fuzz damages: two orbits of the low orbit."""
+    import thermojitter as tj
+
+    low = tj.Orbit(radius=7.0e6, period=5828.5)
+    args = {"rtol": 1e-6, "atol": 1e-8, "progress": False, "window": 600.0}
+    return lambda **kw: tj.simulate_orbits(tj.Panel.paper(), low, 2, **args, **kw), args
+
+
+def checkpoint_reference() -> tuple[bytes, Any]:
+    """(the bytes of an intact checkpoint, the run it answers), made once per process."""
+    if not _RESUME:
+        import tempfile
+        from pathlib import Path
+
+        run, _ = _resume_call()
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / "run.json"
+            result = run(checkpoint=path)
+            _RESUME["bytes"], _RESUME["result"] = path.read_bytes(), result
+    return _RESUME["bytes"], _RESUME["result"]
+
+
+def _resume(text: bytes) -> Any:
+    """Resumes the reference run from a damaged copy of its checkpoint."""
+    import tempfile
+    from pathlib import Path
+
+    run, _ = _resume_call()
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "run.json"
+        path.write_bytes(text)
+        return run(checkpoint=path)
 
 
 @dataclass
@@ -249,6 +359,10 @@ def examples(draw: st.DrawFn, targets: list[str] | None = None) -> Example:
     base = calls[name][1]
     # The receiver of a method ("_self") is not an argument a user passes: it stays valid.
     keys = sorted(k for k in base if not k.startswith("_"))
+    if name == "scenario file":
+        return Example(name, {"text": draw(damaged(SCENARIO_TEXT))})
+    if name == "checkpoint":
+        return Example(name, {"text": draw(damaged(checkpoint_reference()[0]))})
     if name == "scenario":
         # Replace a key of one table (or the table itself) in the scenario data.
         table = draw(st.sampled_from(keys))
@@ -378,6 +492,8 @@ def classify(example: Example) -> tuple[str, str]:
     except (ValueError, TypeError) as exc:
         message = str(exc)
         named = getattr(exc, "parameter", None) or getattr(exc, "key", None)
+        if not named and example.target == "scenario file":
+            named = getattr(exc, "path", None)  # the file itself is what is wrong
         if not named:
             names = [k.split(".")[-1] for k in example.changes]
             named = next((n for n in names if n and n in message), None)
@@ -393,6 +509,12 @@ def classify(example: Example) -> tuple[str, str]:
     bad = _eclipse_rows(result) if example.target == "eclipses" else _non_finite(result)
     if bad:
         return "silent_nan", f"{bad} is not finite"
+    if example.target == "checkpoint":
+        # A damaged checkpoint is refused or recomputed; what it returns is the run itself.
+        reference = checkpoint_reference()[1]
+        for name, column in reference.columns.items():
+            if not np.array_equal(column, result.columns[name], equal_nan=True):
+                return "wrong_result", f"{name} differs from the run's own"
     return "ok", ""
 
 
@@ -472,7 +594,7 @@ class Runner:
         if answered:
             try:
                 return self.conn.recv()  # type: ignore[no-any-return]
-            except EOFError:
+            except (EOFError, OSError):  # the worker died while answering
                 pass
         if self.proc.is_alive():
             self.proc.kill()

@@ -274,6 +274,23 @@ def test_full_disk_in_the_command_names_the_file_and_leaves_nothing_partial(
     assert frame["t"].iloc[-1] == 60.0
 
 
+def test_report_writes_name_the_file_and_leave_nothing_partial(
+    tmp_path: Path, full_disk: None
+) -> None:
+    # The paper command's summary.json and report.md, and the beam comparison's files, go
+    # through the same atomic write: a failed one names its file and leaves no partial file.
+    from thermojitter import paper
+
+    target = tmp_path / "summary.json"
+    with pytest.raises(OSError) as info:
+        paper._write_json(target, {"theta_steady_deg": 4.89})
+    assert info.value.filename == str(target)
+    with pytest.raises(OSError) as info:
+        checkpoint.write_bytes_atomic(tmp_path / "report.md", b"# report\n")
+    assert info.value.filename == str(tmp_path / "report.md")
+    assert leftovers(tmp_path) == []
+
+
 def test_command_refuses_a_non_empty_out_unless_overwrite(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -214,6 +214,13 @@ def test_hinge_energy_of_states_beyond_the_model_is_refused_not_inf() -> None:
     assert e == pytest.approx(0.5 * P.hinge_stiffness * 0.01 - 40.0, rel=1e-12)
 
 
+def test_linearisation_temperature_beyond_any_material_is_refused_not_inf() -> None:
+    # T_star = 1e300 K gave q = inf (the σT³ term) with no error.
+    refused(lambda: tj.linear_thermal_response(P, T_star=1e300), "T_star", "K")
+    refused(lambda: tj.linear_thermal_response(P, T_star=-3784.0), "T_star")
+    assert math.isfinite(tj.linear_thermal_response(P, T_star=1e4).q)
+
+
 @pytest.mark.parametrize("flux", [5e-324, 3e-63, 540.0, 2395.0, 1e12, 1.7976931348623157e308])
 def test_flux_factors_beyond_any_orbit_are_refused_not_a_failed_newton(flux: float) -> None:
     # These used to end in "steady state did not converge" (a singular Jacobian, a panel folded

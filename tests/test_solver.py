@@ -78,6 +78,15 @@ def test_the_fixed_step_is_reported() -> None:
     assert hinge.solver is not None and hinge.solver.rtol == 1e-7
 
 
+def test_the_layered_run_reports_its_settings_as_the_two_layer_run_does() -> None:
+    panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
+    for settings in (tj.SolverSettings(method="rk4", dt=0.5), tj.SolverSettings(rtol=1e-7)):
+        two = tj.simulate(panel, orbit, (0.0, 10.0), solver=settings)
+        nodes = tj.simulate(panel, orbit, (0.0, 10.0), solver=settings, layers=4)
+        assert nodes.solver is not None and nodes.solver == two.solver
+        assert nodes.solver.rtol == settings.rtol and nodes.solver.method == settings.method
+
+
 def test_the_beam_reports_its_settings() -> None:
     beam = tj.beam.FreeFreeBeam(tj.Panel.paper(), n_elements=10)
     settings = tj.SolverSettings(rtol=1e-7, atol=1e-9)

@@ -194,7 +194,7 @@ def simulate(
             n_rejected=raw["n_rejected"],
             n_rhs=raw["n_rhs"],
             method=used.method,
-            settings={**settings, "layers": nodes, "solver": args["solver"]},
+            settings={**settings, "layers": nodes, "solver": dict(raw["solver"])},
             T_front=temps[:, 0],
             T_back=temps[:, -1],
             theta=raw["theta"],

@@ -707,6 +707,8 @@ pub struct LayeredRun {
     pub stats: crate::integrate::Stats,
     /// The end state as node temperatures, θ, θ̇ (a run can resume from it).
     pub y_end: Vec<f64>,
+    /// The integrator settings the run used.
+    pub method: crate::integrate::Method,
 }
 
 /// Integrates the N-node system over `t_span` from `y0` (node temperatures, θ, θ̇; default the
@@ -729,19 +731,13 @@ pub fn simulate(
             check_start(v, n)?;
             v.to_vec()
         }
-        None => {
-            let eq = equilibrium(panel, &conduction, coupling, orbit.flux_scale(t_span.0))?;
-            let mut v = eq.temperatures;
-            v.push(eq.theta);
-            v.push(0.0);
-            v
-        }
+        None => start_state(panel, &conduction, coupling, orbit, t_span.0)?,
     };
     let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
     let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
     let size = y_start.len();
     let orb = LayeredOrbit::new(system.clone(), *orbit);
-    let (t, y, stats, y_end) =
+    let (t, y, stats, y_end, used) =
         on_fastest_state!(orb, size, sample_run(method, t_span, &y_start, output))?;
     let m = system.thermal_size();
     let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
@@ -753,6 +749,7 @@ pub fn simulate(
         t,
         stats,
         y_end: Vec::new(),
+        method: used,
     };
     for (t, y) in run.t.iter().zip(&y) {
         let temps = system.node_temperatures(area_free(*t), y);
@@ -766,8 +763,14 @@ pub fn simulate(
     Ok(run)
 }
 
-/// Samples of one run of `system`: times, states, counters and the end state.
-type Samples = (Vec<f64>, Vec<Vec<f64>>, crate::integrate::Stats, Vec<f64>);
+/// Samples of one run of `system`: times, states, counters, the end state and the settings used.
+type Samples = (
+    Vec<f64>,
+    Vec<Vec<f64>>,
+    crate::integrate::Stats,
+    Vec<f64>,
+    crate::integrate::Method,
+);
 
 fn sample_run<D: Dim, S: OdeSystem<D>>(
     system: &mut S,
@@ -781,7 +784,13 @@ where
 {
     let traj = crate::simulate::run(system, method, t_span, state_of::<D>(y0), output)?;
     let y = traj.y.iter().map(|v| v.as_slice().to_vec()).collect();
-    Ok((traj.t, y, traj.stats, traj.y_end.as_slice().to_vec()))
+    Ok((
+        traj.t,
+        y,
+        traj.stats,
+        traj.y_end.as_slice().to_vec(),
+        traj.method,
+    ))
 }
 
 /// The summaries' view of the N-node system.
@@ -1501,6 +1510,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(lay.t.len(), two.t.len());
+        assert_eq!(lay.method, two.method, "the settings the run reports");
         let theta_scale = two.column(2).iter().fold(0.0_f64, |a, b| a.max(b.abs()));
         let mut worst: f64 = 0.0;
         for (k, y) in two.y.iter().enumerate() {

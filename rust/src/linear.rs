@@ -15,6 +15,7 @@ use crate::error::{require_positive, Error, Result};
 use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::Coupling;
+use crate::thermal::MAX_TEMPERATURE;
 use crate::STEFAN_BOLTZMANN;
 
 /// The coefficients of Sec. 4.2 for one panel and forcing frequency, with what follows from them.
@@ -103,7 +104,13 @@ impl LinearThermal {
             return Err(Error::invalid("omega", omega, "must be finite and >= 0"));
         }
         let t_star = t_star.unwrap_or(0.5 * (eq.t_front + eq.t_back));
-        require_positive("T_star", t_star)?;
+        if !(t_star > 0.0 && t_star <= MAX_TEMPERATURE) {
+            return Err(Error::invalid(
+                "T_star",
+                t_star,
+                &format!("must be in (0, {MAX_TEMPERATURE:e}] K"),
+            ));
+        }
         let mc = panel.heat_capacity();
         let eps = 0.5 * (panel.emissivity_front + panel.emissivity_back);
         Ok(LinearThermal {

@@ -13,6 +13,10 @@ use crate::num::Num;
 use crate::params::Panel;
 use crate::STEFAN_BOLTZMANN;
 
+/// Highest temperature a panel is described at, K: above any structural material's melting point
+/// (and σT⁴ stays a number; at 1e300 K it is inf).
+pub const MAX_TEMPERATURE: f64 = 1e4;
+
 /// The thermal models by their number of layers (the `layers=` of the Python API). This is the
 /// one place a new model is registered: the runs, steady states and bindings that take a
 /// `layers` go through it.

@@ -1,7 +1,8 @@
 //! Bindings of the laminate layups and the N-node through-thickness model.
 
 use super::convert::{
-    coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
+    coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_dict, solver_from,
+    type_error,
 };
 use super::error::{invalid, shield};
 use crate::conduction::Conduction;
@@ -316,6 +317,7 @@ fn simulate_layers<'py>(
         d.set_item("n_rhs", run.stats.n_rhs)?;
         d.set_item("t_end", run.stats.t_end)?;
         d.set_item("y_end", PyArray1::from_vec(py, run.y_end))?;
+        d.set_item("solver", solver_dict(py, &run.method)?)?;
         Ok(d)
     })
 }
