@@ -127,7 +127,8 @@ def test_monte_carlo_stops_on_ctrl_c_within_two_cpu_seconds(tmp_path: Path) -> N
             import thermojitter as tj
             vary = {{"damping": ("uniform", 1.0, 4.0)}}
             df = tj.monte_carlo(tj.Panel.paper(), tj.Orbit.geo_equinox(), vary=vary, n=8,
-                                horizon=100, seed=1, chunk_size=1, method="rk45", checkpoint={str(ckpt)!r})
+                                horizon=100, seed=1, chunk_size=1, method="rk45",
+                                checkpoint={str(ckpt)!r})
             print(len(df), df.attrs["interrupted"])
         """)
     )
