@@ -9,9 +9,11 @@
 //! when the step is not capped (`tests::two_reads_keep_the_peaks`).
 
 use crate::cancel::Cancel;
-use crate::dynamics::{thermal_moment, HingeModel};
+use crate::dynamics::HingeModel;
 use crate::error::Result;
+use crate::integrate::lockstep::{LaneObserver, StepReads};
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, State, Stats};
+use crate::num::Num;
 use crate::orbit::{EclipseTable, Orbit};
 use crate::params::Panel;
 use crate::steady::equilibrium;
@@ -31,6 +33,13 @@ pub trait SummaryView {
     fn rate(&self, y: &[f64]) -> f64;
 }
 
+/// The quasi-static angle M_T/K_el of the two-layer panel, M_T = (M_T per kelvin)(T_f − T_b)
+/// ([`crate::dynamics::thermal_moment`]), for one value or for lanes (the lockstep lanes read their steps with it).
+#[inline(always)]
+pub(crate) fn quasi_static<T: Num>(moment_per_kelvin: T, stiffness: T, t_front: T, t_back: T) -> T {
+    moment_per_kelvin * (t_front - t_back) / stiffness
+}
+
 /// The two-layer system's view: state (T_f, T_b, θ, θ̇).
 pub(crate) struct TwoLayerView {
     pub(crate) panel: Panel,
@@ -43,8 +52,11 @@ impl SummaryView for TwoLayerView {
     }
     #[inline]
     fn angles(&self, _t: f64, y: &[f64]) -> (f64, f64) {
-        let quasi_static = thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
-        (y[2], quasi_static)
+        let p = &self.panel;
+        (
+            y[2],
+            quasi_static(p.moment_per_kelvin(), p.hinge_stiffness, y[0], y[1]),
+        )
     }
     #[inline]
     fn rate(&self, y: &[f64]) -> f64 {
@@ -306,6 +318,24 @@ impl<V: SummaryView> Collector<V> {
         }
     }
 
+    /// A step from t0 read at its middle and end (θ̇ keeps its sign over it), with the dynamic
+    /// part at its start: ∫(dynamic)² by Simpson's rule.
+    #[inline]
+    pub(crate) fn read_two(
+        &mut self,
+        t0: f64,
+        start: f64,
+        mut mid: Point,
+        mut end: Point,
+    ) -> Result<()> {
+        let dt = 0.5 * (end.t - t0);
+        let third = dt / 3.0;
+        mid.sq = third * (start * start + 4.0 * (mid.dynamic * mid.dynamic));
+        end.sq = third * (end.dynamic * end.dynamic);
+        self.end = (end.t, end.dynamic);
+        self.read_points(&[mid, end], dt)
+    }
+
     /// Points of one step, in time order, each standing for the interval dt before it with its
     /// share `sq` of ∫(dynamic)²: the same as [`Collector::record`] of each, taken together when
     /// the points lie inside the calm span (nearly every step) and within the limit.
@@ -528,16 +558,9 @@ where
             _ => c.point(t0, step.y0.as_slice()).dynamic,
         };
         let read = if r0 == r_mid && r_mid == r1 {
-            let (mut mid, mut end) = (
-                c.point(t_mid, y_mid.as_slice()),
-                c.point(t1, step.y1.as_slice()),
-            );
-            let dt = 0.5 * (t1 - t0);
-            let third = dt / 3.0;
-            mid.sq = third * (start * start + 4.0 * (mid.dynamic * mid.dynamic));
-            end.sq = third * (end.dynamic * end.dynamic);
-            c.end = (t1, end.dynamic);
-            c.read_points(&[mid, end], dt)
+            let mid = c.point(t_mid, y_mid.as_slice());
+            let end = c.point(t1, step.y1.as_slice());
+            c.read_two(t0, start, mid, end)
         } else {
             let mut points = [Point::default(); FINE_READS];
             // t0 + 4 (h/8) is the midpoint, bit for bit (h/8 and 4 (h/8) are exact).
@@ -567,6 +590,14 @@ where
             c.end = (t1, points[FINE_READS - 1].dynamic);
             c.read_points(&points, dt)
         };
+        self.after(read)
+    }
+}
+
+impl<V> SummaryObserver<'_, V> {
+    /// Whether the run goes on after a step was read.
+    #[inline]
+    fn after(&mut self, read: Result<()>) -> ControlFlow<()> {
         if let Err(e) = read {
             self.error = Some(e);
             return ControlFlow::Break(());
@@ -575,6 +606,36 @@ where
             return ControlFlow::Break(());
         }
         ControlFlow::Continue(())
+    }
+}
+
+impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
+    fn dynamic_form(&self) -> Option<(f64, f64)> {
+        let p = &self.collector.view.panel;
+        Some((p.moment_per_kelvin(), p.hinge_stiffness))
+    }
+
+    /// The steps `on_step` reads twice (θ̇ keeps its sign, the start read with the last step),
+    /// from the reads the lanes computed; the others from their dense output.
+    #[inline]
+    fn on_reads(&mut self, r: &StepReads) -> Option<ControlFlow<()>> {
+        let c = &mut self.collector;
+        let [r0, r_mid, r1] = r.rising;
+        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0) {
+            return None;
+        }
+        if let Err(e) = self.cancel.check() {
+            self.error = Some(e);
+            return Some(ControlFlow::Break(()));
+        }
+        let point = |t, k: usize| Point {
+            t,
+            theta: r.theta[k],
+            dynamic: r.dynamic[k],
+            sq: 0.0,
+        };
+        let read = c.read_two(r.t0, c.end.1, point(r.t_mid, 0), point(r.t1, 1));
+        Some(self.after(read))
     }
 }
 

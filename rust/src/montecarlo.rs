@@ -11,7 +11,7 @@ use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
 use crate::flutter::{analyse, critical_damping};
 use crate::hybrid::{run_orbits_hybrid, HybridSettings};
-use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LANES};
+use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LaneObserver, StepReads, LANES};
 use crate::integrate::{DenseStep, Method, Observer};
 use crate::longrun::{
     finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, SummaryObserver,
@@ -411,6 +411,16 @@ impl Observer<U4> for LaneSample<'_> {
     #[inline]
     fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
         self.observer.on_step(step)
+    }
+}
+
+impl LaneObserver for LaneSample<'_> {
+    fn dynamic_form(&self) -> Option<(f64, f64)> {
+        self.observer.dynamic_form()
+    }
+    #[inline]
+    fn on_reads(&mut self, reads: &StepReads) -> Option<ControlFlow<()>> {
+        self.observer.on_reads(reads)
     }
 }
 

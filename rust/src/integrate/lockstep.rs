@@ -23,6 +23,7 @@ use super::dopri5::{
 use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
 use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::error::{Error, Result};
+use crate::longrun::quasi_static;
 #[cfg(target_arch = "x86_64")]
 use crate::num::Avx;
 use crate::num::{Lanes, Portable};
@@ -43,6 +44,38 @@ pub struct Job<O> {
     pub t1: f64,
     pub y0: Vector4<f64>,
     pub observer: O,
+}
+
+/// What a lane's run tells its observer. For every accepted step the lanes compute the reads the
+/// per-orbit summary takes of it ([`StepReads`]); an observer that can take the step from them
+/// spares the lane building the step's dense output.
+pub trait LaneObserver: Observer<nalgebra::U4> {
+    /// (M_T per kelvin, K_el) of the run's panel, for the dynamic part θ − M_T/K_el of
+    /// [`StepReads`] (`longrun::quasi_static`); None: the observer takes dense steps only.
+    fn dynamic_form(&self) -> Option<(f64, f64)> {
+        None
+    }
+    /// Takes an accepted step from its reads; None: it needs the dense output, and
+    /// [`Observer::on_step`] is called with it.
+    fn on_reads(&mut self, _reads: &StepReads) -> Option<std::ops::ControlFlow<()>> {
+        None
+    }
+}
+
+/// An accepted step as the lanes read it: its start, middle ([`DenseStep::midpoint`]) and end,
+/// with θ, the dynamic part θ − M_T/K_el at the middle and end, and whether θ̇ > 0 at the start,
+/// middle and end. The same bits as reading the dense step.
+#[derive(Debug, Clone, Copy)]
+pub struct StepReads {
+    pub t0: f64,
+    pub t_mid: f64,
+    pub t1: f64,
+    /// θ at the middle and at the end.
+    pub theta: [f64; 2],
+    /// θ − M_T/K_el at the middle and at the end.
+    pub dynamic: [f64; 2],
+    /// θ̇ > 0 at the start, the middle and the end.
+    pub rising: [bool; 3],
 }
 
 /// Which compilation of the lane kernel runs.
@@ -79,7 +112,7 @@ impl Kernel {
 /// coupling differs from the first job's run alone, through [`solve`].
 pub fn solve_lockstep<O, N, F>(kernel: Kernel, next: N, done: F)
 where
-    O: Observer<nalgebra::U4>,
+    O: LaneObserver,
     N: FnMut() -> Option<Job<O>>,
     F: FnMut(O, Result<(Stats, Vector4<f64>)>),
 {
@@ -97,7 +130,7 @@ where
 #[target_feature(enable = "avx2")]
 unsafe fn drive_avx2<O, N, F>(next: N, done: F)
 where
-    O: Observer<nalgebra::U4>,
+    O: LaneObserver,
     N: FnMut() -> Option<Job<O>>,
     F: FnMut(O, Result<(Stats, Vector4<f64>)>),
 {
@@ -122,6 +155,9 @@ struct Pack<V> {
     rtol: V,
     /// Illumination at the stage times t + c_i h (i = 2..5) and at t + h (stages 6 and 7).
     flux: [V; 5],
+    /// M_T per kelvin and K_el, for the dynamic part of [`StepReads`].
+    moment_per_kelvin: V,
+    hinge_stiffness: V,
 }
 
 /// The lanes' results of one trial step.
@@ -135,6 +171,9 @@ struct Trial<V> {
     mid: [V; 4],
     /// The error norm squared (mean square of the weighted error).
     mean_square: V,
+    /// The middle of the step, and the dynamic part θ − M_T/K_el there and at its end.
+    t_mid: V,
+    dynamic: [V; 2],
 }
 
 impl<V: Lanes> Pack<V> {
@@ -158,6 +197,8 @@ impl<V: Lanes> Pack<V> {
             atol: zero,
             rtol: zero,
             flux: [zero; 5],
+            moment_per_kelvin: zero,
+            hinge_stiffness: V::from(1.0),
         }
     }
 
@@ -198,6 +239,8 @@ impl<V: Lanes> Pack<V> {
         for j in 0..5 {
             put(&mut self.flux[j], &from.flux[j]);
         }
+        put(&mut self.moment_per_kelvin, &from.moment_per_kelvin);
+        put(&mut self.hinge_stiffness, &from.hinge_stiffness);
     }
 }
 
@@ -371,12 +414,18 @@ fn step_lanes<V: Lanes>(model: HingeModel, coupling: Coupling, p: &Pack<V>) -> T
         let y = y0[i] + (r2 + (r3 + (r4 + r5 * th1) * th) * th1) * th;
         mid[i] = y.or_where(at_end, y_new[i]);
     }
+    // The summary's dynamic part at the middle and the end (`Collector::point`).
+    let dynamic = [&mid, &y_new].map(|[tf, tb, th, _]| {
+        *th - quasi_static(p.moment_per_kelvin, p.hinge_stiffness, *tf, *tb)
+    });
     Trial {
         y_new,
         dense,
         k7,
         mid,
         mean_square,
+        t_mid,
+        dynamic,
     }
 }
 
@@ -407,7 +456,7 @@ struct Lane<O> {
 /// How a run left its lane.
 type Outcome = Result<(Stats, Vector4<f64>)>;
 
-impl<O: Observer<nalgebra::U4>> Lane<O> {
+impl<O: LaneObserver> Lane<O> {
     /// Sets up a run (the checks of [`super::solve`]); `Err` hands the job back with its outcome
     /// when it ends before its first step.
     fn start(job: Job<O>) -> std::result::Result<Self, (O, Outcome)> {
@@ -542,6 +591,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
     fn load<V: Lanes>(&self, p: &mut Pack<V>, l: usize) {
         let f = self.system.lane_form();
         let b = f.balance;
+        let form = self.observer.dynamic_form().unwrap_or((0.0, 1.0));
         let to = &mut p.balance;
         for (c, v) in [
             (&mut to.heating, b.heating),
@@ -553,6 +603,8 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             (&mut p.stiffness, f.stiffness),
             (&mut p.atol, self.tol.atol),
             (&mut p.rtol, self.tol.rtol),
+            (&mut p.moment_per_kelvin, form.0),
+            (&mut p.hinge_stiffness, form.1),
         ] {
             c.lanes_mut()[l] = v;
         }
@@ -570,16 +622,29 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
             self.stats.n_steps += 1;
             let y0 = self.y;
             let y_new = lane(&trial.y_new);
-            let [r2, r3, r4, r5] = &trial.dense;
-            let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
             self.y = y_new;
-            let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r, lane(&trial.mid));
+            let at = |v: &V| v.lanes()[l];
+            let reads = StepReads {
+                t0: t,
+                t_mid: at(&trial.t_mid),
+                t1: t_new,
+                theta: [at(&trial.mid[2]), y_new[2]],
+                dynamic: trial.dynamic.map(|d| at(&d)),
+                rising: [y0[3] > 0.0, at(&trial.mid[3]) > 0.0, y_new[3] > 0.0],
+            };
+            let flow = self.observer.on_reads(&reads).unwrap_or_else(|| {
+                let [r2, r3, r4, r5] = &trial.dense;
+                let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
+                let mid = lane(&trial.mid);
+                let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r, mid);
+                self.observer.on_step(&dense)
+            });
             self.t = t_new;
             self.stats.t_end = t_new;
             self.k1 = lane(&trial.k7);
             self.h_abs = dopri5::next_step(h, mean_square, self.rejected, self.tol.max_step);
             self.rejected = false;
-            if self.observer.on_step(&dense).is_break() {
+            if flow.is_break() {
                 self.stats.stopped = self.stats.t_end < self.t1;
                 return Some(Ok((self.stats, self.y)));
             }
@@ -616,7 +681,7 @@ impl<O: Observer<nalgebra::U4>> Lane<O> {
 #[inline(always)]
 fn drive<V: Lanes, O, N, F>(mut next: N, mut done: F)
 where
-    O: Observer<nalgebra::U4>,
+    O: LaneObserver,
     N: FnMut() -> Option<Job<O>>,
     F: FnMut(O, Result<(Stats, Vector4<f64>)>),
 {
@@ -711,6 +776,8 @@ mod tests {
             self.1.on_step(step)
         }
     }
+
+    impl LaneObserver for Tagged {}
 
     /// A job per panel: one orbit sampled at 200 times, with its index.
     fn jobs(panels: &[Panel], model: HingeModel, coupling: Coupling) -> Vec<Job<Tagged>> {
