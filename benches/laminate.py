@@ -12,7 +12,6 @@ public API, alternately, and the median of the repeats is reported with the rati
 from __future__ import annotations
 
 import argparse
-import platform
 import statistics
 import sys
 import time
@@ -23,16 +22,7 @@ import thermojitter as tj
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 from laminates import boom, wing  # noqa: E402
-
-
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
+from machine import describe  # noqa: E402
 
 
 def timed(run: Callable[[], int], repeats: int) -> tuple[float, int]:
@@ -51,7 +41,7 @@ def main() -> None:
     parser.add_argument("--nodes", type=int, default=20)
     args = parser.parse_args()
     orbit = tj.Orbit.geo_equinox()
-    print(f"CPU: {cpu_model()}; Python {platform.python_version()}")
+    print(describe())
     print(f"one GEO orbit ({orbit.period:.0f} s), rk45 rtol 1e-8, atol 1e-10")
     print()
     print("| panel | run | model | wall s | steps | ns/step | x two-layer |")
@@ -90,6 +80,8 @@ def main() -> None:
                 )
     print()
     print(f"largest ratio: {worst:.2f} (target <= 3)")
+    # The load at the end too: a change of load during the run shows here.
+    print(describe().splitlines()[1])
 
 
 if __name__ == "__main__":

@@ -1748,22 +1748,22 @@ mod tests {
     #[test]
     #[ignore]
     fn orbit_cost() {
-        use crate::integrate::{Method, Tolerances};
-        use crate::simulate::{run, Output};
+        use crate::simulate::run;
         let want = std::env::var("LAMINATE_PANEL").unwrap_or_else(|_| "wing".into());
         let nodes: usize = std::env::var("LAMINATE_NODES")
             .ok()
             .and_then(|v| v.parse().ok())
             .unwrap_or(20);
         let (_, p, lam) = examples().into_iter().find(|e| e.0 == want).unwrap();
-        let p = Panel {
-            damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
-            ..p
-        };
-        let o = Orbit::geo_equinox();
-        let method = Method::Dopri5(Tolerances::default());
-        let out = Output::Times(vec![o.period]);
-        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let case = CostCase::of(p);
+        let CostCase {
+            p,
+            o,
+            ref method,
+            ref out,
+            model,
+            coupling,
+        } = case;
         let orbits = std::env::var("LAMINATE_RUN").is_ok_and(|v| v == "orbits");
         let options = crate::longrun::SummaryOptions {
             window: 600.0,
@@ -1777,12 +1777,12 @@ mod tests {
             let y0 = sys.steady_state(1.0).unwrap();
             if orbits {
                 crate::longrun::run_orbits_cancellable(
-                    &p, &o, model, coupling, &method, 0.0, 0, 1, y0, options, &cancel,
+                    &p, &o, model, coupling, method, 0.0, 0, 1, y0, options, &cancel,
                 )
                 .unwrap()
                 .stats
             } else {
-                run(&mut sys, &method, (0.0, o.period), y0, &out)
+                run(&mut sys, method, (0.0, o.period), y0, out)
                     .unwrap()
                     .stats
             }
@@ -1793,27 +1793,61 @@ mod tests {
                 let mut y0 = eq.temperatures.clone();
                 y0.extend([eq.theta, 0.0]);
                 run_orbits(
-                    &p, c, &o, model, coupling, &method, 0.0, 0, 1, &y0, options, &cancel,
+                    &p, c, &o, model, coupling, method, 0.0, 0, 1, &y0, options, &cancel,
                 )
                 .unwrap()
                 .stats
             } else {
-                simulate(
-                    &p,
-                    c,
-                    &o,
-                    model,
-                    coupling,
-                    &method,
-                    (0.0, o.period),
-                    None,
-                    &out,
-                )
-                .unwrap()
-                .stats
+                case.simulate(c).stats
             }
         };
         println!("{want}, {nodes} nodes: {steps:?}");
+    }
+
+    /// The setting of the cost measurements: one GEO orbit of an example panel at 1 % of its
+    /// critical damping, rk45 at the default tolerances, sampled at the orbit's end.
+    struct CostCase {
+        p: Panel,
+        o: Orbit,
+        method: crate::integrate::Method,
+        out: crate::simulate::Output,
+        model: HingeModel,
+        coupling: Coupling,
+    }
+
+    impl CostCase {
+        fn of(p: Panel) -> Self {
+            let o = Orbit::geo_equinox();
+            CostCase {
+                p: Panel {
+                    damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
+                    ..p
+                },
+                o,
+                method: crate::integrate::Method::Dopri5(crate::integrate::Tolerances::default()),
+                out: crate::simulate::Output::Times(vec![o.period]),
+                model: HingeModel::Nonlinear,
+                coupling: Coupling::ProjectedArea,
+            }
+        }
+
+        /// The N-node `simulate` of the orbit from its sunlit equilibrium.
+        fn simulate(&self, c: Conduction) -> LayeredRun {
+            let span = (0.0, self.o.period);
+            let (p, o) = (&self.p, &self.o);
+            simulate(
+                p,
+                c,
+                o,
+                self.model,
+                self.coupling,
+                &self.method,
+                span,
+                None,
+                &self.out,
+            )
+            .unwrap()
+        }
     }
 
     /// Wall time of one GEO orbit (`simulate`), 20 nodes against the two-layer model, both
@@ -1822,38 +1856,26 @@ mod tests {
     #[test]
     #[ignore]
     fn orbit_time() {
-        use crate::integrate::{Method, Tolerances};
-        use crate::simulate::{run, Output};
-        let o = Orbit::geo_equinox();
-        let method = Method::Dopri5(Tolerances::default());
-        let out = Output::Times(vec![o.period]);
-        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        use crate::simulate::run;
         for (name, p, lam) in examples() {
-            let p = Panel {
-                damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
-                ..p
-            };
+            let case = CostCase::of(p);
+            let CostCase {
+                p,
+                o,
+                ref method,
+                ref out,
+                model,
+                coupling,
+            } = case;
             let mut best = [f64::INFINITY; 2];
             for _ in 0..7 {
                 let start = std::time::Instant::now();
                 let mut sys = Coupled::new(p, o, model, coupling);
                 let y0 = sys.steady_state(1.0).unwrap();
-                run(&mut sys, &method, (0.0, o.period), y0, &out).unwrap();
+                run(&mut sys, method, (0.0, o.period), y0, out).unwrap();
                 best[0] = best[0].min(start.elapsed().as_secs_f64());
                 let start = std::time::Instant::now();
-                let c = Conduction::new(&p, &lam, 20).unwrap();
-                simulate(
-                    &p,
-                    c,
-                    &o,
-                    model,
-                    coupling,
-                    &method,
-                    (0.0, o.period),
-                    None,
-                    &out,
-                )
-                .unwrap();
+                case.simulate(Conduction::new(&p, &lam, 20).unwrap());
                 best[1] = best[1].min(start.elapsed().as_secs_f64());
             }
             println!(
