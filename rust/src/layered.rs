@@ -1776,11 +1776,21 @@ mod tests {
             let mut sys = Coupled::new(p, o, model, coupling);
             let y0 = sys.steady_state(1.0).unwrap();
             if orbits {
-                crate::longrun::run_orbits_cancellable(
-                    &p, &o, model, coupling, method, 0.0, 0, 1, y0, options, &cancel,
-                )
-                .unwrap()
-                .stats
+                let req = crate::longrun::OrbitRunRequest {
+                    panel: p,
+                    orbit: o,
+                    model,
+                    coupling,
+                    method: *method,
+                    t_start: 0.0,
+                    first_index: 0,
+                    n_orbits: 1,
+                    y0,
+                    options,
+                };
+                crate::longrun::run_orbits_cancellable(&req, &cancel)
+                    .unwrap()
+                    .stats
             } else {
                 run(&mut sys, method, (0.0, o.period), y0, out)
                     .unwrap()

@@ -648,70 +648,49 @@ pub struct OrbitRun {
     pub crossing: Option<LimitCrossing>,
 }
 
-/// Integrates the coupled system over orbits `first_index .. first_index + n_orbits`, the first
-/// starting at `t_start`, from `y0`, and summarises each orbit.
-#[allow(clippy::too_many_arguments)]
-pub fn run_orbits(
-    panel: &Panel,
-    orbit: &Orbit,
-    model: HingeModel,
-    coupling: Coupling,
-    method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: Vector4<f64>,
-    options: SummaryOptions,
-) -> Result<OrbitRun> {
-    run_orbits_cancellable(
-        panel,
-        orbit,
-        model,
-        coupling,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
-        y0,
-        options,
-        &Cancel::new(),
-    )
+/// What a summarised run of the two-layer panel over whole orbits is asked to do: integrate
+/// orbits `first_index .. first_index + n_orbits`, the first starting at `t_start`, from `y0`,
+/// with `method` (the hybrid propagator's fallback when it runs them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrbitRunRequest {
+    pub panel: Panel,
+    pub orbit: Orbit,
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    pub method: Method,
+    pub t_start: f64,
+    pub first_index: u64,
+    pub n_orbits: u64,
+    pub y0: Vector4<f64>,
+    pub options: SummaryOptions,
+}
+
+/// Integrates the coupled system over the orbits of `req` and summarises each orbit.
+pub fn run_orbits(req: &OrbitRunRequest) -> Result<OrbitRun> {
+    run_orbits_cancellable(req, &Cancel::new())
 }
 
 /// [`run_orbits`] that stops with [`crate::Error::Cancelled`] within one step of `cancel` being
 /// cancelled (the orbits finished before are lost with the call: callers that keep them run
 /// fewer orbits per call).
-#[allow(clippy::too_many_arguments)]
-pub fn run_orbits_cancellable(
-    panel: &Panel,
-    orbit: &Orbit,
-    model: HingeModel,
-    coupling: Coupling,
-    method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: Vector4<f64>,
-    options: SummaryOptions,
-    cancel: &Cancel,
-) -> Result<OrbitRun> {
-    let mut system = Coupled::new(*panel, *orbit, model, coupling);
+pub fn run_orbits_cancellable(req: &OrbitRunRequest, cancel: &Cancel) -> Result<OrbitRun> {
+    let mut system = Coupled::new(req.panel, req.orbit, req.model, req.coupling);
     let view = TwoLayerView {
-        panel: *panel,
-        coupling,
+        panel: req.panel,
+        coupling: req.coupling,
     };
     let run = run_summarised(
         &mut system,
         view,
-        panel,
-        orbit,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
-        y0,
+        &req.panel,
+        &req.orbit,
+        &req.method,
+        req.t_start,
+        req.first_index,
+        req.n_orbits,
+        req.y0,
         2,
-        options,
+        req.options,
         cancel,
     )?;
     Ok(OrbitRun {
@@ -737,35 +716,34 @@ pub(crate) struct PreparedOrbits<'c> {
 }
 
 /// Sets up what [`run_orbits_cancellable`] integrates.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare_orbits<'c>(
-    panel: &Panel,
-    orbit: &Orbit,
-    model: HingeModel,
-    coupling: Coupling,
-    method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: Vector4<f64>,
-    options: SummaryOptions,
+    req: &OrbitRunRequest,
     cancel: &'c Cancel,
 ) -> Result<PreparedOrbits<'c>> {
+    let OrbitRunRequest {
+        panel,
+        orbit,
+        model,
+        coupling,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+        ..
+    } = *req;
     cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
     crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
-    let method = resolve_hinge(method, panel, options.steps_per_period);
+    let method = resolve_hinge(&req.method, &panel, options.steps_per_period);
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
-    let view = TwoLayerView {
-        panel: *panel,
-        coupling,
-    };
-    let collector = Collector::new(view, orbit, options, t_start, first_index, n_orbits, y0[2])?;
+    let view = TwoLayerView { panel, coupling };
+    let collector = Collector::new(view, &orbit, options, t_start, first_index, n_orbits, y0[2])?;
     Ok(PreparedOrbits {
-        system: Coupled::new(*panel, *orbit, model, coupling),
+        system: Coupled::new(panel, orbit, model, coupling),
         method,
         t0: t_start,
         t1: t_start + n_orbits as f64 * orbit.period,
@@ -899,12 +877,18 @@ mod tests {
             stop_at_limit: true,
             steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
-        let method = Method::Dopri5(Tolerances::default());
-        let t_start = first as f64 * o.period;
-        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
-        run_orbits(
-            panel, &o, model, coupling, &method, t_start, first, n, y0, opts,
-        )
+        run_orbits(&OrbitRunRequest {
+            panel: *panel,
+            orbit: o,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: first as f64 * o.period,
+            first_index: first,
+            n_orbits: n,
+            y0,
+            options: opts,
+        })
         .unwrap()
     }
 
@@ -977,12 +961,19 @@ mod tests {
                     stop_at_limit: false,
                     steps_per_period,
                 };
-                let prepare = || {
-                    prepare_orbits(
-                        &panel, &o, model, coupling, &method, 0.0, 0, 2, y0, opts, &cancel,
-                    )
-                    .unwrap()
+                let req = OrbitRunRequest {
+                    panel,
+                    orbit: o,
+                    model,
+                    coupling,
+                    method,
+                    t_start: 0.0,
+                    first_index: 0,
+                    n_orbits: 2,
+                    y0,
+                    options: opts,
                 };
+                let prepare = || prepare_orbits(&req, &cancel).unwrap();
                 let mut run = prepare();
                 let outcome = solve(
                     &mut run.system,

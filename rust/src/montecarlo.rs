@@ -14,8 +14,8 @@ use crate::hybrid::{run_orbits_hybrid, HybridSettings};
 use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LaneObserver, StepReads, LANES};
 use crate::integrate::{DenseStep, Method, Observer};
 use crate::longrun::{
-    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, SummaryObserver,
-    SummaryOptions, TwoLayerView,
+    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, OrbitRunRequest,
+    SummaryObserver, SummaryOptions, TwoLayerView,
 };
 use crate::orbit::Orbit;
 use crate::params::Panel;
@@ -209,22 +209,15 @@ pub fn run_sample(
     settings: &EnsembleSettings,
     cancel: &Cancel,
 ) -> Result<SampleMetrics> {
-    let (head, y0, options) = sample_head(panel, settings, cancel)?;
-    let s = settings;
-    let (run, t_nonlinear) = match &s.hybrid {
+    let (head, req) = sample_head(panel, settings, cancel)?;
+    let (run, t_nonlinear) = match &settings.hybrid {
         None => {
-            let run = run_orbits_cancellable(
-                panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
-                cancel,
-            )?;
+            let run = run_orbits_cancellable(&req, cancel)?;
             let t = run.stats.t_end;
             (run, t)
         }
         Some(h) => {
-            let out = run_orbits_hybrid(
-                panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0, options,
-                h, cancel,
-            )?;
+            let out = run_orbits_hybrid(&req, h, cancel)?;
             (out.run, out.t_exponential + out.t_fallback)
         }
     };
@@ -244,22 +237,32 @@ fn sample_head(
     panel: &Panel,
     settings: &EnsembleSettings,
     cancel: &Cancel,
-) -> Result<(SampleHead, Vector4<f64>, SummaryOptions)> {
+) -> Result<(SampleHead, OrbitRunRequest)> {
     cancel.check()?;
     panel.validate()?;
     let s = settings;
     let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
     let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
     let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
-    let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-    let options = summary_options(s);
+    let req = OrbitRunRequest {
+        panel: *panel,
+        orbit: s.orbit,
+        model: s.model,
+        coupling: s.coupling,
+        method: s.method,
+        t_start: 0.0,
+        first_index: 0,
+        n_orbits: s.n_orbits,
+        y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+        options: summary_options(s),
+    };
     let head = SampleHead {
         theta_eq: flutter.equilibrium.theta,
         growth_rate: flutter.growth_rate,
         frequency_hz: flutter.frequency_hz,
         critical_damping: critical,
     };
-    Ok((head, y0, options))
+    Ok((head, req))
 }
 
 /// The per-orbit summaries every sample of a batch takes.
@@ -433,13 +436,8 @@ fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> 
     let s = settings;
     let next = || {
         for (index, panel) in queue.by_ref() {
-            let prepared = sample_head(panel, s, cancel).and_then(|(head, y0, options)| {
-                let run = prepare_orbits(
-                    panel, &s.orbit, s.model, s.coupling, &s.method, 0.0, 0, s.n_orbits, y0,
-                    options, cancel,
-                )?;
-                Ok((head, run))
-            });
+            let prepared = sample_head(panel, s, cancel)
+                .and_then(|(head, req)| Ok((head, prepare_orbits(&req, cancel)?)));
             match prepared {
                 Ok((head, run)) => {
                     let Method::Dopri5(tol) = run.method else {
@@ -686,23 +684,23 @@ mod tests {
         assert_eq!(m.growth_rate, a.growth_rate);
         assert_eq!(m.stable(), a.stable());
         let eq = equilibrium(&p, s.coupling, 1.0).unwrap();
-        let run = run_orbits(
-            &p,
-            &s.orbit,
-            s.model,
-            s.coupling,
-            &s.method,
-            0.0,
-            0,
-            1,
-            Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-            SummaryOptions {
+        let run = run_orbits(&OrbitRunRequest {
+            panel: p,
+            orbit: s.orbit,
+            model: s.model,
+            coupling: s.coupling,
+            method: s.method,
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: 1,
+            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+            options: SummaryOptions {
                 window: 600.0,
                 theta_limit: 0.2,
                 stop_at_limit: false,
                 steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
             },
-        )
+        })
         .unwrap();
         let o = run.summaries[0];
         assert_eq!(m.exit_peak, o.exit_peak);
@@ -726,26 +724,24 @@ mod tests {
         let p = Panel::paper();
         let m = run_sample(&p, &s, &Cancel::new()).unwrap();
         let eq = equilibrium(&p, s.coupling, s.orbit.flux_scale(0.0)).unwrap();
-        let single = run_orbits_hybrid(
-            &p,
-            &s.orbit,
-            s.model,
-            s.coupling,
-            &s.method,
-            0.0,
-            0,
-            3,
-            Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-            SummaryOptions {
+        let req = OrbitRunRequest {
+            panel: p,
+            orbit: s.orbit,
+            model: s.model,
+            coupling: s.coupling,
+            method: s.method,
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: 3,
+            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+            options: SummaryOptions {
                 window: s.window,
                 theta_limit: f64::MAX,
                 stop_at_limit: false,
                 steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
             },
-            &HybridSettings::default(),
-            &Cancel::new(),
-        )
-        .unwrap();
+        };
+        let single = run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap();
         let amp = single.run.summaries.iter().map(|o| o.amplitude);
         assert_eq!(m.amplitude, amp.fold(f64::NAN, f64::max));
         assert_eq!(m.t_nonlinear, single.t_exponential + single.t_fallback);

@@ -9,7 +9,7 @@
 use crate::dynamics::HingeModel;
 use crate::flutter::{analyse, critical_damping};
 use crate::integrate::{Method, Tolerances};
-use crate::longrun::{run_orbits, SummaryOptions, STEPS_PER_HINGE_PERIOD};
+use crate::longrun::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::simulate::{run, Output};
@@ -81,9 +81,19 @@ fn summaries() -> Vec<u64> {
         stop_at_limit: false,
         steps_per_period: STEPS_PER_HINGE_PERIOD,
     };
-    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
-    let y0 = state(eq.t_front, eq.t_back, eq.theta, 0.0);
-    let run = run_orbits(&p, &o, model, coupling, &adaptive(), 0.0, 0, 2, y0, options).unwrap();
+    let run = run_orbits(&OrbitRunRequest {
+        panel: p,
+        orbit: o,
+        model: HingeModel::Nonlinear,
+        coupling: Coupling::ProjectedArea,
+        method: adaptive(),
+        t_start: 0.0,
+        first_index: 0,
+        n_orbits: 2,
+        y0: state(eq.t_front, eq.t_back, eq.theta, 0.0),
+        options,
+    })
+    .unwrap();
     let mut v = Vec::new();
     for s in &run.summaries {
         v.extend([

@@ -29,7 +29,7 @@ use crate::dynamics::{thermal_moment, HingeModel};
 use crate::error::{require_positive, Error, Result};
 use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
 use crate::longrun::{
-    resolve_hinge, Collector, OrbitRun, SummaryObserver, SummaryOptions, TwoLayerView,
+    resolve_hinge, Collector, OrbitRun, OrbitRunRequest, SummaryObserver, TwoLayerView,
     STEPS_PER_HINGE_PERIOD,
 };
 use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
@@ -132,23 +132,25 @@ struct Driver<'a> {
     eclipses: EclipseTable,
 }
 
-/// Integrates orbits `first_index .. first_index + n_orbits` from (t_start, y0) with the hybrid
-/// propagator and summarises each orbit; `method` is the full integration used as the fallback.
-#[allow(clippy::too_many_arguments)]
+/// Integrates the orbits of `req` with the hybrid propagator and summarises each orbit;
+/// `req.method` is the full integration used as the fallback.
 pub fn run_orbits_hybrid(
-    panel: &Panel,
-    orbit: &Orbit,
-    model: HingeModel,
-    coupling: Coupling,
-    method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: Vector4<f64>,
-    options: SummaryOptions,
+    req: &OrbitRunRequest,
     settings: &HybridSettings,
     cancel: &Cancel,
 ) -> Result<HybridRun> {
+    let OrbitRunRequest {
+        ref panel,
+        ref orbit,
+        model,
+        coupling,
+        ref method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+    } = *req;
     cancel.check()?;
     require_positive("window", options.window)?;
     require_positive("theta_limit", options.theta_limit)?;
@@ -705,7 +707,7 @@ mod tests {
     use super::*;
     use crate::flutter::{analyse, critical_damping};
     use crate::integrate::Tolerances;
-    use crate::longrun::{run_orbits, OrbitSummary};
+    use crate::longrun::{run_orbits, OrbitSummary, SummaryOptions};
     use crate::orbit::Shadow;
 
     fn options() -> SummaryOptions {
@@ -722,22 +724,29 @@ mod tests {
         Vector4::new(eq.t_front, eq.t_back, eq.theta + kick, 0.0)
     }
 
-    fn hybrid(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> HybridRun {
-        run_orbits_hybrid(
-            panel,
-            orbit,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            0.0,
-            0,
-            n,
+    /// Orbits 0 .. n of `panel` from `y0`, the fallback (and the full run) rk45 at T_n/40.
+    fn request(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> OrbitRunRequest {
+        OrbitRunRequest {
+            panel: *panel,
+            orbit: *orbit,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: n,
             y0,
-            options(),
-            &HybridSettings::default(),
-            &Cancel::new(),
-        )
-        .unwrap()
+            options: options(),
+        }
+    }
+
+    fn hybrid(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> HybridRun {
+        let req = request(panel, orbit, n, y0);
+        run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap()
+    }
+
+    fn full(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> OrbitRun {
+        run_orbits(&request(panel, orbit, n, y0)).unwrap()
     }
 
     /// Within 2 %, or 1e-6 rad where the full run's value is below 5e-5 rad (NaN matches NaN).
@@ -775,19 +784,7 @@ mod tests {
         let panel = Panel::paper();
         let orbit = Orbit::geo_year(70.0);
         let y0 = start(&panel, &orbit, 0.0);
-        let full = run_orbits(
-            &panel,
-            &orbit,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            0.0,
-            0,
-            3,
-            y0,
-            options(),
-        )
-        .unwrap();
+        let full = full(&panel, &orbit, 3, y0);
         let hyb = hybrid(&panel, &orbit, 3, y0);
         compare(&full.summaries, &hyb.run.summaries);
         assert!(hyb.t_linear > 2.0 * orbit.period, "{}", hyb.t_linear);
@@ -828,19 +825,7 @@ mod tests {
         let panel = Panel::paper();
         let orbit = Orbit::geo_equinox();
         let y0 = start(&panel, &orbit, 0.0);
-        let full = run_orbits(
-            &panel,
-            &orbit,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            0.0,
-            0,
-            2,
-            y0,
-            options(),
-        )
-        .unwrap();
+        let full = full(&panel, &orbit, 2, y0);
         let hyb = hybrid(&panel, &orbit, 2, y0);
         compare(&full.summaries, &hyb.run.summaries);
         assert!(hyb.t_fallback > 0.0 && hyb.t_linear > orbit.period);

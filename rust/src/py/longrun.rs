@@ -6,7 +6,9 @@ use super::error::shield;
 use super::laminate::conduction_from;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::layered;
-use crate::longrun::{run_orbits_cancellable as run, OrbitSummary, SummaryOptions};
+use crate::longrun::{
+    run_orbits_cancellable as run, OrbitRun, OrbitRunRequest, OrbitSummary, SummaryOptions,
+};
 use crate::system::Coupling;
 use nalgebra::U4;
 use numpy::PyArray1;
@@ -19,6 +21,17 @@ struct Summarised {
     stats: crate::integrate::Stats,
     y_end: Vec<f64>,
     crossing: Option<crate::longrun::LimitCrossing>,
+}
+
+impl From<OrbitRun> for Summarised {
+    fn from(run: OrbitRun) -> Self {
+        Summarised {
+            summaries: run.summaries,
+            stats: run.stats,
+            y_end: run.y_end.as_slice().to_vec(),
+            crossing: run.crossing,
+        }
+    }
 }
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays): the two-layer
@@ -67,104 +80,67 @@ fn run_orbits<'py>(
             steps_per_period,
         };
         let settings = hybrid.map(hybrid_from).transpose()?;
-        let out = match (nodes, settings) {
-            (Some(_), Some(_)) => {
+        if let Some(n) = nodes {
+            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
+            if settings.is_some() {
                 return Err(crate::Error::invalid(
                     "hybrid",
                     "settings",
                     "the hybrid propagator covers the two-layer model: give nodes = None",
                 )
-                .into())
+                .into());
             }
-            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            (Some(n), None) => {
-                let c = conduction_from(&p, layup, n)?;
-                let run = py.detach(|| {
-                    layered::run_orbits(
-                        &p,
-                        c,
-                        &o,
-                        hinge,
-                        coupling,
-                        &m,
-                        t_start,
-                        first_index,
-                        n_orbits,
-                        &y0,
-                        options,
-                        &cancel,
-                    )
-                })?;
-                Summarised {
-                    summaries: run.summaries,
-                    stats: run.stats,
-                    y_end: run.y_end,
-                    crossing: run.crossing,
-                }
-            }
-            (None, None) => {
-                let y = state(&y0, U4)?;
-                let run = py.detach(|| {
-                    run(
-                        &p,
-                        &o,
-                        hinge,
-                        coupling,
-                        &m,
-                        t_start,
-                        first_index,
-                        n_orbits,
-                        y,
-                        options,
-                        &cancel,
-                    )
-                })?;
-                Summarised {
-                    summaries: run.summaries,
-                    stats: run.stats,
-                    y_end: run.y_end.as_slice().to_vec(),
-                    crossing: run.crossing,
-                }
-            }
-            (None, Some(settings)) => {
-                let y = state(&y0, U4)?;
-                crate::dynamics::check_hinge_angle("y0[2]", y[2])?;
-                let out = py.detach(|| {
-                    run_hybrid(
-                        &p,
-                        &o,
-                        hinge,
-                        coupling,
-                        &m,
-                        t_start,
-                        first_index,
-                        n_orbits,
-                        y,
-                        options,
-                        &settings,
-                        &cancel,
-                    )
-                })?;
-                let run = out.run;
-                let d = summary_dict(
-                    py,
-                    &Summarised {
-                        summaries: run.summaries,
-                        stats: run.stats,
-                        y_end: run.y_end.as_slice().to_vec(),
-                        crossing: run.crossing,
-                    },
-                )?;
-                d.set_item("t_linear", out.t_linear)?;
-                d.set_item("t_exponential", out.t_exponential)?;
-                d.set_item("t_fallback", out.t_fallback)?;
-                d.set_item("n_arcs", out.n_arcs)?;
-                d.set_item("n_exp_steps", out.n_exp_steps)?;
-                d.set_item("n_fallback_steps", out.n_fallback_steps)?;
-                return Ok(d);
-            }
+            let c = conduction_from(&p, layup, n)?;
+            let run = py.detach(|| {
+                layered::run_orbits(
+                    &p,
+                    c,
+                    &o,
+                    hinge,
+                    coupling,
+                    &m,
+                    t_start,
+                    first_index,
+                    n_orbits,
+                    &y0,
+                    options,
+                    &cancel,
+                )
+            })?;
+            let out = Summarised {
+                summaries: run.summaries,
+                stats: run.stats,
+                y_end: run.y_end,
+                crossing: run.crossing,
+            };
+            return summary_dict(py, &out);
+        }
+        let req = OrbitRunRequest {
+            panel: p,
+            orbit: o,
+            model: hinge,
+            coupling,
+            method: m,
+            t_start,
+            first_index,
+            n_orbits,
+            y0: state(&y0, U4)?,
+            options,
         };
-        summary_dict(py, &out)
+        let Some(settings) = settings else {
+            let run = py.detach(|| run(&req, &cancel))?;
+            return summary_dict(py, &run.into());
+        };
+        crate::dynamics::check_hinge_angle("y0[2]", req.y0[2])?;
+        let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
+        let d = summary_dict(py, &out.run.into())?;
+        d.set_item("t_linear", out.t_linear)?;
+        d.set_item("t_exponential", out.t_exponential)?;
+        d.set_item("t_fallback", out.t_fallback)?;
+        d.set_item("n_arcs", out.n_arcs)?;
+        d.set_item("n_exp_steps", out.n_exp_steps)?;
+        d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+        Ok(d)
     })
 }
 
