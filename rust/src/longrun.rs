@@ -157,6 +157,15 @@ pub struct SummaryOptions {
     pub steps_per_period: f64,
 }
 
+impl SummaryOptions {
+    /// Refuses a window or limit that is not positive, and a negative step cap.
+    pub fn check(&self) -> Result<()> {
+        crate::error::require_positive("window", self.window)?;
+        crate::error::require_positive("theta_limit", self.theta_limit)?;
+        crate::error::require_non_negative("steps_per_period", self.steps_per_period)
+    }
+}
+
 /// Largest [`SummaryOptions::steps_per_period`]: finer steps than T_n/10⁴ resolve nothing more
 /// and only multiply the cost.
 pub const MAX_STEPS_PER_PERIOD: f64 = 1e4;
@@ -733,9 +742,7 @@ pub(crate) fn prepare_orbits<'c>(
         ..
     } = *req;
     cancel.check()?;
-    crate::error::require_positive("window", options.window)?;
-    crate::error::require_positive("theta_limit", options.theta_limit)?;
-    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    options.check()?;
     let method = resolve_hinge(&req.method, &panel, options.steps_per_period);
     if n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));

@@ -152,9 +152,7 @@ pub fn run_orbits_hybrid(
         options,
     } = *req;
     cancel.check()?;
-    require_positive("window", options.window)?;
-    require_positive("theta_limit", options.theta_limit)?;
-    crate::error::require_non_negative("steps_per_period", options.steps_per_period)?;
+    options.check()?;
     settings.validate()?;
     panel.validate()?;
     orbit.validate()?;
