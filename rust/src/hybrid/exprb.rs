@@ -15,10 +15,9 @@
 //! ```
 
 use super::expm::phi_matrices;
-use super::jacobian::Linearisation;
+use super::model::HybridModel;
 use crate::error::{Error, Result};
-use crate::system::Coupled;
-use nalgebra::Vector4;
+use nalgebra::SVector;
 
 /// Error-control settings of the exponential stretches.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,33 +31,35 @@ pub struct ExpTolerances {
 
 /// One accepted step: both ends and the slopes there (for Hermite interpolation).
 #[derive(Debug, Clone, Copy)]
-pub struct ExpStep {
+pub struct ExpStep<const N: usize> {
     pub t0: f64,
     pub t1: f64,
-    pub y0: Vector4<f64>,
-    pub y1: Vector4<f64>,
-    pub f0: Vector4<f64>,
-    pub f1: Vector4<f64>,
+    pub y0: SVector<f64, N>,
+    pub y1: SVector<f64, N>,
+    pub f0: SVector<f64, N>,
+    pub f1: SVector<f64, N>,
+    /// The illumination factor at t0 and t1.
+    pub flux0: f64,
+    pub flux1: f64,
 }
 
 /// ∂f/∂t through the illumination (s(t) in a penumbra, the Sun's distance) inside the segment
 /// [a, b], by a one-sided difference that stays inside it; `flux` is the flux at t.
-fn time_derivative(
-    system: &Coupled,
-    lin: &Linearisation,
+fn time_derivative<const N: usize, M: HybridModel<N>>(
+    system: &M,
     t: f64,
     flux: f64,
-    y: &Vector4<f64>,
+    y: &SVector<f64, N>,
     a: f64,
     b: f64,
-) -> Vector4<f64> {
+) -> SVector<f64, N> {
     let delta = 1e-2_f64.min(0.5 * (b - a));
     let dflux = if t + delta <= b {
         (system.flux_at(t + delta) - flux) / delta
     } else {
         (flux - system.flux_at((t - delta).max(a))) / delta
     };
-    lin.flux_sensitivity(y) * dflux
+    system.flux_sensitivity(flux, y) * dflux
 }
 
 /// Integrates the segment [a, b] (no breakpoint inside; the system has entered it) from (t, y),
@@ -66,16 +67,15 @@ fn time_derivative(
 /// `h` carries the step size from segment to segment. Returns the number of (accepted,
 /// rejected) steps.
 #[allow(clippy::too_many_arguments)]
-pub fn segment(
-    system: &Coupled,
-    lin: &Linearisation,
+pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
+    system: &M,
     a: f64,
     b: f64,
     t: &mut f64,
-    y: &mut Vector4<f64>,
+    y: &mut SVector<f64, N>,
     h: &mut f64,
     tol: &ExpTolerances,
-    mut on_step: impl FnMut(&ExpStep) -> Result<bool>,
+    mut on_step: impl FnMut(&ExpStep<N>) -> Result<bool>,
 ) -> Result<(u64, u64, bool)> {
     let (mut accepted, mut rejected) = (0u64, 0u64);
     // The flux at the step's start, carried from the end of the last one (s(t) is costly in a
@@ -85,8 +85,8 @@ pub fn segment(
     while *t < b {
         let t0 = *t;
         let y0 = *y;
-        let jac = lin.jacobian(flux, &y0);
-        let v = time_derivative(system, lin, t0, flux, &y0, a, b);
+        let jac = system.jacobian(flux, &y0);
+        let v = time_derivative(system, t0, flux, &y0, a, b);
         let mut rejected_here = false;
         loop {
             let step = h.min(tol.max_step).min(b - t0);
@@ -111,8 +111,8 @@ pub fn segment(
             let corr = phi3 * (d * (2.0 * hs));
             let y1 = u_mid + corr;
             let mut acc = 0.0;
-            for i in 0..4 {
-                let atol = if i < 2 {
+            for i in 0..N {
+                let atol = if i < N - 2 {
                     tol.atol_temperature
                 } else {
                     tol.atol_angle
@@ -120,7 +120,7 @@ pub fn segment(
                 let r = corr[i] / (atol + tol.rtol * y0[i].abs().max(y1[i].abs()));
                 acc += r * r;
             }
-            let err = (acc / 4.0).sqrt();
+            let err = (acc / N as f64).sqrt();
             if err <= 1.0 {
                 let mut factor = if err == 0.0 {
                     5.0
@@ -135,6 +135,7 @@ pub fn segment(
                     *h = hs * factor;
                 }
                 let f1 = system.rhs_at_flux(flux1, &y1);
+                let flux0 = flux;
                 flux = flux1;
                 accepted += 1;
                 *t = t1;
@@ -146,6 +147,8 @@ pub fn segment(
                     y1,
                     f0,
                     f1,
+                    flux0,
+                    flux1,
                 })?;
                 f0 = f1;
                 if stop {

@@ -8,53 +8,53 @@
 //! Every per-orbit summary over the arc then follows from this closed form.
 
 use crate::error::{Error, Result};
-use nalgebra::{Complex, Matrix4, Vector4};
+use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 
 type C64 = Complex<f64>;
 
 /// y(τ) = base + slope τ + Re Σ_k modes_k e^{λ_k τ} for τ in [0, length].
 #[derive(Debug, Clone, Copy)]
-pub struct Arc {
+pub struct Arc<const N: usize> {
     pub length: f64,
-    base: Vector4<f64>,
-    slope: Vector4<f64>,
-    lambda: [C64; 4],
-    modes: [nalgebra::Vector4<C64>; 4],
+    base: SVector<f64, N>,
+    slope: SVector<f64, N>,
+    lambda: [C64; N],
+    modes: [SVector<C64, N>; N],
 }
 
 /// A scalar linear functional w·y(τ) of an arc: q0 + q1 τ + Σ_k a_k e^{λ_k τ} (real in total).
 #[derive(Debug, Clone, Copy)]
-pub struct Signal {
+pub struct Signal<const N: usize> {
     q0: f64,
     q1: f64,
-    a: [C64; 4],
-    lambda: [C64; 4],
+    a: [C64; N],
+    lambda: [C64; N],
 }
 
-impl Arc {
+impl<const N: usize> Arc<N> {
     /// The arc from y(0) = y0 about the equilibrium `y_ref` with Jacobian `a` and drift forcing b τ.
     /// `scale` balances the state's units for the eigen-solve (a diagonal similarity).
     pub fn new(
-        a: &Matrix4<f64>,
-        b: &Vector4<f64>,
-        y_ref: &Vector4<f64>,
-        y0: &Vector4<f64>,
+        a: &SMatrix<f64, N, N>,
+        b: &SVector<f64, N>,
+        y_ref: &SVector<f64, N>,
+        y0: &SVector<f64, N>,
         length: f64,
-        scale: &Vector4<f64>,
-    ) -> Result<Arc> {
+        scale: &SVector<f64, N>,
+    ) -> Result<Arc<N>> {
         let fail = |reason: &str| Error::NoConvergence {
             what: "modal decomposition".into(),
             reason: reason.into(),
         };
-        let lu = a.lu();
+        let lu = Lu::of(a);
         let p1 = -lu.solve(b).ok_or_else(|| fail("singular Jacobian"))?;
         let p0 = lu.solve(&p1).ok_or_else(|| fail("singular Jacobian"))?;
         // Balanced: ab = D⁻¹ A D, so that kelvin and radian rows have comparable sizes.
-        let ab = Matrix4::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
-        let ev = ab.complex_eigenvalues();
-        let abc: Matrix4<C64> = ab.map(|v| C64::new(v, 0.0));
-        let mut vecs: [Vector4<C64>; 4] = [Vector4::zeros(); 4];
-        for k in 0..4 {
+        let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
+        let ev = DMatrix::from_column_slice(N, N, ab.as_slice()).complex_eigenvalues();
+        let abc: SMatrix<C64, N, N> = ab.map(|v| C64::new(v, 0.0));
+        let mut vecs: [SVector<C64, N>; N] = [SVector::zeros(); N];
+        for k in 0..N {
             let lam = ev[k];
             if !(lam.re.is_finite() && lam.im.is_finite()) {
                 return Err(fail("non-finite eigenvalue"));
@@ -63,14 +63,9 @@ impl Arc {
             // to rounding.
             let shift =
                 lam + C64::new(1e-10 * lam.norm().max(1e-12), 1e-10 * lam.norm().max(1e-12));
-            let m = abc - Matrix4::<C64>::identity() * shift;
-            let mlu = m.lu();
-            let mut x = Vector4::new(
-                C64::new(1.0, 0.0),
-                C64::new(0.7, 0.1),
-                C64::new(-0.3, 0.5),
-                C64::new(0.2, -0.4),
-            );
+            let m = abc - SMatrix::<C64, N, N>::identity() * shift;
+            let mlu = Lu::of(&m);
+            let mut x = SVector::<C64, N>::from_fn(|i, _| start_component(i));
             for _ in 0..3 {
                 x = mlu.solve(&x).ok_or_else(|| fail("eigenvector"))?;
                 let n = x.norm();
@@ -85,11 +80,10 @@ impl Arc {
             }
             vecs[k] = x;
         }
-        let v = Matrix4::<C64>::from_columns(&vecs);
+        let v = SMatrix::<C64, N, N>::from_columns(&vecs);
         let h0 = y0 - y_ref - p0;
-        let h0b: Vector4<C64> = Vector4::from_fn(|i, _| C64::new(h0[i] / scale[i], 0.0));
-        let c = v
-            .lu()
+        let h0b: SVector<C64, N> = SVector::from_fn(|i, _| C64::new(h0[i] / scale[i], 0.0));
+        let c = Lu::of(&v)
             .solve(&h0b)
             .ok_or_else(|| fail("eigenvectors not independent"))?;
         let back = v * c;
@@ -97,25 +91,25 @@ impl Arc {
         if err.is_nan() || err > 1e-9 * h0b.norm().max(1e-300) {
             return Err(fail("eigenvectors nearly dependent"));
         }
-        let mut modes = [Vector4::<C64>::zeros(); 4];
-        for k in 0..4 {
-            modes[k] = Vector4::from_fn(|i, _| vecs[k][i] * c[k] * scale[i]);
+        let mut modes = [SVector::<C64, N>::zeros(); N];
+        for k in 0..N {
+            modes[k] = SVector::from_fn(|i, _| vecs[k][i] * c[k] * scale[i]);
         }
         Ok(Arc {
             length,
             base: y_ref + p0,
             slope: p1,
-            lambda: [ev[0], ev[1], ev[2], ev[3]],
+            lambda: std::array::from_fn(|k| ev[k]),
             modes,
         })
     }
 
     /// The state at τ.
-    pub fn state(&self, tau: f64) -> Vector4<f64> {
+    pub fn state(&self, tau: f64) -> SVector<f64, N> {
         let mut y = self.base + self.slope * tau;
-        for k in 0..4 {
+        for k in 0..N {
             let e = (self.lambda[k] * tau).exp();
-            for i in 0..4 {
+            for i in 0..N {
                 y[i] += (self.modes[k][i] * e).re;
             }
         }
@@ -123,14 +117,43 @@ impl Arc {
     }
 
     /// The functional w·y(τ).
-    pub fn signal(&self, w: &Vector4<f64>) -> Signal {
-        let a = self.modes.map(|m| (0..4).map(|i| m[i] * w[i]).sum::<C64>());
+    pub fn signal(&self, w: &SVector<f64, N>) -> Signal<N> {
+        let a = self.modes.map(|m| (0..N).map(|i| m[i] * w[i]).sum::<C64>());
         Signal {
             q0: w.dot(&self.base),
             q1: w.dot(&self.slope),
             a,
             lambda: self.lambda,
         }
+    }
+}
+
+/// The LU factors of an N×N matrix, computed on the run-time size (the compile-time one asks
+/// for dimension bounds a size generic over N does not carry); the same elimination either way.
+struct Lu<T: nalgebra::ComplexField, const N: usize>(
+    nalgebra::linalg::LU<T, nalgebra::Dyn, nalgebra::Dyn>,
+);
+
+impl<T: nalgebra::ComplexField + Copy, const N: usize> Lu<T, N> {
+    fn of(m: &SMatrix<T, N, N>) -> Self {
+        Lu(nalgebra::DMatrix::from_column_slice(N, N, m.as_slice()).lu())
+    }
+
+    fn solve(&self, b: &SVector<T, N>) -> Option<SVector<T, N>> {
+        let x = self
+            .0
+            .solve(&nalgebra::DVector::from_column_slice(b.as_slice()))?;
+        Some(SVector::from_column_slice(x.as_slice()))
+    }
+}
+
+/// The start of inverse iteration: a vector with no special direction (the first four are the
+/// two-layer model's).
+fn start_component(i: usize) -> C64 {
+    const FIRST: [(f64, f64); 4] = [(1.0, 0.0), (0.7, 0.1), (-0.3, 0.5), (0.2, -0.4)];
+    match FIRST.get(i) {
+        Some(&(re, im)) => C64::new(re, im),
+        None => C64::new(0.37 + 0.11 * i as f64, 0.23 - 0.05 * i as f64),
     }
 }
 
@@ -152,10 +175,10 @@ fn phi12(x: C64) -> (C64, C64) {
     }
 }
 
-impl Signal {
+impl<const N: usize> Signal<N> {
     pub fn at(&self, tau: f64) -> f64 {
         let mut v = self.q0 + self.q1 * tau;
-        for k in 0..4 {
+        for k in 0..N {
             v += (self.a[k] * (self.lambda[k] * tau).exp()).re;
         }
         v
@@ -164,7 +187,7 @@ impl Signal {
     /// The signal and its first two derivatives at τ.
     fn with_derivatives(&self, tau: f64) -> (f64, f64, f64) {
         let (mut v, mut d1, mut d2) = (self.q0 + self.q1 * tau, self.q1, 0.0);
-        for k in 0..4 {
+        for k in 0..N {
             let l = self.lambda[k];
             let term = self.a[k] * (l * tau).exp();
             v += term.re;
@@ -177,7 +200,7 @@ impl Signal {
     /// Smooth part (drift and real modes) and the envelope of the oscillatory terms at τ.
     fn smooth_and_envelope(&self, tau: f64) -> (f64, f64) {
         let (mut smooth, mut env) = (self.q0 + self.q1 * tau, 0.0);
-        for k in 0..4 {
+        for k in 0..N {
             let l = self.lambda[k];
             // Re(a e^{λτ}) of a real λ is Re(a) e^{λτ}.
             let decay = (l.re * tau).exp();
@@ -205,11 +228,11 @@ impl Signal {
             q0 * q0 * l + q0 * q1 * l * l + q1 * q1 * l * l * l / 3.0,
             0.0,
         );
-        for k in 0..4 {
+        for k in 0..N {
             // ∫ e^{λτ} = L φ1(λL), ∫ τ e^{λτ} = L² (φ1 − φ2)(λL).
             let (p1, p2) = phi12(self.lambda[k] * l);
             total += self.a[k] * 2.0 * (p1 * (q0 * l) + (p1 - p2) * (q1 * l * l));
-            for j in 0..4 {
+            for j in 0..N {
                 let (p1, _) = phi12((self.lambda[j] + self.lambda[k]) * l);
                 total += self.a[j] * self.a[k] * p1 * l;
             }
@@ -235,7 +258,7 @@ impl Signal {
         for (i, v) in values.iter_mut().enumerate() {
             *v = sign * (self.q0 + self.q1 * (t0 + i as f64 * dx));
         }
-        for k in 0..4 {
+        for k in 0..N {
             let l = self.lambda[k];
             let (mut term, step) = ((l.re * t0).exp(), (l.re * dx).exp());
             let weight = if l.im != 0.0 {
@@ -265,7 +288,7 @@ impl Signal {
             sign * s + e
         };
         let value = |tau: f64| sign * self.at(tau);
-        let oscillating = (0..4)
+        let oscillating = (0..N)
             .filter(|&k| self.lambda[k].im > 0.0)
             .max_by(|&i, &j| self.a[i].norm().total_cmp(&self.a[j].norm()));
         let grid = self.bound_on_grid(sign, t0, t1);
@@ -388,7 +411,7 @@ fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, values: &[f64], width: f64)
 mod tests {
     use super::*;
     use crate::hybrid::expm::expm;
-    use nalgebra::Matrix5;
+    use nalgebra::{Matrix4, Matrix5, Vector4};
 
     /// A coupled thermal–oscillator matrix like the panel's (balanced units).
     fn system() -> (Matrix4<f64>, Vector4<f64>) {

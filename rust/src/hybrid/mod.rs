@@ -23,23 +23,22 @@ pub mod expm;
 pub mod exprb;
 pub mod jacobian;
 pub mod linear;
+pub(crate) mod model;
 
 use crate::cancel::Cancel;
-use crate::dynamics::{thermal_moment, HingeModel};
+use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
-use crate::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
+use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
 use crate::longrun::{
-    resolve_hinge, Collector, OrbitRun, OrbitRunRequest, SummaryObserver, TwoLayerView,
-    STEPS_PER_HINGE_PERIOD,
+    resolve_hinge, Collector, LimitCrossing, OrbitRun, OrbitRunRequest, OrbitSummary,
+    SummaryObserver, SummaryOptions, STEPS_PER_HINGE_PERIOD,
 };
 use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::params::Panel;
-use crate::steady::{equilibrium, newton};
-use crate::system::{Coupled, Coupling};
 use exprb::{ExpStep, ExpTolerances};
-use jacobian::Linearisation;
 use linear::Arc;
-use nalgebra::{DMatrix, DVector, Vector4, U4};
+use model::{HybridModel, TwoLayerModel};
+use nalgebra::{Const, SMatrix, SVector, Vector4};
 use std::cell::Cell;
 use std::ops::ControlFlow;
 
@@ -110,26 +109,33 @@ enum Regime {
     Large,
 }
 
-struct Driver<'a> {
-    panel: Panel,
+struct Driver<'a, const N: usize, M: HybridModel<N>> {
     orbit: Orbit,
     settings: &'a HybridSettings,
     fallback: Method,
-    system: Coupled,
-    obs: SummaryObserver<'a, TwoLayerView>,
+    system: M,
+    obs: SummaryObserver<'a, M::View>,
     t_start: f64,
     t_end: f64,
     t: f64,
-    y: Vector4<f64>,
+    y: SVector<f64, N>,
     h_exp: f64,
     stats: Stats,
     out: HybridRun,
-    /// Static θ per kelvin of gradient, rad/K.
-    theta_per_kelvin: f64,
-    judge: Judge,
+    judge: Judge<N, M>,
     /// Units of the state for the modal decomposition.
-    scale: Vector4<f64>,
+    scale: SVector<f64, N>,
     eclipses: EclipseTable,
+}
+
+/// A hybrid run of any model: the summaries, the counters, the end state.
+pub(crate) struct Propagated<const N: usize> {
+    pub summaries: Vec<OrbitSummary>,
+    pub stats: Stats,
+    pub y_end: SVector<f64, N>,
+    pub crossing: Option<LimitCrossing>,
+    /// How the time was split (its `run` is left empty: the fields above hold it).
+    pub split: HybridRun,
 }
 
 /// Integrates the orbits of `req` with the hybrid propagator and summarises each orbit;
@@ -151,44 +157,107 @@ pub fn run_orbits_hybrid(
         y0,
         options,
     } = *req;
+    panel.validate()?;
+    check_request(
+        orbit,
+        method,
+        t_start,
+        n_orbits,
+        y0.as_slice(),
+        &options,
+        settings,
+        cancel,
+    )?;
+    let done = propagate(
+        TwoLayerModel::new(panel, orbit, model, coupling),
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+        settings,
+        cancel,
+    )?;
+    let mut out = done.split;
+    out.run = OrbitRun {
+        summaries: done.summaries,
+        stats: done.stats,
+        y_end: done.y_end,
+        crossing: done.crossing,
+    };
+    Ok(out)
+}
+
+/// Checks what every hybrid run is asked (the panel is checked by its model).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_request(
+    orbit: &Orbit,
+    method: &Method,
+    t_start: f64,
+    n_orbits: u64,
+    y0: &[f64],
+    options: &SummaryOptions,
+    settings: &HybridSettings,
+    cancel: &Cancel,
+) -> Result<()> {
     cancel.check()?;
     options.check()?;
     settings.validate()?;
-    panel.validate()?;
     orbit.validate()?;
     method.validate()?;
     if n_orbits == 0 {
         return Err(Error::invalid("n_orbits", 0, "must be >= 1"));
     }
     crate::error::require_finite("t_start", t_start)?;
-    if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
-        return Err(Error::invalid(
-            "y0",
-            y0[i],
-            "every component must be finite",
-        ));
+    if let Some(v) = y0.iter().find(|v| !v.is_finite()) {
+        return Err(Error::invalid("y0", v, "every component must be finite"));
     }
+    Ok(())
+}
+
+/// The hybrid propagation of `model` (checked by the caller) over orbits `first_index ..
+/// first_index + n_orbits` from (t_start, y0).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
+    model: M,
+    orbit: &Orbit,
+    method: &Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: SVector<f64, N>,
+    options: SummaryOptions,
+    settings: &HybridSettings,
+    cancel: &Cancel,
+) -> Result<Propagated<N>> {
+    let panel = *model.panel();
     let steps = if options.steps_per_period > 0.0 {
         options.steps_per_period
     } else {
         STEPS_PER_HINGE_PERIOD
     };
-    let view = TwoLayerView {
-        panel: *panel,
-        coupling,
-    };
-    let collector = Collector::new(view, orbit, options, t_start, first_index, n_orbits, y0[2])?;
+    let collector = Collector::new(
+        model.view(),
+        orbit,
+        options,
+        t_start,
+        first_index,
+        n_orbits,
+        y0[N - 2],
+    )?;
     let t_end = t_start + n_orbits as f64 * orbit.period;
-    let t_ref = equilibrium(panel, coupling, orbit.flux_scale(t_start))
-        .map(|e| e.t_front)
+    let t_ref = model
+        .equilibrium(orbit.flux_scale(t_start), None)
+        .map(|e| e[0])
         .unwrap_or(300.0);
     let wn = panel.natural_angular_frequency();
     let mut d = Driver {
-        panel: *panel,
         orbit: *orbit,
         settings,
-        fallback: resolve_hinge(method, panel, steps),
-        system: Coupled::new(*panel, *orbit, model, coupling),
+        fallback: resolve_hinge(method, &panel, steps),
+        system: model.clone(),
         obs: SummaryObserver {
             collector,
             error: None,
@@ -207,7 +276,7 @@ pub fn run_orbits_hybrid(
             run: OrbitRun {
                 summaries: Vec::new(),
                 stats: Stats::default(),
-                y_end: y0,
+                y_end: Vector4::zeros(),
                 crossing: None,
             },
             t_linear: 0.0,
@@ -217,25 +286,24 @@ pub fn run_orbits_hybrid(
             n_exp_steps: 0,
             n_fallback_steps: 0,
         },
-        theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
         judge: Judge {
-            panel: *panel,
+            panel,
             orbit: *orbit,
-            model,
-            coupling,
             settings: *settings,
-            system: Coupled::new(*panel, *orbit, model, coupling),
-            lin: Linearisation::new(panel, model, coupling),
-            theta_per_kelvin: panel.moment_per_kelvin() / panel.hinge_stiffness,
+            model,
             last: Cell::new(None),
         },
-        scale: Vector4::new(1.0, 1.0, 1.0 / t_ref, wn / t_ref),
+        scale: SVector::from_fn(|i, _| match N - i {
+            2 => 1.0 / t_ref,
+            1 => wn / t_ref,
+            _ => 1.0,
+        }),
         eclipses: EclipseTable::new(orbit),
     };
     d.run()?;
     let Driver {
         mut obs,
-        mut out,
+        out,
         mut stats,
         t,
         y,
@@ -244,81 +312,48 @@ pub fn run_orbits_hybrid(
     obs.collector.close();
     stats.t_end = t;
     stats.stopped = t < t_end && obs.collector.crossing.is_some();
-    out.run = OrbitRun {
+    Ok(Propagated {
         summaries: obs.collector.done,
         stats,
         y_end: y,
         crossing: obs.collector.crossing,
-    };
-    Ok(out)
+        split: out,
+    })
 }
 
 /// The tests that decide the regime: everything they need, apart from the driver so that the
 /// fallback's observer can use them too.
 #[derive(Clone)]
-struct Judge {
+struct Judge<const N: usize, M> {
     panel: Panel,
     orbit: Orbit,
-    model: HingeModel,
-    coupling: Coupling,
     settings: HybridSettings,
-    system: Coupled,
-    lin: Linearisation,
-    theta_per_kelvin: f64,
+    model: M,
     /// The last equilibrium and its flux: the next one, at a flux that has barely changed, is
     /// found by Newton's method from it.
-    last: Cell<Option<(f64, Vector4<f64>)>>,
+    last: Cell<Option<(f64, SVector<f64, N>)>>,
 }
 
-impl Judge {
+impl<const N: usize, M: HybridModel<N>> Judge<N, M> {
     /// The sunlit equilibrium and Jacobian at the flux of time t.
-    fn reference(&self, flux: f64) -> Result<(Vector4<f64>, nalgebra::Matrix4<f64>)> {
+    fn reference(&self, flux: f64) -> Result<(SVector<f64, N>, SMatrix<f64, N, N>)> {
         let y_ref = match self.last.get() {
             Some((f, y)) if f == flux => y,
-            Some((_, y)) => self.equilibrium_from(flux, &y)?,
-            None => equilibrium(&self.panel, self.coupling, flux)?.state(),
+            Some((_, y)) => self.model.equilibrium(flux, Some(&y))?,
+            None => self.model.equilibrium(flux, None)?,
         };
         self.last.set(Some((flux, y_ref)));
-        Ok((y_ref, self.lin.jacobian(flux, &y_ref)))
-    }
-
-    /// The equilibrium under `flux` by Newton's method from the state `start` at rest, with the
-    /// analytic Jacobian: the unknowns (T_f, T_b, θ), the equations dT_f/dt = dT_b/dt = θ̈ = 0.
-    fn equilibrium_from(&self, flux: f64, start: &Vector4<f64>) -> Result<Vector4<f64>> {
-        const ROWS: [usize; 3] = [0, 1, 3];
-        let state = |x: &DVector<f64>| Vector4::new(x[0], x[1], x[2], 0.0);
-        let system = |x: &DVector<f64>| {
-            let y = state(x);
-            let (f, jac) = (
-                self.system.rhs_at_flux(flux, &y),
-                self.lin.jacobian(flux, &y),
-            );
-            (
-                DVector::from_fn(3, |i, _| f[ROWS[i]]),
-                DMatrix::from_fn(3, 3, |i, j| jac[(ROWS[i], j)]),
-            )
-        };
-        // As steady::steady: temperatures to 1e-12 relative, the angle to 1e-14 rad.
-        let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
-            dx[0].abs() < 1e-12 * x[0] && dx[1].abs() < 1e-12 * x[1] && dx[2].abs() < 1e-14
-        };
-        let x0 = DVector::from_column_slice(&start.as_slice()[..3]);
-        Ok(state(&newton(
-            "sunlit equilibrium",
-            x0,
-            2,
-            system,
-            settled,
-        )?))
+        Ok((y_ref, self.model.jacobian(flux, &y_ref)))
     }
 
     /// Amplitude of the hinge oscillation about the quasi-static deflection M_T/K_el, from the
     /// dynamic part and its rate.
-    fn oscillation(&self, y: &Vector4<f64>, f: &Vector4<f64>) -> f64 {
-        let d = y[2] - self.theta_per_kelvin * (y[0] - y[1]);
-        let d_rate = y[3] - self.theta_per_kelvin * (f[0] - f[1]);
-        let s = y[2].sin();
-        let inertia = match self.model {
+    fn oscillation(&self, flux: f64, y: &SVector<f64, N>, f: &SVector<f64, N>) -> f64 {
+        let (quasi_static, rate) = self.model.static_angle(flux, y, f);
+        let d = y[N - 2] - quasi_static;
+        let d_rate = y[N - 1] - rate;
+        let s = y[N - 2].sin();
+        let inertia = match self.model.hinge() {
             HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
             HingeModel::Linear => 1.0,
         };
@@ -327,25 +362,25 @@ impl Judge {
     }
 
     /// May the state at sunlit time t be propagated linearly?
-    fn regime(&self, t: f64, y: &Vector4<f64>) -> Result<Regime> {
+    fn regime(&self, t: f64, y: &SVector<f64, N>) -> Result<Regime> {
         if self.orbit.illumination(t) < 1.0 {
             return Ok(Regime::NonLinear);
         }
         let flux = self.orbit.flux_scale(t);
-        let f = self.system.rhs_at_flux(flux, y);
+        let f = self.model.rhs_at_flux(flux, y);
         let (y_ref, a) = self.reference(flux)?;
         let dev = y - y_ref;
-        let amplitude = (dev[2] * dev[2]
-            + dev[3] * dev[3] / self.panel.natural_angular_frequency().powi(2))
+        let amplitude = (dev[N - 2] * dev[N - 2]
+            + dev[N - 1] * dev[N - 1] / self.panel.natural_angular_frequency().powi(2))
         .sqrt();
-        if amplitude.max(self.oscillation(y, &f)) > self.settings.linear_amplitude {
+        if amplitude.max(self.oscillation(flux, y, &f)) > self.settings.linear_amplitude {
             return Ok(Regime::Large);
         }
         let r = f - a * dev;
         let Some(inv) = a.try_inverse() else {
             return Ok(Regime::NonLinear);
         };
-        let static_error: f64 = (0..4).map(|i| (inv[(2, i)] * r[i]).abs()).sum();
+        let static_error: f64 = (0..N).map(|i| (inv[(N - 2, i)] * r[i]).abs()).sum();
         Ok(if static_error <= self.settings.linear_tolerance {
             Regime::Linear
         } else {
@@ -356,9 +391,9 @@ impl Judge {
 
 /// Watches the hinge-resolved fallback and ends it once the state may go back to linear arcs
 /// (checked every `CHECK_EVERY` s of simulated time, in full Sun past the last shadow's window).
-struct FallbackObserver<'a, 'c> {
-    inner: &'a mut SummaryObserver<'c, TwoLayerView>,
-    judge: &'a Judge,
+struct FallbackObserver<'a, 'c, const N: usize, M: HybridModel<N>> {
+    inner: &'a mut SummaryObserver<'c, M::View>,
+    judge: &'a Judge<N, M>,
     eclipses: &'a [Eclipse],
     window: f64,
     next_check: f64,
@@ -368,8 +403,8 @@ struct FallbackObserver<'a, 'c> {
 
 const CHECK_EVERY: f64 = 60.0;
 
-impl Observer<U4> for FallbackObserver<'_, '_> {
-    fn on_step(&mut self, step: &DenseStep<U4>) -> ControlFlow<()> {
+impl<const N: usize, M: HybridModel<N>> Observer<Const<N>> for FallbackObserver<'_, '_, N, M> {
+    fn on_step(&mut self, step: &DenseStep<Const<N>>) -> ControlFlow<()> {
         self.inner.on_step(step)?;
         let t1 = step.t1;
         if t1 < self.next_check {
@@ -403,7 +438,7 @@ impl Observer<U4> for FallbackObserver<'_, '_> {
     }
 }
 
-impl Driver<'_> {
+impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
     fn stopped(&self) -> bool {
         self.obs.collector.options.stop_at_limit && self.obs.collector.crossing.is_some()
     }
@@ -480,13 +515,12 @@ impl Driver<'_> {
         let flux0 = self.orbit.flux_scale(t0);
         let flux1 = self.orbit.flux_scale(end);
         let (y_ref, a) = self.judge.reference(flux0)?;
-        let b = self.judge.lin.flux_sensitivity(&y_ref) * ((flux1 - flux0) / (end - t0));
+        let b = self.judge.model.flux_sensitivity(flux0, &y_ref) * ((flux1 - flux0) / (end - t0));
         let Ok(arc) = Arc::new(&a, &b, &y_ref, &self.y, end - t0, &self.scale) else {
             return Ok(Some(()));
         };
-        let theta = arc.signal(&Vector4::new(0.0, 0.0, 1.0, 0.0));
-        let k = self.theta_per_kelvin;
-        let dynamic = arc.signal(&Vector4::new(-k, k, 1.0, 0.0));
+        let theta = arc.signal(&SVector::from_fn(|i, _| if i == N - 2 { 1.0 } else { 0.0 }));
+        let dynamic = arc.signal(&self.judge.model.dynamic_weights(flux0, &y_ref));
         let limit = self.settings.linear_amplitude;
         let mut length = end - t0;
         let mut early = false;
@@ -586,7 +620,7 @@ impl Driver<'_> {
         cuts.extend(breakpoints_of(eclipses, self.t, horizon));
         cuts.push(horizon);
         let window = self.obs.collector.options.window;
-        let period = 2.0 * std::f64::consts::PI / self.panel.natural_angular_frequency();
+        let period = 2.0 * std::f64::consts::PI / self.judge.panel.natural_angular_frequency();
         let mut large = false;
         let mut done = false;
         for w in cuts.windows(2) {
@@ -595,8 +629,7 @@ impl Driver<'_> {
                 continue;
             }
             self.system.enter_segment(a, b);
-            let system = self.system;
-            let lin = self.judge.lin;
+            let system = self.system.clone();
             let settings = self.settings;
             let mut t = self.t;
             let mut y = self.y;
@@ -605,14 +638,13 @@ impl Driver<'_> {
             let this = &mut *self;
             let (acc, rej, stop) = exprb::segment(
                 &system,
-                &lin,
                 a,
                 b,
                 &mut t,
                 &mut y,
                 &mut h,
                 &settings.tolerances,
-                |st: &ExpStep| -> Result<bool> {
+                |st: &ExpStep<N>| -> Result<bool> {
                     this.obs.cancel.check()?;
                     this.read_step(st, period)?;
                     if this.stopped() {
@@ -627,7 +659,9 @@ impl Driver<'_> {
                         .fold(f64::NEG_INFINITY, f64::max);
                     // The exponential integrator's summaries read a small oscillation through
                     // its envelope; a larger one is resolved by the full integration.
-                    if this.judge.oscillation(&st.y1, &st.f1) > settings.resolved_amplitude {
+                    if this.judge.oscillation(st.flux1, &st.y1, &st.f1)
+                        > settings.resolved_amplitude
+                    {
                         large = true;
                         return Ok(true);
                     }
@@ -668,13 +702,13 @@ impl Driver<'_> {
     /// Feeds one exponential step to the summaries: four points of its Hermite interpolant when
     /// the step resolves the hinge period, else bands θ_qs ± a (the quasi-static deflection and the
     /// oscillation's amplitude, interpolated between the step's ends).
-    fn read_step(&mut self, st: &ExpStep, period: f64) -> Result<()> {
-        let dense = DenseStep::<U4>::hermite(st.t0, st.t1, st.y0, st.y1, st.f0, st.f1);
+    fn read_step(&mut self, st: &ExpStep<N>, period: f64) -> Result<()> {
+        let dense = DenseStep::<Const<N>>::hermite(st.t0, st.t1, st.y0, st.y1, st.f0, st.f1);
         let h = (st.t1 - st.t0) / 4.0;
         let resolved = st.t1 - st.t0 <= period / 8.0;
         let (a0, a1) = (
-            self.judge.oscillation(&st.y0, &st.f0),
-            self.judge.oscillation(&st.y1, &st.f1),
+            self.judge.oscillation(st.flux0, &st.y0, &st.f0),
+            self.judge.oscillation(st.flux1, &st.y1, &st.f1),
         );
         for j in 1..=4 {
             let t = if j == 4 { st.t1 } else { st.t0 + j as f64 * h };
@@ -684,8 +718,8 @@ impl Driver<'_> {
             } else {
                 let frac = j as f64 / 4.0;
                 let amp = a0 + (a1 - a0) * frac;
-                let quasi_static =
-                    thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness;
+                let flux = st.flux0 + (st.flux1 - st.flux0) * frac;
+                let quasi_static = self.judge.model.quasi_static(flux, &y);
                 self.obs.collector.record(
                     t,
                     quasi_static - amp,
@@ -707,6 +741,7 @@ mod tests {
     use crate::integrate::Tolerances;
     use crate::longrun::{run_orbits, OrbitSummary, SummaryOptions};
     use crate::orbit::Shadow;
+    use crate::steady::equilibrium;
 
     fn options() -> SummaryOptions {
         SummaryOptions {
