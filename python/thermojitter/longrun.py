@@ -304,9 +304,6 @@ def simulate_orbits(
     n_orbits = orbit_count("n_orbits", n_orbits, orbit, t_start)
     method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
     nodes = None if layers is None else check_layers(layers)
-    if nodes is not None and method == "hybrid":
-        # The hybrid propagator covers the two-layer model; layered panels are integrated in full.
-        method = "rk45"
     used = SolverSettings.of(
         solver,
         method=None if method == "hybrid" else method,

@@ -317,8 +317,7 @@ def _with_layers(
     """The run options with the N-node through-thickness model (``layers`` nodes) on the
     panel's layup, or on each sample's panel as one homogeneous layer for a plain panel.
 
-    The N-node model is integrated in full: the hybrid propagator (two-layer only) gives way to
-    its rk45 fallback, as in ``simulate_orbits``. On a laminate panel the fields its layup
+    The hybrid propagator, when asked, runs the N-node model too. On a laminate panel the fields its layup
     decides cannot be varied (the N-node model takes them from the layers)."""
     if layers is None:
         return options
@@ -334,7 +333,7 @@ def _with_layers(
                     "integrates layer by layer: vary a plain panel, or run one study per laminate"
                 ),
             )
-    return {**options, "hybrid": None, "nodes": nodes, "layup": layup_dict(panel)}
+    return {**options, "nodes": nodes, "layup": layup_dict(panel)}
 
 
 def _default_method(method: str | None, orbit: Orbit, horizon: Any) -> str:

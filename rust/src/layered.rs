@@ -18,12 +18,13 @@
 use crate::conduction::{Conduction, Modes};
 use crate::dynamics::{sin_cos, HingeModel};
 use crate::error::{Error, Result};
+use crate::hybrid::model::HybridModel;
 use crate::integrate::{Dyn, OdeSystem, State};
 use crate::orbit::Orbit;
 use crate::params::Panel;
 use crate::system::{Coupling, Sunlight};
 use nalgebra::allocator::Allocator;
-use nalgebra::{Const, DMatrix, DVector, DefaultAllocator, Dim, SVector};
+use nalgebra::{Const, DMatrix, DVector, DefaultAllocator, Dim, SMatrix, SVector};
 
 /// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
 /// the hinge's angular frequency), and quasi-static above. See docs/laminates.md for the
@@ -1194,6 +1195,313 @@ pub fn critical_damping(
         .damping
         .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
     crate::flutter::critical_value(rate, start, 1e-12)
+}
+
+/// The N-node system as the hybrid propagator's model, on a state of S components (the slow
+/// thermal coordinates, θ, θ̇): the same right-hand side as the full run, its derivatives by
+/// central differences (the slow-mode model's faces are solved by Newton's method, so it has no
+/// closed-form Jacobian; S is small, so 2S evaluations a Jacobian are cheap).
+#[derive(Debug, Clone)]
+struct HybridLayered<const S: usize> {
+    orbit: LayeredOrbit,
+    panel: Panel,
+    coupling: Coupling,
+}
+
+/// Relative step of the central differences (the cube root of the rounding unit), and the
+/// magnitudes below which each kind of component is stepped absolutely: K, rad, rad/s.
+const DIFFERENCE_STEP: f64 = 6.055454e-6;
+const DIFFERENCE_FLOOR: [f64; 3] = [1.0, 1e-3, 1e-3];
+
+impl<const S: usize> HybridLayered<S> {
+    fn step(&self, y: &SVector<f64, S>, j: usize) -> f64 {
+        let floor = DIFFERENCE_FLOOR[match S - j {
+            2 => 1,
+            1 => 2,
+            _ => 0,
+        }];
+        DIFFERENCE_STEP * y[j].abs().max(floor)
+    }
+
+    /// ∂g/∂y_j of a function of the state by central differences, for every j.
+    fn gradient<R>(
+        &self,
+        y: &SVector<f64, S>,
+        g: impl Fn(&SVector<f64, S>) -> R,
+        mut column: impl FnMut(usize, R, R, f64),
+    ) {
+        for j in 0..S {
+            let h = self.step(y, j);
+            let (mut plus, mut minus) = (*y, *y);
+            plus[j] += h;
+            minus[j] -= h;
+            // The step actually taken, so that rounding of y ± h does not bias the quotient.
+            column(j, g(&plus), g(&minus), plus[j] - minus[j]);
+        }
+    }
+
+    fn angle(&self, flux: f64, y: &SVector<f64, S>) -> f64 {
+        self.orbit.system.moment_of(flux, y.as_slice()) / self.panel.hinge_stiffness
+    }
+}
+
+impl<const S: usize> OdeSystem<Const<S>> for HybridLayered<S> {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State<Const<S>>) -> State<Const<S>> {
+        HybridModel::rhs_at_flux(self, self.orbit.sun.flux(t), y)
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.orbit.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.orbit.enter_segment(a, b);
+    }
+}
+
+impl<const S: usize> HybridModel<S> for HybridLayered<S> {
+    type View = LayeredView;
+
+    fn view(&self) -> LayeredView {
+        LayeredView::new(
+            self.orbit.system.clone(),
+            self.panel,
+            self.orbit.sun.orbit,
+            self.coupling,
+        )
+    }
+    fn panel(&self) -> &Panel {
+        &self.panel
+    }
+    fn hinge(&self) -> HingeModel {
+        self.orbit.system.model
+    }
+    fn rhs_at_flux(&self, flux: f64, y: &SVector<f64, S>) -> SVector<f64, S> {
+        let mut dy = SVector::<f64, S>::zeros();
+        self.orbit
+            .system
+            .rhs_at_flux(flux, y.as_slice(), dy.as_mut_slice());
+        dy
+    }
+    fn flux_at(&self, t: f64) -> f64 {
+        self.orbit.sun.flux(t)
+    }
+    fn jacobian(&self, flux: f64, y: &SVector<f64, S>) -> SMatrix<f64, S, S> {
+        let mut jac = SMatrix::<f64, S, S>::zeros();
+        self.gradient(
+            y,
+            |x| HybridModel::rhs_at_flux(self, flux, x),
+            |j, plus, minus, h| jac.set_column(j, &((plus - minus) / h)),
+        );
+        jac
+    }
+    fn flux_sensitivity(&self, flux: f64, y: &SVector<f64, S>) -> SVector<f64, S> {
+        let h = 1e-6;
+        (self.rhs_at_flux(flux + h, y) - self.rhs_at_flux(flux - h, y)) / (2.0 * h)
+    }
+    fn equilibrium(&self, flux: f64, from: Option<&SVector<f64, S>>) -> Result<SVector<f64, S>> {
+        let start = match from {
+            Some(y) => *y,
+            None => {
+                let c = &self.orbit.system.conduction;
+                let eq = equilibrium(&self.panel, c, self.coupling, flux)?;
+                let y = self
+                    .orbit
+                    .system
+                    .state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+                SVector::from_column_slice(&y)
+            }
+        };
+        // Refined on this model's own right-hand side (the slow-mode model's steady state in its
+        // coordinates): every component but θ̇, every equation but θ' = θ̇.
+        let rows: Vec<usize> = (0..S).filter(|&i| i != S - 2).collect();
+        let state = |x: &DVector<f64>| {
+            let mut y = SVector::<f64, S>::zeros();
+            y.as_mut_slice()[..S - 1].copy_from_slice(x.as_slice());
+            y
+        };
+        let system = |x: &DVector<f64>| {
+            let y = state(x);
+            let (f, jac) = (self.rhs_at_flux(flux, &y), self.jacobian(flux, &y));
+            (
+                DVector::from_fn(S - 1, |i, _| f[rows[i]]),
+                DMatrix::from_fn(S - 1, S - 1, |i, j| jac[(rows[i], j)]),
+            )
+        };
+        let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
+            (0..S - 2).all(|i| dx[i].abs() < 1e-12 * x[i].abs().max(1.0)) && dx[S - 2].abs() < 1e-14
+        };
+        let x0 = DVector::from_column_slice(&start.as_slice()[..S - 1]);
+        Ok(state(&crate::steady::newton(
+            "sunlit equilibrium",
+            x0,
+            0,
+            system,
+            settled,
+        )?))
+    }
+    fn static_angle(&self, flux: f64, y: &SVector<f64, S>, f: &SVector<f64, S>) -> (f64, f64) {
+        // The rate along the flow by a central difference over 10 ms.
+        let dt = 1e-2;
+        let rate = (self.angle(flux, &(y + f * dt)) - self.angle(flux, &(y - f * dt))) / (2.0 * dt);
+        (self.angle(flux, y), rate)
+    }
+    fn quasi_static(&self, flux: f64, y: &SVector<f64, S>) -> f64 {
+        self.angle(flux, y)
+    }
+    fn dynamic_weights(&self, flux: f64, y_ref: &SVector<f64, S>) -> SVector<f64, S> {
+        let mut w = SVector::<f64, S>::zeros();
+        self.gradient(
+            y_ref,
+            |x| self.angle(flux, x),
+            |j, plus, minus, h| w[j] = -(plus - minus) / h,
+        );
+        w[S - 2] += 1.0;
+        w
+    }
+}
+
+/// A hybrid run of the N-node system: the summaries (end state as node temperatures, θ, θ̇)
+/// and how the time was split.
+pub struct LayeredHybrid {
+    pub run: LayeredSummaries,
+    pub split: crate::hybrid::HybridRun,
+}
+
+/// The largest state (slow thermal coordinates, θ, θ̇) the hybrid propagator is built for.
+pub const HYBRID_MAX_STATE: usize = 24;
+
+/// Per-orbit summaries of the N-node system by the hybrid propagator (as
+/// [`crate::hybrid::run_orbits_hybrid`]), from `y0` = (node temperatures, θ, θ̇); `method` is
+/// the full integration of its fallback.
+#[allow(clippy::too_many_arguments)]
+pub fn run_orbits_hybrid(
+    panel: &Panel,
+    conduction: Conduction,
+    orbit: &Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: &crate::integrate::Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: &[f64],
+    options: crate::longrun::SummaryOptions,
+    settings: &crate::hybrid::HybridSettings,
+    cancel: &crate::cancel::Cancel,
+) -> Result<LayeredHybrid> {
+    let n = conduction.nodes();
+    check_start(y0, n)?;
+    crate::hybrid::check_request(
+        orbit, method, t_start, n_orbits, y0, &options, settings, cancel,
+    )?;
+    crate::dynamics::check_hinge_angle("y0[θ]", y0[n])?;
+    if conduction.two_layer {
+        // Two nodes on a plain panel are eq. 2: the two-layer hybrid run, to the bit.
+        let req = crate::longrun::OrbitRunRequest {
+            panel: *panel,
+            orbit: *orbit,
+            model,
+            coupling,
+            method: *method,
+            t_start,
+            first_index,
+            n_orbits,
+            y0: nalgebra::Vector4::from_column_slice(y0),
+            options,
+        };
+        let out = crate::hybrid::run_orbits_hybrid(&req, settings, cancel)?;
+        let run = LayeredSummaries {
+            summaries: out.run.summaries.clone(),
+            stats: out.run.stats,
+            y_end: out.run.y_end.as_slice().to_vec(),
+            crossing: out.run.crossing,
+        };
+        return Ok(LayeredHybrid { run, split: out });
+    }
+    let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
+    let m = system.thermal_size();
+    let start = system.state_from_nodes(&y0[..n], y0[n], y0[n + 1]);
+    let args = HybridArgs {
+        orbit,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        options,
+        settings,
+        cancel,
+    };
+    macro_rules! sizes {
+        ($($s:literal)*) => {
+            match start.len() {
+                $($s => hybrid_run::<$s>(
+                    HybridLayered {
+                        orbit: LayeredOrbit::new(system.clone(), *orbit),
+                        panel: *panel,
+                        coupling,
+                    },
+                    &start,
+                    &args,
+                ),)*
+                other => Err(Error::invalid(
+                    "layers",
+                    other,
+                    &format!(
+                        "gives a state of {other} components; the hybrid propagator takes 3 to \
+                         {HYBRID_MAX_STATE} (use method = \"rk45\")"
+                    ),
+                )),
+            }
+        };
+    }
+    let (mut run, split) = sizes!(3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24)?;
+    let t_end = run.stats.t_end;
+    let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);
+    let mut end = system.node_temperatures(flux, &run.y_end);
+    end.push(run.y_end[m]);
+    end.push(run.y_end[m + 1]);
+    run.y_end = end;
+    Ok(LayeredHybrid { run, split })
+}
+
+/// What a hybrid run is asked, passed through the size dispatch.
+struct HybridArgs<'a> {
+    orbit: &'a Orbit,
+    method: &'a crate::integrate::Method,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    options: crate::longrun::SummaryOptions,
+    settings: &'a crate::hybrid::HybridSettings,
+    cancel: &'a crate::cancel::Cancel,
+}
+
+fn hybrid_run<const S: usize>(
+    model: HybridLayered<S>,
+    y0: &[f64],
+    a: &HybridArgs<'_>,
+) -> Result<(LayeredSummaries, crate::hybrid::HybridRun)> {
+    let done = crate::hybrid::propagate(
+        model,
+        a.orbit,
+        a.method,
+        a.t_start,
+        a.first_index,
+        a.n_orbits,
+        SVector::from_column_slice(y0),
+        a.options,
+        a.settings,
+        a.cancel,
+    )?;
+    Ok((
+        LayeredSummaries {
+            summaries: done.summaries,
+            stats: done.stats,
+            y_end: done.y_end.as_slice().to_vec(),
+            crossing: done.crossing,
+        },
+        done.split,
+    ))
 }
 
 #[cfg(test)]

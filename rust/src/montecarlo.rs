@@ -298,13 +298,6 @@ pub fn run_sample_layered(
     cancel.check()?;
     panel.validate()?;
     let s = settings;
-    if s.hybrid.is_some() {
-        return Err(Error::invalid(
-            "method",
-            "hybrid",
-            "covers the two-layer model only; N-node samples are integrated in full (rk45 or rk4)",
-        ));
-    }
     let c = match &layers.layup {
         Some(l) => crate::conduction::Conduction::new(panel, l, layers.nodes)?,
         None => crate::conduction::Conduction::homogeneous(panel, layers.nodes)?,
@@ -320,20 +313,44 @@ pub fn run_sample_layered(
         frequency_hz: flutter.frequency_hz,
         critical_damping: critical,
     };
-    let out = layered::run_orbits(
-        panel,
-        c,
-        &s.orbit,
-        s.model,
-        s.coupling,
-        &s.method,
-        0.0,
-        0,
-        s.n_orbits,
-        &y0,
-        summary_options(s),
-        cancel,
-    )?;
+    let (out, t_nonlinear) = match &s.hybrid {
+        None => {
+            let out = layered::run_orbits(
+                panel,
+                c,
+                &s.orbit,
+                s.model,
+                s.coupling,
+                &s.method,
+                0.0,
+                0,
+                s.n_orbits,
+                &y0,
+                summary_options(s),
+                cancel,
+            )?;
+            let t = out.stats.t_end;
+            (out, t)
+        }
+        Some(h) => {
+            let out = layered::run_orbits_hybrid(
+                panel,
+                c,
+                &s.orbit,
+                s.model,
+                s.coupling,
+                &s.method,
+                0.0,
+                0,
+                s.n_orbits,
+                &y0,
+                summary_options(s),
+                h,
+                cancel,
+            )?;
+            (out.run, out.split.t_exponential + out.split.t_fallback)
+        }
+    };
     let n = out.y_end.len();
     let run = OrbitRun {
         summaries: out.summaries,
@@ -347,7 +364,7 @@ pub fn run_sample_layered(
         ),
         crossing: out.crossing,
     };
-    Ok(sample_metrics(&head, settings, &run, run.stats.t_end))
+    Ok(sample_metrics(&head, settings, &run, t_nonlinear))
 }
 
 /// [`run_batch`] with the N-node model (one sample at a time per thread).

@@ -22,6 +22,8 @@
 pub mod expm;
 pub mod exprb;
 pub mod jacobian;
+#[cfg(test)]
+mod laminate_tests;
 pub mod linear;
 pub(crate) mod model;
 
@@ -741,9 +743,10 @@ mod tests {
     use crate::integrate::Tolerances;
     use crate::longrun::{run_orbits, OrbitSummary, SummaryOptions};
     use crate::orbit::Shadow;
+    use crate::system::Coupling;
     use crate::steady::equilibrium;
 
-    fn options() -> SummaryOptions {
+    pub(super) fn options() -> SummaryOptions {
         SummaryOptions {
             window: 600.0,
             theta_limit: 0.35,
@@ -783,7 +786,7 @@ mod tests {
     }
 
     /// Within 2 %, or 1e-6 rad where the full run's value is below 5e-5 rad (NaN matches NaN).
-    fn close(name: &str, k: usize, full: f64, hyb: f64) {
+    pub(super) fn close(name: &str, k: usize, full: f64, hyb: f64) {
         if full.is_nan() {
             assert!(
                 hyb.is_nan(),
@@ -799,7 +802,7 @@ mod tests {
         assert!(ok, "{name}[{k}]: hybrid {hyb:e} vs full {full:e}");
     }
 
-    fn compare(full: &[OrbitSummary], hyb: &[OrbitSummary]) {
+    pub(super) fn compare(full: &[OrbitSummary], hyb: &[OrbitSummary]) {
         assert_eq!(full.len(), hyb.len());
         for (k, (f, h)) in full.iter().zip(hyb).enumerate() {
             close("amplitude", k, f.amplitude, h.amplitude);

@@ -23,6 +23,17 @@ struct Summarised {
     crossing: Option<crate::longrun::LimitCrossing>,
 }
 
+impl From<layered::LayeredSummaries> for Summarised {
+    fn from(run: layered::LayeredSummaries) -> Self {
+        Summarised {
+            summaries: run.summaries,
+            stats: run.stats,
+            y_end: run.y_end,
+            crossing: run.crossing,
+        }
+    }
+}
+
 impl From<OrbitRun> for Summarised {
     fn from(run: OrbitRun) -> Self {
         Summarised {
@@ -82,17 +93,28 @@ fn run_orbits<'py>(
         let settings = hybrid.map(hybrid_from).transpose()?;
         if let Some(n) = nodes {
             // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            if settings.is_some() {
-                return Err(crate::Error::invalid(
-                    "hybrid",
-                    "settings",
-                    "the hybrid propagator covers the two-layer model: give nodes = None",
-                )
-                .into());
-            }
             let c = conduction_from(&p, layup, n)?;
-            let run = py.detach(|| {
-                layered::run_orbits(
+            let Some(settings) = settings else {
+                let run = py.detach(|| {
+                    layered::run_orbits(
+                        &p,
+                        c,
+                        &o,
+                        hinge,
+                        coupling,
+                        &m,
+                        t_start,
+                        first_index,
+                        n_orbits,
+                        &y0,
+                        options,
+                        &cancel,
+                    )
+                })?;
+                return summary_dict(py, &run.into());
+            };
+            let out = py.detach(|| {
+                layered::run_orbits_hybrid(
                     &p,
                     c,
                     &o,
@@ -104,16 +126,12 @@ fn run_orbits<'py>(
                     n_orbits,
                     &y0,
                     options,
+                    &settings,
                     &cancel,
                 )
             })?;
-            let out = Summarised {
-                summaries: run.summaries,
-                stats: run.stats,
-                y_end: run.y_end,
-                crossing: run.crossing,
-            };
-            return summary_dict(py, &out);
+            let d = summary_dict(py, &out.run.into())?;
+            return hybrid_counters(d, &out.split);
         }
         let req = OrbitRunRequest {
             panel: p,
@@ -132,16 +150,33 @@ fn run_orbits<'py>(
             return summary_dict(py, &run.into());
         };
         crate::dynamics::check_hinge_angle("y0[2]", req.y0[2])?;
-        let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
-        let d = summary_dict(py, &out.run.into())?;
-        d.set_item("t_linear", out.t_linear)?;
-        d.set_item("t_exponential", out.t_exponential)?;
-        d.set_item("t_fallback", out.t_fallback)?;
-        d.set_item("n_arcs", out.n_arcs)?;
-        d.set_item("n_exp_steps", out.n_exp_steps)?;
-        d.set_item("n_fallback_steps", out.n_fallback_steps)?;
-        Ok(d)
+        let mut out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
+        let run = std::mem::take(&mut out.run.summaries);
+        let d = summary_dict(
+            py,
+            &Summarised {
+                summaries: run,
+                stats: out.run.stats,
+                y_end: out.run.y_end.as_slice().to_vec(),
+                crossing: out.run.crossing,
+            },
+        )?;
+        hybrid_counters(d, &out)
     })
+}
+
+/// A hybrid run's summary columns with how it split the simulated time.
+fn hybrid_counters<'py>(
+    d: Bound<'py, PyDict>,
+    out: &crate::hybrid::HybridRun,
+) -> PyResult<Bound<'py, PyDict>> {
+    d.set_item("t_linear", out.t_linear)?;
+    d.set_item("t_exponential", out.t_exponential)?;
+    d.set_item("t_fallback", out.t_fallback)?;
+    d.set_item("n_arcs", out.n_arcs)?;
+    d.set_item("n_exp_steps", out.n_exp_steps)?;
+    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+    Ok(d)
 }
 
 /// The summaries of a run as columns, with its counters.
