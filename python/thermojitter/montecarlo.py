@@ -317,8 +317,8 @@ def _with_layers(
     """The run options with the N-node through-thickness model (``layers`` nodes) on the
     panel's layup, or on each sample's panel as one homogeneous layer for a plain panel.
 
-    The hybrid propagator, when asked, runs the N-node model too. On a laminate panel the fields its layup
-    decides cannot be varied (the N-node model takes them from the layers)."""
+    The hybrid propagator, when asked, runs the N-node model too. On a laminate panel the fields
+    its layup decides cannot be varied (the N-node model takes them from the layers)."""
     if layers is None:
         return options
     nodes = check_layers(layers)

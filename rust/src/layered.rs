@@ -1348,15 +1348,19 @@ impl<const S: usize> HybridModel<S> for HybridLayered<S> {
     fn quasi_static(&self, flux: f64, y: &SVector<f64, S>) -> f64 {
         self.angle(flux, y)
     }
-    fn dynamic_weights(&self, flux: f64, y_ref: &SVector<f64, S>) -> SVector<f64, S> {
-        let mut w = SVector::<f64, S>::zeros();
+    fn dynamic_weights(&self, flux: f64, y_ref: &SVector<f64, S>) -> (SVector<f64, S>, f64) {
+        // M_T/K_el ≈ m(y_ref) + ∇m·(y − y_ref): affine in the slow-mode coordinates, so
+        // θ − M_T/K_el ≈ w·y + c with w = e_θ − ∇m and c = ∇m·y_ref − m(y_ref).
+        let mut grad = SVector::<f64, S>::zeros();
         self.gradient(
             y_ref,
             |x| self.angle(flux, x),
-            |j, plus, minus, h| w[j] = -(plus - minus) / h,
+            |j, plus, minus, h| grad[j] = (plus - minus) / h,
         );
+        let offset = grad.dot(y_ref) - self.angle(flux, y_ref);
+        let mut w = -grad;
         w[S - 2] += 1.0;
-        w
+        (w, offset)
     }
 }
 

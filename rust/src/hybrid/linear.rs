@@ -176,6 +176,14 @@ fn phi12(x: C64) -> (C64, C64) {
 }
 
 impl<const N: usize> Signal<N> {
+    /// The signal plus a constant.
+    pub fn shifted(mut self, c: f64) -> Signal<N> {
+        if c != 0.0 {
+            self.q0 += c;
+        }
+        self
+    }
+
     pub fn at(&self, tau: f64) -> f64 {
         let mut v = self.q0 + self.q1 * tau;
         for k in 0..N {

@@ -522,7 +522,8 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             return Ok(Some(()));
         };
         let theta = arc.signal(&SVector::from_fn(|i, _| if i == N - 2 { 1.0 } else { 0.0 }));
-        let dynamic = arc.signal(&self.judge.model.dynamic_weights(flux0, &y_ref));
+        let (w, offset) = self.judge.model.dynamic_weights(flux0, &y_ref);
+        let dynamic = arc.signal(&w).shifted(offset);
         let limit = self.settings.linear_amplitude;
         let mut length = end - t0;
         let mut early = false;
@@ -743,8 +744,8 @@ mod tests {
     use crate::integrate::Tolerances;
     use crate::longrun::{run_orbits, OrbitSummary, SummaryOptions};
     use crate::orbit::Shadow;
-    use crate::system::Coupling;
     use crate::steady::equilibrium;
+    use crate::system::Coupling;
 
     pub(super) fn options() -> SummaryOptions {
         SummaryOptions {

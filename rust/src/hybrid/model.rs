@@ -38,8 +38,10 @@ pub(crate) trait HybridModel<const N: usize>: OdeSystem<Const<N>> + Clone {
     fn static_angle(&self, flux: f64, y: &SVector<f64, N>, f: &SVector<f64, N>) -> (f64, f64);
     /// M_T/K_el as the summaries read it (rad).
     fn quasi_static(&self, flux: f64, y: &SVector<f64, N>) -> f64;
-    /// w with w·δy the linearised dynamic part θ − M_T/K_el about `y_ref`.
-    fn dynamic_weights(&self, flux: f64, y_ref: &SVector<f64, N>) -> SVector<f64, N>;
+    /// (w, c) with w·y + c the dynamic part θ − M_T/K_el linearised about `y_ref`: c is zero
+    /// when M_T is linear in the state, and not when it is affine (a reduced model's
+    /// coordinates, a reference temperature).
+    fn dynamic_weights(&self, flux: f64, y_ref: &SVector<f64, N>) -> (SVector<f64, N>, f64);
 }
 
 /// The paper's two-layer model (T_f, T_b, θ, θ̇).
@@ -158,8 +160,9 @@ impl HybridModel<4> for TwoLayerModel {
     fn quasi_static(&self, _flux: f64, y: &Vector4<f64>) -> f64 {
         thermal_moment(&self.panel, y[0], y[1]) / self.panel.hinge_stiffness
     }
-    fn dynamic_weights(&self, _flux: f64, _y_ref: &Vector4<f64>) -> Vector4<f64> {
+    fn dynamic_weights(&self, _flux: f64, _y_ref: &Vector4<f64>) -> (Vector4<f64>, f64) {
+        // M_T/K_el = k (T_f − T_b): linear, no offset.
         let k = self.theta_per_kelvin;
-        Vector4::new(-k, k, 1.0, 0.0)
+        (Vector4::new(-k, k, 1.0, 0.0), 0.0)
     }
 }
