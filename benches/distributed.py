@@ -10,27 +10,15 @@ Timings are medians over ``--repeat`` alternating runs (the machine is shared; r
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 from typing import Any
 
+import machine  # benches/machine.py
 import numpy as np
 
 import thermojitter as tj
 from thermojitter.distributed import distributed_convergence
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
 
 
 def timed(run: Any) -> tuple[float, Any]:
@@ -52,7 +40,7 @@ def main() -> None:
     defaults = tj.distributed_defaults(panel)
     elements = args.elements or defaults["elements"]
     modes = args.modes or defaults["modes"]
-    print(f"CPU: {cpu_model()}; {os.cpu_count()} CPUs; load {os.getloadavg()[0]:.2f}")
+    print(machine.describe())
     print(
         f"one GEO orbit ({orbit.period:.0f} s), rk45 rtol 1e-8 atol 1e-10, output every 10 s; "
         f"distributed: {elements} elements, {modes} modes"

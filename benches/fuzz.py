@@ -10,25 +10,15 @@ from __future__ import annotations
 
 import argparse
 import collections
-import platform
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
+import machine  # noqa: E402  (benches/machine.py)
 from fuzzing import FAILURES, OUTCOMES, Example, Runner, examples  # noqa: E402
 from hypothesis import HealthCheck, given, seed, settings  # noqa: E402
-
-
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def main() -> int:
@@ -86,7 +76,7 @@ def main() -> int:
     runner.close()
     total = sum(counts.values())
     refusals = counts["refused_named"] + counts["refused_unnamed"]
-    print(f"CPU: {cpu_model()}")
+    print(machine.describe())
     print(f"{total} generated calls in {time.perf_counter() - started:.0f} s")
     for outcome in OUTCOMES:
         print(f"  {outcome:16s} {counts[outcome]:6d}")

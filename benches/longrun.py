@@ -16,8 +16,6 @@ The machine may be shared: the load average is printed before and after.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import resource
 import time
 
@@ -32,21 +30,6 @@ METRICS = ("amplitude", "exit_peak", "entry_peak", "jitter_rms", "theta_max", "t
 def peak_rss_mb() -> float:
     # ru_maxrss is in KiB on Linux.
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
-def load() -> str:
-    return " ".join(f"{v:.2f}" for v in os.getloadavg())
 
 
 def gate(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries) -> None:
@@ -85,7 +68,6 @@ def main() -> None:
         panel = panel.replace(damping=args.damping)
     orbit = tj.Orbit.geo_year(args.start)
     per_year = 365.25 * 86400.0 / orbit.period
-    print(f"CPU: {cpu_model()}; {os.cpu_count()} cores; load average {load()}")
     print(f"panel: Table 1, c_d = {panel.damping:g} N m s/rad; orbit: geo_year from {args.start}")
 
     n = int(round(args.years * per_year))
@@ -132,7 +114,7 @@ def main() -> None:
         print(f"\n3. Monte Carlo, {args.mc_samples} samples x {horizon} orbits "
               f"({args.mc_years:g} years), hybrid: {t_mc:.1f} s, {rate:.2f} samples/s "
               f"({failed} failed); 1000 samples: about {1000 / rate / 60:.1f} min")  # fmt: skip
-    print(f"\nload average after: {load()}")
+    print(f"\nload average after: {machine.load()}")
 
 
 if __name__ == "__main__":

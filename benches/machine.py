@@ -11,12 +11,16 @@ import platform
 import thermojitter as tj
 
 
+def load() -> str:
+    """The load average over 1, 5 and 15 minutes, for a line printed again at a run's end."""
+    return " ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "n/a"
+
+
 def describe() -> str:
     """Two lines: the CPU and instruction sets (from the engine), then cores, load and Python."""
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "n/a"
     return (
         f"{tj._core.cpu_info()['summary']}\n"
-        f"{os.cpu_count()} cores, load average {load}, Python {platform.python_version()} "
+        f"{os.cpu_count()} cores, load average {load()}, Python {platform.python_version()} "
         f"on {platform.system()} {platform.machine()}"
     )
 

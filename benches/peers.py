@@ -437,10 +437,9 @@ def main() -> None:
         print(f", CyRK {CyRK.__version__}, numba {numba.__version__}", end="")
     import scipy
 
-    load = ", ".join(f"{v:.2f}" for v in os.getloadavg())
     print(
         f", scipy {scipy.__version__}, numpy {np.__version__}; {os.cpu_count()} CPUs, "
-        f"load average {load}"
+        f"load average {machine.load()}"
     )
     if CyRK is None:
         print("CyRK is not installed (pip install -e '.[bench]'): its rows are left out")

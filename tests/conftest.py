@@ -8,6 +8,7 @@ import hypothesis.strategies as st
 from hypothesis import settings
 
 import thermojitter as tj
+from thermojitter import materials as mat
 
 settings.register_profile("ci", deadline=None, print_blob=True, derandomize=True)
 settings.register_profile("dev", deadline=None)
@@ -16,6 +17,22 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "dev"))
 PAPER = tj.Panel.paper()
 GEO = tj.Orbit.geo_equinox()
 ENTRY, EXIT = GEO.shadow_intervals(0.0, GEO.period)[0]
+
+
+def wing_layup() -> tj.Laminate:
+    """The solar-array wing's layup of examples/laminates.py (the example keeps its own copy, so
+    that it reads on its own): Kapton, 0.3 mm CFRP face sheets on a 20 mm honeycomb core."""
+    return tj.Laminate(
+        [
+            mat.KAPTON.layer(50e-6),
+            mat.CFRP_M55J_QI.layer(0.3e-3),
+            mat.ALUMINIUM_HONEYCOMB.layer(20e-3),
+            mat.CFRP_M55J_QI.layer(0.3e-3),
+        ],
+        emissivity_front=0.8,
+        emissivity_back=0.8,
+        absorptivity=0.9,
+    )
 
 
 @st.composite

@@ -13,23 +13,10 @@ import numpy as np
 import pytest
 
 import thermojitter as tj
+from conftest import wing_layup
 from thermojitter import materials as mat
 
 GEO = tj.Orbit.geo_equinox()
-
-
-def wing() -> tj.Laminate:
-    return tj.Laminate(
-        [
-            mat.KAPTON.layer(50e-6),
-            mat.CFRP_M55J_QI.layer(0.3e-3),
-            mat.ALUMINIUM_HONEYCOMB.layer(20e-3),
-            mat.CFRP_M55J_QI.layer(0.3e-3),
-        ],
-        emissivity_front=0.8,
-        emissivity_back=0.8,
-        absorptivity=0.9,
-    )
 
 
 def test_layer_errors_name_the_layer_and_field() -> None:
@@ -74,7 +61,7 @@ def test_lamination_theory_of_a_sandwich() -> None:
 
 
 def test_from_laminate_gives_the_layup_its_panel() -> None:
-    lam = wing()
+    lam = wing_layup()
     p = tj.Panel.from_laminate(lam, length=20.0)
     assert p.layup is lam
     assert p.youngs_modulus * p.bending_inertia == pytest.approx(lam.bending_stiffness, rel=1e-12)
@@ -106,12 +93,12 @@ def test_two_layers_on_a_plain_panel_are_the_two_layer_model() -> None:
 
 def test_node_temperatures_over_time_and_depth() -> None:
     xr = pytest.importorskip("xarray")
-    p = tj.Panel.from_laminate(wing(), length=20.0)
+    p = tj.Panel.from_laminate(wing_layup(), length=20.0)
     t0 = GEO.shadow_intervals(0.0, GEO.period)[0][1] - 100.0
     sol = tj.simulate(p, GEO, (t0, t0 + 400.0), layers=20, dt_out=5.0)
     assert sol.T_nodes is not None and sol.depth is not None
     assert sol.T_nodes.shape == (sol.t.size, 20)
-    assert sol.depth[0] == 0.0 and sol.depth[-1] == pytest.approx(wing().thickness)
+    assert sol.depth[0] == 0.0 and sol.depth[-1] == pytest.approx(wing_layup().thickness)
     # Sunrise warms the front face first.
     after = sol.t > t0 + 100.0
     assert np.all(np.diff(sol.T_nodes[after, 0]) > 0.0)
@@ -128,7 +115,7 @@ def test_node_temperatures_over_time_and_depth() -> None:
 
 def test_node_temperatures_in_pandas_name_node_and_layer() -> None:
     pd = pytest.importorskip("pandas")
-    p = tj.Panel.from_laminate(wing(), length=20.0)
+    p = tj.Panel.from_laminate(wing_layup(), length=20.0)
     sol = tj.simulate(p, GEO, (0.0, 600.0), layers=12, dt_out=60.0)
     frame = sol.to_pandas()
     assert isinstance(frame, pd.DataFrame)
@@ -148,7 +135,7 @@ def test_node_temperatures_in_pandas_name_node_and_layer() -> None:
         assert np.array_equal(frame[name].to_numpy(), sol.T_nodes[:, k])
     assert frame.attrs["depth"] == pytest.approx(list(sol.depth), abs=0.0)
     # The interface nodes sit at the layers' boundaries.
-    bounds = np.cumsum([layer.thickness for layer in wing().layers])[:-1]
+    bounds = np.cumsum([layer.thickness for layer in wing_layup().layers])[:-1]
     at = [sol.depth[k] for k, n in enumerate(names) if "|" in n]
     assert at == pytest.approx(list(bounds), rel=1e-12)
     # Without layers=N: the plain columns only.
@@ -157,7 +144,7 @@ def test_node_temperatures_in_pandas_name_node_and_layer() -> None:
 
 
 def test_layers_is_checked() -> None:
-    p = tj.Panel.from_laminate(wing(), length=20.0)
+    p = tj.Panel.from_laminate(wing_layup(), length=20.0)
     with pytest.raises(ValueError, match="layers"):
         tj.simulate(p, GEO, (0.0, 10.0), layers=3)  # fewer nodes than the layup needs
     with pytest.raises(ValueError, match="layers"):
@@ -171,7 +158,7 @@ def test_layers_is_checked() -> None:
 def test_the_laminate_bends_with_a_uniform_temperature_like_a_bimetal() -> None:
     # Kapton on one side only: the sunlit equilibrium angle of the N-node model includes the
     # moment of the mean temperature above T_ref, which the two-layer equivalent leaves out.
-    p = tj.Panel.from_laminate(wing(), length=20.0)
+    p = tj.Panel.from_laminate(wing_layup(), length=20.0)
     eq2 = tj.flutter(p).equilibrium
     eqn = tj.flutter(p, layers=20).equilibrium
     assert eqn.thermal_moment > eq2.thermal_moment > 0.0

@@ -8,24 +8,13 @@ import math
 import pytest
 
 import thermojitter as tj
-from thermojitter import materials as mat
+from conftest import wing_layup
 
 LEO = tj.Orbit.leo()
 
 
 def wing() -> tj.Panel:
-    layup = tj.Laminate(
-        [
-            mat.KAPTON.layer(50e-6),
-            mat.CFRP_M55J_QI.layer(0.3e-3),
-            mat.ALUMINIUM_HONEYCOMB.layer(20e-3),
-            mat.CFRP_M55J_QI.layer(0.3e-3),
-        ],
-        emissivity_front=0.8,
-        emissivity_back=0.8,
-        absorptivity=0.9,
-    )
-    panel = tj.Panel.from_laminate(layup, length=20.0)
+    panel = tj.Panel.from_laminate(wing_layup(), length=20.0)
     return panel.replace(damping=0.01 * math.sqrt(panel.hinge_stiffness * panel.hinge_inertia))
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -88,17 +88,8 @@ def flutter(
     raw = _core.flutter(panel.as_dict(), model, coupled, flux)
     tf, tb, th = raw["equilibrium"]
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
-    return FlutterResult(
-        equilibrium=Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment),
-        jacobian=np.asarray(raw["jacobian"]),
-        eigenvalues=np.array([complex(re, im) for re, im in raw["eigenvalues"]]),
-        growth_rate=float(raw["growth_rate"]),
-        frequency_hz=float(raw["frequency_hz"]),
-        critical_damping=float(raw["critical_damping"]),
-        model=model,
-        coupled=bool(coupled),
-        flux=float(flux),
-    )
+    equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
+    return _result(raw, equilibrium, model, coupled, flux)
 
 
 def _layered_flutter(
@@ -110,21 +101,29 @@ def _layered_flutter(
     nodes = check_layers(layers)
     raw = _core.layered_flutter(panel.as_dict(), layup_dict(panel), nodes, model, coupled, flux)
     temps = raw["temperatures"]
+    equilibrium = Equilibrium(
+        T_front=float(temps[0]),
+        T_back=float(temps[-1]),
+        theta=float(raw["theta"]),
+        thermal_moment=float(raw["thermal_moment"]),
+    )
+    return _result(raw, equilibrium, model, coupled, flux)
+
+
+def _result(
+    raw: dict[str, Any], equilibrium: Equilibrium, model: str, coupled: bool, flux: float
+) -> FlutterResult:
+    """The result from the engine's analysis (two-layer or N-node alike) about ``equilibrium``."""
     return FlutterResult(
-        equilibrium=Equilibrium(
-            T_front=float(temps[0]),
-            T_back=float(temps[-1]),
-            theta=float(raw["theta"]),
-            thermal_moment=float(raw["thermal_moment"]),
-        ),
+        equilibrium=equilibrium,
         jacobian=np.asarray(raw["jacobian"]),
         eigenvalues=np.array([complex(re, im) for re, im in raw["eigenvalues"]]),
         growth_rate=float(raw["growth_rate"]),
         frequency_hz=float(raw["frequency_hz"]),
         critical_damping=float(raw["critical_damping"]),
         model=model,
-        coupled=coupled,
-        flux=flux,
+        coupled=bool(coupled),
+        flux=float(flux),
     )
 
 

@@ -283,19 +283,30 @@ def _options(
     horizon: int,
     model: str,
     coupled: bool,
-    method: str,
-    full: SolverSettings,
+    method: str | None,
+    solver: SolverSettings | None,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    max_steps: int,
     window: float,
     threshold: float | None,
     stop_at_threshold: bool,
 ) -> dict[str, Any]:
-    """The keyword arguments of EnsemblePool.run shared by every chunk (plain data)."""
+    """The keyword arguments of EnsemblePool.run shared by every chunk (plain data), from the
+    study's own arguments (those monte_carlo, sweep and sensitivity share)."""
+    chosen = _default_method(method, orbit, horizon)
+    # The method as given (None: the solver's or the default); "hybrid" is no solver method.
+    full = SolverSettings.of(
+        solver, method=None if method == "hybrid" else method, rtol=rtol, atol=atol, dt=dt,
+        max_steps=max_steps,
+    )  # fmt: skip
     horizon = orbit_count("horizon", horizon, orbit)
     if threshold is not None and not (math.isfinite(threshold) and threshold > 0):
         raise ValueError(f"threshold = {threshold!r} is invalid: must be a finite angle > 0 (rad)")
     if not (isinstance(window, (int, float)) and math.isfinite(window) and window > 0):
         raise ValueError(f"window = {window!r} is invalid: must be finite and > 0 (s)")
-    hybrid = method == "hybrid"
+    hybrid = chosen == "hybrid"
     return {
         "orbit": orbit.as_dict(),
         "model": str(model),
@@ -855,10 +866,8 @@ def monte_carlo(
     if sampler not in ("random", "lhs", "sobol"):
         raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
     options = _options(
-        orbit, horizon, model, coupled, _default_method(method, orbit, horizon),
-        SolverSettings.of(solver, method=method if method != "hybrid" else None, rtol=rtol,
-                          atol=atol, dt=dt, max_steps=max_steps),
-        window, threshold, stop_at_threshold,
+        orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
+        threshold, stop_at_threshold,
     )  # fmt: skip
     options = _with_layers(options, panel, layers, list(vary))
     u = _unit_design(sampler, n, len(vary), seed)
@@ -918,10 +927,8 @@ def sweep(
             raise ValueError(f"grid[{name!r}] = {vals!r} is invalid: must be finite numbers")
         axes.append(arr.tolist())
     options = _options(
-        orbit, horizon, model, coupled, _default_method(method, orbit, horizon),
-        SolverSettings.of(solver, method=method if method != "hybrid" else None, rtol=rtol,
-                          atol=atol, dt=dt, max_steps=max_steps),
-        window, threshold, stop_at_threshold,
+        orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
+        threshold, stop_at_threshold,
     )  # fmt: skip
     names = list(grid)
     size = math.prod(len(a) for a in axes)
@@ -1007,10 +1014,8 @@ def sensitivity(
     if metric not in _FLOAT_METRICS and metric != "stable":
         raise ValueError(f"metric = {metric!r} is invalid: choose from {', '.join(_FLOAT_METRICS)}")
     options = _options(
-        orbit, horizon, model, coupled, _default_method(method, orbit, horizon),
-        SolverSettings.of(solver, method=method if method != "hybrid" else None, rtol=rtol,
-                          atol=atol, dt=dt, max_steps=max_steps),
-        window, threshold, stop_at_threshold,
+        orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
+        threshold, stop_at_threshold,
     )  # fmt: skip
     names = list(vary)
     options = _with_layers(options, panel, layers, names)

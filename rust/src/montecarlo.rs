@@ -692,6 +692,29 @@ mod tests {
         }
     }
 
+    /// The one long run a sample of `s` should equal, built here from the settings' parts (from
+    /// the sunlit equilibrium, the summary's θ limit `theta_limit`) rather than by the ensemble.
+    fn single_run(panel: Panel, s: &EnsembleSettings, theta_limit: f64) -> OrbitRunRequest {
+        let eq = equilibrium(&panel, s.coupling, s.orbit.flux_scale(0.0)).unwrap();
+        OrbitRunRequest {
+            panel,
+            orbit: s.orbit,
+            model: s.model,
+            coupling: s.coupling,
+            method: s.method,
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: s.n_orbits,
+            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+            options: SummaryOptions {
+                window: s.window,
+                theta_limit,
+                stop_at_limit: false,
+                steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
+            },
+        }
+    }
+
     #[test]
     fn a_sample_equals_its_single_run_and_flutter_analysis() {
         let s = settings();
@@ -701,24 +724,7 @@ mod tests {
         assert_eq!(m.growth_rate, a.growth_rate);
         assert_eq!(m.stable(), a.stable());
         let eq = equilibrium(&p, s.coupling, 1.0).unwrap();
-        let run = run_orbits(&OrbitRunRequest {
-            panel: p,
-            orbit: s.orbit,
-            model: s.model,
-            coupling: s.coupling,
-            method: s.method,
-            t_start: 0.0,
-            first_index: 0,
-            n_orbits: 1,
-            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-            options: SummaryOptions {
-                window: 600.0,
-                theta_limit: 0.2,
-                stop_at_limit: false,
-                steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
-            },
-        })
-        .unwrap();
+        let run = run_orbits(&single_run(p, &s, 0.2)).unwrap();
         let o = run.summaries[0];
         assert_eq!(m.exit_peak, o.exit_peak);
         assert_eq!(m.theta_abs_max, o.theta_max.abs().max(o.theta_min.abs()));
@@ -740,24 +746,7 @@ mod tests {
         assert_eq!(bits(&one), bits(&two));
         let p = Panel::paper();
         let m = run_sample(&p, &s, &Cancel::new()).unwrap();
-        let eq = equilibrium(&p, s.coupling, s.orbit.flux_scale(0.0)).unwrap();
-        let req = OrbitRunRequest {
-            panel: p,
-            orbit: s.orbit,
-            model: s.model,
-            coupling: s.coupling,
-            method: s.method,
-            t_start: 0.0,
-            first_index: 0,
-            n_orbits: 3,
-            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-            options: SummaryOptions {
-                window: s.window,
-                theta_limit: f64::MAX,
-                stop_at_limit: false,
-                steps_per_period: crate::longrun::STEPS_PER_HINGE_PERIOD,
-            },
-        };
+        let req = single_run(p, &s, f64::MAX);
         let single = run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap();
         let amp = single.run.summaries.iter().map(|o| o.amplitude);
         assert_eq!(m.amplitude, amp.fold(f64::NAN, f64::max));
