@@ -29,6 +29,7 @@ __all__ = [
     "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
+    "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
     "STEFAN_BOLTZMANN",
@@ -295,6 +296,7 @@ class EnsemblePool:
 
 # --- laminates and the N-node model -------------------------------------------------------------
 LAYER_FIELDS: list[str]
+REFERENCE_TEMPERATURE: float
 
 def validate_layer(layer: dict[str, Any]) -> None: ...
 def validate_laminate(laminate: dict[str, Any]) -> None: ...

@@ -384,6 +384,7 @@ def _calibrations(cmp: BeamComparison, panel: Panel, orbit: Orbit) -> dict[str, 
     freq = hinge_stiffness(panel, "frequency")
     chi = _core.derived(panel.replace(hinge_stiffness=freq).as_dict())["matching_moment_scale"]
     small_angle = hinge_stiffness(panel, "deflection_small_angle")
+    ei_over_l = _core.derived(panel.as_dict())["rigidity_per_length"]
     cases: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
         "stiffness_damping": (("hinge_stiffness", "damping"), {}),
         "stiffness_damping_chi": (
@@ -396,7 +397,7 @@ def _calibrations(cmp: BeamComparison, panel: Panel, orbit: Orbit) -> dict[str, 
         summary = r.summary()
         summary["initial"] = {k: float(getattr(panel, k)) for k in fit} | initial
         # In units of EI/L (4 for the small-angle deflection criterion).
-        summary["hinge_stiffness_over_EI_L"] = 4.0 * r.parameters["hinge_stiffness"] / small_angle
+        summary["hinge_stiffness_over_EI_L"] = r.parameters["hinge_stiffness"] / ei_over_l
         out[name] = summary
     out["criteria"] = {
         "deflection": hinge_stiffness(panel, "deflection"),

@@ -73,7 +73,7 @@ class Laminate:
     """ε of the back face, in (0, 1]."""
     absorptivity: float
     """α of the front face, in (0, 1]."""
-    reference_temperature: float = 293.15
+    reference_temperature: float = _core.REFERENCE_TEMPERATURE
     """T_ref, K."""
 
     def __post_init__(self) -> None:

@@ -413,8 +413,8 @@ def jitter_section(ctx: PaperContext) -> SectionResult:
             "K_el, frequency criterion",
             "≈ 5.21 EI/L",
             f"{stiffness['frequency']:.0f} N m/rad "
-            # in units of EI/L: 4EI/L is the small-angle deflection criterion's K_el
-            f"= {4.0 * stiffness['frequency'] / stiffness['deflection_small_angle']:.2f} EI/L",
+            f"= {stiffness['frequency'] / _core.derived(p.as_dict())['rigidity_per_length']:.2f}"
+            " EI/L",
             "–",
         ),
     ]

@@ -29,6 +29,9 @@ pub struct Layer {
 }
 
 /// The fields of a layer, in declaration order (the Python layer uses them).
+/// The default stress-free reference temperature T_ref of a laminate, K (20 °C).
+pub const REFERENCE_TEMPERATURE: f64 = 293.15;
+
 pub const LAYER_FIELDS: [&str; 6] = [
     "thickness",
     "conductivity",
@@ -275,7 +278,7 @@ impl Laminate {
             emissivity_back: panel.emissivity_back,
             absorptivity: panel.absorptivity,
             // A homogeneous plate bends only with the gradient, whatever T_ref.
-            reference_temperature: 293.15,
+            reference_temperature: REFERENCE_TEMPERATURE,
         }
     }
 }

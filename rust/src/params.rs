@@ -257,10 +257,17 @@ impl Panel {
         self.mass_per_length * self.specific_heat
     }
 
+    /// E I / L, N m/rad: the unit in which the paper states hinge stiffnesses (K_el ≈ 5.21 E I / L
+    /// by the frequency criterion).
+    pub fn rigidity_per_length(&self) -> f64 {
+        self.youngs_modulus * self.bending_inertia / self.length
+    }
+
     /// 4 E I / L, N m/rad: the small-angle deflection criterion's K_el, the hinge stiffness of
-    /// the continuous panel's bending under end moments.
+    /// the continuous panel's bending under end moments. (The factor 4 is a power of two: the
+    /// product is the same to the bit as 4 E I / L written out.)
     pub fn flexural_stiffness(&self) -> f64 {
-        4.0 * self.youngs_modulus * self.bending_inertia / self.length
+        4.0 * self.rigidity_per_length()
     }
 
     /// χ = K_el / (4 E I / L): the scale of the flexural rigidity in the thermal moment that
@@ -333,6 +340,15 @@ mod tests {
     #[test]
     fn paper_panel_is_valid() {
         Panel::paper().validate().unwrap();
+    }
+
+    #[test]
+    fn table_1_rigidity_per_length_is_1120() {
+        // E I / L = 70e9 Pa · 8e-7 m⁴ / 50 m = 1120 N m/rad, by hand from Table 1; 4 E I / L is
+        // the 4480 N m/rad of the small-angle deflection criterion.
+        let p = Panel::paper();
+        assert!((p.rigidity_per_length() - 1120.0).abs() <= 1e-12 * 1120.0);
+        assert!((p.flexural_stiffness() - 4480.0).abs() <= 1e-12 * 4480.0);
     }
 
     #[test]

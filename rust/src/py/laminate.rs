@@ -324,6 +324,10 @@ fn simulate_layers<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LAYER_FIELDS", LAYER_FIELDS.to_vec())?;
+    m.add(
+        "REFERENCE_TEMPERATURE",
+        crate::laminate::REFERENCE_TEMPERATURE,
+    )?;
     m.add_function(wrap_pyfunction!(validate_layer, m)?)?;
     m.add_function(wrap_pyfunction!(validate_laminate, m)?)?;
     m.add_function(wrap_pyfunction!(laminate_properties, m)?)?;

@@ -164,6 +164,7 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
         )?;
         d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
         d.set_item("flexural_stiffness", p.flexural_stiffness())?;
+        d.set_item("rigidity_per_length", p.rigidity_per_length())?;
         d.set_item("matching_moment_scale", p.matching_moment_scale())?;
         Ok(d)
     })
