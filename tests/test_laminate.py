@@ -87,7 +87,7 @@ def test_two_layers_on_a_plain_panel_are_the_two_layer_model() -> None:
     assert fb.critical_damping == pytest.approx(fa.critical_damping, rel=1e-10)
     assert fb.growth_rate == pytest.approx(fa.growth_rate, rel=1e-10)
     sa = tj.simulate_orbits(p, GEO, 1, progress=False, method="rk45")
-    sb = tj.simulate_orbits(p, GEO, 1, progress=False, layers=2)
+    sb = tj.simulate_orbits(p, GEO, 1, progress=False, layers=2, method="rk45")
     assert np.array_equal(sa.exit_peak, sb.exit_peak)
 
 
