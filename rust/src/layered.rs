@@ -855,50 +855,78 @@ impl crate::longrun::SummaryView for LayeredView {
     }
 }
 
-/// Per-orbit summaries of the N-node system (as [`crate::longrun::run_orbits`]), from `y0` =
-/// (node temperatures, θ, θ̇); the end state is returned in the same form.
-#[allow(clippy::too_many_arguments)]
+/// What a run of the N-node system over whole orbits is asked, as
+/// [`crate::longrun::OrbitRunRequest`] is for the two-layer model: its conduction model, and
+/// `y0` = (node temperatures, θ, θ̇).
+#[derive(Debug, Clone)]
+pub struct LayeredRunRequest {
+    pub panel: Panel,
+    pub conduction: Conduction,
+    pub orbit: Orbit,
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    pub method: crate::integrate::Method,
+    pub t_start: f64,
+    pub first_index: u64,
+    pub n_orbits: u64,
+    pub y0: Vec<f64>,
+    pub options: crate::longrun::SummaryOptions,
+}
+
+/// Per-orbit summaries of the N-node system (as [`crate::longrun::run_orbits`]); the end state
+/// is returned as (node temperatures, θ, θ̇).
 pub fn run_orbits(
-    panel: &Panel,
-    conduction: Conduction,
-    orbit: &Orbit,
-    model: HingeModel,
-    coupling: Coupling,
-    method: &crate::integrate::Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: &[f64],
-    options: crate::longrun::SummaryOptions,
+    req: &LayeredRunRequest,
     cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredSummaries> {
-    let n = conduction.nodes();
-    check_start(y0, n)?;
-    let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
-    let m = system.thermal_size();
-    let start = system.state_from_nodes(&y0[..n], y0[n], y0[n + 1]);
-    let view = LayeredView::new(system.clone(), *panel, *orbit, coupling);
-    let orb = LayeredOrbit::new(system.clone(), *orbit);
+    check_start(&req.y0, req.conduction.nodes())?;
+    let (system, start) = req.system()?;
+    let view = LayeredView::new(system.clone(), req.panel, req.orbit, req.coupling);
+    let orb = LayeredOrbit::new(system.clone(), req.orbit);
     let size = start.len();
     let args = (
         view,
-        panel,
-        orbit,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
-        options,
+        &req.panel,
+        &req.orbit,
+        &req.method,
+        req.t_start,
+        req.first_index,
+        req.n_orbits,
+        req.options,
         cancel,
     );
-    let mut run = on_fastest_state!(orb, size, summarised_run(&start, m, args))?;
-    let t_end = run.stats.t_end;
-    let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);
-    let mut end = system.node_temperatures(flux, &run.y_end);
-    end.push(run.y_end[m]);
-    end.push(run.y_end[m + 1]);
-    run.y_end = end;
+    let mut run = on_fastest_state!(
+        orb,
+        size,
+        summarised_run(&start, system.thermal_size(), args)
+    )?;
+    run.y_end = req.nodal(&system, run.stats.t_end, &run.y_end);
     Ok(run)
+}
+
+impl LayeredRunRequest {
+    /// The system of the request (its slow conduction modes) and y0 in its coordinates.
+    fn system(&self) -> Result<(Layered, Vec<f64>)> {
+        let n = self.conduction.nodes();
+        let system = Layered::new(
+            &self.panel,
+            self.conduction.clone(),
+            self.model,
+            self.coupling,
+            FAST_MODE_FACTOR,
+        )?;
+        let start = system.state_from_nodes(&self.y0[..n], self.y0[n], self.y0[n + 1]);
+        Ok((system, start))
+    }
+
+    /// A state `y` of `system` at time t as (node temperatures, θ, θ̇).
+    fn nodal(&self, system: &Layered, t: f64, y: &[f64]) -> Vec<f64> {
+        let m = system.thermal_size();
+        let flux = self.orbit.illumination(t) * self.orbit.flux_scale(t);
+        let mut out = system.node_temperatures(flux, y);
+        out.extend([y[m], y[m + 1]]);
+        out
+    }
 }
 
 /// The summarised run's settings, passed through the size dispatch.
@@ -1375,45 +1403,40 @@ pub struct LayeredHybrid {
 pub const HYBRID_MAX_STATE: usize = 24;
 
 /// Per-orbit summaries of the N-node system by the hybrid propagator (as
-/// [`crate::hybrid::run_orbits_hybrid`]), from `y0` = (node temperatures, θ, θ̇); `method` is
-/// the full integration of its fallback.
-#[allow(clippy::too_many_arguments)]
+/// [`crate::hybrid::run_orbits_hybrid`]); `req.method` is the full integration of its fallback.
 pub fn run_orbits_hybrid(
-    panel: &Panel,
-    conduction: Conduction,
-    orbit: &Orbit,
-    model: HingeModel,
-    coupling: Coupling,
-    method: &crate::integrate::Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    y0: &[f64],
-    options: crate::longrun::SummaryOptions,
+    req: &LayeredRunRequest,
     settings: &crate::hybrid::HybridSettings,
     cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredHybrid> {
-    let n = conduction.nodes();
+    let (y0, n) = (&req.y0, req.conduction.nodes());
     check_start(y0, n)?;
     crate::hybrid::check_request(
-        orbit, method, t_start, n_orbits, y0, &options, settings, cancel,
+        &req.orbit,
+        &req.method,
+        req.t_start,
+        req.n_orbits,
+        y0,
+        &req.options,
+        settings,
+        cancel,
     )?;
     crate::dynamics::check_hinge_angle("y0[θ]", y0[n])?;
-    if conduction.two_layer {
+    if req.conduction.two_layer {
         // Two nodes on a plain panel are eq. 2: the two-layer hybrid run, to the bit.
-        let req = crate::longrun::OrbitRunRequest {
-            panel: *panel,
-            orbit: *orbit,
-            model,
-            coupling,
-            method: *method,
-            t_start,
-            first_index,
-            n_orbits,
+        let two = crate::longrun::OrbitRunRequest {
+            panel: req.panel,
+            orbit: req.orbit,
+            model: req.model,
+            coupling: req.coupling,
+            method: req.method,
+            t_start: req.t_start,
+            first_index: req.first_index,
+            n_orbits: req.n_orbits,
             y0: nalgebra::Vector4::from_column_slice(y0),
-            options,
+            options: req.options,
         };
-        let out = crate::hybrid::run_orbits_hybrid(&req, settings, cancel)?;
+        let out = crate::hybrid::run_orbits_hybrid(&two, settings, cancel)?;
         let run = LayeredSummaries {
             summaries: out.run.summaries.clone(),
             stats: out.run.stats,
@@ -1422,16 +1445,14 @@ pub fn run_orbits_hybrid(
         };
         return Ok(LayeredHybrid { run, split: out });
     }
-    let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
-    let m = system.thermal_size();
-    let start = system.state_from_nodes(&y0[..n], y0[n], y0[n + 1]);
+    let (system, start) = req.system()?;
     let args = HybridArgs {
-        orbit,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
-        options,
+        orbit: &req.orbit,
+        method: &req.method,
+        t_start: req.t_start,
+        first_index: req.first_index,
+        n_orbits: req.n_orbits,
+        options: req.options,
         settings,
         cancel,
     };
@@ -1440,9 +1461,9 @@ pub fn run_orbits_hybrid(
             match start.len() {
                 $($s => hybrid_run::<$s>(
                     HybridLayered {
-                        orbit: LayeredOrbit::new(system.clone(), *orbit),
-                        panel: *panel,
-                        coupling,
+                        orbit: LayeredOrbit::new(system.clone(), req.orbit),
+                        panel: req.panel,
+                        coupling: req.coupling,
                     },
                     &start,
                     &args,
@@ -1459,12 +1480,7 @@ pub fn run_orbits_hybrid(
         };
     }
     let (mut run, split) = sizes!(3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24)?;
-    let t_end = run.stats.t_end;
-    let flux = orbit.illumination(t_end) * orbit.flux_scale(t_end);
-    let mut end = system.node_temperatures(flux, &run.y_end);
-    end.push(run.y_end[m]);
-    end.push(run.y_end[m + 1]);
-    run.y_end = end;
+    run.y_end = req.nodal(&system, run.stats.t_end, &run.y_end);
     Ok(LayeredHybrid { run, split })
 }
 
@@ -1910,21 +1926,20 @@ mod tests {
             stop_at_limit: false,
             steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
-        let run = run_orbits(
-            &p,
-            c,
-            &o,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            &Method::Dopri5(Tolerances::default()),
-            0.0,
-            0,
-            1,
-            &y0,
+        let req = LayeredRunRequest {
+            panel: p,
+            conduction: c,
+            orbit: o,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: 1,
+            y0,
             options,
-            &crate::cancel::Cancel::new(),
-        )
-        .unwrap();
+        };
+        let run = run_orbits(&req, &crate::cancel::Cancel::new()).unwrap();
         let s = run.summaries[0];
         assert!(
             s.jitter_rms < 0.05 * eq.theta,
@@ -2114,11 +2129,20 @@ mod tests {
                 let eq = equilibrium(&p, &c, coupling, 1.0).unwrap();
                 let mut y0 = eq.temperatures.clone();
                 y0.extend([eq.theta, 0.0]);
-                run_orbits(
-                    &p, c, &o, model, coupling, method, 0.0, 0, 1, &y0, options, &cancel,
-                )
-                .unwrap()
-                .stats
+                let req = LayeredRunRequest {
+                    panel: p,
+                    conduction: c,
+                    orbit: o,
+                    model,
+                    coupling,
+                    method: *method,
+                    t_start: 0.0,
+                    first_index: 0,
+                    n_orbits: 1,
+                    y0,
+                    options,
+                };
+                run_orbits(&req, &cancel).unwrap().stats
             } else {
                 case.simulate(c).stats
             }

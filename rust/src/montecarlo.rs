@@ -313,41 +313,27 @@ pub fn run_sample_layered(
         frequency_hz: flutter.frequency_hz,
         critical_damping: critical,
     };
+    let req = layered::LayeredRunRequest {
+        panel: *panel,
+        conduction: c,
+        orbit: s.orbit,
+        model: s.model,
+        coupling: s.coupling,
+        method: s.method,
+        t_start: 0.0,
+        first_index: 0,
+        n_orbits: s.n_orbits,
+        y0,
+        options: summary_options(s),
+    };
     let (out, t_nonlinear) = match &s.hybrid {
         None => {
-            let out = layered::run_orbits(
-                panel,
-                c,
-                &s.orbit,
-                s.model,
-                s.coupling,
-                &s.method,
-                0.0,
-                0,
-                s.n_orbits,
-                &y0,
-                summary_options(s),
-                cancel,
-            )?;
+            let out = layered::run_orbits(&req, cancel)?;
             let t = out.stats.t_end;
             (out, t)
         }
         Some(h) => {
-            let out = layered::run_orbits_hybrid(
-                panel,
-                c,
-                &s.orbit,
-                s.model,
-                s.coupling,
-                &s.method,
-                0.0,
-                0,
-                s.n_orbits,
-                &y0,
-                summary_options(s),
-                h,
-                cancel,
-            )?;
+            let out = layered::run_orbits_hybrid(&req, h, cancel)?;
             (out.run, out.split.t_exponential + out.split.t_fallback)
         }
     };

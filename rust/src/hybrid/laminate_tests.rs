@@ -7,7 +7,7 @@ use crate::cancel::Cancel;
 use crate::conduction::Conduction;
 use crate::dynamics::HingeModel;
 use crate::integrate::{Method, Tolerances};
-use crate::layered::{self, LayeredHybrid};
+use crate::layered::{self, LayeredHybrid, LayeredRunRequest};
 use crate::orbit::{Orbit, Shadow};
 use crate::params::Panel;
 use crate::system::Coupling;
@@ -22,23 +22,26 @@ fn start(panel: &Panel, c: &Conduction, orbit: &Orbit, kick: f64) -> Vec<f64> {
     y
 }
 
+/// The N-node run of `n` orbits from `y0` at the tests' settings.
+fn request(panel: &Panel, c: &Conduction, orbit: &Orbit, n: u64, y0: &[f64]) -> LayeredRunRequest {
+    LayeredRunRequest {
+        panel: *panel,
+        conduction: c.clone(),
+        orbit: *orbit,
+        model: MODEL,
+        coupling: COUPLING,
+        method: Method::Dopri5(Tolerances::default()),
+        t_start: 0.0,
+        first_index: 0,
+        n_orbits: n,
+        y0: y0.to_vec(),
+        options: options(),
+    }
+}
+
 fn hybrid(panel: &Panel, c: &Conduction, orbit: &Orbit, n: u64, y0: &[f64]) -> LayeredHybrid {
-    layered::run_orbits_hybrid(
-        panel,
-        c.clone(),
-        orbit,
-        MODEL,
-        COUPLING,
-        &Method::Dopri5(Tolerances::default()),
-        0.0,
-        0,
-        n,
-        y0,
-        options(),
-        &HybridSettings::default(),
-        &Cancel::new(),
-    )
-    .unwrap()
+    let req = request(panel, c, orbit, n, y0);
+    layered::run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap()
 }
 
 fn full(
@@ -48,21 +51,7 @@ fn full(
     n: u64,
     y0: &[f64],
 ) -> layered::LayeredSummaries {
-    layered::run_orbits(
-        panel,
-        c.clone(),
-        orbit,
-        MODEL,
-        COUPLING,
-        &Method::Dopri5(Tolerances::default()),
-        0.0,
-        0,
-        n,
-        y0,
-        options(),
-        &Cancel::new(),
-    )
-    .unwrap()
+    layered::run_orbits(&request(panel, c, orbit, n, y0), &Cancel::new()).unwrap()
 }
 
 #[test]

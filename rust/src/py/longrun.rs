@@ -93,43 +93,24 @@ fn run_orbits<'py>(
         let settings = hybrid.map(hybrid_from).transpose()?;
         if let Some(n) = nodes {
             // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            let c = conduction_from(&p, layup, n)?;
+            let req = layered::LayeredRunRequest {
+                panel: p,
+                conduction: conduction_from(&p, layup, n)?,
+                orbit: o,
+                model: hinge,
+                coupling,
+                method: m,
+                t_start,
+                first_index,
+                n_orbits,
+                y0,
+                options,
+            };
             let Some(settings) = settings else {
-                let run = py.detach(|| {
-                    layered::run_orbits(
-                        &p,
-                        c,
-                        &o,
-                        hinge,
-                        coupling,
-                        &m,
-                        t_start,
-                        first_index,
-                        n_orbits,
-                        &y0,
-                        options,
-                        &cancel,
-                    )
-                })?;
+                let run = py.detach(|| layered::run_orbits(&req, &cancel))?;
                 return summary_dict(py, &run.into());
             };
-            let out = py.detach(|| {
-                layered::run_orbits_hybrid(
-                    &p,
-                    c,
-                    &o,
-                    hinge,
-                    coupling,
-                    &m,
-                    t_start,
-                    first_index,
-                    n_orbits,
-                    &y0,
-                    options,
-                    &settings,
-                    &cancel,
-                )
-            })?;
+            let out = py.detach(|| layered::run_orbits_hybrid(&req, &settings, &cancel))?;
             let d = summary_dict(py, &out.run.into())?;
             return hybrid_counters(d, &out.split);
         }
