@@ -131,17 +131,9 @@ fn run_orbits<'py>(
             return summary_dict(py, &run.into());
         };
         crate::dynamics::check_hinge_angle("y0[2]", req.y0[2])?;
-        let mut out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
-        let run = std::mem::take(&mut out.run.summaries);
-        let d = summary_dict(
-            py,
-            &Summarised {
-                summaries: run,
-                stats: out.run.stats,
-                y_end: out.run.y_end.as_slice().to_vec(),
-                crossing: out.run.crossing,
-            },
-        )?;
+        let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
+        // The run is copied (one summary per orbit) so that the counters stay with `out`.
+        let d = summary_dict(py, &out.run.clone().into())?;
         hybrid_counters(d, &out)
     })
 }
