@@ -39,7 +39,7 @@ def test_bad_values_are_refused_naming_the_parameter(changes: dict, parameter: s
 @pytest.mark.parametrize("value", [True, "1e-8", None])
 def test_a_number_must_be_a_number(value: object) -> None:
     with pytest.raises(TypeError, match="rtol"):
-        tj.SolverSettings(rtol=value)  # type: ignore[arg-type]
+        tj.SolverSettings(rtol=value)
 
 
 def test_the_object_and_the_keywords_give_the_same_run() -> None:
@@ -62,7 +62,7 @@ def test_giving_both_with_different_values_is_refused() -> None:
         tj.simulate(panel, orbit, (0.0, 10.0), solver=tj.SolverSettings(rtol=1e-9), atol=1e-6)
     assert info.value.parameter == "solver"
     with pytest.raises(TypeError, match="solver"):
-        tj.simulate(panel, orbit, (0.0, 10.0), solver={"rtol": 1e-9})  # type: ignore[arg-type]
+        tj.simulate(panel, orbit, (0.0, 10.0), solver={"rtol": 1e-9})
     # the same value twice is not a conflict
     sol = tj.simulate(
         panel, orbit, (0.0, 10.0), solver=tj.SolverSettings(method="rk4", dt=0.5), method="rk4"
@@ -111,3 +111,57 @@ def test_the_scenario_gives_one_settings_object() -> None:
     assert info.value.parameter == "rtol"
     sim = parse_scenario({"simulation": {"method": "rk4", "dt": 0.25}}).simulation
     assert sim.solver == tj.SolverSettings(method="rk4", dt=0.25)
+
+
+ASKED = tj.SolverSettings(rtol=1e-7, atol=1e-9, max_step=0.5, max_steps=10**7)
+"""Settings away from every default, for the runs that must report them."""
+
+
+@pytest.mark.parametrize("layers", [None, 2, 4])
+@pytest.mark.parametrize("method", ["rk45", "hybrid"])
+def test_long_runs_report_the_settings_the_engine_ran_with(layers: int | None, method: str) -> None:
+    panel, orbit = tj.Panel.paper(), tj.Orbit.leo()
+    run = tj.simulate_orbits(
+        panel, orbit, 1, method=method, solver=ASKED, layers=layers, progress=False
+    )
+    # hybrid runs report their rk45 fallback's settings
+    assert run.solver == ASKED
+    assert run.settings["rtol"] == ASKED.rtol  # the request as given, as before
+
+
+def test_long_runs_report_the_fixed_step_and_the_engines_defaults() -> None:
+    panel, orbit = tj.Panel.paper(), tj.Orbit.leo()
+    fixed = tj.simulate_orbits(panel, orbit, 1, method="rk4", dt=0.25, progress=False)
+    assert fixed.solver is not None and (fixed.solver.method, fixed.solver.dt) == ("rk4", 0.25)
+    plain = tj.simulate_orbits(panel, orbit, 1, progress=False)
+    assert plain.solver is not None
+    assert plain.solver.as_dict() == dict(_core.SOLVER_DEFAULTS)
+
+
+def test_a_run_resumed_whole_from_its_checkpoint_reports_its_settings(tmp_path) -> None:
+    panel, orbit = tj.Panel.paper(), tj.Orbit.leo()
+    path = tmp_path / "run.ckpt"
+    kw = {"method": "rk45", "solver": ASKED, "checkpoint": path, "progress": False}
+    first = tj.simulate_orbits(panel, orbit, 1, **kw)
+    again = tj.simulate_orbits(panel, orbit, 1, **kw)
+    assert again.n_steps == first.n_steps  # read, not run again
+    assert first.solver == again.solver == ASKED
+
+
+@pytest.mark.parametrize("method", ["rk45", "hybrid"])
+def test_monte_carlo_reports_the_settings_the_engine_ran_with(method: str, tmp_path) -> None:
+    panel, orbit = tj.Panel.paper(), tj.Orbit.leo()
+    kw = {"vary": {"damping": ("uniform", 0.5, 2.0)}, "n": 2, "seed": 3, "progress": False}
+    frame = tj.monte_carlo(panel, orbit, method=method, solver=ASKED, **kw)
+    assert tj.montecarlo.solver_of(frame) == ASKED
+    assert frame.attrs["solver"] == ASKED.as_dict()  # plain data: the frame writes to Parquet
+    assert frame.attrs["settings"]["run"]["solver"] == ASKED.as_dict()  # the request, as before
+    plain = tj.monte_carlo(panel, orbit, method=method, **kw)
+    assert frame.attrs["solver"] != plain.attrs["solver"]
+    assert plain.attrs["solver"] == dict(_core.SOLVER_DEFAULTS)
+    # a study read whole from its checkpoint reports the same
+    for _ in range(2):
+        read = tj.monte_carlo(
+            panel, orbit, method=method, solver=ASKED, checkpoint=tmp_path / "mc", **kw
+        )
+        assert tj.montecarlo.solver_of(read) == ASKED

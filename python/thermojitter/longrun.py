@@ -76,6 +76,10 @@ class OrbitSummaries:
     """Hybrid runs: simulated time (s) by linear arcs (``t_linear``), by the non-linear model
     (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
     full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``)."""
+    solver: SolverSettings | None = None
+    """The integrator settings the engine ran with, as it reports them (with ``method="hybrid"``,
+    those of its rk45 fallback); rk45's step is further capped at T_n/``steps_per_period``.
+    ``settings`` holds the request as given (the checkpoint's identity)."""
 
     @property
     def nonlinear_fraction(self) -> float:
@@ -283,7 +287,8 @@ def simulate_orbits(
     - ``layers=N``: the N-node through-thickness model on the panel's layup (see
       :func:`thermojitter.simulate`); ``y0`` and ``y_end`` are then (node temperatures…, θ, θ̇).
     - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
-      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback).
+      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback);
+      ``result.solver`` is what the engine ran with.
     """
     check_inputs(panel, orbit)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
@@ -394,6 +399,7 @@ def simulate_orbits(
             columns, y, next_index, counters, crossing = _restore(path, saved)
             _check_extension(path, saved, n_orbits, orbits_per_call, next_index)
 
+    ran_with: dict[str, Any] | None = None  # the settings the engine reports it ran with
     bar = progress_bar(n_orbits, initial=next_index, unit="orbit", enabled=progress)
     interrupted = report = False
     stopped = crossing is not None and on_limit == "stop"
@@ -419,6 +425,7 @@ def simulate_orbits(
             for name in SUMMARY_FIELDS:
                 columns[name].extend(np.asarray(raw[name]).tolist())
             y = list(raw["y_end"])
+            ran_with = raw["solver"]
             counters["n_steps"] += int(raw["n_steps"])
             counters["n_rhs"] += int(raw["n_rhs"])
             for name in HYBRID_COUNTERS if method == "hybrid" else ():
@@ -478,4 +485,7 @@ def simulate_orbits(
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,
+        # A run all read from its checkpoint made no engine call: the engine's reading of the
+        # same settings (the check every run makes of them) stands for it.
+        solver=SolverSettings(**(_core.check_solver(full) if ran_with is None else ran_with)),
     )

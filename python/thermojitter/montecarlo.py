@@ -372,6 +372,7 @@ def _run_chunk(
     out["stable"] = np.asarray(raw["stable"], dtype=bool)
     out["n_steps"] = np.asarray(raw["n_steps"], dtype=np.int64)
     out["error"] = list(raw["error"])
+    out["solver"] = dict(raw["solver"])  # the settings the engine reports it ran with
     return out
 
 
@@ -728,6 +729,12 @@ def _run_design(
     rows = np.concatenate([np.arange(a, b) for _, a, b in finished] or [np.empty(0, np.int64)])
     frame = _frame(names, values, [done[k] for k, _, _ in finished], rows.astype(np.int64))
     frame.attrs["settings"] = settings
+    # The solver settings the engine reports it ran the samples with (a plain mapping, so that
+    # the frame's attrs stay JSON for Parquet; solver_of(frame) gives the SolverSettings). When
+    # every chunk was read from the checkpoint no engine ran: its reading of the same settings
+    # (the check every run makes of them) stands for it.
+    echoes = [done[k]["solver"] for k, _, _ in finished if "solver" in done[k]]
+    frame.attrs["solver"] = dict(echoes[0] if echoes else _core.check_solver(options["solver"]))
     frame.attrs["interrupted"] = interrupted
     if interrupted:
         kept = f"kept {len(frame)} of {n} samples (frame.attrs['interrupted'] is True)"
@@ -739,6 +746,14 @@ def _run_design(
         else:
             report_interrupted(kept, "pass checkpoint=DIR to make a run resumable")
     return frame
+
+
+def solver_of(frame: Any) -> SolverSettings:
+    """The integrator settings the engine ran a study's samples with (``frame.attrs["solver"]``
+    of a :func:`monte_carlo`, :func:`sweep` or :func:`sensitivity` frame) as a
+    :class:`thermojitter.SolverSettings`; with ``method="hybrid"``, those of its rk45 fallback.
+    Each sample's rk45 step is further capped at its hinge period / 40, as long runs cap it."""
+    return SolverSettings(**frame.attrs["solver"])
 
 
 def _check_seed(seed: Any, checkpoint: Any) -> int:
@@ -850,7 +865,8 @@ def monte_carlo(
       refused, naming them.
 
     - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
-      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback).
+      and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback); those the engine
+      ran with are :func:`thermojitter.montecarlo.solver_of` (``frame.attrs["solver"]``).
     - ``layers``: N runs every sample with the N-node through-thickness model (as
       ``simulate_orbits(..., layers=N)``): on the layup of a panel made by
       :meth:`Panel.from_laminate` (whose layup-decided fields cannot be varied then), or on each

@@ -1,7 +1,7 @@
 //! Bindings of the long runs (`crate::longrun`, and the hybrid propagator).
 
 use super::cancel::{token, CancelToken};
-use super::convert::{hinge_model, orbit_from, panel_from, solver_from, state};
+use super::convert::{hinge_model, orbit_from, panel_from, solver_dict, solver_from, state};
 use super::error::shield;
 use super::laminate::conduction_from;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
@@ -108,10 +108,10 @@ fn run_orbits<'py>(
             };
             let Some(settings) = settings else {
                 let run = py.detach(|| layered::run_orbits(&req, &cancel))?;
-                return summary_dict(py, &run.into());
+                return summary_dict(py, &run.into(), &req.method);
             };
             let out = py.detach(|| layered::run_orbits_hybrid(&req, &settings, &cancel))?;
-            let d = summary_dict(py, &out.run.into())?;
+            let d = summary_dict(py, &out.run.into(), &req.method)?;
             return hybrid_counters(d, &out.split);
         }
         let req = OrbitRunRequest {
@@ -128,12 +128,12 @@ fn run_orbits<'py>(
         };
         let Some(settings) = settings else {
             let run = py.detach(|| run(&req, &cancel))?;
-            return summary_dict(py, &run.into());
+            return summary_dict(py, &run.into(), &req.method);
         };
         crate::dynamics::check_hinge_angle("y0[2]", req.y0[2])?;
         let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
         // The run is copied (one summary per orbit) so that the counters stay with `out`.
-        let d = summary_dict(py, &out.run.clone().into())?;
+        let d = summary_dict(py, &out.run.clone().into(), &req.method)?;
         hybrid_counters(d, &out)
     })
 }
@@ -152,8 +152,13 @@ fn hybrid_counters<'py>(
     Ok(d)
 }
 
-/// The summaries of a run as columns, with its counters.
-fn summary_dict<'py>(py: Python<'py>, out: &Summarised) -> PyResult<Bound<'py, PyDict>> {
+/// The summaries of a run as columns, with its counters and the solver settings it ran with
+/// (`method`, as [`solver_dict`] reports them for every run).
+fn summary_dict<'py>(
+    py: Python<'py>,
+    out: &Summarised,
+    method: &crate::integrate::Method,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let col = |f: fn(&crate::longrun::OrbitSummary) -> f64| -> Vec<f64> {
         out.summaries.iter().map(f).collect()
@@ -187,6 +192,7 @@ fn summary_dict<'py>(py: Python<'py>, out: &Summarised) -> PyResult<Bound<'py, P
     d.set_item("stopped", out.stats.stopped)?;
     d.set_item("y_end", out.y_end.clone())?;
     d.set_item("crossing", out.crossing.map(|c| (c.t, c.orbit, c.theta)))?;
+    d.set_item("solver", solver_dict(py, method)?)?;
     Ok(d)
 }
 

@@ -3,7 +3,7 @@
 //! up front.
 
 use super::cancel::{token, CancelToken};
-use super::convert::{coupling, hinge_model, orbit_from, solver_from};
+use super::convert::{coupling, hinge_model, orbit_from, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use super::laminate::laminate_from;
@@ -198,6 +198,9 @@ impl EnsemblePool {
             d.set_item("n_steps", PyArray1::from_vec(py, steps))?;
             let errors: Vec<Option<String>> = out.into_iter().map(|m| m.error).collect();
             d.set_item("error", errors)?;
+            // The solver settings the samples ran with (each sample's step capped at its
+            // hinge period as the long runs cap it).
+            d.set_item("solver", solver_dict(py, &settings.method)?)?;
             Ok(d)
         })
     }
