@@ -951,6 +951,22 @@ pub struct LayeredSummaries {
     pub crossing: Option<crate::longrun::LimitCrossing>,
 }
 
+/// The summaries of any model's run (a two-layer [`crate::longrun::OrbitRun`] among them), the
+/// end state as a plain vector.
+impl<D: Dim> From<crate::longrun::Summarised<D>> for LayeredSummaries
+where
+    DefaultAllocator: Allocator<D>,
+{
+    fn from(run: crate::longrun::Summarised<D>) -> Self {
+        LayeredSummaries {
+            summaries: run.summaries,
+            stats: run.stats,
+            y_end: run.y_end.as_slice().to_vec(),
+            crossing: run.crossing,
+        }
+    }
+}
+
 fn summarised_run<D: Dim, S: OdeSystem<D>>(
     system: &mut S,
     y0: &[f64],
@@ -975,12 +991,7 @@ where
         options,
         cancel,
     )?;
-    Ok(LayeredSummaries {
-        summaries: run.summaries,
-        stats: run.stats,
-        y_end: run.y_end.as_slice().to_vec(),
-        crossing: run.crossing,
-    })
+    Ok(run.into())
 }
 
 /// Checks a start state of node temperatures, θ and θ̇.
@@ -1441,12 +1452,7 @@ pub fn run_orbits_hybrid(
             options: req.options,
         };
         let out = crate::hybrid::run_orbits_hybrid(&two, settings, cancel)?;
-        let run = LayeredSummaries {
-            summaries: out.run.summaries.clone(),
-            stats: out.run.stats,
-            y_end: out.run.y_end.as_slice().to_vec(),
-            crossing: out.run.crossing,
-        };
+        let run = out.run.clone().into();
         return Ok(LayeredHybrid { run, split: out });
     }
     let (system, start) = req.system()?;
@@ -1517,15 +1523,7 @@ fn hybrid_run<const S: usize>(
         a.settings,
         a.cancel,
     )?;
-    Ok((
-        LayeredSummaries {
-            summaries: done.summaries,
-            stats: done.stats,
-            y_end: done.y_end.as_slice().to_vec(),
-            crossing: done.crossing,
-        },
-        done.split,
-    ))
+    Ok((done.run.into(), done.split))
 }
 
 #[cfg(test)]

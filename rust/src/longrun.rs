@@ -19,7 +19,7 @@ use crate::params::Panel;
 use crate::steady::equilibrium;
 use crate::system::{Coupled, Coupling};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, Vector4};
+use nalgebra::{DefaultAllocator, Dim, Vector4, U4};
 use std::ops::ControlFlow;
 
 /// How the summaries read a model's state: the hinge angle and the quasi-static angle
@@ -288,6 +288,20 @@ impl<V: SummaryView> Collector<V> {
             .first()
             .map(|e| (e.outer.0.max(t0), e.outer.1.min(t1)));
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
+    }
+
+    /// The run's summaries, with its counters and end state: the last orbit closed.
+    pub(crate) fn finish<D: Dim>(mut self, stats: Stats, y_end: State<D>) -> Summarised<D>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        self.close();
+        Summarised {
+            summaries: self.done,
+            stats,
+            y_end,
+            crossing: self.crossing,
+        }
     }
 
     pub(crate) fn close(&mut self) {
@@ -648,14 +662,8 @@ impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
     }
 }
 
-/// Result of a summarised run over whole orbits.
-#[derive(Debug, Clone)]
-pub struct OrbitRun {
-    pub summaries: Vec<OrbitSummary>,
-    pub stats: Stats,
-    pub y_end: Vector4<f64>,
-    pub crossing: Option<LimitCrossing>,
-}
+/// Result of a summarised run of the two-layer panel over whole orbits.
+pub type OrbitRun = Summarised<U4>;
 
 /// What a summarised run of the two-layer panel over whole orbits is asked to do: integrate
 /// orbits `first_index .. first_index + n_orbits`, the first starting at `t_start`, from `y0`,
@@ -688,7 +696,7 @@ pub fn run_orbits_cancellable(req: &OrbitRunRequest, cancel: &Cancel) -> Result<
         panel: req.panel,
         coupling: req.coupling,
     };
-    let run = run_summarised(
+    run_summarised(
         &mut system,
         view,
         &req.panel,
@@ -701,16 +709,9 @@ pub fn run_orbits_cancellable(req: &OrbitRunRequest, cancel: &Cancel) -> Result<
         2,
         req.options,
         cancel,
-    )?;
-    Ok(OrbitRun {
-        summaries: run.summaries,
-        stats: run.stats,
-        y_end: run.y_end,
-        crossing: run.crossing,
-    })
+    )
 }
 
-/// A summarised run of any model: the summaries, the counters and the end state.
 /// A summarised run of the two-layer panel set up but not yet integrated: integrate `system` with
 /// `method` from (`t0`, `y0`) to `t1` into `observer` (with [`solve`], or in lockstep with
 /// other runs), then hand the outcome to [`finish_orbits`]. The same checks and observer as
@@ -735,54 +736,94 @@ pub(crate) fn prepare_orbits<'c>(
         model,
         coupling,
         t_start,
-        first_index,
-        n_orbits,
         y0,
-        options,
         ..
     } = *req;
-    cancel.check()?;
-    options.check()?;
-    let method = resolve_hinge(&req.method, &panel, options.steps_per_period);
-    if n_orbits == 0 {
-        return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
-    }
-    let view = TwoLayerView { panel, coupling };
-    let collector = Collector::new(view, &orbit, options, t_start, first_index, n_orbits, y0[2])?;
+    let (method, t1, observer) = prepare_summarised(
+        TwoLayerView { panel, coupling },
+        &panel,
+        &orbit,
+        &req.method,
+        (t_start, req.first_index, req.n_orbits),
+        (2, y0[2]),
+        req.options,
+        cancel,
+    )?;
     Ok(PreparedOrbits {
         system: Coupled::new(panel, orbit, model, coupling),
         method,
         t0: t_start,
-        t1: t_start + n_orbits as f64 * orbit.period,
+        t1,
         y0,
-        observer: SummaryObserver {
-            collector,
-            error: None,
-            cancel,
-        },
+        observer,
     })
 }
 
 /// The summaries of a prepared run from the outcome of its integration (as
-/// [`run_orbits_cancellable`] returns them).
-pub(crate) fn finish_orbits(
-    observer: SummaryObserver<'_, TwoLayerView>,
-    outcome: Result<(Stats, Vector4<f64>)>,
-) -> Result<OrbitRun> {
+/// [`run_orbits_cancellable`] and [`run_summarised`] return them).
+pub(crate) fn finish_orbits<D: Dim, V: SummaryView>(
+    observer: SummaryObserver<'_, V>,
+    outcome: Result<(Stats, State<D>)>,
+) -> Result<Summarised<D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let (stats, y_end) = outcome?;
     if let Some(e) = observer.error {
         return Err(e);
     }
-    let mut c = observer.collector;
-    c.close();
-    Ok(OrbitRun {
-        summaries: c.done,
-        stats,
-        y_end,
-        crossing: c.crossing,
-    })
+    Ok(observer.collector.finish(stats, y_end))
 }
 
+/// The checks of a summarised run of orbits `first_index .. first_index + n_orbits` from
+/// `t_start` (`span`) whose start state has θ = `theta.1` at component `theta.0`, and what it
+/// integrates with: `method` with its step capped as `options` ask, the end time, the observer.
+#[allow(clippy::too_many_arguments)]
+fn prepare_summarised<'c, V: SummaryView>(
+    view: V,
+    panel: &Panel,
+    orbit: &Orbit,
+    method: &Method,
+    span: (f64, u64, u64),
+    theta: (usize, f64),
+    options: SummaryOptions,
+    cancel: &'c Cancel,
+) -> Result<(Method, f64, SummaryObserver<'c, V>)> {
+    let (t_start, first_index, n_orbits) = span;
+    cancel.check()?;
+    crate::error::require_positive("window", options.window)?;
+    crate::error::require_positive("theta_limit", options.theta_limit)?;
+    crate::dynamics::check_hinge_angle(&format!("y0[{}]", theta.0), theta.1)?;
+    if !(0.0..=MAX_STEPS_PER_PERIOD).contains(&options.steps_per_period) {
+        return Err(crate::Error::invalid(
+            "steps_per_period",
+            options.steps_per_period,
+            &format!("must be in [0, {MAX_STEPS_PER_PERIOD:e}] (0: error control alone)"),
+        ));
+    }
+    let method = resolve_hinge(method, panel, options.steps_per_period);
+    if n_orbits == 0 {
+        return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
+    }
+    let t_end = t_start + n_orbits as f64 * orbit.period;
+    let collector = Collector::new(
+        view,
+        orbit,
+        options,
+        t_start,
+        first_index,
+        n_orbits,
+        theta.1,
+    )?;
+    let observer = SummaryObserver {
+        collector,
+        error: None,
+        cancel,
+    };
+    Ok((method, t_end, observer))
+}
+
+/// A summarised run of any model: the summaries, the counters and the end state.
 #[derive(Debug, Clone)]
 pub struct Summarised<D: Dim>
 where
@@ -815,48 +856,18 @@ pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
 where
     DefaultAllocator: Allocator<D>,
 {
-    cancel.check()?;
-    crate::error::require_positive("window", options.window)?;
-    crate::error::require_positive("theta_limit", options.theta_limit)?;
-    crate::dynamics::check_hinge_angle(&format!("y0[{theta_index}]"), y0[theta_index])?;
-    if !(0.0..=MAX_STEPS_PER_PERIOD).contains(&options.steps_per_period) {
-        return Err(crate::Error::invalid(
-            "steps_per_period",
-            options.steps_per_period,
-            &format!("must be in [0, {MAX_STEPS_PER_PERIOD:e}] (0: error control alone)"),
-        ));
-    }
-    let method = &resolve_hinge(method, panel, options.steps_per_period);
-    if n_orbits == 0 {
-        return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
-    }
-    let t_end = t_start + n_orbits as f64 * orbit.period;
-    let collector = Collector::new(
+    let (method, t_end, mut observer) = prepare_summarised(
         view,
+        panel,
         orbit,
+        method,
+        (t_start, first_index, n_orbits),
+        (theta_index, y0[theta_index]),
         options,
-        t_start,
-        first_index,
-        n_orbits,
-        y0[theta_index],
-    )?;
-    let mut observer = SummaryObserver {
-        collector,
-        error: None,
         cancel,
-    };
-    let (stats, y_end) = solve(system, method, t_start, y0, t_end, &mut observer)?;
-    if let Some(e) = observer.error {
-        return Err(e);
-    }
-    let mut c = observer.collector;
-    c.close();
-    Ok(Summarised {
-        summaries: c.done,
-        stats,
-        y_end,
-        crossing: c.crossing,
-    })
+    )?;
+    let outcome = solve(system, &method, t_start, y0, t_end, &mut observer);
+    finish_orbits(observer, outcome)
 }
 
 #[cfg(test)]

@@ -32,8 +32,8 @@ use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
 use crate::integrate::{solve, DenseStep, Method, Observer, Stats};
 use crate::longrun::{
-    resolve_hinge, Collector, LimitCrossing, OrbitRun, OrbitRunRequest, OrbitSummary,
-    SummaryObserver, SummaryOptions, STEPS_PER_HINGE_PERIOD,
+    resolve_hinge, Collector, OrbitRun, OrbitRunRequest, Summarised, SummaryObserver,
+    SummaryOptions, STEPS_PER_HINGE_PERIOD,
 };
 use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::params::Panel;
@@ -132,11 +132,8 @@ struct Driver<'a, const N: usize, M: HybridModel<N>> {
 
 /// A hybrid run of any model: the summaries, the counters, the end state.
 pub(crate) struct Propagated<const N: usize> {
-    pub summaries: Vec<OrbitSummary>,
-    pub stats: Stats,
-    pub y_end: SVector<f64, N>,
-    pub crossing: Option<LimitCrossing>,
-    /// How the time was split (its `run` is left empty: the fields above hold it).
+    pub run: Summarised<Const<N>>,
+    /// How the time was split (its `run` is left empty: `run` above holds it).
     pub split: HybridRun,
 }
 
@@ -183,12 +180,7 @@ pub fn run_orbits_hybrid(
         cancel,
     )?;
     let mut out = done.split;
-    out.run = OrbitRun {
-        summaries: done.summaries,
-        stats: done.stats,
-        y_end: done.y_end,
-        crossing: done.crossing,
-    };
+    out.run = done.run;
     Ok(out)
 }
 
@@ -304,21 +296,17 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
     };
     d.run()?;
     let Driver {
-        mut obs,
+        obs,
         out,
         mut stats,
         t,
         y,
         ..
     } = d;
-    obs.collector.close();
     stats.t_end = t;
     stats.stopped = t < t_end && obs.collector.crossing.is_some();
     Ok(Propagated {
-        summaries: obs.collector.done,
-        stats,
-        y_end: y,
-        crossing: obs.collector.crossing,
+        run: obs.collector.finish(stats, y),
         split: out,
     })
 }

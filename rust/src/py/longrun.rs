@@ -6,44 +6,12 @@ use super::error::shield;
 use super::laminate::conduction_from;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::layered;
-use crate::longrun::{
-    run_orbits_cancellable as run, OrbitRun, OrbitRunRequest, OrbitSummary, SummaryOptions,
-};
+use crate::longrun::{run_orbits_cancellable as run, OrbitRunRequest, SummaryOptions};
 use crate::system::Coupling;
 use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-/// What either model's summarised run hands back.
-struct Summarised {
-    summaries: Vec<OrbitSummary>,
-    stats: crate::integrate::Stats,
-    y_end: Vec<f64>,
-    crossing: Option<crate::longrun::LimitCrossing>,
-}
-
-impl From<layered::LayeredSummaries> for Summarised {
-    fn from(run: layered::LayeredSummaries) -> Self {
-        Summarised {
-            summaries: run.summaries,
-            stats: run.stats,
-            y_end: run.y_end,
-            crossing: run.crossing,
-        }
-    }
-}
-
-impl From<OrbitRun> for Summarised {
-    fn from(run: OrbitRun) -> Self {
-        Summarised {
-            summaries: run.summaries,
-            stats: run.stats,
-            y_end: run.y_end.as_slice().to_vec(),
-            crossing: run.crossing,
-        }
-    }
-}
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays): the two-layer
 /// model, or the N-node model (`nodes`, `layup`), or with `hybrid` (its settings) the hybrid
@@ -108,10 +76,10 @@ fn run_orbits<'py>(
             };
             let Some(settings) = settings else {
                 let run = py.detach(|| layered::run_orbits(&req, &cancel))?;
-                return summary_dict(py, &run.into(), &req.method);
+                return summary_dict(py, &run, &req.method);
             };
             let out = py.detach(|| layered::run_orbits_hybrid(&req, &settings, &cancel))?;
-            let d = summary_dict(py, &out.run.into(), &req.method)?;
+            let d = summary_dict(py, &out.run, &req.method)?;
             return hybrid_counters(d, &out.split);
         }
         let req = OrbitRunRequest {
@@ -152,11 +120,12 @@ fn hybrid_counters<'py>(
     Ok(d)
 }
 
-/// The summaries of a run as columns, with its counters and the solver settings it ran with
-/// (`method`, as [`solver_dict`] reports them for every run).
+/// The summaries of a run (of either model: a two-layer `OrbitRun` converts) as columns, with
+/// its counters and the solver settings it ran with (`method`, as [`solver_dict`] reports them
+/// for every run).
 fn summary_dict<'py>(
     py: Python<'py>,
-    out: &Summarised,
+    out: &layered::LayeredSummaries,
     method: &crate::integrate::Method,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
