@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 import thermojitter as tj
 from conftest import GEO, PAPER
 from thermojitter import reference as ref
+from thermojitter.scenario import parse_scenario
 
 R_SUN = 6.957e8
 AU = 1.495978707e11
@@ -155,6 +156,10 @@ def test_leo_preset():
     assert np.allclose(iv, ref.shadow_intervals(leo, 0.0, 10 * leo.period), rtol=0, atol=1e-6)
     with pytest.raises(ValueError, match="altitude"):
         tj.Orbit.leo(-1.0)
+    # one default (the engine's), for the method and for a scenario's preset
+    assert tj.orbit.LEO_ALTITUDE == 540e3
+    assert parse_scenario({"orbit": {"preset": "leo"}}).orbit == leo
+    assert parse_scenario({"orbit": {"preset": "leo", "altitude": 600e3}}).orbit != leo
 
 
 def test_defaults_and_validation():

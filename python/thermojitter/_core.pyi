@@ -15,6 +15,9 @@ __all__ = [
     "PERIHELION_DAY",
     "MU_EARTH",
     "GEO_RADIUS",
+    "LEO_ALTITUDE",
+    "MAX_LEO_ALTITUDE",
+    "MIN_LEO_ALTITUDE",
     "GEO_EQUINOX_ORBIT",
     "EQUINOX_DAY",
     "EARTH_RADIUS",
@@ -86,6 +89,9 @@ LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
+LEO_ALTITUDE: float
+MIN_LEO_ALTITUDE: float
+MAX_LEO_ALTITUDE: float
 EARTH_RADIUS: float
 SIDEREAL_DAY: float
 MU_EARTH: float

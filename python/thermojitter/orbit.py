@@ -51,10 +51,12 @@ PERIHELION_DAY: float = _core.PERIHELION_DAY
 """Mean perihelion, days since 1 January 00:00 UTC."""
 _GEO_EQUINOX: dict[str, Any] = dict(_core.GEO_EQUINOX_ORBIT)
 
-MIN_LEO_ALTITUDE = 100e3
+LEO_ALTITUDE: float = _core.LEO_ALTITUDE
+"""Default altitude of :meth:`Orbit.leo` (a Hubble-like low orbit), m."""
+MIN_LEO_ALTITUDE: float = _core.MIN_LEO_ALTITUDE
 """Lowest altitude of :meth:`Orbit.leo`, m (the Kármán line; lower, the atmosphere ends an orbit
 within hours)."""
-MAX_LEO_ALTITUDE = 1e9
+MAX_LEO_ALTITUDE: float = _core.MAX_LEO_ALTITUDE
 """Highest altitude of :meth:`Orbit.leo`, m (beyond the Moon)."""
 
 ShadowModel = Literal["none", "cylindrical", "penumbra"]
@@ -151,7 +153,7 @@ class Orbit:
         )
 
     @classmethod
-    def leo(cls, altitude: float = 540e3, *, shadow: ShadowModel = "cylindrical") -> Orbit:
+    def leo(cls, altitude: float = LEO_ALTITUDE, *, shadow: ShadowModel = "cylindrical") -> Orbit:
         """A Hubble-like circular low orbit at ``altitude`` (m): Keplerian period (about 95 min at
         540 km), the Sun in the orbit plane (the longest eclipses, about 36 min)."""
         height = checks.real("altitude", altitude)

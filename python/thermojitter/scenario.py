@@ -43,7 +43,7 @@ from thermojitter import materials
 from thermojitter.errors import ParameterError
 from thermojitter.laminate import Laminate, Layer
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
-from thermojitter.orbit import Orbit
+from thermojitter.orbit import LEO_ALTITUDE, Orbit
 from thermojitter.panel import LAYUP_FIELDS, Panel
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
@@ -371,7 +371,7 @@ def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
         except (ValueError, TypeError) as exc:
             raise ScenarioError(path, "orbit.start_date", str(exc)) from None
     elif preset == "leo":
-        altitude = _positive(path, "orbit.altitude", table.get("altitude", 540e3))
+        altitude = _positive(path, "orbit.altitude", table.get("altitude", LEO_ALTITUDE))
         base = Orbit.leo(altitude).as_dict()
     elif preset is not None:
         base = ORBIT_PRESETS[preset]().as_dict()

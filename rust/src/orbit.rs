@@ -59,6 +59,14 @@ pub const OBLIQUITY: f64 = 23.44 * PI / 180.0;
 pub const EARTH_ECCENTRICITY: f64 = 0.0167;
 /// Mean day of the March equinox, days since 1 January 00:00 UTC (about 20 March, 12:00).
 pub const EQUINOX_DAY: f64 = 78.5;
+/// Altitude of a Hubble-like low orbit, m: the default of `tj.Orbit.leo` and of a scenario's
+/// `leo` preset (about 95 min a revolution).
+pub const LEO_ALTITUDE: f64 = 540e3;
+/// Lowest altitude of a low orbit, m (the Kármán line; lower, the atmosphere ends an orbit within
+/// hours).
+pub const MIN_LEO_ALTITUDE: f64 = 100e3;
+/// Highest altitude of a low orbit, m (beyond the Moon).
+pub const MAX_LEO_ALTITUDE: f64 = 1e9;
 /// Mean day of perihelion, days since 1 January 00:00 UTC (about 4 January, 00:00).
 pub const PERIHELION_DAY: f64 = 3.0;
 
@@ -792,7 +800,7 @@ mod tests {
         for orbit in [
             Orbit::geo_year(EQUINOX_DAY - 30.0),
             Orbit::geo_equinox(),
-            Orbit::leo(540e3),
+            Orbit::leo(LEO_ALTITUDE),
         ] {
             let mut table = EclipseTable::new(&orbit);
             let p = orbit.period;
@@ -816,7 +824,7 @@ mod tests {
 
     #[test]
     fn leo_period_is_keplerian() {
-        let o = Orbit::leo(540e3);
+        let o = Orbit::leo(LEO_ALTITUDE);
         assert!((o.period / 60.0 - 95.4).abs() < 0.3, "{}", o.period / 60.0);
         assert_eq!(o.shadow_intervals(0.0, o.period).len(), 1);
     }

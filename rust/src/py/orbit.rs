@@ -139,9 +139,13 @@ fn leo_orbit(py: Python<'_>, altitude: f64) -> PyResult<Bound<'_, PyDict>> {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     use crate::orbit::{
-        EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, MU_EARTH, PERIHELION_DAY, SIDEREAL_DAY,
+        EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, LEO_ALTITUDE, MAX_LEO_ALTITUDE, MIN_LEO_ALTITUDE,
+        MU_EARTH, PERIHELION_DAY, SIDEREAL_DAY,
     };
     m.add("GEO_RADIUS", GEO_RADIUS)?;
+    m.add("LEO_ALTITUDE", LEO_ALTITUDE)?;
+    m.add("MIN_LEO_ALTITUDE", MIN_LEO_ALTITUDE)?;
+    m.add("MAX_LEO_ALTITUDE", MAX_LEO_ALTITUDE)?;
     m.add("EARTH_RADIUS", EARTH_RADIUS)?;
     m.add("SIDEREAL_DAY", SIDEREAL_DAY)?;
     m.add("MU_EARTH", MU_EARTH)?;
