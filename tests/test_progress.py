@@ -167,7 +167,8 @@ def test_the_command_stops_on_ctrl_c_in_one_line(tmp_path: Path) -> None:
 
 def test_interruptible_cancels_the_engine_call() -> None:
     """The token handed to the engine stops a long batch from another thread."""
-    pool = _core.EnsemblePool(1)
+    pool = _core.MonteCarloPool(1)
+    assert _core.EnsemblePool is _core.MonteCarloPool  # the name before, kept
     panel = tj.Panel.paper()
     row = np.array([[getattr(panel, f) for f in _core.PANEL_FIELDS]])
     with Interruptible() as engine:

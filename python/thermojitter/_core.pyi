@@ -25,6 +25,7 @@ __all__ = [
     "CancelToken",
     "ConvergenceError",
     "EnsemblePool",
+    "MonteCarloPool",
     "IntegrationError",
     "LAYER_FIELDS",
     "MAX_THREADS",
@@ -276,8 +277,8 @@ def least_steps(
 ) -> _F: ...
 
 @final
-class EnsemblePool:
-    def __new__(cls, threads: int | None = None) -> EnsemblePool: ...
+class MonteCarloPool:
+    def __new__(cls, threads: int | None = None) -> MonteCarloPool: ...
     @property
     def threads(self) -> int: ...
     def run(
@@ -299,6 +300,9 @@ class EnsemblePool:
         layup: dict[str, Any] | None = None,
         nodes: int | None = None,
     ) -> dict[str, Any]: ...
+
+EnsemblePool = MonteCarloPool
+"""The name before :class:`MonteCarloPool` (the same class)."""
 
 # --- laminates and the N-node model -------------------------------------------------------------
 LAYER_FIELDS: list[str]

@@ -293,7 +293,7 @@ def _options(
     threshold: float | None,
     stop_at_threshold: bool,
 ) -> dict[str, Any]:
-    """The keyword arguments of EnsemblePool.run shared by every chunk (plain data), from the
+    """The keyword arguments of MonteCarloPool.run shared by every chunk (plain data), from the
     study's own arguments (those monte_carlo, sweep and sensitivity share)."""
     chosen = _default_method(method, orbit, horizon)
     # The method as given (None: the solver's or the default); "hybrid" is no solver method.
@@ -396,7 +396,7 @@ def dask_chunk(panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str
     with _WORKER_POOLS_LOCK:
         pool = _WORKER_POOLS.get(key)
         if pool is None:
-            pool = _core.EnsemblePool(key[1] or None)
+            pool = _core.MonteCarloPool(key[1] or None)
             _WORKER_POOLS[key] = pool
     return _run_chunk(pool, panels, options)
 
@@ -411,7 +411,7 @@ def _local_chunks(
     pool, so the pool's threads stay busy while a chunk finishes its last samples. Leaving early
     (Ctrl-C in the consumer) cancels the engine's token: the running chunks stop within one
     integration step and are dropped."""
-    pool = _core.EnsemblePool(threads)
+    pool = _core.MonteCarloPool(threads)
     token = _core.CancelToken()
     with cf.ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermojitter") as ex:
         futures = {ex.submit(_run_chunk, pool, matrix[a:b], options, token): k for k, a, b in todo}

@@ -1,6 +1,7 @@
 //! Bindings of the Monte Carlo batches (`crate::montecarlo`): a rayon pool of its own
-//! (`_core.EnsemblePool`, the name the Python side has always used), and the check of a design
-//! up front.
+//! (`_core.MonteCarloPool`, named as the engine's module and `montecarlo.py`; `_core.EnsemblePool`
+//! is the same class under the name the Python side used before), and the check of a design up
+//! front.
 
 use super::cancel::{token, CancelToken};
 use super::convert::{coupling, hinge_model, orbit_from, solver_dict, solver_from};
@@ -86,12 +87,12 @@ fn check_panels(panels: PyReadonlyArray2<'_, f64>) -> PyResult<Vec<(usize, Strin
 /// A rayon thread pool of its own; batches run on it with the GIL released. Several Python
 /// threads may run batches on one pool at once: they share its threads.
 #[pyclass(frozen, module = "thermojitter._core")]
-struct EnsemblePool {
+struct MonteCarloPool {
     pool: ThreadPool,
 }
 
 #[pymethods]
-impl EnsemblePool {
+impl MonteCarloPool {
     #[new]
     #[pyo3(signature = (threads=None))]
     fn new(threads: Option<usize>) -> PyResult<Self> {
@@ -102,7 +103,7 @@ impl EnsemblePool {
                 "must be >= 1 (or None for one per core)",
             ));
         }
-        Ok(EnsemblePool {
+        Ok(MonteCarloPool {
             pool: pool(threads.unwrap_or(0))?,
         })
     }
@@ -223,7 +224,9 @@ fn cpu_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<EnsemblePool>()?;
+    m.add_class::<MonteCarloPool>()?;
+    // The name before MonteCarloPool, kept for the scripts that use it: the same class.
+    m.add("EnsemblePool", m.getattr("MonteCarloPool")?)?;
     m.add_function(wrap_pyfunction!(cpu_info, m)?)?;
     m.add_function(wrap_pyfunction!(check_panels, m)?)?;
     m.add_function(wrap_pyfunction!(least_steps, m)?)?;
