@@ -919,6 +919,23 @@ impl LayeredRunRequest {
         Ok((system, start))
     }
 
+    /// The same request of the two-layer model (whose state is that of two nodes on a plain
+    /// panel: `y0` = (T_front, T_back, θ, θ̇), checked by the caller).
+    pub fn two_layer(&self) -> crate::longrun::OrbitRunRequest {
+        crate::longrun::OrbitRunRequest {
+            panel: self.panel,
+            orbit: self.orbit,
+            model: self.model,
+            coupling: self.coupling,
+            method: self.method,
+            t_start: self.t_start,
+            first_index: self.first_index,
+            n_orbits: self.n_orbits,
+            y0: nalgebra::Vector4::from_column_slice(&self.y0),
+            options: self.options,
+        }
+    }
+
     /// A state `y` of `system` at time t as (node temperatures, θ, θ̇).
     fn nodal(&self, system: &Layered, t: f64, y: &[f64]) -> Vec<f64> {
         let m = system.thermal_size();
@@ -1439,19 +1456,7 @@ pub fn run_orbits_hybrid(
     crate::dynamics::check_hinge_angle("y0[θ]", y0[n])?;
     if req.conduction.two_layer {
         // Two nodes on a plain panel are eq. 2: the two-layer hybrid run, to the bit.
-        let two = crate::longrun::OrbitRunRequest {
-            panel: req.panel,
-            orbit: req.orbit,
-            model: req.model,
-            coupling: req.coupling,
-            method: req.method,
-            t_start: req.t_start,
-            first_index: req.first_index,
-            n_orbits: req.n_orbits,
-            y0: nalgebra::Vector4::from_column_slice(y0),
-            options: req.options,
-        };
-        let out = crate::hybrid::run_orbits_hybrid(&two, settings, cancel)?;
+        let out = crate::hybrid::run_orbits_hybrid(&req.two_layer(), settings, cancel)?;
         let run = out.run.clone().into();
         return Ok(LayeredHybrid { run, split: out });
     }

@@ -118,18 +118,7 @@ fn two_nodes_are_the_two_layer_hybrid_to_the_bit() {
     let c = Conduction::homogeneous(&panel, 2).unwrap();
     let orbit = Orbit::geo_year(70.0);
     let y0 = start(&panel, &c, &orbit, 1e-6);
-    let req = crate::longrun::OrbitRunRequest {
-        panel,
-        orbit,
-        model: MODEL,
-        coupling: COUPLING,
-        method: Method::Dopri5(Tolerances::default()),
-        t_start: 0.0,
-        first_index: 0,
-        n_orbits: 2,
-        y0: nalgebra::Vector4::from_column_slice(&y0),
-        options: options(),
-    };
+    let req = request(&panel, &c, &orbit, 2, &y0).two_layer();
     let two = super::run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap();
     let n = hybrid(&panel, &c, &orbit, 2, &y0);
     assert_eq!(n.run.summaries, two.run.summaries);
