@@ -1,8 +1,43 @@
 //! Arithmetic written once for one value (`f64`) and for one value per SIMD lane ([`Lanes`]), so
 //! that the model's formulas have a single source and a lane computes exactly what the scalar
-//! code does, operation for operation (`integrate::lockstep`).
+//! code does, operation for operation (`integrate::lockstep`); and the one-dimensional search
+//! the engine's modules share ([`golden_section`]).
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// The bracket [a, b] of the minimum of a unimodal `f` by golden-section search: once it is
+/// narrower than `width`, or after `max_iter` steps.
+pub(crate) fn golden_section(
+    f: impl Fn(f64) -> f64,
+    mut a: f64,
+    mut b: f64,
+    width: f64,
+    max_iter: usize,
+) -> (f64, f64) {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..max_iter {
+        if (b - a).abs() < width {
+            break;
+        }
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    (a, b)
+}
 
 /// What the model's formulas need of a number: the four operations and constants.
 pub(crate) trait Num:

@@ -634,26 +634,8 @@ fn bisect(f: impl Fn(f64) -> f64, mut neg: f64, mut pos: f64) -> f64 {
 }
 
 /// The minimum of a unimodal f on [a, b] by golden-section search, to 1e-3 s.
-fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    while (b - a).abs() > 1e-3 {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
+fn golden_min(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    let (a, b) = crate::num::golden_section(f, a, b, 1e-3, usize::MAX);
     0.5 * (a + b)
 }
 

@@ -384,29 +384,9 @@ fn grid_max(f: &impl Fn(f64) -> f64, a: f64, b: f64, values: &[f64], width: f64)
             best_v = v;
         }
     }
-    let (mut lo, mut hi) = ((best - dx).max(a), (best + dx).min(b));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut c = hi - g * (hi - lo);
-    let mut d = lo + g * (hi - lo);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..40 {
-        if hi - lo < width {
-            break;
-        }
-        if fc > fd {
-            hi = d;
-            d = c;
-            fd = fc;
-            c = hi - g * (hi - lo);
-            fc = f(c);
-        } else {
-            lo = c;
-            c = d;
-            fc = fd;
-            d = lo + g * (hi - lo);
-            fd = f(d);
-        }
-    }
+    // The maximum of f is the minimum of −f (negation is exact: the same comparisons).
+    let (lo, hi) =
+        crate::num::golden_section(|x| -f(x), (best - dx).max(a), (best + dx).min(b), width, 40);
     let x = 0.5 * (lo + hi);
     if f(x) >= best_v {
         x
