@@ -126,11 +126,37 @@ pub struct Reduced {
 }
 
 /// The faces of a state: their heat inputs b(u), the radiative conductances
-/// D(u) = diag(4 σ ε u³) and (I + F D)⁻¹ at the slow faces.
+/// D = diag(4 σ ε u³) (at the Newton point) and (I + F D)⁻¹ at the slow faces.
 struct Faces {
     inputs: [f64; 2],
+    /// b and D at the Newton point u_slow + δ (within ~2e-6 K of u: a relative 1e-8 in b and
+    /// D), which the first-order lag terms use.
+    newton_inputs: [f64; 2],
     radiative: [f64; 2],
     inverse: [[f64; 2]; 2],
+    /// J⁻¹ P.
+    inverse_gain: [[f64; 2]; 2],
+}
+
+/// The 2×2 product a b.
+#[inline(always)]
+fn mul2(a: &[[f64; 2]; 2], b: &[[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    [
+        [
+            a[0][0] * b[0][0] + a[0][1] * b[1][0],
+            a[0][0] * b[0][1] + a[0][1] * b[1][1],
+        ],
+        [
+            a[1][0] * b[0][0] + a[1][1] * b[1][0],
+            a[1][0] * b[0][1] + a[1][1] * b[1][1],
+        ],
+    ]
+}
+
+/// The 2×2 matrix a times x.
+#[inline(always)]
+fn scale2(a: &[[f64; 2]; 2], x: f64) -> [[f64; 2]; 2] {
+    [[a[0][0] * x, a[0][1] * x], [a[1][0] * x, a[1][1] * x]]
 }
 
 /// One kept conduction mode k.
@@ -225,22 +251,45 @@ impl Layered {
             Coupling::ProjectedArea => cos,
             Coupling::Frozen => 1.0,
         };
-        // M_T / I_B.
-        let moment_rate = match &self.thermal {
-            Thermal::Nodal(r) => r.rates(flux * area, &y[..m], dy),
-            Thermal::Modal(r) => {
-                let flux_rate = self.area_rate(sin, om) * flux;
-                r.evaluate(&self.conduction, flux * area, flux_rate, &y[..m], dy)
-                    .0
-                    * self.inverse_inertia
-            }
-        };
-        let forced = moment_rate - self.damping * om - self.stiffness * th;
         dy[m] = om;
-        dy[m + 1] = match self.model {
-            HingeModel::Linear => forced,
-            HingeModel::Nonlinear => (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin),
-        };
+        match &self.thermal {
+            // In the order of operations of the two-layer system, to the bit.
+            Thermal::Nodal(r) => {
+                let moment_rate = r.rates(flux * area, &y[..m], dy);
+                let forced = moment_rate - self.damping * om - self.stiffness * th;
+                dy[m + 1] = match self.model {
+                    HingeModel::Linear => forced,
+                    HingeModel::Nonlinear => {
+                        (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin)
+                    }
+                };
+            }
+            // θ̈ = M_T r/I_B − bias: the hinge's terms, and the non-linear model's division, are
+            // ready before the faces are solved, so that M_T is two operations from the end.
+            Thermal::Modal(r) => {
+                let (reciprocal, bias) = self.hinge_terms(th, om, sin, cos);
+                let flux_rate = self.area_rate(sin, om) * flux;
+                let moment = r
+                    .evaluate(&self.conduction, flux * area, flux_rate, &y[..m], dy)
+                    .0;
+                dy[m + 1] = moment * (reciprocal * self.inverse_inertia) - bias;
+            }
+        }
+    }
+
+    /// (r, bias) of θ̈ = (M_T/I_B − c_d θ̇/I_B − K_el θ/I_B − 3 θ̇² sin θ cos θ) r with
+    /// r = 1/(1 + 3 sin² θ) (the non-linear model; r = 1 and no θ̇² term for the linear one):
+    /// θ̈ = M_T r/I_B − bias.
+    #[inline(always)]
+    fn hinge_terms(&self, th: f64, om: f64, sin: f64, cos: f64) -> (f64, f64) {
+        let restoring = self.damping * om + self.stiffness * th;
+        match self.model {
+            HingeModel::Linear => (1.0, restoring),
+            HingeModel::Nonlinear => {
+                let r = 1.0 / (1.0 + 3.0 * sin * sin);
+                (r, (restoring + 3.0 * om * om * sin * cos) * r)
+            }
+        }
     }
 
     /// d(projected-area factor)/dt = −sin θ θ̇ with the two-way coupling, 0 when frozen.
@@ -273,6 +322,18 @@ impl Layered {
                 r.moment(&self.conduction, f, rate, &y[..m])
             }
         }
+    }
+
+    /// M_T/K_el of state y read off the equation of motion from its rate dy = f(y) (the hinge's
+    /// angular acceleration): what [`Layered::moment_of`] gives over K_el, without evaluating
+    /// the faces again.
+    pub fn quasi_static_from_rate(&self, y: &[f64], dy: &[f64]) -> f64 {
+        let m = self.thermal_size();
+        let (th, om, acc) = (y[m], y[m + 1], dy[m + 1]);
+        let (sin, cos) = self.sin_cos(th);
+        let (reciprocal, bias) = self.hinge_terms(th, om, sin, cos);
+        // θ̈ = M_T r/I_B − bias, and K_el/I_B is `stiffness`.
+        (acc + bias) / (reciprocal * self.stiffness)
     }
 
     /// Node temperatures of a state at illumination factor `flux` (front first).
@@ -354,28 +415,29 @@ impl Reduced {
     }
 
     /// Face temperatures u = u_slow + F b(u) (u_slow: the faces of the kept modes), with the
-    /// face inputs b(u), D(u) = diag(4 σ ε u³), and J⁻¹ = (I + F D(u_slow))⁻¹, the Jacobian of
-    /// that equation at the slow faces (reused for the face rates).
+    /// face inputs b(u), D = diag(4 σ ε u³), and J⁻¹ P, J⁻¹ = (I + F D(u_slow))⁻¹ the inverse
+    /// Jacobian of that equation at the slow faces (reused for the face rates).
     ///
     /// One Newton step from the slow faces, δ = J⁻¹ F b(u_slow), then one chord step with the
     /// same J⁻¹ on the residual at u_slow + δ, which is exactly F σ ε (6 s² δ² + 4 s δ³ + δ⁴)
-    /// per face (the Taylor remainder of the fourth power): no face input is evaluated twice,
-    /// and the division is done while the heat input is still being formed. The fast modes'
-    /// face compliance F is small against radiation (|F D| ≈ 4e-3 for the example wing's
-    /// honeycomb, 8e-6 for the aluminium boom; δ ≈ 0.3 K and 1e-3 K), so the Newton step is
-    /// within ½ |3 F D/u| δ² ≈ 2e-6 K of the root and the chord step within ~1e-11 K.
+    /// per face (the Taylor remainder of the fourth power): together u = u_slow + J⁻¹ F (b(u_slow)
+    /// − that remainder), and no face input is evaluated twice. The fast modes' face compliance F
+    /// is small against radiation (|F D| ≈ 4e-3 for the example wing's honeycomb, 8e-6 for the
+    /// aluminium boom; δ ≈ 0.3 K and 1e-3 K), so the Newton step is within ½ |3 F D/u| δ² ≈ 2e-6 K
+    /// of the root and the chord step within ~1e-11 K.
+    ///
+    /// Written for latency (each evaluation waits for the last in a step): the heating, which
+    /// waits for cos θ, enters δ and u linearly and last; J⁻¹ F = adj(J) F / det(J) is formed
+    /// while the division runs.
     #[inline(always)]
-    fn faces(&self, c: &Conduction, flux: f64, s: [f64; 2]) -> Faces {
+    fn faces(&self, c: &Conduction, heat: f64, s: [f64; 2]) -> Faces {
         let sigma = [c.radiation_front, c.radiation_back];
         let s2 = [s[0] * s[0], s[1] * s[1]];
-        let heat = c.absorbed * flux;
-        let b_slow = [
-            heat - sigma[0] * (s2[0] * s2[0]),
-            -sigma[1] * (s2[1] * s2[1]),
-        ];
+        // Radiation alone at the slow faces; b(u_slow) = radiated + (heat, 0).
+        let radiated = [-sigma[0] * (s2[0] * s2[0]), -sigma[1] * (s2[1] * s2[1])];
         let d_slow = [
-            4.0 * sigma[0] * (s2[0] * s[0]),
-            4.0 * sigma[1] * (s2[1] * s[1]),
+            (4.0 * sigma[0] * s[0]) * s2[0],
+            (4.0 * sigma[1] * s[1]) * s2[1],
         ];
         let f = &self.compliance;
         let j = [
@@ -383,40 +445,46 @@ impl Reduced {
             [f[1][0] * d_slow[0], 1.0 + f[1][1] * d_slow[1]],
         ];
         let inv_det = 1.0 / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
-        let inverse = [
-            [j[1][1] * inv_det, -j[0][1] * inv_det],
-            [-j[1][0] * inv_det, j[0][0] * inv_det],
-        ];
-        let fb = [
-            f[0][0] * b_slow[0] + f[0][1] * b_slow[1],
-            f[1][0] * b_slow[0] + f[1][1] * b_slow[1],
+        let adj = [[j[1][1], -j[0][1]], [-j[1][0], j[0][0]]];
+        let adj_f = mul2(&adj, f);
+        let inverse = scale2(&adj, inv_det);
+        let jf = scale2(&adj_f, inv_det);
+        let newton = [
+            adj_f[0][0] * radiated[0] + adj_f[0][1] * radiated[1],
+            adj_f[1][0] * radiated[0] + adj_f[1][1] * radiated[1],
         ];
         let delta = [
-            inverse[0][0] * fb[0] + inverse[0][1] * fb[1],
-            inverse[1][0] * fb[0] + inverse[1][1] * fb[1],
+            newton[0] * inv_det + jf[0][0] * heat,
+            newton[1] * inv_det + jf[1][0] * heat,
         ];
         let rest = [
             sigma[0] * (delta[0] * delta[0]) * (6.0 * s2[0] + delta[0] * (4.0 * s[0] + delta[0])),
             sigma[1] * (delta[1] * delta[1]) * (6.0 * s2[1] + delta[1] * (4.0 * s[1] + delta[1])),
         ];
-        let g = [
-            f[0][0] * rest[0] + f[0][1] * rest[1],
-            f[1][0] * rest[0] + f[1][1] * rest[1],
-        ];
+        let e = [(heat + radiated[0]) - rest[0], radiated[1] - rest[1]];
         let u = [
-            s[0] + (delta[0] - (inverse[0][0] * g[0] + inverse[0][1] * g[1])),
-            s[1] + (delta[1] - (inverse[1][0] * g[0] + inverse[1][1] * g[1])),
+            s[0] + (jf[0][0] * e[0] + jf[0][1] * e[1]),
+            s[1] + (jf[1][0] * e[0] + jf[1][1] * e[1]),
         ];
         let u2 = [u[0] * u[0], u[1] * u[1]];
+        // The Newton point u_slow + δ, within ~2e-6 K of u, for the first-order lag terms: they
+        // need not wait for the chord step.
+        let n = [s[0] + delta[0], s[1] + delta[1]];
+        let n2 = [n[0] * n[0], n[1] * n[1]];
         Faces {
             inputs: [
                 heat - sigma[0] * (u2[0] * u2[0]),
                 -sigma[1] * (u2[1] * u2[1]),
             ],
-            radiative: [
-                4.0 * sigma[0] * (u2[0] * u[0]),
-                4.0 * sigma[1] * (u2[1] * u[1]),
+            newton_inputs: [
+                heat - sigma[0] * (n2[0] * n2[0]),
+                -sigma[1] * (n2[1] * n2[1]),
             ],
+            radiative: [
+                (4.0 * sigma[0] * n[0]) * n2[0],
+                (4.0 * sigma[1] * n[1]) * n2[1],
+            ],
+            inverse_gain: mul2(&inverse, &self.slow_gain),
             inverse,
         }
     }
@@ -479,11 +547,14 @@ impl Reduced {
         dy: &mut [f64],
     ) -> (f64, [f64; 2], [f64; 2]) {
         // One pass over the kept modes: the faces they carry, the part of the faces' rate that
-        // comes from their own decay, and their moment.
-        let mut slow = [0.0, 0.0];
-        let mut decay = [0.0, 0.0];
-        let mut slow_moment = 0.0;
-        for (row, &a) in rows.iter().zip(amp) {
+        // comes from their own decay, and their moment (the uniform mode is always kept: the
+        // sums start from the first mode's terms).
+        let (first, rest) = rows.split_first().expect("the uniform mode is always kept");
+        let fall = first.rate * amp[0];
+        let mut slow = [first.front_shape * amp[0], first.back_shape * amp[0]];
+        let mut decay = [first.front_shape * fall, first.back_shape * fall];
+        let mut slow_moment = first.moment * amp[0];
+        for (row, &a) in rest.iter().zip(&amp[1..]) {
             slow[0] += row.front_shape * a;
             slow[1] += row.back_shape * a;
             let fall = row.rate * a;
@@ -493,42 +564,33 @@ impl Reduced {
         }
         let Faces {
             inputs: b,
+            newton_inputs: b_near,
             radiative: d,
             inverse,
-        } = self.faces(c, flux, slow);
+            inverse_gain,
+        } = self.faces(c, c.absorbed * flux, slow);
         // The lag needs ḃ = (α C ḟ, 0) − D u̇, with (I + F D) u̇ = u̇_slow + F (α C ḟ, 0) and the
         // slow modes' zero-order face rates u̇_slow = P b − (Σ φ_face,k λ_k q_k) (the Jacobian is
         // taken at the slow faces: the difference is of the next order in this first-order
         // term). Written as ḃ = c − A b, with A = D J⁻¹ P and c = (α C ḟ, 0) + D J⁻¹ (decay −
         // F (α C ḟ, 0)), which do not wait for b.
         let f = &self.compliance;
-        let p = &self.slow_gain;
         let heating_rate = c.absorbed * flux_rate;
-        let di = [
-            [d[0] * inverse[0][0], d[0] * inverse[0][1]],
-            [d[1] * inverse[1][0], d[1] * inverse[1][1]],
-        ];
         let a = [
-            [
-                di[0][0] * p[0][0] + di[0][1] * p[1][0],
-                di[0][0] * p[0][1] + di[0][1] * p[1][1],
-            ],
-            [
-                di[1][0] * p[0][0] + di[1][1] * p[1][0],
-                di[1][0] * p[0][1] + di[1][1] * p[1][1],
-            ],
+            [d[0] * inverse_gain[0][0], d[0] * inverse_gain[0][1]],
+            [d[1] * inverse_gain[1][0], d[1] * inverse_gain[1][1]],
         ];
         let v = [
             decay[0] - f[0][0] * heating_rate,
             decay[1] - f[1][0] * heating_rate,
         ];
         let offset = [
-            heating_rate + (di[0][0] * v[0] + di[0][1] * v[1]),
-            di[1][0] * v[0] + di[1][1] * v[1],
+            heating_rate + d[0] * (inverse[0][0] * v[0] + inverse[0][1] * v[1]),
+            d[1] * (inverse[1][0] * v[0] + inverse[1][1] * v[1]),
         ];
         let b_rate = [
-            offset[0] - (a[0][0] * b[0] + a[0][1] * b[1]),
-            offset[1] - (a[1][0] * b[0] + a[1][1] * b[1]),
+            offset[0] - (a[0][0] * b_near[0] + a[0][1] * b_near[1]),
+            offset[1] - (a[1][0] * b_near[0] + a[1][1] * b_near[1]),
         ];
         // The lag lowers the faces by G ḃ, which raises what they take in by D G ḃ.
         let g = &self.lag_compliance;
@@ -540,9 +602,10 @@ impl Reduced {
             b[0] + (dg[0][0] * b_rate[0] + dg[0][1] * b_rate[1]),
             b[1] + (dg[1][0] * b_rate[0] + dg[1][1] * b_rate[1]),
         ];
-        let moment = slow_moment + self.fast_moment[0] * b[0] + self.fast_moment[1] * b[1]
-            - (self.lag_moment[0] * b_rate[0] + self.lag_moment[1] * b_rate[1])
-            - c.moment_offset;
+        // The terms that do not wait for the lagged inputs first.
+        let settled = (slow_moment - c.moment_offset)
+            - (self.lag_moment[0] * b_rate[0] + self.lag_moment[1] * b_rate[1]);
+        let moment = settled + (self.fast_moment[0] * b[0] + self.fast_moment[1] * b[1]);
         for ((row, &a), d) in rows.iter().zip(amp).zip(dy.iter_mut()) {
             *d = -row.rate * a + row.front * b[0] + row.back * b[1];
         }
@@ -852,6 +915,20 @@ impl crate::longrun::SummaryView for LayeredView {
     }
     fn rate(&self, y: &[f64]) -> f64 {
         y[self.system.thermal_size() + 1]
+    }
+    /// With the fast modes quasi-static, M_T costs a solve of the faces: read it off the
+    /// step's end slope instead, except where t is a breakpoint of a shadow without penumbra
+    /// (the slope there saw the illumination before it, the summaries read the one after).
+    fn angles_at_end(&self, t: f64, y: &[f64], dy: &[f64]) -> (f64, f64) {
+        if let Thermal::Modal(_) = self.system.thermal {
+            self.illumination(t);
+            let penumbra = matches!(self.orbit.shadow, crate::orbit::Shadow::Penumbra);
+            if penumbra || self.sunlit.get().0 != t {
+                let theta = y[self.system.thermal_size()];
+                return (theta, self.system.quasi_static_from_rate(y, dy));
+            }
+        }
+        self.angles(t, y)
     }
 }
 
@@ -2240,10 +2317,20 @@ mod tests {
         }
     }
 
+    /// The right-hand side's cost, 20 nodes against the two-layer model on the same panel:
+    /// throughput (independent evaluations) and latency (each waits for the last, as the stages
+    /// of a step do). `cargo test --release --lib -- --ignored rhs_cost --nocapture`
     #[test]
     #[ignore]
     fn rhs_cost() {
-        use crate::integrate::OdeSystem;
+        let n = 10_000_000;
+        let time = |f: &mut dyn FnMut()| {
+            let start = std::time::Instant::now();
+            for _ in 0..n {
+                f();
+            }
+            start.elapsed().as_secs_f64() / n as f64 * 1e9
+        };
         for (name, p, lam) in examples() {
             let c = Conduction::new(&p, &lam, 20).unwrap();
             let sys = Layered::new(
@@ -2257,14 +2344,19 @@ mod tests {
             let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
             let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 1e-3);
             let mut dy = vec![0.0; y.len()];
-            let n = 10_000_000;
-            let start = std::time::Instant::now();
-            let mut acc = 0.0;
-            for i in 0..n {
-                sys.rhs_at_flux(1.0 - (i & 1) as f64 * 1e-9, &y, &mut dy);
-                acc += dy[0];
-            }
-            let t1 = start.elapsed().as_secs_f64() / n as f64 * 1e9;
+            let mut flux = 1.0;
+            let through = time(&mut || {
+                flux = 2.0 - flux;
+                sys.rhs_at_flux(std::hint::black_box(flux), &y, &mut dy);
+                std::hint::black_box(&dy);
+            });
+            let mut z = y.clone();
+            let latency = time(&mut || {
+                sys.rhs_at_flux(1.0, &z, &mut dy);
+                for (zi, (yi, di)) in z.iter_mut().zip(y.iter().zip(&dy)) {
+                    *zi = yi + 1e-30 * di;
+                }
+            });
             let two = Coupled::new(
                 p,
                 Orbit::geo_equinox(),
@@ -2273,14 +2365,20 @@ mod tests {
             );
             let y4 =
                 nalgebra::Vector4::new(eq.temperatures[0], eq.temperatures[19], eq.theta, 1e-3);
-            let start = std::time::Instant::now();
-            for i in 0..n {
-                let d = two.rhs(1.0 + (i & 1) as f64 * 1e-9, &y4);
-                acc += d[0];
-            }
-            let t2 = start.elapsed().as_secs_f64() / n as f64 * 1e9;
+            let mut out = y4;
+            let two_through = time(&mut || {
+                flux = 2.0 - flux;
+                out = two.rhs_at_flux(std::hint::black_box(flux), &y4);
+                std::hint::black_box(&out);
+            });
+            let mut z4 = y4;
+            let two_latency = time(&mut || {
+                let d = two.rhs_at_flux(1.0, &z4);
+                z4 = y4 + d * 1e-30;
+            });
             println!(
-                "{name}: state {} rhs {t1:.1} ns, two-layer rhs {t2:.1} ns ({acc:e})",
+                "{name}: state {}: rhs {through:.1} ns, latency {latency:.1} ns; \
+                 two-layer rhs {two_through:.1} ns, latency {two_latency:.1} ns",
                 y.len()
             );
         }

@@ -31,6 +31,14 @@ pub trait SummaryView {
     /// θ̇ in state y, rad/s: where its sign changes within a step, θ has an extreme there and
     /// the step is read more finely.
     fn rate(&self, y: &[f64]) -> f64;
+    /// (θ, M_T/K_el) at the end t of a step, with the slope `dy` = f(t, y) the integrator
+    /// evaluated there: a view whose M_T costs a model evaluation reads it off the equation of
+    /// motion instead. By default as [`SummaryView::angles`].
+    #[inline]
+    fn angles_at_end(&self, t: f64, y: &[f64], dy: &[f64]) -> (f64, f64) {
+        let _ = dy;
+        self.angles(t, y)
+    }
 }
 
 /// The quasi-static angle M_T/K_el of the two-layer panel, M_T = (M_T per kelvin)(T_f − T_b)
@@ -341,6 +349,18 @@ impl<V: SummaryView> Collector<V> {
         }
     }
 
+    /// The end (t, y) of a step with its slope `dy` there, as the summaries read it.
+    #[inline]
+    pub(crate) fn end_point(&self, t: f64, y: &[f64], dy: &[f64]) -> Point {
+        let (theta, quasi_static) = self.view.angles_at_end(t, y, dy);
+        Point {
+            t,
+            theta,
+            dynamic: theta - quasi_static,
+            sq: 0.0,
+        }
+    }
+
     /// A step from t0 read at its middle and end (θ̇ keeps its sign over it), with the dynamic
     /// part at its start: ∫(dynamic)² by Simpson's rule.
     #[inline]
@@ -571,6 +591,10 @@ where
         }
         let c = &mut self.collector;
         let (t0, t1) = (step.t0, step.t1);
+        let end_point = |c: &Collector<V>| match step.end_slope() {
+            Some(dy) => c.end_point(t1, step.y1.as_slice(), dy.as_slice()),
+            None => c.point(t1, step.y1.as_slice()),
+        };
         let (t_mid, y_mid) = step.midpoint();
         let rate = |y: &State<D>| c.view.rate(y.as_slice()) > 0.0;
         let (r0, r_mid, r1) = (rate(&step.y0), rate(&y_mid), rate(&step.y1));
@@ -582,7 +606,7 @@ where
         };
         let read = if r0 == r_mid && r_mid == r1 {
             let mid = c.point(t_mid, y_mid.as_slice());
-            let end = c.point(t1, step.y1.as_slice());
+            let end = end_point(c);
             c.read_two(t0, start, mid, end)
         } else {
             let mut points = [Point::default(); FINE_READS];
@@ -592,7 +616,7 @@ where
             for (j, p) in points.iter_mut().enumerate() {
                 let k = j + 1;
                 *p = if k == FINE_READS {
-                    c.point(t1, step.y1.as_slice())
+                    end_point(c)
                 } else if 2 * k == FINE_READS {
                     c.point(t_mid, y_mid.as_slice())
                 } else {

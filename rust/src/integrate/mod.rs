@@ -175,6 +175,17 @@ where
         }
     }
 
+    /// f(t1, y1), the slope at the step's end, when the integrator evaluated it (Dormand–Prince's
+    /// k7, the Hermite step's f1); None for a step built from given coefficients.
+    #[inline]
+    pub fn end_slope(&self) -> Option<&State<D>> {
+        match &self.slopes {
+            Slopes::Hermite([_, f1]) => Some(f1),
+            Slopes::Dopri5(k) => Some(&k[5]),
+            Slopes::Given => None,
+        }
+    }
+
     /// Value of the interpolant at t in [t0, t1].
     pub fn eval(&self, t: f64) -> State<D> {
         if t == self.t1 {
