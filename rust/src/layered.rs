@@ -866,6 +866,9 @@ struct LayeredView {
     /// (from, to, s): the illumination s holds on [from, to) (between two breakpoints of a
     /// shadow without penumbra), so the reads of a step need not recompute the geometry.
     sunlit: std::cell::Cell<(f64, f64, f64)>,
+    /// Whether the slow-mode model's points inside a step read M_T off the interpolant's slope
+    /// (true but in the test that compares the two reads).
+    slope_reads: bool,
 }
 
 impl LayeredView {
@@ -876,6 +879,7 @@ impl LayeredView {
             orbit,
             coupling,
             sunlit: std::cell::Cell::new((0.0, 0.0, 0.0)),
+            slope_reads: true,
         }
     }
 
@@ -930,6 +934,16 @@ impl crate::longrun::SummaryView for LayeredView {
         }
         self.angles(t, y)
     }
+    /// With the fast modes quasi-static, inside a step too: M_T off the equation of motion with
+    /// the interpolant's slope, which is within a relative (ωh)⁴/1920 of the system's (at the
+    /// middle; 4e-7 at the default 40 steps per hinge period) — against a solve of the faces.
+    fn reads_slopes(&self) -> bool {
+        self.slope_reads && matches!(self.system.thermal, Thermal::Modal(_))
+    }
+    fn angles_inside(&self, _t: f64, y: &[f64], dy: &[f64]) -> (f64, f64) {
+        let theta = y[self.system.thermal_size()];
+        (theta, self.system.quasi_static_from_rate(y, dy))
+    }
 }
 
 /// What a run of the N-node system over whole orbits is asked, as
@@ -956,9 +970,19 @@ pub fn run_orbits(
     req: &LayeredRunRequest,
     cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredSummaries> {
+    run_orbits_reading(req, cancel, true)
+}
+
+/// [`run_orbits`], the points inside a step read off the interpolant's slope or not.
+fn run_orbits_reading(
+    req: &LayeredRunRequest,
+    cancel: &crate::cancel::Cancel,
+    slope_reads: bool,
+) -> Result<LayeredSummaries> {
     check_start(&req.y0, req.conduction.nodes())?;
     let (system, start) = req.system()?;
-    let view = LayeredView::new(system.clone(), req.panel, req.orbit, req.coupling);
+    let mut view = LayeredView::new(system.clone(), req.panel, req.orbit, req.coupling);
+    view.slope_reads = slope_reads;
     let orb = LayeredOrbit::new(system.clone(), req.orbit);
     let size = start.len();
     let args = (
@@ -2031,6 +2055,62 @@ mod tests {
             s.jitter_rms,
             eq.theta
         );
+    }
+
+    #[test]
+    fn slope_reads_inside_a_step_match_a_solve_of_the_faces() {
+        // The slow-mode model's summaries read M_T inside a step off the interpolant's slope;
+        // against reading it by solving the faces at each point, on both example panels
+        // through a LEO orbit's eclipse (1 % of critical damping, so the jitter lives on).
+        use crate::integrate::{Method, Tolerances};
+        use crate::longrun::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
+        for (name, p, lam) in examples() {
+            let p = Panel {
+                damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
+                ..p
+            };
+            let c = Conduction::new(&p, &lam, 20).unwrap();
+            let o = Orbit::leo(500e3);
+            let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
+            let mut y0 = eq.temperatures.clone();
+            y0.extend([eq.theta, 0.0]);
+            let req = LayeredRunRequest {
+                panel: p,
+                conduction: c,
+                orbit: o,
+                model: HingeModel::Nonlinear,
+                coupling: Coupling::ProjectedArea,
+                method: Method::Dopri5(Tolerances::default()),
+                t_start: 0.0,
+                first_index: 0,
+                n_orbits: 1,
+                y0,
+                options: SummaryOptions {
+                    window: 600.0,
+                    theta_limit: 1.0,
+                    stop_at_limit: false,
+                    steps_per_period: STEPS_PER_HINGE_PERIOD,
+                },
+            };
+            let cancel = crate::cancel::Cancel::new();
+            let system = req.system().unwrap().0;
+            assert!(matches!(system.thermal, Thermal::Modal(_)), "{name}");
+            let slope = run_orbits_reading(&req, &cancel, true).unwrap().summaries[0];
+            let solve = run_orbits_reading(&req, &cancel, false).unwrap().summaries[0];
+            // θ is read from the same interpolant either way.
+            assert_eq!(slope.theta_max, solve.theta_max, "{name}");
+            assert_eq!(slope.theta_min, solve.theta_min, "{name}");
+            let scale = solve.jitter_peak;
+            assert!(scale > 0.0, "{name}");
+            for (what, a, b) in [
+                ("jitter_rms", slope.jitter_rms, solve.jitter_rms),
+                ("jitter_peak", slope.jitter_peak, solve.jitter_peak),
+            ] {
+                let rel = (a - b).abs() / scale;
+                println!("{name}: {what} {a:e} vs {b:e}: {rel:.1e} of the peak");
+                assert!(rel < 1e-5, "{name}: {what} {a} vs {b}");
+            }
+        }
     }
 
     /// The growth rate of the reduced model (finite-difference Jacobian) for several cuts,

@@ -39,6 +39,21 @@ pub trait SummaryView {
         let _ = dy;
         self.angles(t, y)
     }
+    /// Whether the points inside a step are read with the interpolant's slope there
+    /// ([`crate::integrate::DenseStep::slope`]), through [`SummaryView::angles_inside`]: a
+    /// view whose M_T costs a model evaluation reads it off the equation of motion. By default
+    /// no: the slope is not formed.
+    #[inline]
+    fn reads_slopes(&self) -> bool {
+        false
+    }
+    /// (θ, M_T/K_el) at a time t strictly inside a step, with `dy` the interpolant's slope
+    /// there (when [`SummaryView::reads_slopes`]). By default as [`SummaryView::angles`].
+    #[inline]
+    fn angles_inside(&self, t: f64, y: &[f64], dy: &[f64]) -> (f64, f64) {
+        let _ = dy;
+        self.angles(t, y)
+    }
 }
 
 /// The quasi-static angle M_T/K_el of the two-layer panel, M_T = (M_T per kelvin)(T_f − T_b)
@@ -349,6 +364,25 @@ impl<V: SummaryView> Collector<V> {
         }
     }
 
+    /// A point (t, y) strictly inside `step`, as the summaries read it: with the interpolant's
+    /// slope there when the view reads slopes.
+    #[inline]
+    pub(crate) fn inside_point<D: Dim>(&self, step: &DenseStep<D>, t: f64, y: &[f64]) -> Point
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        if !self.view.reads_slopes() {
+            return self.point(t, y);
+        }
+        let (theta, quasi_static) = self.view.angles_inside(t, y, step.slope(t).as_slice());
+        Point {
+            t,
+            theta,
+            dynamic: theta - quasi_static,
+            sq: 0.0,
+        }
+    }
+
     /// The end (t, y) of a step with its slope `dy` there, as the summaries read it.
     #[inline]
     pub(crate) fn end_point(&self, t: f64, y: &[f64], dy: &[f64]) -> Point {
@@ -605,7 +639,7 @@ where
             _ => c.point(t0, step.y0.as_slice()).dynamic,
         };
         let read = if r0 == r_mid && r_mid == r1 {
-            let mid = c.point(t_mid, y_mid.as_slice());
+            let mid = c.inside_point(step, t_mid, y_mid.as_slice());
             let end = end_point(c);
             c.read_two(t0, start, mid, end)
         } else {
@@ -618,10 +652,10 @@ where
                 *p = if k == FINE_READS {
                     end_point(c)
                 } else if 2 * k == FINE_READS {
-                    c.point(t_mid, y_mid.as_slice())
+                    c.inside_point(step, t_mid, y_mid.as_slice())
                 } else {
                     let t = t0 + k as f64 * dt;
-                    c.point(t, step.eval(t).as_slice())
+                    c.inside_point(step, t, step.eval(t).as_slice())
                 };
                 // Simpson's weights (1, 4, 2, 4, …, 2, 4, 1).
                 let w = if k == FINE_READS {

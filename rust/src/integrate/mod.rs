@@ -196,6 +196,24 @@ where
         let [r1, r2, r3, r4, r5] = self.r.get_or_init(|| self.coefficients());
         r1 + (r2 + (r3 + (r4 + r5 * th1) * th) * th1) * th
     }
+
+    /// The interpolant's time derivative at t in [t0, t1]: an estimate of f(t, y(t)) without
+    /// evaluating the system. At the middle it is the cubic Hermite's slope (the quartic term
+    /// of Dormand–Prince's extension has none there), 3/2 (y1 − y0)/h − (f0 + f1)/4, whose error
+    /// is h⁴ y⁽⁵⁾/1920: a relative (ωh)⁴/1920 of an oscillation at ω.
+    pub fn slope(&self, t: f64) -> State<D> {
+        let h = self.t1 - self.t0;
+        let th = (t - self.t0) / h;
+        let th1 = 1.0 - th;
+        let [_, r2, r3, r4, r5] = self.r.get_or_init(|| self.coefficients());
+        // y = r1 + θ P, P = r2 + (1 − θ) Q, Q = r3 + θ R, R = r4 + (1 − θ) r5.
+        let rr = r4 + r5 * th1;
+        let q = r3 + &rr * th;
+        let p = r2 + &q * th1;
+        let dq = rr - r5 * th;
+        let dp = dq * th1 - &q;
+        (p + dp * th) / h
+    }
 }
 
 /// What the observer is told after each accepted step.

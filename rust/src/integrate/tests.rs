@@ -357,3 +357,49 @@ fn least_steps_is_the_fixed_count_or_the_span_over_the_cap() {
     assert_eq!(Method::Dopri5(capped).max_steps(), 500_000_000);
     assert_eq!(Method::Rk4 { dt: 1.0 }.max_steps(), MAX_FIXED_STEPS as u64);
 }
+
+/// One Dormand–Prince step of y'' = −y from the exact state at t0, as the integrator builds it.
+fn oscillator_step(t0: f64, h: f64) -> DenseStep<U2> {
+    let sys = Oscillator {
+        forcing_on_segment: 0.0,
+        jump_at: None,
+    };
+    let y0 = exact_free(t0);
+    let k1 = sys.rhs(t0, &y0);
+    let s = dopri5::step(&sys, t0, t0 + h, &y0, &k1);
+    let [k1, _, k3, k4, k5, k6, k7] = s.k;
+    DenseStep::dopri5(t0, t0 + h, y0, s.y_new, [k1, k3, k4, k5, k6, k7])
+}
+
+#[test]
+fn the_interpolants_slope_is_the_derivative_at_fourth_order() {
+    // Against the exact derivative (−sin t, −cos t): at the middle the error falls as h⁴ and
+    // is h⁴ |y⁽⁵⁾|/1920 to leading order; inside the step it falls at least as h⁴ too.
+    let t0 = 0.3;
+    let exact_slope = |t: f64| Vector2::new(-t.sin(), -t.cos());
+    let mut mid = Vec::new();
+    let mut inside = Vec::new();
+    for h in [0.2, 0.1, 0.05] {
+        let step = oscillator_step(t0, h);
+        let t_mid = step.midpoint().0;
+        mid.push((step.slope(t_mid) - exact_slope(t_mid)).amax() / h.powi(4));
+        let worst = (1..8)
+            .map(|j| {
+                let t = t0 + h * j as f64 / 8.0;
+                (step.slope(t) - exact_slope(t)).amax()
+            })
+            .fold(0.0, f64::max);
+        inside.push(worst);
+        // The ends: the slopes the step was built from.
+        assert!((step.slope(t0) - exact_slope(t0)).amax() < 1e-15);
+    }
+    for w in mid.windows(2) {
+        // err/h⁴ settles on a constant no larger than the leading term's bound.
+        assert!((w[1] / w[0] - 1.0).abs() < 0.1, "{mid:?}");
+    }
+    assert!(mid[2] < 1.05 / 1920.0, "{mid:?}");
+    for w in inside.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!(order > 3.8, "observed order {order}: {inside:?}");
+    }
+}
