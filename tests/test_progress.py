@@ -19,7 +19,7 @@ import pytest
 
 import thermojitter as tj
 from thermojitter import _core
-from thermojitter.progress import Interruptible
+from thermojitter.progress import DeferredInterrupt, Interruptible
 from thermojitter.simulate import solver_settings
 
 REPO = Path(__file__).resolve().parent.parent
@@ -189,3 +189,46 @@ def test_interruptible_cancels_the_engine_call() -> None:
                 stop_at_threshold=False,
             )
         assert time.process_time() - started < 5.0
+
+
+def test_ctrl_c_in_a_held_section_is_raised_when_it_ends_not_lost() -> None:
+
+    finished = []
+
+    class Finalised:
+        def __del__(self) -> None:
+            # Python ignores an exception raised here: Ctrl-C raised in a finalizer is lost.
+            signal.raise_signal(signal.SIGINT)
+            finished.append("finaliser")
+
+    with DeferredInterrupt() as ctrl_c:
+        with pytest.raises(KeyboardInterrupt):
+            with ctrl_c.hold():
+                Finalised()  # dropped at once: its __del__ runs inside the held section
+                finished.append("write")
+        assert finished == ["finaliser", "write"]
+        with pytest.raises(KeyboardInterrupt):  # outside a held section: at once
+            signal.raise_signal(signal.SIGINT)
+        with ctrl_c.hold(then_raise=False):
+            signal.raise_signal(signal.SIGINT)
+        # dropped, and not carried into the next section
+        with ctrl_c.hold():
+            pass
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_programs_own_sigint_handler_is_kept() -> None:
+
+    seen = []
+
+    def own(signum: int, frame: object) -> None:
+        seen.append(signum)
+
+    previous = signal.signal(signal.SIGINT, own)
+    try:
+        with DeferredInterrupt() as ctrl_c, ctrl_c.hold():
+            assert signal.getsignal(signal.SIGINT) is own
+            signal.raise_signal(signal.SIGINT)
+        assert seen == [signal.SIGINT]
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -23,7 +23,12 @@ from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.progress import Interruptible, progress_bar, report_interrupted
+from thermojitter.progress import (
+    DeferredInterrupt,
+    Interruptible,
+    progress_bar,
+    report_interrupted,
+)
 from thermojitter.simulate import (
     check_inputs,
     check_layers,
@@ -405,62 +410,69 @@ def simulate_orbits(
     stopped = crossing is not None and on_limit == "stop"
     last_save = time.monotonic()
     engine = Interruptible()
-    try:
-        while next_index < n_orbits and not stopped:
-            # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same places.
-            count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
-            t0 = float(t_start) + next_index * orbit.period
-            extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
-            raw = engine.call(
-                _core.run_orbits,
-                panel.as_dict(),
-                orbit.as_dict(),
-                t_start=t0,
-                first_index=next_index,
-                n_orbits=count,
-                y0=y,
-                **core_args,
-                **extra,
-            )
-            for name in SUMMARY_FIELDS:
-                columns[name].extend(np.asarray(raw[name]).tolist())
-            y = list(raw["y_end"])
-            ran_with = raw["solver"]
-            counters["n_steps"] += int(raw["n_steps"])
-            counters["n_rhs"] += int(raw["n_rhs"])
-            for name in HYBRID_COUNTERS if method == "hybrid" else ():
-                counters[name] += raw[name]
-            if crossing is None and raw["crossing"] is not None:
-                crossing = tuple(raw["crossing"])  # type: ignore[assignment]
-            if raw["stopped"]:
-                stopped = True
-                next_index = int(columns["index"][-1]) + 1
-            else:
-                next_index += count
-            if counters["n_steps"] >= budget and next_index < n_orbits and not stopped:
-                raise _core.IntegrationError(
-                    f"max_steps = {budget} reached after {next_index} of {n_orbits} orbits "
-                    f"({counters['n_steps']} steps; the budget holds for the whole run): pass "
-                    "a larger max_steps or fewer orbits"
+    # Ctrl-C waits for the bookkeeping of a finished call and for checkpoint writes.
+    with DeferredInterrupt() as ctrl_c:
+        try:
+            while next_index < n_orbits and not stopped:
+                # Chunks start at multiples of orbits_per_call, so resumed runs cut in the same
+                # places.
+                count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
+                t0 = float(t_start) + next_index * orbit.period
+                extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
+                raw = engine.call(
+                    _core.run_orbits,
+                    panel.as_dict(),
+                    orbit.as_dict(),
+                    t_start=t0,
+                    first_index=next_index,
+                    n_orbits=count,
+                    y0=y,
+                    **core_args,
+                    **extra,
                 )
+                with ctrl_c.hold():
+                    for name in SUMMARY_FIELDS:
+                        columns[name].extend(np.asarray(raw[name]).tolist())
+                    y = list(raw["y_end"])
+                    ran_with = raw["solver"]
+                    counters["n_steps"] += int(raw["n_steps"])
+                    counters["n_rhs"] += int(raw["n_rhs"])
+                    for name in HYBRID_COUNTERS if method == "hybrid" else ():
+                        counters[name] += raw[name]
+                    if crossing is None and raw["crossing"] is not None:
+                        crossing = tuple(raw["crossing"])  # type: ignore[assignment]
+                    if raw["stopped"]:
+                        stopped = True
+                        next_index = int(columns["index"][-1]) + 1
+                    else:
+                        next_index += count
+                    if counters["n_steps"] >= budget and next_index < n_orbits and not stopped:
+                        raise _core.IntegrationError(
+                            f"max_steps = {budget} reached after {next_index} of {n_orbits} "
+                            f"orbits ({counters['n_steps']} steps; the budget holds for the whole "
+                            "run): pass a larger max_steps or fewer orbits"
+                        )
+                    if bar is not None:
+                        bar.update(count)
+                    if path is not None and time.monotonic() - last_save > checkpoint_every:
+                        _save_checkpoint(
+                            path, settings, n_orbits, columns, y, next_index, counters, crossing
+                        )
+                        last_save = time.monotonic()
+                if stop is not None and stop() and next_index < n_orbits and not stopped:
+                    interrupted = True  # the caller asked, and reports it
+                    break
+        except KeyboardInterrupt:
+            interrupted = report = True
+        finally:
+            engine.__exit__()
             if bar is not None:
-                bar.update(count)
-            if path is not None and time.monotonic() - last_save > checkpoint_every:
-                _save_checkpoint(
-                    path, settings, n_orbits, columns, y, next_index, counters, crossing
-                )
-                last_save = time.monotonic()
-            if stop is not None and stop() and next_index < n_orbits and not stopped:
-                interrupted = True  # the caller asked, and reports it
-                break
-    except KeyboardInterrupt:
-        interrupted = report = True
-    finally:
-        engine.__exit__()
-        if bar is not None:
-            bar.close()
-        if path is not None:
-            _save_checkpoint(path, settings, n_orbits, columns, y, next_index, counters, crossing)
+                bar.close()
+            if path is not None:
+                with ctrl_c.hold(then_raise=False):
+                    _save_checkpoint(
+                        path, settings, n_orbits, columns, y, next_index, counters, crossing
+                    )
     if report:
         kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
         if path is not None:

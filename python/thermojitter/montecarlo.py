@@ -38,7 +38,7 @@ from thermojitter.errors import ParameterError
 from thermojitter.longrun import DEFAULT_THETA_LIMIT, orbit_count, refuse_beyond_budget
 from thermojitter.orbit import Orbit
 from thermojitter.panel import LAYUP_FIELDS, Panel
-from thermojitter.progress import progress_bar, report_interrupted
+from thermojitter.progress import DeferredInterrupt, progress_bar, report_interrupted
 from thermojitter.simulate import check_inputs, check_layers, layup_dict
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
@@ -698,22 +698,27 @@ def _run_design(
             )
             written = set(done)
             failed_write = False  # after one failed write, the rest are kept in memory only
-            # closing: on any error (Ctrl-C included) the pending chunks are cancelled at once.
-            with contextlib.closing(stream):
+            # closing: on any error (Ctrl-C included) the pending chunks are cancelled at once;
+            # Ctrl-C during a chunk's write is raised when the write is whole.
+            with DeferredInterrupt() as ctrl_c, contextlib.closing(stream):
                 try:
                     for k, metrics in stream:
                         done[k] = metrics
                         start, stop = bounds[k][1], bounds[k][2]
                         if directory is not None and not failed_write:
-                            failed_write = not _write_chunk(directory, k, start, metrics, request)
-                            written.add(k)
+                            with ctrl_c.hold():
+                                failed_write = not _write_chunk(
+                                    directory, k, start, metrics, request
+                                )
+                                written.add(k)
                         if bar is not None:
                             bar.update(stop - start)
                 except BaseException as exc:
-                    # A finished chunk whose write was interrupted is written before leaving.
+                    # A finished chunk not yet written is written before leaving.
                     if directory is not None and not failed_write:
-                        for k in sorted(set(done) - written):
-                            _write_chunk(directory, k, bounds[k][1], done[k], request)
+                        with ctrl_c.hold(then_raise=False):
+                            for k in sorted(set(done) - written):
+                                _write_chunk(directory, k, bounds[k][1], done[k], request)
                     if not isinstance(exc, KeyboardInterrupt):
                         raise
                     interrupted = True

@@ -7,14 +7,19 @@ One home for how a long call looks while it runs and how it stops:
 - :class:`Interruptible` runs engine calls in a worker thread with a cancellation token, so that
   Ctrl-C reaches the waiting thread at once, the engine stops within one integration step, and
   the caller keeps what finished.
+- :class:`DeferredInterrupt` holds Ctrl-C back while a write that must not be cut runs (a
+  checkpoint chunk), and raises it once the write is whole.
 - :func:`report_interrupted` is the one line a stopped call prints: what was kept and how to go on.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
+import signal
 import sys
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from typing import Any, TypeVar
 
 from thermojitter import _core
@@ -94,3 +99,53 @@ class Interruptible:
     def __exit__(self, *exc: object) -> None:
         self.token.cancel()  # whatever is still running stops; nothing new starts
         self._executor.shutdown(wait=True)
+
+
+class DeferredInterrupt:
+    """Ctrl-C that waits for the end of :meth:`hold` sections (checkpoint writes).
+
+    Outside a held section Ctrl-C raises ``KeyboardInterrupt`` at once, as Python's own handler
+    does; inside one it is remembered and raised when the section ends, so that a write is never
+    cut in the middle, and never lost in a finalizer that ran then (Python ignores an exception
+    raised in ``__del__``, and with it the Ctrl-C). The handler is installed for the ``with``
+    block only, and only in the main thread over Python's default handler: a program with its
+    own SIGINT handler keeps it."""
+
+    def __init__(self) -> None:
+        self._depth = 0
+        self._pending = False
+        self._previous: Any = None
+
+    def __enter__(self) -> DeferredInterrupt:
+        if (
+            threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        ):
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+            self._previous = None
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self._depth:
+            self._pending = True
+        else:
+            raise KeyboardInterrupt
+
+    @contextlib.contextmanager
+    def hold(self, *, then_raise: bool = True) -> Iterator[None]:
+        """Runs the block with Ctrl-C held back; one that came meanwhile is raised at its end
+        (``then_raise``), or dropped when the caller is already stopping."""
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+            pending = self._depth == 0 and self._pending
+            if pending:
+                self._pending = False
+        if pending and then_raise:
+            raise KeyboardInterrupt
