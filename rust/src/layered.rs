@@ -129,8 +129,8 @@ pub struct Reduced {
 /// D = diag(4 σ ε u³) (at the Newton point) and (I + F D)⁻¹ at the slow faces.
 struct Faces {
     inputs: [f64; 2],
-    /// b and D at the Newton point u_slow + δ (within ~2e-6 K of u: a relative 1e-8 in b and
-    /// D), which the first-order lag terms use.
+    /// b at the Newton point u_slow + δ (within ~2e-6 K of u: a relative 1e-8 in b), which the
+    /// first-order lag terms use with D (`radiative`, also taken there).
     newton_inputs: [f64; 2],
     radiative: [f64; 2],
     inverse: [[f64; 2]; 2],
@@ -181,10 +181,11 @@ pub struct Layered {
     pub thermal: Thermal,
     model: HingeModel,
     coupling: Coupling,
-    /// 1/I_B, c_d/I_B, K_el/I_B.
+    /// 1/I_B, c_d/I_B, K_el/I_B and I_B/K_el.
     inverse_inertia: f64,
     damping: f64,
     stiffness: f64,
+    compliance: f64,
 }
 
 impl Layered {
@@ -217,6 +218,7 @@ impl Layered {
             inverse_inertia: 1.0 / inertia,
             damping: panel.damping / inertia,
             stiffness: panel.hinge_stiffness / inertia,
+            compliance: inertia / panel.hinge_stiffness,
         })
     }
 
@@ -330,10 +332,17 @@ impl Layered {
     pub fn quasi_static_from_rate(&self, y: &[f64], dy: &[f64]) -> f64 {
         let m = self.thermal_size();
         let (th, om, acc) = (y[m], y[m + 1], dy[m + 1]);
-        let (sin, cos) = self.sin_cos(th);
-        let (reciprocal, bias) = self.hinge_terms(th, om, sin, cos);
-        // θ̈ = M_T r/I_B − bias, and K_el/I_B is `stiffness`.
-        (acc + bias) / (reciprocal * self.stiffness)
+        let restoring = self.damping * om + self.stiffness * th;
+        // The equation of [`Layered::hinge_terms`] solved for M_T/I_B, without its division:
+        // M_T/I_B = θ̈ (1 + 3 sin² θ) + restoring + 3 θ̇² sin θ cos θ (θ̈ + restoring, linear).
+        let moment = match self.model {
+            HingeModel::Linear => acc + restoring,
+            HingeModel::Nonlinear => {
+                let (sin, cos) = self.sin_cos(th);
+                acc * (1.0 + 3.0 * sin * sin) + (restoring + 3.0 * om * om * sin * cos)
+            }
+        };
+        moment * self.compliance
     }
 
     /// Node temperatures of a state at illumination factor `flux` (front first).
@@ -457,33 +466,43 @@ impl Reduced {
             newton[0] * inv_det + jf[0][0] * heat,
             newton[1] * inv_det + jf[1][0] * heat,
         ];
+        // The remainder σ (6 s² δ² + 4 s δ³ + δ⁴), its coefficients ready before δ.
+        let (six, four) = (
+            [6.0 * sigma[0] * s2[0], 6.0 * sigma[1] * s2[1]],
+            [4.0 * sigma[0] * s[0], 4.0 * sigma[1] * s[1]],
+        );
+        let d2 = [delta[0] * delta[0], delta[1] * delta[1]];
         let rest = [
-            sigma[0] * (delta[0] * delta[0]) * (6.0 * s2[0] + delta[0] * (4.0 * s[0] + delta[0])),
-            sigma[1] * (delta[1] * delta[1]) * (6.0 * s2[1] + delta[1] * (4.0 * s[1] + delta[1])),
+            d2[0] * (six[0] + four[0] * delta[0]) + sigma[0] * (d2[0] * d2[0]),
+            d2[1] * (six[1] + four[1] * delta[1]) + sigma[1] * (d2[1] * d2[1]),
         ];
-        let e = [(heat + radiated[0]) - rest[0], radiated[1] - rest[1]];
-        let u = [
-            s[0] + (jf[0][0] * e[0] + jf[0][1] * e[1]),
-            s[1] + (jf[1][0] * e[0] + jf[1][1] * e[1]),
-        ];
-        let u2 = [u[0] * u[0], u[1] * u[1]];
         // The Newton point u_slow + δ, within ~2e-6 K of u, for the first-order lag terms: they
         // need not wait for the chord step.
         let n = [s[0] + delta[0], s[1] + delta[1]];
         let n2 = [n[0] * n[0], n[1] * n[1]];
+        let newton_inputs = [
+            heat - sigma[0] * (n2[0] * n2[0]),
+            -sigma[1] * (n2[1] * n2[1]),
+        ];
+        let radiative = [
+            (4.0 * sigma[0] * n[0]) * n2[0],
+            (4.0 * sigma[1] * n[1]) * n2[1],
+        ];
+        // The chord step moves the faces from the Newton point by u − (u_slow + δ) = −J⁻¹ F ·
+        // rest, and what they take in by D times as much: b(u) = b(u_slow + δ) + D J⁻¹ F rest,
+        // up to 6 σ u² (J⁻¹ F rest)², the order of the chord step's own error (and ~1e-16 W/m²
+        // for the example panels), which does not wait for u's fourth power.
+        let chord = [
+            jf[0][0] * rest[0] + jf[0][1] * rest[1],
+            jf[1][0] * rest[0] + jf[1][1] * rest[1],
+        ];
         Faces {
             inputs: [
-                heat - sigma[0] * (u2[0] * u2[0]),
-                -sigma[1] * (u2[1] * u2[1]),
+                newton_inputs[0] + radiative[0] * chord[0],
+                newton_inputs[1] + radiative[1] * chord[1],
             ],
-            newton_inputs: [
-                heat - sigma[0] * (n2[0] * n2[0]),
-                -sigma[1] * (n2[1] * n2[1]),
-            ],
-            radiative: [
-                (4.0 * sigma[0] * n[0]) * n2[0],
-                (4.0 * sigma[1] * n[1]) * n2[1],
-            ],
+            newton_inputs,
+            radiative,
             inverse_gain: mul2(&inverse, &self.slow_gain),
             inverse,
         }
