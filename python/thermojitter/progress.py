@@ -101,25 +101,19 @@ class Interruptible:
         self._executor.shutdown(wait=True)
 
 
-class DeferredInterrupt:
-    """Ctrl-C that waits for the end of :meth:`hold` sections (checkpoint writes).
+class SigintHandler:
+    """A SIGINT handler (the subclass's ``_handle``) for the length of a ``with`` block, the
+    previous one put back after. Installed only in the main thread (the only one that can), and,
+    with ``keep_own``, only over Python's default handler, so that a program's own stays."""
 
-    Outside a held section Ctrl-C raises ``KeyboardInterrupt`` at once, as Python's own handler
-    does; inside one it is remembered and raised when the section ends, so that a write is never
-    cut in the middle, and never lost in a finalizer that ran then (Python ignores an exception
-    raised in ``__del__``, and with it the Ctrl-C). The handler is installed for the ``with``
-    block only, and only in the main thread over Python's default handler: a program with its
-    own SIGINT handler keeps it."""
+    keep_own = False
 
     def __init__(self) -> None:
-        self._depth = 0
-        self._pending = False
         self._previous: Any = None
 
-    def __enter__(self) -> DeferredInterrupt:
-        if (
-            threading.current_thread() is threading.main_thread()
-            and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    def __enter__(self: H) -> H:
+        if threading.current_thread() is threading.main_thread() and (
+            not self.keep_own or signal.getsignal(signal.SIGINT) is signal.default_int_handler
         ):
             self._previous = signal.signal(signal.SIGINT, self._handle)
         return self
@@ -129,7 +123,30 @@ class DeferredInterrupt:
             signal.signal(signal.SIGINT, self._previous)
             self._previous = None
 
-    def _handle(self, signum: int, frame: object) -> None:
+    def _handle(self, signum: int, frame: Any) -> None:
+        raise NotImplementedError
+
+
+H = TypeVar("H", bound=SigintHandler)
+
+
+class DeferredInterrupt(SigintHandler):
+    """Ctrl-C that waits for the end of :meth:`hold` sections (checkpoint writes).
+
+    Outside a held section Ctrl-C raises ``KeyboardInterrupt`` at once, as Python's own handler
+    does; inside one it is remembered and raised when the section ends, so that a write is never
+    cut in the middle, and never lost in a finalizer that ran then (Python ignores an exception
+    raised in ``__del__``, and with it the Ctrl-C). A program with its own SIGINT handler keeps
+    it."""
+
+    keep_own = True
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._depth = 0
+        self._pending = False
+
+    def _handle(self, signum: int, frame: Any) -> None:
         if self._depth:
             self._pending = True
         else:

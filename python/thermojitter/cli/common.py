@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import argparse
 import math
-import signal
-import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO, NoReturn
 
 from thermojitter.checkpoint import write_atomic
+from thermojitter.progress import SigintHandler
 
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
@@ -25,14 +24,14 @@ class Interrupted(KeyboardInterrupt):
     """Ctrl-C after the command has already said, in one line, what it kept (exit code 130)."""
 
 
-class StopFlag:
+class StopFlag(SigintHandler):
     """Ctrl-C as a flag polled between orbits and figures, so the stop happens at a clean point
     (never inside matplotlib or a callback); a second Ctrl-C stops at once. Commands whose work
     stops by itself on KeyboardInterrupt (Monte Carlo) run without it."""
 
     def __init__(self) -> None:
+        super().__init__()
         self.requested = False
-        self._previous: Any = None
 
     def __call__(self) -> bool:
         return self.requested
@@ -44,14 +43,7 @@ class StopFlag:
 
     def __enter__(self) -> StopFlag:
         self.requested = False
-        if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self._handle)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
-            self._previous = None
+        return super().__enter__()
 
 
 STOP = StopFlag()
