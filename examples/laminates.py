@@ -61,7 +61,8 @@ def compare(name: str, panel: tj.Panel, nodes: int) -> None:
     )
     print()
     print(
-        "| model | T_front K | T_back K | θ_eq rad | exit peak rad | jitter peak rad | jitter RMS rad | c_d* N m s/rad |"
+        "| model | T_front K | T_back K | θ_eq rad | exit peak rad | jitter peak rad "
+        "| jitter RMS rad | c_d* N m s/rad |"
     )
     print("|---|---|---|---|---|---|---|---|")
     for layers in (None, nodes):
