@@ -2038,34 +2038,12 @@ mod tests {
         // modes quasi-static, M_T jumps with the illumination, and a run that rests at its
         // sunlit and its eclipse steady states has a jitter RMS near zero, not the size of the
         // angle (the aluminium boom: every non-uniform mode is fast).
-        use crate::integrate::{Method, Tolerances};
-        use crate::longrun::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
         let (_, p, lam) = examples().pop().unwrap();
         let p = Panel { damping: 50.0, ..p };
         let c = Conduction::new(&p, &lam, 20).unwrap();
         let o = Orbit::geo_equinox();
         let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
-        let mut y0 = eq.temperatures.clone();
-        y0.extend([eq.theta, 0.0]);
-        let options = SummaryOptions {
-            window: 600.0,
-            theta_limit: 1.0,
-            stop_at_limit: false,
-            steps_per_period: STEPS_PER_HINGE_PERIOD,
-        };
-        let req = LayeredRunRequest {
-            panel: p,
-            conduction: c,
-            orbit: o,
-            model: HingeModel::Nonlinear,
-            coupling: Coupling::ProjectedArea,
-            method: Method::Dopri5(Tolerances::default()),
-            t_start: 0.0,
-            first_index: 0,
-            n_orbits: 1,
-            y0,
-            options,
-        };
+        let req = one_orbit_from_equilibrium(p, c, o, &eq);
         let run = run_orbits(&req, &crate::cancel::Cancel::new()).unwrap();
         let s = run.summaries[0];
         assert!(
@@ -2076,13 +2054,43 @@ mod tests {
         );
     }
 
+    /// One orbit of the non-linear, two-way coupled model from the sunlit equilibrium `eq`,
+    /// rk45 at the default tolerances, summarised with 600 s windows and a 1 rad limit.
+    fn one_orbit_from_equilibrium(
+        panel: Panel,
+        conduction: Conduction,
+        orbit: Orbit,
+        eq: &LayeredEquilibrium,
+    ) -> LayeredRunRequest {
+        use crate::integrate::{Method, Tolerances};
+        use crate::longrun::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
+        let mut y0 = eq.temperatures.clone();
+        y0.extend([eq.theta, 0.0]);
+        LayeredRunRequest {
+            panel,
+            conduction,
+            orbit,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: 1,
+            y0,
+            options: SummaryOptions {
+                window: 600.0,
+                theta_limit: 1.0,
+                stop_at_limit: false,
+                steps_per_period: STEPS_PER_HINGE_PERIOD,
+            },
+        }
+    }
+
     #[test]
     fn slope_reads_inside_a_step_match_a_solve_of_the_faces() {
         // The slow-mode model's summaries read M_T inside a step off the interpolant's slope;
         // against reading it by solving the faces at each point, on both example panels
         // through a LEO orbit's eclipse (1 % of critical damping, so the jitter lives on).
-        use crate::integrate::{Method, Tolerances};
-        use crate::longrun::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
         for (name, p, lam) in examples() {
             let p = Panel {
                 damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
@@ -2091,26 +2099,7 @@ mod tests {
             let c = Conduction::new(&p, &lam, 20).unwrap();
             let o = Orbit::leo(500e3);
             let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
-            let mut y0 = eq.temperatures.clone();
-            y0.extend([eq.theta, 0.0]);
-            let req = LayeredRunRequest {
-                panel: p,
-                conduction: c,
-                orbit: o,
-                model: HingeModel::Nonlinear,
-                coupling: Coupling::ProjectedArea,
-                method: Method::Dopri5(Tolerances::default()),
-                t_start: 0.0,
-                first_index: 0,
-                n_orbits: 1,
-                y0,
-                options: SummaryOptions {
-                    window: 600.0,
-                    theta_limit: 1.0,
-                    stop_at_limit: false,
-                    steps_per_period: STEPS_PER_HINGE_PERIOD,
-                },
-            };
+            let req = one_orbit_from_equilibrium(p, c, o, &eq);
             let cancel = crate::cancel::Cancel::new();
             let system = req.system().unwrap().0;
             assert!(matches!(system.thermal, Thermal::Modal(_)), "{name}");
