@@ -192,7 +192,6 @@ def test_interruptible_cancels_the_engine_call() -> None:
 
 
 def test_ctrl_c_in_a_held_section_is_raised_when_it_ends_not_lost() -> None:
-
     finished = []
 
     class Finalised:
@@ -218,7 +217,6 @@ def test_ctrl_c_in_a_held_section_is_raised_when_it_ends_not_lost() -> None:
 
 
 def test_a_programs_own_sigint_handler_is_kept() -> None:
-
     seen = []
 
     def own(signum: int, frame: object) -> None:

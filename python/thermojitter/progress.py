@@ -101,6 +101,9 @@ class Interruptible:
         self._executor.shutdown(wait=True)
 
 
+H = TypeVar("H", bound="SigintHandler")
+
+
 class SigintHandler:
     """A SIGINT handler (the subclass's ``_handle``) for the length of a ``with`` block, the
     previous one put back after. Installed only in the main thread (the only one that can), and,
@@ -125,9 +128,6 @@ class SigintHandler:
 
     def _handle(self, signum: int, frame: Any) -> None:
         raise NotImplementedError
-
-
-H = TypeVar("H", bound=SigintHandler)
 
 
 class DeferredInterrupt(SigintHandler):

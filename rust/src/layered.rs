@@ -279,17 +279,28 @@ impl Layered {
         }
     }
 
-    /// (r, bias) of θ̈ = (M_T/I_B − c_d θ̇/I_B − K_el θ/I_B − 3 θ̇² sin θ cos θ) r with
-    /// r = 1/(1 + 3 sin² θ) (the non-linear model; r = 1 and no θ̇² term for the linear one):
-    /// θ̈ = M_T r/I_B − bias.
+    /// The hinge's equation of motion (1 + 3 sin² θ) θ̈ = M_T/I_B − load, load = c_d θ̇/I_B +
+    /// K_el θ/I_B + 3 θ̇² sin θ cos θ, as (1 + 3 sin² θ, load) (the non-linear model; 1 and no
+    /// θ̇² term for the linear one).
     #[inline(always)]
-    fn hinge_terms(&self, th: f64, om: f64, sin: f64, cos: f64) -> (f64, f64) {
+    fn hinge_equation(&self, th: f64, om: f64, sin: f64, cos: f64) -> (f64, f64) {
         let restoring = self.damping * om + self.stiffness * th;
         match self.model {
             HingeModel::Linear => (1.0, restoring),
+            HingeModel::Nonlinear => (1.0 + 3.0 * sin * sin, restoring + 3.0 * om * om * sin * cos),
+        }
+    }
+
+    /// (r, bias) of [`Layered::hinge_equation`] solved for θ̈: θ̈ = M_T r/I_B − bias, with
+    /// r = 1/(1 + 3 sin² θ) (1 for the linear model, no division).
+    #[inline(always)]
+    fn hinge_terms(&self, th: f64, om: f64, sin: f64, cos: f64) -> (f64, f64) {
+        let (factor, load) = self.hinge_equation(th, om, sin, cos);
+        match self.model {
+            HingeModel::Linear => (1.0, load),
             HingeModel::Nonlinear => {
-                let r = 1.0 / (1.0 + 3.0 * sin * sin);
-                (r, (restoring + 3.0 * om * om * sin * cos) * r)
+                let r = 1.0 / factor;
+                (r, load * r)
             }
         }
     }
@@ -332,16 +343,10 @@ impl Layered {
     pub fn quasi_static_from_rate(&self, y: &[f64], dy: &[f64]) -> f64 {
         let m = self.thermal_size();
         let (th, om, acc) = (y[m], y[m + 1], dy[m + 1]);
-        let restoring = self.damping * om + self.stiffness * th;
-        // The equation of [`Layered::hinge_terms`] solved for M_T/I_B, without its division:
-        // M_T/I_B = θ̈ (1 + 3 sin² θ) + restoring + 3 θ̇² sin θ cos θ (θ̈ + restoring, linear).
-        let moment = match self.model {
-            HingeModel::Linear => acc + restoring,
-            HingeModel::Nonlinear => {
-                let (sin, cos) = self.sin_cos(th);
-                acc * (1.0 + 3.0 * sin * sin) + (restoring + 3.0 * om * om * sin * cos)
-            }
-        };
+        let (sin, cos) = self.sin_cos(th);
+        // [`Layered::hinge_equation`] solved for M_T/I_B, which needs no division.
+        let (factor, load) = self.hinge_equation(th, om, sin, cos);
+        let moment = acc * factor + load;
         moment * self.compliance
     }
 
