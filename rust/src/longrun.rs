@@ -415,9 +415,15 @@ impl<V: SummaryView> Collector<V> {
 
     /// Points of one step, in time order, each standing for the interval dt before it with its
     /// share `sq` of ∫(dynamic)²: the same as [`Collector::record`] of each, taken together when
-    /// the points lie inside the calm span (nearly every step) and within the limit.
-    pub(crate) fn read_points(&mut self, points: &[Point], dt: f64) -> Result<()> {
-        let (first, last) = (points[0].t, points[points.len() - 1].t);
+    /// the points lie inside the calm span (nearly every step) and within the limit. Generic in
+    /// their number so that this common case unrolls into the caller.
+    #[inline(always)]
+    pub(crate) fn read_points<const N: usize>(
+        &mut self,
+        points: &[Point; N],
+        dt: f64,
+    ) -> Result<()> {
+        let (first, last) = (points[0].t, points[N - 1].t);
         let calm = self.calm;
         if first > calm.from && last < calm.to {
             // The points are finite (the integrator accepts only finite states).
@@ -432,15 +438,22 @@ impl<V: SummaryView> Collector<V> {
             }
             let limit = self.options.theta_limit;
             if self.crossing.is_some() || (hi <= limit && lo >= -limit) {
-                let span = dt * points.len() as f64;
+                let span = dt * N as f64;
                 self.take(lo, hi, peak, sq, span, calm.in_entry, calm.in_exit);
                 return Ok(());
             }
         }
+        self.record_each(points, dt)
+    }
+
+    /// [`Collector::record`] of each point, then the calm span after them: the steps near a
+    /// window's edge or the limit.
+    #[inline(never)]
+    fn record_each(&mut self, points: &[Point], dt: f64) -> Result<()> {
         for p in points {
             self.record(p.t, p.theta, p.theta, p.dynamic.abs(), p.sq, dt)?;
         }
-        self.calm = self.calm_around(last);
+        self.calm = self.calm_around(points[points.len() - 1].t);
         Ok(())
     }
 
@@ -482,11 +495,11 @@ impl<V: SummaryView> Collector<V> {
         in_exit: bool,
     ) {
         let s = &mut self.current;
-        s.theta_max = s.theta_max.max(hi);
-        s.theta_min = s.theta_min.min(lo);
-        let dev = (hi - s.theta_eq).abs().max((lo - s.theta_eq).abs());
-        s.amplitude = s.amplitude.max(dev);
-        s.jitter_peak = s.jitter_peak.max(dynamic_abs);
+        s.theta_max = larger(s.theta_max, hi);
+        s.theta_min = smaller(s.theta_min, lo);
+        let dev = larger((hi - s.theta_eq).abs(), (lo - s.theta_eq).abs());
+        s.amplitude = larger(s.amplitude, dev);
+        s.jitter_peak = larger(s.jitter_peak, dynamic_abs);
         self.sq_sum += sq;
         self.duration += dt;
         if in_entry {
@@ -587,6 +600,27 @@ impl<V: SummaryView> Collector<V> {
             }
         }
         Ok(())
+    }
+}
+
+/// max(acc, v) for values that are never NaN (the solution's, and accumulators that start at
+/// ±∞ or 0): one comparison, where `f64::max` also sorts out NaN on every step.
+#[inline(always)]
+fn larger(acc: f64, v: f64) -> f64 {
+    if v > acc {
+        v
+    } else {
+        acc
+    }
+}
+
+/// min(acc, v) for values that are never NaN, as [`larger`].
+#[inline(always)]
+fn smaller(acc: f64, v: f64) -> f64 {
+    if v < acc {
+        v
+    } else {
+        acc
     }
 }
 

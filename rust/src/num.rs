@@ -54,7 +54,7 @@ pub(crate) trait Num:
 impl Num for f64 {}
 
 /// Values advanced side by side, one per lane.
-pub(crate) const LANES: usize = 4;
+pub(crate) const LANES: usize = 8;
 
 /// One f64 per lane: what the lockstep kernel needs beyond [`Num`]. Every operation is the same
 /// IEEE operation in each lane, nothing fused or reordered, so each lane's bits are those of the
@@ -74,14 +74,14 @@ pub(crate) trait Lanes: Num {
 
 /// [`Lanes`] written lane by lane, for any processor (the compiler vectorises what it can).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub(crate) struct Portable(pub(crate) [f64; LANES]);
 
 impl Portable {
     #[inline(always)]
     fn map2(self, o: Portable, f: impl Fn(f64, f64) -> f64) -> Portable {
         let (a, b) = (self.0, o.0);
-        Portable([f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2]), f(a[3], b[3])])
+        Portable(std::array::from_fn(|l| f(a[l], b[l])))
     }
 }
 
@@ -180,22 +180,46 @@ mod avx {
     use std::arch::x86_64::*;
     use std::ops::{Add, Div, Mul, Neg, Sub};
 
+    /// Four lanes in one AVX register.
+    const HALF: usize = 4;
+
     #[derive(Debug, Clone, Copy, PartialEq)]
-    #[repr(C, align(32))]
+    #[repr(C, align(64))]
     pub(crate) struct Avx(pub(crate) [f64; LANES]);
 
     impl Avx {
+        /// The lanes as two AVX registers (lanes 0-3, 4-7).
         #[inline(always)]
-        fn get(self) -> __m256d {
+        fn get(self) -> [__m256d; 2] {
             // SAFETY: see the type's comment (the processor has AVX); the array is aligned.
-            unsafe { _mm256_load_pd(self.0.as_ptr()) }
+            unsafe {
+                [
+                    _mm256_load_pd(self.0.as_ptr()),
+                    _mm256_load_pd(self.0.as_ptr().add(HALF)),
+                ]
+            }
         }
         #[inline(always)]
-        fn put(v: __m256d) -> Avx {
+        fn put(v: [__m256d; 2]) -> Avx {
             let mut out = Avx([0.0; LANES]);
             // SAFETY: as in `get`.
-            unsafe { _mm256_store_pd(out.0.as_mut_ptr(), v) };
+            unsafe {
+                _mm256_store_pd(out.0.as_mut_ptr(), v[0]);
+                _mm256_store_pd(out.0.as_mut_ptr().add(HALF), v[1]);
+            }
             out
+        }
+        /// `f` on each half.
+        #[inline(always)]
+        fn each(self, f: impl Fn(__m256d) -> __m256d) -> Avx {
+            let [a, b] = self.get();
+            Avx::put([f(a), f(b)])
+        }
+        /// `f` on each half of the two.
+        #[inline(always)]
+        fn each2(self, o: Avx, f: impl Fn(__m256d, __m256d) -> __m256d) -> Avx {
+            let ([a, b], [c, d]) = (self.get(), o.get());
+            Avx::put([f(a, c), f(b, d)])
         }
     }
 
@@ -206,7 +230,7 @@ mod avx {
                 #[inline(always)]
                 fn $method(self, o: Avx) -> Avx {
                     // SAFETY: see the type's comment.
-                    Avx::put(unsafe { $intrinsic(self.get(), o.get()) })
+                    self.each2(o, |a, b| unsafe { $intrinsic(a, b) })
                 }
             }
         };
@@ -221,7 +245,7 @@ mod avx {
         #[inline(always)]
         fn neg(self) -> Avx {
             // SAFETY: see the type's comment. Flipping the sign bit is IEEE negation.
-            Avx::put(unsafe { _mm256_xor_pd(self.get(), _mm256_set1_pd(-0.0)) })
+            self.each(|a| unsafe { _mm256_xor_pd(a, _mm256_set1_pd(-0.0)) })
         }
     }
 
@@ -244,37 +268,155 @@ mod avx {
         #[inline(always)]
         fn abs(self) -> Avx {
             // SAFETY: see the type's comment. Clearing the sign bit is `f64::abs`.
-            Avx::put(unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.get()) })
+            self.each(|a| unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), a) })
         }
         #[inline(always)]
         fn max(self, o: Avx) -> Avx {
             // `vmaxpd` gives its second operand when either is NaN; `f64::max` gives the other
             // operand when one is NaN: take `self` where `o` is NaN.
             // SAFETY: see the type's comment.
-            Avx::put(unsafe {
-                let (a, b) = (self.get(), o.get());
+            self.each2(o, |a, b| unsafe {
                 let m = _mm256_max_pd(a, b);
                 _mm256_blendv_pd(m, a, _mm256_cmp_pd(b, b, _CMP_UNORD_Q))
             })
         }
         #[inline(always)]
         fn or_where(self, take: [bool; LANES], a: Avx) -> Avx {
-            let sign = |l: usize| if take[l] { -0.0 } else { 0.0 };
+            let mask = Avx(take.map(|t| if t { -0.0 } else { 0.0 }));
+            let ([x, y], [p, q], [m, n]) = (self.get(), a.get(), mask.get());
             // SAFETY: see the type's comment. `blendv` picks by the mask's sign bit.
-            Avx::put(unsafe {
-                let mask = _mm256_setr_pd(sign(0), sign(1), sign(2), sign(3));
-                _mm256_blendv_pd(self.get(), a.get(), mask)
-            })
+            unsafe { Avx::put([_mm256_blendv_pd(x, p, m), _mm256_blendv_pd(y, q, n)]) }
         }
         #[inline(always)]
         fn any_abs_above(self, bound: f64) -> bool {
+            let [a, b] = self.abs().get();
             // SAFETY: see the type's comment.
             unsafe {
-                let above = _mm256_cmp_pd(self.abs().get(), _mm256_set1_pd(bound), _CMP_GT_OQ);
+                let bound = _mm256_set1_pd(bound);
+                let above = _mm256_or_pd(
+                    _mm256_cmp_pd(a, bound, _CMP_GT_OQ),
+                    _mm256_cmp_pd(b, bound, _CMP_GT_OQ),
+                );
                 _mm256_movemask_pd(above) != 0
             }
         }
     }
 
     impl Num for Avx {}
+}
+
+/// [`Lanes`] as AVX-512 instructions, all eight lanes in one register: made only inside the
+/// lockstep kernel compiled for AVX-512F, under the same rules as [`Avx`].
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx512::Avx512;
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use super::{Lanes, Num, LANES};
+    use std::arch::x86_64::*;
+    use std::ops::{Add, Div, Mul, Neg, Sub};
+
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[repr(C, align(64))]
+    pub(crate) struct Avx512(pub(crate) [f64; LANES]);
+
+    impl Avx512 {
+        #[inline(always)]
+        fn get(self) -> __m512d {
+            // SAFETY: see the type's comment (the processor has AVX-512F); the array is aligned.
+            unsafe { _mm512_load_pd(self.0.as_ptr()) }
+        }
+        #[inline(always)]
+        fn put(v: __m512d) -> Avx512 {
+            let mut out = Avx512([0.0; LANES]);
+            // SAFETY: as in `get`.
+            unsafe { _mm512_store_pd(out.0.as_mut_ptr(), v) };
+            out
+        }
+        /// The lanes where `take` holds, as a mask.
+        #[inline(always)]
+        fn mask(take: [bool; LANES]) -> __mmask8 {
+            take.iter()
+                .enumerate()
+                .fold(0, |m, (l, &t)| m | (u8::from(t) << l))
+        }
+    }
+
+    macro_rules! binary {
+        ($trait:ident, $method:ident, $intrinsic:ident) => {
+            impl $trait for Avx512 {
+                type Output = Avx512;
+                #[inline(always)]
+                fn $method(self, o: Avx512) -> Avx512 {
+                    // SAFETY: see the type's comment.
+                    Avx512::put(unsafe { $intrinsic(self.get(), o.get()) })
+                }
+            }
+        };
+    }
+    binary!(Add, add, _mm512_add_pd);
+    binary!(Sub, sub, _mm512_sub_pd);
+    binary!(Mul, mul, _mm512_mul_pd);
+    binary!(Div, div, _mm512_div_pd);
+
+    impl Neg for Avx512 {
+        type Output = Avx512;
+        #[inline(always)]
+        fn neg(self) -> Avx512 {
+            // SAFETY: see the type's comment. Flipping the sign bit is IEEE negation (an integer
+            // xor: the floating-point one needs AVX-512DQ).
+            Avx512::put(unsafe {
+                let sign = _mm512_set1_epi64(i64::MIN);
+                _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(self.get()), sign))
+            })
+        }
+    }
+
+    impl From<f64> for Avx512 {
+        #[inline(always)]
+        fn from(x: f64) -> Avx512 {
+            Avx512([x; LANES])
+        }
+    }
+
+    impl Lanes for Avx512 {
+        #[inline(always)]
+        fn lanes(&self) -> &[f64; LANES] {
+            &self.0
+        }
+        #[inline(always)]
+        fn lanes_mut(&mut self) -> &mut [f64; LANES] {
+            &mut self.0
+        }
+        #[inline(always)]
+        fn abs(self) -> Avx512 {
+            // SAFETY: see the type's comment. Clearing the sign bit is `f64::abs`.
+            Avx512::put(unsafe { _mm512_abs_pd(self.get()) })
+        }
+        #[inline(always)]
+        fn max(self, o: Avx512) -> Avx512 {
+            // As `Avx::max`: `vmaxpd` gives its second operand when either is NaN, `f64::max`
+            // the other operand when one is: take `self` where `o` is NaN.
+            // SAFETY: see the type's comment.
+            Avx512::put(unsafe {
+                let (a, b) = (self.get(), o.get());
+                let nan = _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(b, b);
+                _mm512_mask_blend_pd(nan, _mm512_max_pd(a, b), a)
+            })
+        }
+        #[inline(always)]
+        fn or_where(self, take: [bool; LANES], a: Avx512) -> Avx512 {
+            // SAFETY: see the type's comment. The blend takes `a` where the mask's bit is set.
+            Avx512::put(unsafe { _mm512_mask_blend_pd(Avx512::mask(take), self.get(), a.get()) })
+        }
+        #[inline(always)]
+        fn any_abs_above(self, bound: f64) -> bool {
+            // SAFETY: see the type's comment.
+            unsafe {
+                _mm512_cmp_pd_mask::<_CMP_GT_OQ>(self.abs().get(), _mm512_set1_pd(bound)) != 0
+            }
+        }
+    }
+
+    impl Num for Avx512 {}
 }

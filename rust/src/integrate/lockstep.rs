@@ -25,7 +25,7 @@ use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, 
 use crate::error::{Error, Result};
 use crate::longrun::quasi_static;
 #[cfg(target_arch = "x86_64")]
-use crate::num::Avx;
+use crate::num::{Avx, Avx512};
 use crate::num::{Lanes, Portable};
 use crate::system::{Coupled, Coupling, LaneForm};
 use crate::thermal::Balance;
@@ -85,6 +85,8 @@ pub enum Kernel {
     Portable,
     /// AVX2 (x86-64 only, when the processor has it).
     Avx2,
+    /// AVX-512F (x86-64 only, when the processor has it).
+    Avx512,
 }
 
 impl Kernel {
@@ -92,6 +94,9 @@ impl Kernel {
     pub fn detect() -> Self {
         #[cfg(target_arch = "x86_64")]
         {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return Kernel::Avx512;
+            }
             if std::arch::is_x86_feature_detected!("avx2") {
                 return Kernel::Avx2;
             }
@@ -99,10 +104,26 @@ impl Kernel {
         Kernel::Portable
     }
 
+    /// Every kernel this processor runs, the portable one first.
+    pub fn available() -> Vec<Self> {
+        let mut out = vec![Kernel::Portable];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                out.push(Kernel::Avx2);
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                out.push(Kernel::Avx512);
+            }
+        }
+        out
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Kernel::Portable => "portable",
             Kernel::Avx2 => "avx2",
+            Kernel::Avx512 => "avx512f",
         }
     }
 }
@@ -122,6 +143,11 @@ where
             // SAFETY: the processor has AVX2 (checked just above).
             unsafe { drive_avx2(next, done) }
         }
+        #[cfg(target_arch = "x86_64")]
+        Kernel::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
+            // SAFETY: the processor has AVX-512F (checked just above).
+            unsafe { drive_avx512(next, done) }
+        }
         _ => drive::<Portable, O, N, F>(next, done),
     }
 }
@@ -135,6 +161,17 @@ where
     F: FnMut(O, Result<(Stats, Vector4<f64>)>),
 {
     drive::<Avx, O, N, F>(next, done)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn drive_avx512<O, N, F>(next: N, done: F)
+where
+    O: LaneObserver,
+    N: FnMut() -> Option<Job<O>>,
+    F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+{
+    drive::<Avx512, O, N, F>(next, done)
 }
 
 /// The lanes' inputs to one trial step, lane by lane in each value.
@@ -163,7 +200,7 @@ struct Pack<V> {
 /// The lanes' results of one trial step.
 struct Trial<V> {
     y_new: [V; 4],
-    /// The continuous extension's coefficients r2..r5 (r1 is y0).
+    /// The continuous extension's coefficients r2..r5 (r1 is y0) of each component.
     dense: [[V; 4]; 4],
     /// k7 = f(t + h, y_new), the next step's k1.
     k7: [V; 4],
@@ -314,7 +351,6 @@ fn stage<V: Lanes, const M: usize>(y0: &[V; 4], h: V, terms: [(&[V; 4], f64); M]
 /// [`dopri5`]'s segment loop, operation for operation.
 #[inline(always)]
 fn step_lanes<V: Lanes>(model: HingeModel, coupling: Coupling, p: &Pack<V>) -> Trial<V> {
-    let zero = V::from(0.0);
     let (y0, k1, h) = (&p.y0, &p.k1, p.h);
     let f = |flux: V, y: &[V; 4]| rhs_lanes(model, coupling, p, flux, y);
     let k2 = f(p.flux[0], &stage(y0, h, [(k1, A21)]));
@@ -375,18 +411,18 @@ fn step_lanes<V: Lanes>(model: HingeModel, coupling: Coupling, p: &Pack<V>) -> T
     }
     // The scaled error e_i = err_i / (atol + rtol max(|y0_i|, |y_new_i|)), and its mean square
     // summed as nalgebra's norm_squared sums a 4-vector: (e0² + e2²) + (e1² + e3²).
-    let mut e = [zero; 4];
-    for i in 0..4 {
+    // Arrays are built whole (`from_fn`), not zeroed and filled: the filling is not always
+    // seen through, and zeroing a kilobyte per step costs.
+    let e: [V; 4] = std::array::from_fn(|i| {
         let weight = V::from(1.0) / (p.atol + y0[i].abs().max(y_new[i].abs()) * p.rtol);
-        e[i] = err[i] * weight;
-    }
+        err[i] * weight
+    });
     let a = e[0] * e[0] + e[2] * e[2];
     let b = e[1] * e[1] + e[3] * e[3];
     let mean_square = (a + b) / V::from(4.0);
     // `dopri5::dense_coefficients`, computed for every lane (most trials are accepted and the
     // summary reads every step).
-    let mut dense = [[zero; 4]; 4];
-    for i in 0..4 {
+    let dense: [[V; 4]; 4] = std::array::from_fn(|i| {
         let diff = y_new[i] - y0[i];
         let bspl = k1[i] * h - diff;
         let r4 = diff - k7[i] * h - bspl;
@@ -397,23 +433,19 @@ fn step_lanes<V: Lanes>(model: HingeModel, coupling: Coupling, p: &Pack<V>) -> T
             + k6[i] * V::from(DENSE[5])
             + k7[i] * V::from(DENSE[6]))
             * h;
-        dense[0][i] = diff;
-        dense[1][i] = bspl;
-        dense[2][i] = r4;
-        dense[3][i] = r5;
-    }
+        [diff, bspl, r4, r5]
+    });
     // `DenseStep::midpoint`: the interpolant at t + h/2 as `DenseStep::eval` evaluates it
     // (the summaries read every step there), or y_new where that time rounds onto the end.
     let t_mid = p.t + V::from(0.5) * h;
     let th = (t_mid - p.t) / h;
     let th1 = V::from(1.0) - th;
     let at_end: [bool; LANES] = std::array::from_fn(|l| t_mid.lanes()[l] == p.t_new.lanes()[l]);
-    let mut mid = [zero; 4];
-    for i in 0..4 {
-        let [r2, r3, r4, r5] = [dense[0][i], dense[1][i], dense[2][i], dense[3][i]];
+    let mid: [V; 4] = std::array::from_fn(|i| {
+        let [r2, r3, r4, r5] = dense[i];
         let y = y0[i] + (r2 + (r3 + (r4 + r5 * th1) * th) * th1) * th;
-        mid[i] = y.or_where(at_end, y_new[i]);
-    }
+        y.or_where(at_end, y_new[i])
+    });
     // The summary's dynamic part at the middle and the end (`Collector::point`).
     let dynamic = [&mid, &y_new].map(|[tf, tb, th, _]| {
         *th - quasi_static(p.moment_per_kelvin, p.hinge_stiffness, *tf, *tb)
@@ -448,9 +480,14 @@ struct Lane<O> {
     t_new: f64,
     stats: Stats,
     y: Vector4<f64>,
+    /// The first stage of the next trial, when the lane's pack holds another (`stale`).
     k1: Vector4<f64>,
     /// The illumination when it is the same over the whole segment.
     constant_flux: Option<f64>,
+    /// The pack's y0, k1 and constant illumination in this lane are not the run's: the run has
+    /// just started or entered a segment. Otherwise the pack keeps them from step to step (the
+    /// lanes that accept take y_new and k7 together, [`drive`]).
+    stale: bool,
 }
 
 /// How a run left its lane.
@@ -505,6 +542,7 @@ impl<O: LaneObserver> Lane<O> {
             y: y0,
             k1: y0,
             constant_flux: None,
+            stale: true,
         };
         if lane.enter_segment() {
             Ok(lane)
@@ -528,6 +566,7 @@ impl<O: LaneObserver> Lane<O> {
             self.t = a;
             self.b = b;
             self.k1 = self.system.rhs(a, &self.y);
+            self.stale = true;
             self.stats.n_rhs += 1;
             let h0 = dopri5::initial_step(
                 &self.system,
@@ -570,15 +609,19 @@ impl<O: LaneObserver> Lane<O> {
         p.t.lanes_mut()[l] = t;
         p.h.lanes_mut()[l] = h;
         p.t_new.lanes_mut()[l] = t_new;
-        for i in 0..4 {
-            p.y0[i].lanes_mut()[l] = self.y[i];
-            p.k1[i].lanes_mut()[l] = self.k1[i];
-        }
-        if let Some(flux) = self.constant_flux {
-            for f in &mut p.flux {
-                f.lanes_mut()[l] = flux;
+        if self.stale {
+            for i in 0..4 {
+                p.y0[i].lanes_mut()[l] = self.y[i];
+                p.k1[i].lanes_mut()[l] = self.k1[i];
             }
-        } else {
+            if let Some(flux) = self.constant_flux {
+                for f in &mut p.flux {
+                    f.lanes_mut()[l] = flux;
+                }
+            }
+            self.stale = false;
+        }
+        if self.constant_flux.is_none() {
             for (j, c) in C[1..5].iter().enumerate() {
                 p.flux[j].lanes_mut()[l] = self.system.flux_at(t + c * h);
             }
@@ -633,15 +676,14 @@ impl<O: LaneObserver> Lane<O> {
                 rising: [y0[3] > 0.0, at(&trial.mid[3]) > 0.0, y_new[3] > 0.0],
             };
             let flow = self.observer.on_reads(&reads).unwrap_or_else(|| {
-                let [r2, r3, r4, r5] = &trial.dense;
-                let r = [y0, lane(r2), lane(r3), lane(r4), lane(r5)];
+                let r_j = |j: usize| Vector4::from(trial.dense.map(|c| c[j].lanes()[l]));
+                let r = [y0, r_j(0), r_j(1), r_j(2), r_j(3)];
                 let mid = lane(&trial.mid);
                 let dense = DenseStep::with_coefficients(t, t_new, y0, y_new, r, mid);
                 self.observer.on_step(&dense)
             });
             self.t = t_new;
             self.stats.t_end = t_new;
-            self.k1 = lane(&trial.k7);
             self.h_abs = dopri5::next_step(h, mean_square, self.rejected, self.tol.max_step);
             self.rejected = false;
             if flow.is_break() {
@@ -746,6 +788,14 @@ where
             continue;
         }
         let trial = step_lanes(model, coupling, &pack);
+        // The lanes that accept start their next trial from y_new with k1 = k7 (a lane that
+        // then enters a segment or ends is reloaded or cleared below).
+        let accepted: [bool; LANES] =
+            std::array::from_fn(|l| lanes[l].is_some() && trial.mean_square.lanes()[l] < 1.0);
+        for i in 0..4 {
+            pack.y0[i] = pack.y0[i].or_where(accepted, trial.y_new[i]);
+            pack.k1[i] = pack.k1[i].or_where(accepted, trial.k7[i]);
+        }
         for (l, slot) in lanes.iter_mut().enumerate() {
             let Some(lane) = slot else {
                 continue;
@@ -810,7 +860,7 @@ mod tests {
                     },
                     t0: 0.0,
                     t1: orbit.period,
-                    y0: Vector4::new(eq.t_front, eq.t_back, eq.theta + 0.15 * k as f64, 0.0),
+                    y0: Vector4::new(eq.t_front, eq.t_back, eq.theta + 0.15 * (k % 8) as f64, 0.0),
                     observer: Tagged(k, Recorder::every(0.0, orbit.period, orbit.period / 200.0)),
                 }
             })
@@ -866,19 +916,19 @@ mod tests {
 
     #[test]
     fn lanes_equal_single_runs() {
-        // Seven runs on four lanes: lanes refill, and the last ones run with idle lanes. The
-        // last two start beyond π/4, where sin/cos come from the library.
+        // Three runs more than there are lanes: lanes refill, and the last ones run with idle
+        // lanes. Runs 6 and 7 start beyond π/4, where sin/cos come from the library.
         for (model, coupling) in [
             (HingeModel::Nonlinear, Coupling::ProjectedArea),
             (HingeModel::Linear, Coupling::Frozen),
             (HingeModel::Nonlinear, Coupling::Frozen),
         ] {
-            let ps = panels(7);
+            let ps = panels(LANES + 3);
             let want = alone(jobs(&ps, model, coupling));
             assert!(want
                 .iter()
                 .all(|(_, _, s)| s.n_rejected > 0 || s.n_steps > 100));
-            for kernel in [Kernel::Portable, Kernel::detect()] {
+            for kernel in Kernel::available() {
                 let got = in_lockstep(kernel, jobs(&ps, model, coupling));
                 for (k, (g, w)) in got.iter().zip(&want).enumerate() {
                     assert_eq!(g, w, "{model:?} {coupling:?} {kernel:?}: run {k}");
@@ -895,7 +945,7 @@ mod tests {
         let ps = panels(5);
         let (m, c) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
         let want = alone(jobs_on(orbit, &ps, m, c));
-        for kernel in [Kernel::Portable, Kernel::detect()] {
+        for kernel in Kernel::available() {
             assert_eq!(in_lockstep(kernel, jobs_on(orbit, &ps, m, c)), want);
         }
     }
