@@ -88,6 +88,7 @@ __all__ = [
 PANEL_FIELDS: list[str]
 LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
+ENSEMBLE_LANES: int
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
 LEO_ALTITUDE: float

@@ -587,9 +587,10 @@ def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_si
 
 def _default_chunk_size(n: int) -> int:
     """Depends on n only, so that a default run cuts the same chunks on any machine: about a
-    sixteenth of the run, at most 64, and a multiple of 4 so that the engine's lockstep lanes
-    (four samples per core at once) are full."""
-    return min(64, 4 * math.ceil(n / 64))
+    sixteenth of the run, at most 64, and a multiple of the engine's lockstep lanes (samples
+    per core at once) so that they are full."""
+    lanes = _core.ENSEMBLE_LANES
+    return min(64 // lanes * lanes, lanes * math.ceil(n / (16 * lanes)))
 
 
 def _frame(

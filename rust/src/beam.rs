@@ -76,7 +76,7 @@ impl FreeFreeBeam {
     /// node) and between 2 and [`MAX_ELEMENTS`].
     pub fn new(panel: &Panel, n_elements: usize) -> Result<Self> {
         panel.validate()?;
-        if n_elements < 2 || n_elements % 2 != 0 || n_elements > MAX_ELEMENTS {
+        if n_elements < 2 || !n_elements.is_multiple_of(2) || n_elements > MAX_ELEMENTS {
             return Err(Error::invalid(
                 "n_elements",
                 n_elements,

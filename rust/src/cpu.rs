@@ -2,8 +2,9 @@
 //! figures from different machines are never compared blind.
 //!
 //! The build targets baseline x86-64 (SSE2) so that one wheel runs everywhere; the ensemble's
-//! lockstep kernel is compiled a second time for AVX2 and picked at run time
-//! ([`crate::integrate::lockstep::Kernel`]). Neither path uses FMA, so both give the same bits.
+//! lockstep kernel is compiled again for AVX2 and for AVX-512F, the newest the processor has
+//! picked at run time ([`crate::integrate::lockstep::Kernel`]). No path uses FMA, so all give
+//! the same bits.
 
 /// Instruction sets worth reporting, oldest first.
 #[cfg(target_arch = "x86_64")]

@@ -167,10 +167,10 @@ impl Neg for Portable {
 
 impl Num for Portable {}
 
-/// [`Lanes`] as AVX instructions, one per operation. Values of this type are made only inside
-/// the lockstep kernel compiled for AVX2, which runs only once the processor is known to have it
-/// (`integrate::lockstep::Kernel`); its operations are inlined there. The lanes are kept in an
-/// array (no vector type crosses a function boundary compiled without AVX).
+/// [`Lanes`] as AVX instructions, two per operation (four lanes each). Values of this type are
+/// made only inside the lockstep kernel compiled for AVX2, which runs only once the processor is
+/// known to have it (`integrate::lockstep::Kernel`); its operations are inlined there. The lanes
+/// are kept in an array (no vector type crosses a function boundary compiled without AVX).
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx::Avx;
 

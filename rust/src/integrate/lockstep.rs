@@ -4,18 +4,20 @@
 //! one before, each step for the step size of the one before), which leaves most of a core's
 //! arithmetic units idle. Ensembles integrate many panels over the same span: running [`LANES`]
 //! of them side by side fills those units, and the stage arithmetic maps onto vector
-//! instructions (two SSE2 or one AVX2 operation for four lanes).
+//! instructions (for the eight lanes: four SSE2, two AVX2 or one AVX-512 operation). Each
+//! lane's y0, k1 and constant illumination stay in the vectors from step to step; only its
+//! step size, times and reads pass through scalars.
 //!
 //! Every lane has its own step size, accept/reject decision, segments (shadow crossings),
 //! counters and observer: lanes share only the instruction stream. A lane performs for its run
 //! exactly the floating-point operations of [`super::solve`] with [`super::dopri5`], in the same
-//! order, and no fused multiply-add (Rust never contracts on its own, and neither kernel enables
+//! order, and no fused multiply-add (Rust never contracts on its own, and no kernel enables
 //! FMA), so a run gives the same bits in any lane as alone, whatever the other lanes hold
 //! (`tests::lanes_equal_single_runs`). A lane whose run ends takes the next job; a lane without
 //! one computes on zeros and is ignored.
 //!
-//! The kernel is compiled twice: for the build's baseline and for AVX2, picked at run time
-//! ([`Kernel::detect`]). Both give the same bits.
+//! The kernel is compiled three times: for the build's baseline, for AVX2 and for AVX-512F, the
+//! newest the processor has picked at run time ([`Kernel::detect`]). All give the same bits.
 
 use super::dopri5::{
     self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
