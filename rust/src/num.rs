@@ -56,12 +56,69 @@ impl Num for f64 {}
 /// Values advanced side by side, one per lane.
 pub(crate) const LANES: usize = 8;
 
+/// A lane type's values, lane by lane.
+pub(crate) trait LaneArray {
+    fn lanes(&self) -> &[f64; LANES];
+    fn lanes_mut(&mut self) -> &mut [f64; LANES];
+}
+
+/// What every lane type (an array of [`LANES`] f64) shares: made from one value, the same in
+/// every lane; read and written lane by lane; and the four operations, each applied to the two
+/// values by the type's method `$pair` with the closure given (one instruction per register).
+macro_rules! lane_type {
+    ($t:ident, $pair:ident, $add:expr, $sub:expr, $mul:expr, $div:expr) => {
+        impl From<f64> for $t {
+            #[inline(always)]
+            fn from(x: f64) -> $t {
+                $t([x; LANES])
+            }
+        }
+        impl LaneArray for $t {
+            #[inline(always)]
+            fn lanes(&self) -> &[f64; LANES] {
+                &self.0
+            }
+            #[inline(always)]
+            fn lanes_mut(&mut self) -> &mut [f64; LANES] {
+                &mut self.0
+            }
+        }
+        impl std::ops::Add for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn add(self, o: $t) -> $t {
+                self.$pair(o, $add)
+            }
+        }
+        impl std::ops::Sub for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn sub(self, o: $t) -> $t {
+                self.$pair(o, $sub)
+            }
+        }
+        impl std::ops::Mul for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn mul(self, o: $t) -> $t {
+                self.$pair(o, $mul)
+            }
+        }
+        impl std::ops::Div for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn div(self, o: $t) -> $t {
+                self.$pair(o, $div)
+            }
+        }
+        impl Num for $t {}
+    };
+}
+
 /// One f64 per lane: what the lockstep kernel needs beyond [`Num`]. Every operation is the same
 /// IEEE operation in each lane, nothing fused or reordered, so each lane's bits are those of the
 /// scalar code.
-pub(crate) trait Lanes: Num {
-    fn lanes(&self) -> &[f64; LANES];
-    fn lanes_mut(&mut self) -> &mut [f64; LANES];
+pub(crate) trait Lanes: Num + LaneArray {
     /// |x| in each lane.
     fn abs(self) -> Self;
     /// `f64::max` in each lane.
@@ -85,15 +142,16 @@ impl Portable {
     }
 }
 
+lane_type!(
+    Portable,
+    map2,
+    |a, b| a + b,
+    |a, b| a - b,
+    |a, b| a * b,
+    |a, b| a / b
+);
+
 impl Lanes for Portable {
-    #[inline(always)]
-    fn lanes(&self) -> &[f64; LANES] {
-        &self.0
-    }
-    #[inline(always)]
-    fn lanes_mut(&mut self) -> &mut [f64; LANES] {
-        &mut self.0
-    }
     #[inline(always)]
     fn abs(self) -> Portable {
         Portable(self.0.map(f64::abs))
@@ -118,45 +176,6 @@ impl Lanes for Portable {
     }
 }
 
-impl From<f64> for Portable {
-    #[inline(always)]
-    fn from(x: f64) -> Portable {
-        Portable([x; LANES])
-    }
-}
-
-impl Add for Portable {
-    type Output = Portable;
-    #[inline(always)]
-    fn add(self, o: Portable) -> Portable {
-        self.map2(o, |a, b| a + b)
-    }
-}
-
-impl Sub for Portable {
-    type Output = Portable;
-    #[inline(always)]
-    fn sub(self, o: Portable) -> Portable {
-        self.map2(o, |a, b| a - b)
-    }
-}
-
-impl Mul for Portable {
-    type Output = Portable;
-    #[inline(always)]
-    fn mul(self, o: Portable) -> Portable {
-        self.map2(o, |a, b| a * b)
-    }
-}
-
-impl Div for Portable {
-    type Output = Portable;
-    #[inline(always)]
-    fn div(self, o: Portable) -> Portable {
-        self.map2(o, |a, b| a / b)
-    }
-}
-
 impl Neg for Portable {
     type Output = Portable;
     #[inline(always)]
@@ -164,8 +183,6 @@ impl Neg for Portable {
         Portable(self.0.map(|a| -a))
     }
 }
-
-impl Num for Portable {}
 
 /// [`Lanes`] as AVX instructions, two per operation (four lanes each). Values of this type are
 /// made only inside the lockstep kernel compiled for AVX2, which runs only once the processor is
@@ -176,9 +193,9 @@ pub(crate) use avx::Avx;
 
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{Lanes, Num, LANES};
+    use super::{LaneArray, Lanes, Num, LANES};
     use std::arch::x86_64::*;
-    use std::ops::{Add, Div, Mul, Neg, Sub};
+    use std::ops::Neg;
 
     /// Four lanes in one AVX register.
     const HALF: usize = 4;
@@ -223,22 +240,15 @@ mod avx {
         }
     }
 
-    macro_rules! binary {
-        ($trait:ident, $method:ident, $intrinsic:ident) => {
-            impl $trait for Avx {
-                type Output = Avx;
-                #[inline(always)]
-                fn $method(self, o: Avx) -> Avx {
-                    // SAFETY: see the type's comment.
-                    self.each2(o, |a, b| unsafe { $intrinsic(a, b) })
-                }
-            }
-        };
-    }
-    binary!(Add, add, _mm256_add_pd);
-    binary!(Sub, sub, _mm256_sub_pd);
-    binary!(Mul, mul, _mm256_mul_pd);
-    binary!(Div, div, _mm256_div_pd);
+    // SAFETY (the four operations): see the type's comment.
+    lane_type!(
+        Avx,
+        each2,
+        |a, b| unsafe { _mm256_add_pd(a, b) },
+        |a, b| unsafe { _mm256_sub_pd(a, b) },
+        |a, b| unsafe { _mm256_mul_pd(a, b) },
+        |a, b| unsafe { _mm256_div_pd(a, b) }
+    );
 
     impl Neg for Avx {
         type Output = Avx;
@@ -249,22 +259,7 @@ mod avx {
         }
     }
 
-    impl From<f64> for Avx {
-        #[inline(always)]
-        fn from(x: f64) -> Avx {
-            Avx([x; LANES])
-        }
-    }
-
     impl Lanes for Avx {
-        #[inline(always)]
-        fn lanes(&self) -> &[f64; LANES] {
-            &self.0
-        }
-        #[inline(always)]
-        fn lanes_mut(&mut self) -> &mut [f64; LANES] {
-            &mut self.0
-        }
         #[inline(always)]
         fn abs(self) -> Avx {
             // SAFETY: see the type's comment. Clearing the sign bit is `f64::abs`.
@@ -301,8 +296,6 @@ mod avx {
             }
         }
     }
-
-    impl Num for Avx {}
 }
 
 /// [`Lanes`] as AVX-512 instructions, all eight lanes in one register: made only inside the
@@ -312,9 +305,9 @@ pub(crate) use avx512::Avx512;
 
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    use super::{Lanes, Num, LANES};
+    use super::{LaneArray, Lanes, Num, LANES};
     use std::arch::x86_64::*;
-    use std::ops::{Add, Div, Mul, Neg, Sub};
+    use std::ops::Neg;
 
     #[derive(Debug, Clone, Copy, PartialEq)]
     #[repr(C, align(64))]
@@ -333,6 +326,11 @@ mod avx512 {
             unsafe { _mm512_store_pd(out.0.as_mut_ptr(), v) };
             out
         }
+        /// `f` on the two.
+        #[inline(always)]
+        fn both(self, o: Avx512, f: impl Fn(__m512d, __m512d) -> __m512d) -> Avx512 {
+            Avx512::put(f(self.get(), o.get()))
+        }
         /// The lanes where `take` holds, as a mask.
         #[inline(always)]
         fn mask(take: [bool; LANES]) -> __mmask8 {
@@ -342,22 +340,15 @@ mod avx512 {
         }
     }
 
-    macro_rules! binary {
-        ($trait:ident, $method:ident, $intrinsic:ident) => {
-            impl $trait for Avx512 {
-                type Output = Avx512;
-                #[inline(always)]
-                fn $method(self, o: Avx512) -> Avx512 {
-                    // SAFETY: see the type's comment.
-                    Avx512::put(unsafe { $intrinsic(self.get(), o.get()) })
-                }
-            }
-        };
-    }
-    binary!(Add, add, _mm512_add_pd);
-    binary!(Sub, sub, _mm512_sub_pd);
-    binary!(Mul, mul, _mm512_mul_pd);
-    binary!(Div, div, _mm512_div_pd);
+    // SAFETY (the four operations): see the type's comment.
+    lane_type!(
+        Avx512,
+        both,
+        |a, b| unsafe { _mm512_add_pd(a, b) },
+        |a, b| unsafe { _mm512_sub_pd(a, b) },
+        |a, b| unsafe { _mm512_mul_pd(a, b) },
+        |a, b| unsafe { _mm512_div_pd(a, b) }
+    );
 
     impl Neg for Avx512 {
         type Output = Avx512;
@@ -372,22 +363,7 @@ mod avx512 {
         }
     }
 
-    impl From<f64> for Avx512 {
-        #[inline(always)]
-        fn from(x: f64) -> Avx512 {
-            Avx512([x; LANES])
-        }
-    }
-
     impl Lanes for Avx512 {
-        #[inline(always)]
-        fn lanes(&self) -> &[f64; LANES] {
-            &self.0
-        }
-        #[inline(always)]
-        fn lanes_mut(&mut self) -> &mut [f64; LANES] {
-            &mut self.0
-        }
         #[inline(always)]
         fn abs(self) -> Avx512 {
             // SAFETY: see the type's comment. Clearing the sign bit is `f64::abs`.
@@ -417,6 +393,4 @@ mod avx512 {
             }
         }
     }
-
-    impl Num for Avx512 {}
 }
