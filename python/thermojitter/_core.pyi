@@ -33,6 +33,7 @@ __all__ = [
     "MAX_TIME",
     "PANEL_FIELDS",
     "PAPER_PANEL",
+    "ENSEMBLE_LANES",
     "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
