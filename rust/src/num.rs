@@ -197,8 +197,9 @@ mod avx {
     use std::arch::x86_64::*;
     use std::ops::Neg;
 
-    /// Four lanes in one AVX register.
+    /// Four lanes in one AVX register; the type's methods hold two.
     const HALF: usize = 4;
+    const _: () = assert!(LANES == 2 * HALF);
 
     #[derive(Debug, Clone, Copy, PartialEq)]
     #[repr(C, align(64))]
@@ -309,6 +310,9 @@ mod avx512 {
     use std::arch::x86_64::*;
     use std::ops::Neg;
 
+    // One register holds all the lanes (`get`, `put`, `mask`).
+    const _: () = assert!(LANES == 8);
+
     #[derive(Debug, Clone, Copy, PartialEq)]
     #[repr(C, align(64))]
     pub(crate) struct Avx512(pub(crate) [f64; LANES]);
@@ -326,9 +330,9 @@ mod avx512 {
             unsafe { _mm512_store_pd(out.0.as_mut_ptr(), v) };
             out
         }
-        /// `f` on the two.
+        /// `f` on the two (one register each), as `Avx::each2` on each half.
         #[inline(always)]
-        fn both(self, o: Avx512, f: impl Fn(__m512d, __m512d) -> __m512d) -> Avx512 {
+        fn each2(self, o: Avx512, f: impl Fn(__m512d, __m512d) -> __m512d) -> Avx512 {
             Avx512::put(f(self.get(), o.get()))
         }
         /// The lanes where `take` holds, as a mask.
@@ -343,7 +347,7 @@ mod avx512 {
     // SAFETY (the four operations): see the type's comment.
     lane_type!(
         Avx512,
-        both,
+        each2,
         |a, b| unsafe { _mm512_add_pd(a, b) },
         |a, b| unsafe { _mm512_sub_pd(a, b) },
         |a, b| unsafe { _mm512_mul_pd(a, b) },

@@ -92,33 +92,34 @@ pub enum Kernel {
 }
 
 impl Kernel {
+    /// Every kernel, oldest instruction set first.
+    const ALL: [Kernel; 3] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512];
+
+    /// Whether this processor has the kernel's instruction set.
+    pub fn runs_here(self) -> bool {
+        match self {
+            Kernel::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512 => std::arch::is_x86_feature_detected!("avx512f"),
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+
     /// The best kernel this processor runs.
     pub fn detect() -> Self {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                return Kernel::Avx512;
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                return Kernel::Avx2;
-            }
-        }
-        Kernel::Portable
+        Kernel::ALL
+            .into_iter()
+            .rev()
+            .find(|k| k.runs_here())
+            .unwrap_or(Kernel::Portable)
     }
 
     /// Every kernel this processor runs, the portable one first.
     pub fn available() -> Vec<Self> {
-        let mut out = vec![Kernel::Portable];
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                out.push(Kernel::Avx2);
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                out.push(Kernel::Avx512);
-            }
-        }
-        out
+        Kernel::ALL.into_iter().filter(|k| k.runs_here()).collect()
     }
 
     pub fn name(self) -> &'static str {
@@ -141,12 +142,12 @@ where
 {
     match kernel {
         #[cfg(target_arch = "x86_64")]
-        Kernel::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
+        Kernel::Avx2 if kernel.runs_here() => {
             // SAFETY: the processor has AVX2 (checked just above).
             unsafe { drive_avx2(next, done) }
         }
         #[cfg(target_arch = "x86_64")]
-        Kernel::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
+        Kernel::Avx512 if kernel.runs_here() => {
             // SAFETY: the processor has AVX-512F (checked just above).
             unsafe { drive_avx512(next, done) }
         }
