@@ -15,6 +15,7 @@ use std::time::Instant;
 use thermojitter::cancel::Cancel;
 use thermojitter::dynamics::HingeModel;
 use thermojitter::integrate::dopri5;
+use thermojitter::integrate::lockstep::RUNS_PER_CORE;
 use thermojitter::integrate::{solve, Method, OdeSystem, Recorder, StepCounter, Tolerances};
 use thermojitter::montecarlo::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::steady::equilibrium;
@@ -147,9 +148,10 @@ fn main() {
         ("ensemble-lockstep", "lockstep lanes", Path::Lockstep),
     ];
     if paths.iter().any(|(key, _, _)| wanted(key)) {
-        // Eight panels around Table 1 on one thread, each one GEO orbit with the per-orbit
-        // summary and the flutter analysis (a Monte Carlo sample), alternating the two paths.
-        let panels: Vec<Panel> = (0..8)
+        // As many panels around Table 1 as one thread runs in lockstep at once, each one GEO
+        // orbit with the per-orbit summary and the flutter analysis (a Monte Carlo sample),
+        // alternating the two paths.
+        let panels: Vec<Panel> = (0..RUNS_PER_CORE)
             .map(|k| Panel {
                 damping: 2.0 + 0.25 * k as f64,
                 conductance: 22.0 + 0.75 * k as f64,

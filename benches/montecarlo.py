@@ -36,6 +36,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="runs per thread count (best)")
     parser.add_argument("--simulate", type=int, default=50, help="panels run with tj.simulate")
     args = parser.parse_args()
+    if args.n < 1 or args.simulate < 1 or args.repeat < 1 or min(args.threads) < 1:
+        parser.error("--n, --simulate, --repeat and --threads must be at least 1")
 
     panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
     print(machine.describe())

@@ -34,6 +34,7 @@ __all__ = [
     "PANEL_FIELDS",
     "PAPER_PANEL",
     "ENSEMBLE_LANES",
+    "ENSEMBLE_RUNS_PER_CORE",
     "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
@@ -90,6 +91,7 @@ PANEL_FIELDS: list[str]
 LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 ENSEMBLE_LANES: int
+ENSEMBLE_RUNS_PER_CORE: int
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
 LEO_ALTITUDE: float

@@ -587,10 +587,10 @@ def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_si
 
 def _default_chunk_size(n: int) -> int:
     """Depends on n only, so that a default run cuts the same chunks on any machine: about a
-    sixteenth of the run, at most 64, and a multiple of the engine's lockstep lanes (samples
-    per core at once) so that they are full."""
-    lanes = _core.ENSEMBLE_LANES
-    return min(64 // lanes * lanes, lanes * math.ceil(n / (16 * lanes)))
+    sixteenth of the run, at most 64, and a multiple of the samples a core runs at once in the
+    engine's lockstep lanes, so that they are full."""
+    per_core = _core.ENSEMBLE_RUNS_PER_CORE
+    return min(64 // per_core * per_core, per_core * math.ceil(n / (16 * per_core)))
 
 
 def _frame(

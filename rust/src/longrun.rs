@@ -494,21 +494,25 @@ impl<V: SummaryView> Collector<V> {
         in_entry: bool,
         in_exit: bool,
     ) {
+        // Every accumulator is read before any is written: the compiler may merge two of the
+        // updates into one masked vector store, and a later load of a neighbour would wait for
+        // that store to retire (masked stores are not forwarded).
+        let before = self.current;
         let s = &mut self.current;
-        s.theta_max = larger(s.theta_max, hi);
-        s.theta_min = smaller(s.theta_min, lo);
-        let dev = larger((hi - s.theta_eq).abs(), (lo - s.theta_eq).abs());
-        s.amplitude = larger(s.amplitude, dev);
-        s.jitter_peak = larger(s.jitter_peak, dynamic_abs);
+        let dev = larger((hi - before.theta_eq).abs(), (lo - before.theta_eq).abs());
+        s.theta_max = larger(before.theta_max, hi);
+        s.theta_min = smaller(before.theta_min, lo);
+        s.amplitude = larger(before.amplitude, dev);
+        s.jitter_peak = larger(before.jitter_peak, dynamic_abs);
         self.sq_sum += sq;
         self.duration += dt;
         if in_entry {
-            s.entry_theta_min = nan_min(s.entry_theta_min, lo);
-            s.entry_peak = nan_max(s.entry_peak, dev);
+            s.entry_theta_min = nan_min(before.entry_theta_min, lo);
+            s.entry_peak = nan_max(before.entry_peak, dev);
         }
         if in_exit {
-            s.exit_theta_max = nan_max(s.exit_theta_max, hi);
-            s.exit_peak = nan_max(s.exit_peak, dev);
+            s.exit_theta_max = nan_max(before.exit_theta_max, hi);
+            s.exit_peak = nan_max(before.exit_peak, dev);
         }
     }
 
@@ -731,8 +735,10 @@ impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
     }
 
     /// The steps `on_step` reads twice (θ̇ keeps its sign, the start read with the last step),
-    /// from the reads the lanes computed; the others from their dense output.
-    #[inline]
+    /// from the reads the lanes computed; the others from their dense output. Inlined into the
+    /// lanes' loop: called out of line, its loads of the reads just written there wait for the
+    /// stores to retire (two 8-byte stores read back as one 16-byte load are not forwarded).
+    #[inline(always)]
     fn on_reads(&mut self, r: &StepReads) -> Option<ControlFlow<()>> {
         let c = &mut self.collector;
         let [r0, r_mid, r1] = r.rising;

@@ -11,7 +11,9 @@ use crate::dynamics::HingeModel;
 use crate::error::{require_positive, Error, Result};
 use crate::flutter::{analyse, critical_damping};
 use crate::hybrid::{run_orbits_hybrid, HybridSettings};
-use crate::integrate::lockstep::{solve_lockstep, Job, Kernel, LaneObserver, StepReads, LANES};
+use crate::integrate::lockstep::{
+    solve_lockstep, Job, Kernel, LaneObserver, StepReads, RUNS_PER_CORE,
+};
 use crate::integrate::{DenseStep, Method, Observer};
 use crate::longrun::{
     finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, OrbitRunRequest,
@@ -424,14 +426,15 @@ impl LaneObserver for LaneSample<'_> {
     fn dynamic_form(&self) -> Option<(f64, f64)> {
         self.observer.dynamic_form()
     }
-    #[inline]
+    #[inline(always)]
     fn on_reads(&mut self, reads: &StepReads) -> Option<ControlFlow<()>> {
         self.observer.on_reads(reads)
     }
 }
 
-/// Runs `panels` (hinge-resolved Dormand–Prince samples) on this thread, [`LANES`] at a time in
-/// lockstep; results in input order, each the same, bit for bit, as [`run_sample`]'s.
+/// Runs `panels` (hinge-resolved Dormand–Prince samples) on this thread, up to
+/// [`RUNS_PER_CORE`] at a time in lockstep; results in input order, each the same, bit for bit,
+/// as [`run_sample`]'s.
 fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> Vec<SampleMetrics> {
     // Rows are written by `next` (a sample that fails before its run) and by `done`.
     let out = RefCell::new(vec![None; panels.len()]);
@@ -512,16 +515,19 @@ pub fn run_batch(
 /// How a batch's samples are integrated; both give the same rows, bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Path {
-    /// [`LANES`] samples at a time per thread, in SIMD lanes (hinge-resolved Dormand–Prince
-    /// batches; others run one at a time).
+    /// Up to [`RUNS_PER_CORE`] samples at a time per thread, in SIMD lanes (hinge-resolved
+    /// Dormand–Prince batches; others run one at a time).
     Lockstep,
     /// One sample at a time per thread.
     Scalar,
 }
 
-/// Samples given to one lockstep group: one per lane. Samples of a batch take about the same
-/// number of steps, so the lanes of a group end together; a group of one runs alone.
-const GROUP: usize = LANES;
+/// Samples given to one thread's lockstep loop at a time: as many as it runs at once, or fewer
+/// so that every thread of the pool has some. Samples of a batch take about the same number of
+/// steps, so the lanes end together; a group of one runs alone.
+fn group_size(samples: usize, threads: usize) -> usize {
+    RUNS_PER_CORE.min(samples.div_ceil(threads.max(1))).max(1)
+}
 
 /// [`run_batch`] along `path`.
 pub fn run_batch_on(
@@ -538,8 +544,9 @@ pub fn run_batch_on(
     let scalar = |p: &Panel| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed);
     let out = pool.install(|| {
         if lockstep {
+            let group = group_size(panels.len(), rayon::current_num_threads());
             let groups: Vec<Vec<SampleMetrics>> = panels
-                .par_chunks(GROUP)
+                .par_chunks(group)
                 .with_max_len(1)
                 .map(|group| match group {
                     [p] => vec![scalar(p)],
@@ -592,6 +599,24 @@ mod tests {
                 ..Panel::paper()
             })
             .collect()
+    }
+
+    #[test]
+    fn lockstep_groups_give_every_thread_work_and_fill_a_core() {
+        for threads in 1..=9 {
+            for samples in 1..=4 * RUNS_PER_CORE * threads {
+                let group = group_size(samples, threads);
+                assert!((1..=RUNS_PER_CORE).contains(&group));
+                // The smallest group with which one per thread takes every sample, unless a
+                // core's worth is not enough.
+                let covers = |g: usize| g * threads >= samples;
+                assert!(
+                    covers(group) || group == RUNS_PER_CORE,
+                    "{samples} on {threads}"
+                );
+                assert!(!covers(group - 1), "{samples} on {threads}: {group}");
+            }
+        }
     }
 
     /// Every number of a batch by its bits (NaN equals NaN), with the errors.

@@ -201,6 +201,7 @@ struct Pack<V> {
 }
 
 /// The lanes' results of one trial step.
+#[derive(Clone, Copy)]
 struct Trial<V> {
     y_new: [V; 4],
     /// The continuous extension's coefficients r2..r5 (r1 is y0) of each component.
@@ -214,6 +215,22 @@ struct Trial<V> {
     /// The middle of the step, and the dynamic part θ − M_T/K_el there and at its end.
     t_mid: V,
     dynamic: [V; 2],
+}
+
+impl<V: Lanes> Trial<V> {
+    /// A trial of nothing, the starting value of a group's last trial.
+    fn zeros() -> Self {
+        let zero = V::from(0.0);
+        Trial {
+            y_new: [zero; 4],
+            dense: [[zero; 4]; 4],
+            k7: [zero; 4],
+            mid: [zero; 4],
+            mean_square: zero,
+            t_mid: zero,
+            dynamic: [zero; 2],
+        }
+    }
 }
 
 impl<V: Lanes> Pack<V> {
@@ -722,24 +739,51 @@ impl<O: LaneObserver> Lane<O> {
     }
 }
 
-/// The lockstep loop (compiled once per [`Kernel`]).
-#[inline(always)]
-fn drive<V: Lanes, O, N, F>(mut next: N, mut done: F)
-where
-    O: LaneObserver,
-    N: FnMut() -> Option<Job<O>>,
-    F: FnMut(O, Result<(Stats, Vector4<f64>)>),
-{
-    let mut lanes: [Option<Lane<O>>; LANES] = std::array::from_fn(|_| None);
-    let mut pack = Pack::<V>::zeros();
-    let mut form: Option<(HingeModel, Coupling)> = None;
-    let mut exhausted = false;
-    loop {
-        // Give every idle lane the next job.
-        for (l, slot) in lanes.iter_mut().enumerate() {
-            while slot.is_none() && !exhausted {
+/// Groups of [`LANES`] runs the loop alternates between. While one group's trial step runs its
+/// chain of dependent vector operations, the processor does the other group's bookkeeping (its
+/// accepts, rejections, next steps and the observers' reads), which needs none of that step's
+/// results.
+const GROUPS: usize = 2;
+
+/// Runs a core holds at once: [`GROUPS`] groups of [`LANES`].
+pub const RUNS_PER_CORE: usize = GROUPS * LANES;
+
+/// One group of lanes: their runs, their inputs to the next trial and the last trial's results.
+struct Group<V, O> {
+    lanes: [Option<Lane<O>>; LANES],
+    pack: Pack<V>,
+    /// Kept in place (not moved in and out of an `Option`: two kilobytes a step).
+    trial: Trial<V>,
+    /// `trial` has been taken and not yet finished.
+    pending: bool,
+}
+
+impl<V: Lanes, O: LaneObserver> Group<V, O> {
+    fn new() -> Self {
+        Group {
+            lanes: std::array::from_fn(|_| None),
+            pack: Pack::zeros(),
+            trial: Trial::zeros(),
+            pending: false,
+        }
+    }
+
+    /// Gives every idle lane the next job (a job of another model or coupling than the loop's
+    /// runs alone, at once).
+    fn fill<N, F>(
+        &mut self,
+        next: &mut N,
+        done: &mut F,
+        form: &mut Option<(HingeModel, Coupling)>,
+        exhausted: &mut bool,
+    ) where
+        N: FnMut() -> Option<Job<O>>,
+        F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+    {
+        for (l, slot) in self.lanes.iter_mut().enumerate() {
+            while slot.is_none() && !*exhausted {
                 let Some(mut job) = next() else {
-                    exhausted = true;
+                    *exhausted = true;
                     break;
                 };
                 let LaneForm {
@@ -760,54 +804,97 @@ where
                 }
                 match Lane::start(job) {
                     Ok(lane) => {
-                        lane.load(&mut pack, l);
+                        lane.load(&mut self.pack, l);
                         *slot = Some(lane);
                     }
                     Err((observer, outcome)) => done(observer, outcome),
                 }
             }
         }
-        let Some((model, coupling)) = form else {
-            return;
-        };
+    }
+
+    /// Loads every run's next trial into the pack; false when no lane holds a run.
+    fn begin<F>(&mut self, done: &mut F) -> bool
+    where
+        F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+    {
         let mut busy = false;
-        for (l, slot) in lanes.iter_mut().enumerate() {
+        for (l, slot) in self.lanes.iter_mut().enumerate() {
             let Some(lane) = slot else {
                 continue;
             };
-            match lane.begin_trial(&mut pack, l) {
+            match lane.begin_trial(&mut self.pack, l) {
                 Ok(()) => busy = true,
                 Err(e) => {
                     let lane = slot.take().expect("a lane");
-                    pack.clear(l);
+                    self.pack.clear(l);
                     done(lane.observer, Err(e));
                 }
             }
         }
-        if !busy {
-            if exhausted {
-                return;
-            }
-            continue;
-        }
-        let trial = step_lanes(model, coupling, &pack);
+        busy
+    }
+
+    /// Accepts or rejects the last trial in every lane, and hands back the runs that ended.
+    fn finish<F>(&mut self, done: &mut F)
+    where
+        F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+    {
+        let trial = &self.trial;
         // The lanes that accept start their next trial from y_new with k1 = k7 (a lane that
         // then enters a segment or ends is reloaded or cleared below).
         let accepted: [bool; LANES] =
-            std::array::from_fn(|l| lanes[l].is_some() && trial.mean_square.lanes()[l] < 1.0);
+            std::array::from_fn(|l| self.lanes[l].is_some() && trial.mean_square.lanes()[l] < 1.0);
+        let p = &mut self.pack;
         for i in 0..4 {
-            pack.y0[i] = pack.y0[i].or_where(accepted, trial.y_new[i]);
-            pack.k1[i] = pack.k1[i].or_where(accepted, trial.k7[i]);
+            p.y0[i] = p.y0[i].or_where(accepted, trial.y_new[i]);
+            p.k1[i] = p.k1[i].or_where(accepted, trial.k7[i]);
         }
-        for (l, slot) in lanes.iter_mut().enumerate() {
+        for (l, slot) in self.lanes.iter_mut().enumerate() {
             let Some(lane) = slot else {
                 continue;
             };
-            if let Some(outcome) = lane.end_trial(&trial, l) {
+            if let Some(outcome) = lane.end_trial(trial, l) {
                 let lane = slot.take().expect("a lane");
-                pack.clear(l);
+                self.pack.clear(l);
                 done(lane.observer, outcome);
             }
+        }
+    }
+}
+
+/// The lockstep loop (compiled once per [`Kernel`]): [`GROUPS`] groups in turn, each finishing
+/// its last trial, taking new jobs into its idle lanes and starting its next trial.
+#[inline(always)]
+fn drive<V: Lanes, O, N, F>(mut next: N, mut done: F)
+where
+    O: LaneObserver,
+    N: FnMut() -> Option<Job<O>>,
+    F: FnMut(O, Result<(Stats, Vector4<f64>)>),
+{
+    let mut groups: [Group<V, O>; GROUPS] = std::array::from_fn(|_| Group::new());
+    let mut form: Option<(HingeModel, Coupling)> = None;
+    let mut exhausted = false;
+    loop {
+        let mut busy = false;
+        for group in &mut groups {
+            if group.pending {
+                group.finish(&mut done);
+                group.pending = false;
+            }
+            group.fill(&mut next, &mut done, &mut form, &mut exhausted);
+            let Some((model, coupling)) = form else {
+                // No job has been taken in lockstep, so none is left.
+                return;
+            };
+            if group.begin(&mut done) {
+                group.trial = step_lanes(model, coupling, &group.pack);
+                group.pending = true;
+                busy = true;
+            }
+        }
+        if !busy && exhausted {
+            return;
         }
     }
 }
@@ -919,14 +1006,14 @@ mod tests {
 
     #[test]
     fn lanes_equal_single_runs() {
-        // Three runs more than there are lanes: lanes refill, and the last ones run with idle
-        // lanes. Runs 6 and 7 start beyond π/4, where sin/cos come from the library.
+        // Three runs more than a core holds: lanes of both groups refill, and the last ones run
+        // with idle lanes. Runs 6 and 7 start beyond π/4, where sin/cos come from the library.
         for (model, coupling) in [
             (HingeModel::Nonlinear, Coupling::ProjectedArea),
             (HingeModel::Linear, Coupling::Frozen),
             (HingeModel::Nonlinear, Coupling::Frozen),
         ] {
-            let ps = panels(LANES + 3);
+            let ps = panels(RUNS_PER_CORE + 3);
             let want = alone(jobs(&ps, model, coupling));
             assert!(want
                 .iter()

@@ -412,6 +412,10 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("STEFAN_BOLTZMANN", crate::STEFAN_BOLTZMANN)?;
     m.add("MAX_TIME", crate::integrate::MAX_TIME)?;
     m.add("ENSEMBLE_LANES", crate::integrate::lockstep::LANES)?;
+    m.add(
+        "ENSEMBLE_RUNS_PER_CORE",
+        crate::integrate::lockstep::RUNS_PER_CORE,
+    )?;
     m.add("MAX_THREADS", crate::montecarlo::MAX_THREADS)?;
     m.add("VALIDITY_LIMIT", crate::dynamics::VALIDITY_LIMIT)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
