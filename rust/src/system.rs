@@ -66,7 +66,12 @@ impl Sunlight {
                 self.orbit.illumination_on(t, a, b)
             }
         };
-        s * self.orbit.flux_scale(t)
+        // At 1 au the scale is exactly 1: no division on the right-hand side's path.
+        if self.orbit.eccentric_sun {
+            s * self.orbit.flux_scale(t)
+        } else {
+            s
+        }
     }
 }
 
