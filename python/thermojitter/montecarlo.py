@@ -587,10 +587,11 @@ def _open_checkpoint(directory: Path, settings: dict[str, Any], n: int, chunk_si
 
 def _default_chunk_size(n: int) -> int:
     """Depends on n only, so that a default run cuts the same chunks on any machine: about a
-    sixteenth of the run, at most 64, and a multiple of the samples a core runs at once in the
-    engine's lockstep lanes, so that they are full."""
-    per_core = _core.ENSEMBLE_RUNS_PER_CORE
-    return min(64 // per_core * per_core, per_core * math.ceil(n / (16 * per_core)))
+    sixteenth of the run, at most 64, and a multiple of what two cores run at once in the
+    engine's lockstep lanes, so that on two cores or more a chunk keeps their lanes full (the
+    engine gives each thread a share of a chunk, at most a core's worth)."""
+    two_cores = 2 * _core.ENSEMBLE_RUNS_PER_CORE
+    return min(max(64 // two_cores, 1) * two_cores, two_cores * math.ceil(n / (16 * two_cores)))
 
 
 def _frame(
