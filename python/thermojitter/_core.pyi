@@ -90,8 +90,8 @@ __all__ = [
 PANEL_FIELDS: list[str]
 LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
-ENSEMBLE_LANES: int
-ENSEMBLE_RUNS_PER_CORE: int
+ENSEMBLE_LANES: int  # SIMD lanes of one lockstep group
+ENSEMBLE_RUNS_PER_CORE: int  # samples one core runs at once (its groups' lanes)
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
 LEO_ALTITUDE: float
