@@ -379,7 +379,13 @@ impl Orbit {
     }
 
     /// Solar flux relative to the nominal solar constant (1 au) at time t: 1/r², r in au.
+    #[inline]
     pub fn flux_scale(&self, t: f64) -> f64 {
+        // Exactly 1 at 1 au, returned before the division: right-hand sides call this at every
+        // evaluation.
+        if !self.eccentric_sun {
+            return 1.0;
+        }
         let r = self.sun_distance_au(t);
         1.0 / (r * r)
     }

@@ -66,7 +66,8 @@ impl Sunlight {
                 self.orbit.illumination_on(t, a, b)
             }
         };
-        // At 1 au the scale is exactly 1: no division on the right-hand side's path.
+        // At 1 au the scale is exactly 1: no multiplication, no division on the right-hand
+        // side's path (with the multiplication the compiler merged both paths into a division).
         if self.orbit.eccentric_sun {
             s * self.orbit.flux_scale(t)
         } else {

@@ -201,7 +201,6 @@ struct Pack<V> {
 }
 
 /// The lanes' results of one trial step.
-#[derive(Clone, Copy)]
 struct Trial<V> {
     y_new: [V; 4],
     /// The continuous extension's coefficients r2..r5 (r1 is y0) of each component.
