@@ -16,7 +16,9 @@ use thermojitter::cancel::Cancel;
 use thermojitter::dynamics::HingeModel;
 use thermojitter::integrate::dopri5;
 use thermojitter::integrate::lockstep::RUNS_PER_CORE;
-use thermojitter::integrate::{solve, Method, OdeSystem, Recorder, StepCounter, Tolerances};
+use thermojitter::integrate::{
+    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, ScalarKernel, StepCounter, Tolerances,
+};
 use thermojitter::montecarlo::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::steady::equilibrium;
 use thermojitter::system::{Coupled, Coupling};
@@ -49,6 +51,58 @@ fn process_cpu_ns() -> Option<u64> {
     Some(total)
 }
 
+/// `n` calls of the right-hand side as `kernel`'s integration loop has it: the portable one, or
+/// the fused one compiled for AVX and FMA.
+fn rhs_calls(kernel: ScalarKernel, sys: &Coupled, y: &Vector4<f64>, n: u64) {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    unsafe fn fused(sys: &Coupled, y: &Vector4<f64>, n: u64) {
+        for _ in 0..n {
+            black_box(sys.rhs_fused(black_box(100.0), black_box(y)));
+        }
+    }
+    match kernel {
+        // SAFETY: `ScalarKernel::available` lists the fused kernel only where it runs.
+        #[cfg(target_arch = "x86_64")]
+        ScalarKernel::Fma => unsafe { fused(sys, y, n) },
+        _ => {
+            for _ in 0..n {
+                black_box(sys.rhs(black_box(100.0), black_box(y)));
+            }
+        }
+    }
+}
+
+/// One Dormand–Prince step as `kernel`'s loop takes it.
+fn step_on(kernel: ScalarKernel, sys: &Coupled, y: &Vector4<f64>, k1: &Vector4<f64>) {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    unsafe fn fused(sys: &Coupled, y: &Vector4<f64>, k1: &Vector4<f64>) {
+        let sys = FusedRhs(sys);
+        black_box(dopri5::step(
+            &sys,
+            black_box(100.0),
+            black_box(100.37),
+            y,
+            k1,
+        ));
+    }
+    match kernel {
+        // SAFETY: as in `rhs_calls`.
+        #[cfg(target_arch = "x86_64")]
+        ScalarKernel::Fma => unsafe { fused(sys, black_box(y), black_box(k1)) },
+        _ => {
+            black_box(dopri5::step(
+                sys,
+                black_box(100.0),
+                black_box(100.37),
+                black_box(y),
+                black_box(k1),
+            ));
+        }
+    }
+}
+
 fn main() {
     let filter: Vec<String> = std::env::args()
         .skip(1)
@@ -67,24 +121,22 @@ fn main() {
     // A state slightly off equilibrium so that the hinge terms are all non-trivial.
     let y = y0 + Vector4::new(0.5, -0.3, 1e-3, 2e-4);
     if wanted("rhs") {
-        let rhs = median_ns(21, 1_000_000, || {
-            black_box(sys.rhs(black_box(100.0), black_box(&y)));
-        });
-        println!("rhs (coupled, nonlinear)        {rhs:8.1} ns/call");
+        for kernel in ScalarKernel::available() {
+            let rhs = median_ns(21, 1, || rhs_calls(kernel, &sys, &y, 1_000_000)) * 1e-6;
+            let label = format!("rhs (coupled, nonlinear), {}", kernel.name());
+            println!("{label:<36}{rhs:8.1} ns/call");
+        }
     }
 
     if wanted("step") {
-        let k1 = sys.rhs(100.0, &y);
-        let step = median_ns(21, 200_000, || {
-            black_box(dopri5::step(
-                &sys,
-                black_box(100.0),
-                black_box(100.37),
-                black_box(&y),
-                black_box(&k1),
-            ));
-        });
-        println!("dopri5 step (6 rhs)             {step:8.1} ns/step");
+        for kernel in ScalarKernel::available() {
+            let (k1, label) = (
+                sys.rhs(100.0, &y),
+                format!("dopri5 step (6 rhs), {}", kernel.name()),
+            );
+            let step = median_ns(21, 200_000, || step_on(kernel, &sys, &y, &k1));
+            println!("{label:<36}{step:8.1} ns/step");
+        }
     }
 
     let method = Method::Dopri5(Tolerances::default());
@@ -95,25 +147,29 @@ fn main() {
         let mut steps = 0;
         let ns = median_ns(7, 1, || steps = observe());
         println!(
-            "one GEO orbit, {name:<19} {:8.3} ms, {steps} steps, {:.1} ns/step",
+            "one GEO orbit, {name:<21} {:8.3} ms, {steps} steps, {:.1} ns/step",
             ns * 1e-6,
             ns / steps as f64
         );
     };
-    orbit_run("orbit-none", "no output", &mut || {
-        let mut counter = StepCounter::default();
-        let (stats, y_end) = solve(
-            &mut sys,
-            &method,
-            0.0,
-            black_box(y0),
-            orbit.period,
-            &mut counter,
-        )
-        .expect("orbit");
-        black_box(y_end);
-        stats.n_steps
-    });
+    for kernel in ScalarKernel::available() {
+        let name = format!("no output, {}", kernel.name());
+        orbit_run("orbit-none", &name, &mut || {
+            let mut counter = StepCounter::default();
+            let (stats, y_end) = solve_on(
+                kernel,
+                &mut sys,
+                &method,
+                0.0,
+                black_box(y0),
+                orbit.period,
+                &mut counter,
+            )
+            .expect("orbit");
+            black_box(y_end);
+            stats.n_steps
+        });
+    }
     orbit_run("orbit-end", "sampled at the end", &mut || {
         let mut recorder = Recorder::new(vec![orbit.period]);
         let (stats, _) = solve(

@@ -79,16 +79,27 @@ def test_two_layers_on_a_plain_panel_are_the_two_layer_model() -> None:
     p = tj.Panel.paper()
     a = tj.simulate(p, GEO, (0.0, GEO.period), dt_out=60.0)
     b = tj.simulate(p, GEO, (0.0, GEO.period), dt_out=60.0, layers=2)
+    # On the portable kernel the two do eq. 2's arithmetic alike and take the same steps. The
+    # fused kernel rounds the two-layer model's multiply-adds once and not the nodal model's,
+    # so their adaptive steps part and θ, θ̇ differ by about the integration's own error
+    # (measured 1.1e-6 and 3.7e-5 of their largest values; the portable case is checked to the
+    # bit by rust/src/layered.rs on every processor).
+    fused = tj._core.cpu_info()["scalar_kernel"] == "fma"
+    bounds = {"theta": 1e-5, "theta_dot": 5e-4} if fused else {}
     for name in ("T_front", "T_back", "theta", "theta_dot", "thermal_moment"):
         x, y = getattr(a, name), getattr(b, name)
-        assert np.max(np.abs(x - y)) <= 1e-10 * np.max(np.abs(x)), name
+        bound = bounds.get(name, 1e-9 if fused else 1e-10)
+        assert np.max(np.abs(x - y)) <= bound * np.max(np.abs(x)), name
     assert b.T_nodes is not None and b.T_nodes.shape == (a.t.size, 2)
     fa, fb = tj.flutter(p.replace(damping=0.0)), tj.flutter(p.replace(damping=0.0), layers=2)
     assert fb.critical_damping == pytest.approx(fa.critical_damping, rel=1e-10)
     assert fb.growth_rate == pytest.approx(fa.growth_rate, rel=1e-10)
     sa = tj.simulate_orbits(p, GEO, 1, progress=False, method="rk45")
     sb = tj.simulate_orbits(p, GEO, 1, progress=False, layers=2, method="rk45")
-    assert np.array_equal(sa.exit_peak, sb.exit_peak)
+    if fused:
+        np.testing.assert_allclose(sb.exit_peak, sa.exit_peak, rtol=1e-6)
+    else:
+        assert np.array_equal(sa.exit_peak, sb.exit_peak)
 
 
 def test_node_temperatures_over_time_and_depth() -> None:

@@ -6,7 +6,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
-from thermojitter import beam, materials
+from thermojitter import _core, beam, materials
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
@@ -44,6 +44,24 @@ from thermojitter.simulate import (
 from thermojitter.solver import SolverSettings
 
 __version__ = "0.1.0"
+
+
+def _check_kernel_variable() -> None:
+    """Refuses a value of THERMOJITTER_KERNEL the engine would not understand (it reads the
+    variable at its first run: ``portable`` forces the kernels without FMA, whose bits are the
+    same on every processor; ``auto`` or unset, the best the processor has)."""
+    import os
+
+    value = os.environ.get(_core.KERNEL_VARIABLE)
+    if value is not None and value.strip().lower() not in ("", *_core.KERNEL_CHOICES):
+        raise ParameterError(
+            _core.KERNEL_VARIABLE,
+            value,
+            f"the environment variable must be one of {', '.join(_core.KERNEL_CHOICES)}",
+        )
+
+
+_check_kernel_variable()
 
 __all__ = [
     "BeamComparison",

@@ -35,6 +35,8 @@ __all__ = [
     "PAPER_PANEL",
     "ENSEMBLE_LANES",
     "ENSEMBLE_RUNS_PER_CORE",
+    "KERNEL_CHOICES",
+    "KERNEL_VARIABLE",
     "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
@@ -92,6 +94,8 @@ LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 ENSEMBLE_LANES: int  # SIMD lanes of one lockstep group
 ENSEMBLE_RUNS_PER_CORE: int  # samples one core runs at once (its groups' lanes)
+KERNEL_VARIABLE: str  # environment variable: "portable" forces the kernels without FMA
+KERNEL_CHOICES: list[str]  # its values ("auto", "portable")
 SOLVER_DEFAULTS: dict[str, Any]
 GEO_RADIUS: float
 LEO_ALTITUDE: float

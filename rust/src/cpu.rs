@@ -1,10 +1,11 @@
 //! The processor a run is on and the instruction sets the engine uses there, so that benchmark
 //! figures from different machines are never compared blind.
 //!
-//! The build targets baseline x86-64 (SSE2) so that one wheel runs everywhere; the ensemble's
-//! lockstep kernel is compiled again for AVX2 and for AVX-512F, the newest the processor has
-//! picked at run time ([`crate::integrate::lockstep::Kernel`]). No path uses FMA, so all give
-//! the same bits.
+//! The build targets baseline x86-64 (SSE2) so that one wheel runs everywhere; the scalar
+//! integration loop is compiled again for AVX ([`crate::integrate::ScalarKernel`]) and the
+//! ensemble's lockstep kernel for AVX2 and for AVX-512F
+//! ([`crate::integrate::lockstep::Kernel`]), the newest the processor has picked at run time.
+//! No path uses FMA, so all give the same bits.
 
 /// Instruction sets worth reporting, oldest first.
 #[cfg(target_arch = "x86_64")]
@@ -79,11 +80,13 @@ pub fn describe() -> String {
         }
     };
     format!(
-        "CPU: {} | has: {} | build: {} {} | ensemble kernel: {} (chosen at run time)",
+        "CPU: {} | has: {} | build: {} {} | scalar kernel: {}, ensemble kernel: {} (chosen at \
+         run time)",
         model_name(),
         list(detected()),
         std::env::consts::ARCH,
         list(compiled()),
+        crate::integrate::ScalarKernel::detect().name(),
         crate::integrate::lockstep::Kernel::detect().name(),
     )
 }

@@ -1,7 +1,7 @@
 //! Thermal bending moment and the one-degree-of-freedom hinge model (paper Sec. 3, eqs. 20, 28).
 
 use crate::error::{Error, Result};
-use crate::num::Num;
+use crate::num::{Fused, Num};
 use crate::params::Panel;
 
 /// Structural model of the hinge.
@@ -78,6 +78,14 @@ pub trait StructuralModel {
     /// [`StructuralModel::area_factor`] of `q`, so that what both need is computed once.
     fn rates(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64;
 
+    /// [`StructuralModel::rates`] with its multiply-adds fused where the model has a fused form
+    /// (the hinge does), else `rates` itself. Only code compiled for FMA calls it
+    /// (`integrate::ScalarKernel::Fma`).
+    #[inline(always)]
+    fn rates_fused(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        self.rates(load, q, out)
+    }
+
     /// Number of position states (the first ones); the velocities that follow are zero at rest.
     fn positions(&self) -> usize;
 
@@ -122,7 +130,8 @@ pub(crate) fn generalised_moment<T: Num>(
     theta: T,
     theta_dot: T,
 ) -> T {
-    moment - damping * theta_dot - stiffness * theta
+    // (M − c θ̇) − k θ.
+    stiffness.neg_mul_add(theta, damping.neg_mul_add(theta_dot, moment))
 }
 
 /// θ̈ from the generalised moment over I_B, `forced`: eq. 28, or eq. 20 with 3/(2 m l³) = 1/I_B
@@ -139,8 +148,9 @@ pub(crate) fn angular_acceleration<T: Num>(
     match model {
         HingeModel::Linear => forced,
         HingeModel::Nonlinear => {
-            (forced - three * theta_dot * theta_dot * sin * cos)
-                / (T::from(1.0) + three * sin * sin)
+            // (forced − 3 θ̇² sin cos) / (1 + 3 sin²), the products taken left to right.
+            let coriolis = three * theta_dot * theta_dot * sin;
+            coriolis.neg_mul_add(cos, forced) / (three * sin).mul_add(sin, T::from(1.0))
         }
     }
 }
@@ -201,6 +211,18 @@ impl Hinge {
     pub(crate) fn rate_form(&self) -> (HingeModel, f64, f64) {
         (self.model, self.damping, self.stiffness)
     }
+
+    /// [`StructuralModel::rates`] in the arithmetic of `T` (`f64`, or [`Fused`]).
+    #[inline(always)]
+    fn rates_as<T: Num + Into<f64>>(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        let (theta, theta_dot) = (T::from(q[0]), T::from(q[1]));
+        let (damping, stiffness) = (T::from(self.damping), T::from(self.stiffness));
+        let forced = generalised_moment(T::from(load), damping, stiffness, theta, theta_dot);
+        let (s, c) = sin_cos_as::<T>(q[0]);
+        out[0] = q[1];
+        out[1] = angular_acceleration(self.model, forced, theta_dot, s, c).into();
+        c.into()
+    }
 }
 
 impl StructuralModel for Hinge {
@@ -226,6 +248,10 @@ impl StructuralModel for Hinge {
         out[0] = theta_dot;
         out[1] = angular_acceleration(self.model, forced, theta_dot, s, c);
         c
+    }
+    #[inline(always)]
+    fn rates_fused(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        self.rates_as::<Fused>(load, q, out)
     }
     fn positions(&self) -> usize {
         1
@@ -286,10 +312,17 @@ impl StructuralModel for Rigid {
 /// free of calls into libm, which make every caller spill its registers.
 #[inline]
 pub fn sin_cos(theta: f64) -> (f64, f64) {
+    sin_cos_as(theta)
+}
+
+/// [`sin_cos`] in the arithmetic of `T` (beyond π/4 the library's values, whatever `T`).
+#[inline(always)]
+pub(crate) fn sin_cos_as<T: Num>(theta: f64) -> (T, T) {
     if theta.abs() > std::f64::consts::FRAC_PI_4 {
-        return theta.sin_cos();
+        let (s, c) = theta.sin_cos();
+        return (T::from(s), T::from(c));
     }
-    sin_cos_kernel(theta)
+    sin_cos_kernel(T::from(theta))
 }
 
 /// The polynomials of [`sin_cos`] alone, for |θ| ≤ π/4 (no branch, so that a loop over SIMD
@@ -317,12 +350,18 @@ pub(crate) fn sin_cos_kernel<T: Num>(theta: T) -> (T, T) {
     let z = theta * theta;
     let w = z * z;
     let w2 = w * w;
-    // Estrin's scheme: three independent pairs, then two levels.
-    let ps = (s0 + z * s1) + w * (s2 + z * s3) + w2 * (s4 + z * s5);
-    let pc = (c0 + z * c1) + w * (c2 + z * c3) + w2 * (c4 + z * c5);
+    // Estrin's scheme: three independent pairs, then two levels,
+    // ((k0 + z k1) + w (k2 + z k3)) + w² (k4 + z k5), in that order.
+    let estrin = |k0, k1, k2, k3, k4, k5| {
+        let low = z.mul_add(k1, k0);
+        let low = w.mul_add(z.mul_add(k3, k2), low);
+        w2.mul_add(z.mul_add(k5, k4), low)
+    };
+    let ps = estrin(s0, s1, s2, s3, s4, s5);
+    let pc = estrin(c0, c1, c2, c3, c4, c5);
     (
-        theta + theta * z * ps,
-        T::from(1.0) - (T::from(0.5) * z - w * pc),
+        (theta * z).mul_add(ps, theta),
+        T::from(1.0) - w.neg_mul_add(pc, T::from(0.5) * z),
     )
 }
 

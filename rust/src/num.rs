@@ -39,7 +39,8 @@ pub(crate) fn golden_section(
     (a, b)
 }
 
-/// What the model's formulas need of a number: the four operations and constants.
+/// What the model's formulas need of a number: the four operations, constants, and a
+/// multiply-add.
 pub(crate) trait Num:
     Copy
     + Add<Output = Self>
@@ -49,9 +50,86 @@ pub(crate) trait Num:
     + Neg<Output = Self>
     + From<f64>
 {
+    /// b + self · a: two roundings (a multiplication, then an addition) unless the type is a
+    /// fused one, which rounds once. (The three forms keep the unfused arithmetic written as it
+    /// always was, operand for operand.)
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        b + self * a
+    }
+    /// self · a − b, likewise.
+    #[inline(always)]
+    fn mul_sub(self, a: Self, b: Self) -> Self {
+        self * a - b
+    }
+    /// b − self · a, likewise.
+    #[inline(always)]
+    fn neg_mul_add(self, a: Self, b: Self) -> Self {
+        b - self * a
+    }
 }
 
 impl Num for f64 {}
+
+/// One f64 whose [`Num::mul_add`] rounds once (a fused multiply-add): the scalar twin of the
+/// AVX2 and AVX-512 lanes, used by the scalar loop compiled for FMA
+/// (`integrate::ScalarKernel::Fma`). Compiled without FMA, `f64::mul_add` is a library call:
+/// the same bits, slowly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Fused(pub(crate) f64);
+
+impl From<f64> for Fused {
+    #[inline(always)]
+    fn from(x: f64) -> Fused {
+        Fused(x)
+    }
+}
+
+impl From<Fused> for f64 {
+    #[inline(always)]
+    fn from(x: Fused) -> f64 {
+        x.0
+    }
+}
+
+macro_rules! fused_operation {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for Fused {
+            type Output = Fused;
+            #[inline(always)]
+            fn $method(self, o: Fused) -> Fused {
+                Fused(self.0 $op o.0)
+            }
+        }
+    };
+}
+fused_operation!(Add, add, +);
+fused_operation!(Sub, sub, -);
+fused_operation!(Mul, mul, *);
+fused_operation!(Div, div, /);
+
+impl Neg for Fused {
+    type Output = Fused;
+    #[inline(always)]
+    fn neg(self) -> Fused {
+        Fused(-self.0)
+    }
+}
+
+impl Num for Fused {
+    #[inline(always)]
+    fn mul_add(self, a: Fused, b: Fused) -> Fused {
+        Fused(self.0.mul_add(a.0, b.0))
+    }
+    #[inline(always)]
+    fn mul_sub(self, a: Fused, b: Fused) -> Fused {
+        Fused(self.0.mul_add(a.0, -b.0))
+    }
+    #[inline(always)]
+    fn neg_mul_add(self, a: Fused, b: Fused) -> Fused {
+        Fused((-self.0).mul_add(a.0, b.0))
+    }
+}
 
 /// Values advanced side by side, one per lane.
 pub(crate) const LANES: usize = 8;
@@ -67,6 +145,33 @@ pub(crate) trait LaneArray {
 /// values by the type's method `$pair` with the closure given (one instruction per register).
 macro_rules! lane_type {
     ($t:ident, $pair:ident, $add:expr, $sub:expr, $mul:expr, $div:expr) => {
+        lane_type!($t, $pair, $add, $sub, $mul, $div, fused: false);
+        impl Num for $t {}
+    };
+    (
+        $t:ident, $pair:ident, $add:expr, $sub:expr, $mul:expr, $div:expr,
+        $triple:ident, $fmadd:expr, $fmsub:expr, $fnmadd:expr
+    ) => {
+        lane_type!($t, $pair, $add, $sub, $mul, $div, fused: true);
+        impl Num for $t {
+            #[inline(always)]
+            fn mul_add(self, a: $t, b: $t) -> $t {
+                self.$triple(a, b, $fmadd)
+            }
+            #[inline(always)]
+            fn mul_sub(self, a: $t, b: $t) -> $t {
+                self.$triple(a, b, $fmsub)
+            }
+            #[inline(always)]
+            fn neg_mul_add(self, a: $t, b: $t) -> $t {
+                self.$triple(a, b, $fnmadd)
+            }
+        }
+    };
+    ($t:ident, $pair:ident, $add:expr, $sub:expr, $mul:expr, $div:expr, fused: $fused:expr) => {
+        impl Fusion for $t {
+            const FUSED: bool = $fused;
+        }
         impl From<f64> for $t {
             #[inline(always)]
             fn from(x: f64) -> $t {
@@ -111,14 +216,19 @@ macro_rules! lane_type {
                 self.$pair(o, $div)
             }
         }
-        impl Num for $t {}
     };
 }
 
+/// Whether a lane type's [`Num::mul_add`] is fused (rounds once).
+pub(crate) trait Fusion {
+    const FUSED: bool;
+}
+
 /// One f64 per lane: what the lockstep kernel needs beyond [`Num`]. Every operation is the same
-/// IEEE operation in each lane, nothing fused or reordered, so each lane's bits are those of the
-/// scalar code.
-pub(crate) trait Lanes: Num + LaneArray {
+/// IEEE operation in each lane, nothing reordered, so each lane's bits are those of the scalar
+/// code in the same arithmetic: `f64` for the unfused lane types, [`Fused`] for the fused ones
+/// ([`Fusion::FUSED`]), whose `mul_add` is one FMA per lane.
+pub(crate) trait Lanes: Num + LaneArray + Fusion {
     /// |x| in each lane.
     fn abs(self) -> Self;
     /// `f64::max` in each lane.
@@ -184,16 +294,17 @@ impl Neg for Portable {
     }
 }
 
-/// [`Lanes`] as AVX instructions, two per operation (four lanes each). Values of this type are
-/// made only inside the lockstep kernel compiled for AVX2, which runs only once the processor is
-/// known to have it (`integrate::lockstep::Kernel`); its operations are inlined there. The lanes
+/// [`Lanes`] as AVX instructions, two per operation (four lanes each), `mul_add` fused. Values
+/// of this type are made only inside the lockstep kernel compiled for AVX2 and FMA, which runs
+/// only once the processor is known to have both (`integrate::lockstep::Kernel`); its
+/// operations are inlined there. The lanes
 /// are kept in an array (no vector type crosses a function boundary compiled without AVX).
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx::Avx;
 
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{LaneArray, Lanes, Num, LANES};
+    use super::{Fusion, LaneArray, Lanes, Num, LANES};
     use std::arch::x86_64::*;
     use std::ops::Neg;
 
@@ -239,16 +350,27 @@ mod avx {
             let ([a, b], [c, d]) = (self.get(), o.get());
             Avx::put([f(a, c), f(b, d)])
         }
+        /// `f` on each half of the three.
+        #[inline(always)]
+        fn each3(self, o: Avx, p: Avx, f: impl Fn(__m256d, __m256d, __m256d) -> __m256d) -> Avx {
+            let ([a, b], [c, d], [e, g]) = (self.get(), o.get(), p.get());
+            Avx::put([f(a, c, e), f(b, d, g)])
+        }
     }
 
-    // SAFETY (the four operations): see the type's comment.
+    // SAFETY (the operations): see the type's comment; the kernel compiled for AVX2 is
+    // compiled for FMA too, and runs only where the processor has both.
     lane_type!(
         Avx,
         each2,
         |a, b| unsafe { _mm256_add_pd(a, b) },
         |a, b| unsafe { _mm256_sub_pd(a, b) },
         |a, b| unsafe { _mm256_mul_pd(a, b) },
-        |a, b| unsafe { _mm256_div_pd(a, b) }
+        |a, b| unsafe { _mm256_div_pd(a, b) },
+        each3,
+        |a, b, c| unsafe { _mm256_fmadd_pd(a, b, c) },
+        |a, b, c| unsafe { _mm256_fmsub_pd(a, b, c) },
+        |a, b, c| unsafe { _mm256_fnmadd_pd(a, b, c) }
     );
 
     impl Neg for Avx {
@@ -299,14 +421,15 @@ mod avx {
     }
 }
 
-/// [`Lanes`] as AVX-512 instructions, all eight lanes in one register: made only inside the
-/// lockstep kernel compiled for AVX-512F, under the same rules as [`Avx`].
+/// [`Lanes`] as AVX-512 instructions, all eight lanes in one register, `mul_add` fused: made
+/// only inside the lockstep kernel compiled for AVX-512F and FMA, under the same rules as
+/// [`Avx`].
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx512::Avx512;
 
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    use super::{LaneArray, Lanes, Num, LANES};
+    use super::{Fusion, LaneArray, Lanes, Num, LANES};
     use std::arch::x86_64::*;
     use std::ops::Neg;
 
@@ -335,6 +458,16 @@ mod avx512 {
         fn each2(self, o: Avx512, f: impl Fn(__m512d, __m512d) -> __m512d) -> Avx512 {
             Avx512::put(f(self.get(), o.get()))
         }
+        /// `f` on the three.
+        #[inline(always)]
+        fn each3(
+            self,
+            o: Avx512,
+            p: Avx512,
+            f: impl Fn(__m512d, __m512d, __m512d) -> __m512d,
+        ) -> Avx512 {
+            Avx512::put(f(self.get(), o.get(), p.get()))
+        }
         /// The lanes where `take` holds, as a mask.
         #[inline(always)]
         fn mask(take: [bool; LANES]) -> __mmask8 {
@@ -344,14 +477,18 @@ mod avx512 {
         }
     }
 
-    // SAFETY (the four operations): see the type's comment.
+    // SAFETY (the operations): see the type's comment.
     lane_type!(
         Avx512,
         each2,
         |a, b| unsafe { _mm512_add_pd(a, b) },
         |a, b| unsafe { _mm512_sub_pd(a, b) },
         |a, b| unsafe { _mm512_mul_pd(a, b) },
-        |a, b| unsafe { _mm512_div_pd(a, b) }
+        |a, b| unsafe { _mm512_div_pd(a, b) },
+        each3,
+        |a, b, c| unsafe { _mm512_fmadd_pd(a, b, c) },
+        |a, b, c| unsafe { _mm512_fmsub_pd(a, b, c) },
+        |a, b, c| unsafe { _mm512_fnmadd_pd(a, b, c) }
     );
 
     impl Neg for Avx512 {

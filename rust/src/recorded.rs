@@ -6,13 +6,18 @@
 //! its sunlit equilibrium with the adaptive integrator over one orbit, plus the linear/frozen
 //! variants, a fixed-step run, per-orbit summaries and the flutter analysis.
 //!
+//! The records are the portable kernel's bits (`integrate::ScalarKernel::Portable`, the only
+//! one there was), so every case runs on it ([`on_portable`]); the fused kernel's results are
+//! checked against them within a tolerance ([`fused_kernel_stays_near_the_records`]).
+//!
 //! One exception, made on purpose: the per-orbit summary fields were re-recorded after issue 16
 //! changed how the summary reads each step (see [`SUMMARIES_TWO_READS`]); the four-read values
 //! are kept and checked within 1e-3.
 
 use crate::dynamics::HingeModel;
 use crate::flutter::{analyse, critical_damping};
-use crate::integrate::{Method, Tolerances};
+use crate::integrate::lockstep::on_portable;
+use crate::integrate::{Method, ScalarKernel, Tolerances};
 use crate::longrun::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
 use crate::orbit::Orbit;
 use crate::params::Panel;
@@ -28,6 +33,16 @@ fn year_orbit() -> Orbit {
 /// One orbit from the sunlit equilibrium, sampled at 12 evenly spaced times; returns the bits of
 /// (T_f, T_b, θ, θ̇) at each sample, then n_steps, n_rejected, n_rhs.
 fn trajectory(orbit: Orbit, model: HingeModel, coupling: Coupling, method: Method) -> Vec<u64> {
+    on_portable(|| trajectory_here(orbit, model, coupling, method))
+}
+
+/// [`trajectory`] on the kernel this thread's runs take.
+fn trajectory_here(
+    orbit: Orbit,
+    model: HingeModel,
+    coupling: Coupling,
+    method: Method,
+) -> Vec<u64> {
     let panel = Panel::paper();
     let eq = equilibrium(&panel, coupling, orbit.flux_scale(0.0)).unwrap();
     let y0 = state(eq.t_front, eq.t_back, eq.theta, 0.0);
@@ -76,6 +91,11 @@ fn analysis() -> Vec<u64> {
 
 /// Bits of every field of the per-orbit summaries of two year orbits.
 fn summaries() -> Vec<u64> {
+    on_portable(summaries_here)
+}
+
+/// [`summaries`] on the kernel this thread's runs take.
+fn summaries_here() -> Vec<u64> {
     let p = Panel::paper();
     let o = year_orbit();
     let eq = equilibrium(&p, Coupling::ProjectedArea, o.flux_scale(0.0)).unwrap();
@@ -628,4 +648,55 @@ fn check_four_reads(got: &[u64], want: &[u64]) {
 #[test]
 fn steady_states_and_flutter_are_unchanged() {
     check("ANALYSIS", analysis(), &ANALYSIS);
+}
+
+/// The fused kernel's trajectories against the portable records: not the same bits (the
+/// right-hand side's multiply-adds round once), and as near as two runs can be whose adaptive
+/// step sequences part (a rejection here or there; θ's error against a tight solution is about
+/// as large on either kernel: `integrate::tests::the_fused_kernel_is_as_accurate_as_the_portable_one`).
+/// Bounds per column, of its range over the samples, ten times what was measured: temperatures
+/// 1e-9 (5.6e-11), θ 1e-5 (1.6e-6), θ̇ 1e-3 (9.4e-5: θ̇ is near zero at the samples); steps to
+/// 0.1% and rejections to 2%. The fixed-step run takes the same steps on both kernels, so it
+/// agrees to rounding (θ̇ 1.4e-11 of its range).
+#[test]
+fn fused_kernel_stays_near_the_records() {
+    if ScalarKernel::detect() != ScalarKernel::Fma {
+        eprintln!("no FMA kernel on this processor: nothing to compare");
+        return;
+    }
+    let f = f64::from_bits;
+    let near = |name: &str, got: &[u64], want: &[u64], bounds: [f64; 4]| {
+        assert_eq!(got.len(), want.len(), "{name}");
+        assert_ne!(got, want, "{name}: the fused kernel gave the portable bits");
+        // (T_f, T_b, θ, θ̇) at 13 times, then n_steps, n_rejected, n_rhs.
+        let n = got.len() - 3;
+        for (c, bound) in bounds.iter().enumerate() {
+            let column = || (c..n).step_by(4).map(|i| f(want[i]));
+            let range = column().fold(f64::MIN, f64::max) - column().fold(f64::MAX, f64::min);
+            for i in (c..n).step_by(4) {
+                let (a, b) = (f(got[i]), f(want[i]));
+                assert!(
+                    (a - b).abs() <= bound * range,
+                    "{name} entry {i}: fused {a:e}, recorded {b:e} (range {range:e})"
+                );
+            }
+        }
+        let counter = |i: usize, share: f64| {
+            let (a, b) = (got[n + i] as f64, want[n + i] as f64);
+            assert!(
+                (a - b).abs() <= share * b,
+                "{name} counter {i}: {a} against {b}"
+            );
+        };
+        counter(0, 1e-3);
+        counter(1, 2e-2);
+    };
+    let (pa, nl) = (Coupling::ProjectedArea, HingeModel::Nonlinear);
+    let adaptive_bounds = [1e-9, 1e-9, 1e-5, 1e-3];
+    let paper = trajectory_here(Orbit::geo_equinox(), nl, pa, adaptive());
+    near("PAPER", &paper, &PAPER, adaptive_bounds);
+    let year = trajectory_here(year_orbit(), nl, pa, adaptive());
+    near("YEAR", &year, &YEAR, adaptive_bounds);
+    let rk4 = trajectory_here(year_orbit(), nl, pa, Method::Rk4 { dt: 2.0 });
+    near("YEAR_RK4", &rk4, &YEAR_RK4, [1e-13, 1e-13, 1e-13, 1e-9]);
 }

@@ -221,20 +221,39 @@ where
     /// The right-hand side at a given illumination factor (used by the equilibrium solver too).
     #[inline(always)]
     pub fn rhs_at_flux(&self, flux: f64, y: &State<D>) -> State<D> {
+        self.rhs_at_flux_as::<false>(flux, y)
+    }
+
+    /// [`Coupled::rhs_at_flux`], with the models' fused rates when `FUSED`.
+    #[inline(always)]
+    fn rhs_at_flux_as<const FUSED: bool>(&self, flux: f64, y: &State<D>) -> State<D> {
         let mut out = State::<D>::zeros_generic(self.dim, U1);
         let n = self.thermal.size();
         let (temps, q) = y.as_slice().split_at(n);
         let (temp_rates, q_rates) = out.as_mut_slice().split_at_mut(n);
         let load = self.load_per_kelvin * self.thermal.gradient(temps);
         let area = match self.coupling {
-            Coupling::ProjectedArea => self.structure.rates(load, q, q_rates),
+            Coupling::ProjectedArea => self.structure_rates::<FUSED>(load, q, q_rates),
             Coupling::Frozen => {
-                self.structure.rates(load, q, q_rates);
+                self.structure_rates::<FUSED>(load, q, q_rates);
                 1.0
             }
         };
-        self.thermal.rates(flux * area, temps, temp_rates);
+        if FUSED {
+            self.thermal.rates_fused(flux * area, temps, temp_rates);
+        } else {
+            self.thermal.rates(flux * area, temps, temp_rates);
+        }
         out
+    }
+
+    #[inline(always)]
+    fn structure_rates<const FUSED: bool>(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        if FUSED {
+            self.structure.rates_fused(load, q, out)
+        } else {
+            self.structure.rates(load, q, out)
+        }
     }
 
     /// Illumination factor (s × flux scale) inside the current segment at time t.
@@ -250,6 +269,10 @@ where
     #[inline(always)]
     fn rhs(&self, t: f64, y: &State<D>) -> State<D> {
         self.rhs_at_flux(self.sun.flux(t), y)
+    }
+    #[inline(always)]
+    fn rhs_fused(&self, t: f64, y: &State<D>) -> State<D> {
+        self.rhs_at_flux_as::<true>(self.sun.flux(t), y)
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)

@@ -9,7 +9,7 @@
 //! (K/s, the form the integrator's hot path uses, with no division left in it).
 
 use crate::error::{Error, Result};
-use crate::num::Num;
+use crate::num::{Fused, Num};
 use crate::params::Panel;
 use crate::STEFAN_BOLTZMANN;
 
@@ -63,6 +63,14 @@ pub trait ThermalModel {
         self.flow_rates(flux, temps, out);
     }
 
+    /// [`ThermalModel::rates`] with its multiply-adds fused where the model has a fused form
+    /// (the two-layer plate does), else `rates` itself. Only code compiled for FMA calls it
+    /// (`integrate::ScalarKernel::Fma`).
+    #[inline(always)]
+    fn rates_fused(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
+        self.rates(flux, temps, out);
+    }
+
     /// dT/dt as written: the heat flows over the capacities, K/s. Not meant to be overridden.
     #[inline]
     fn flow_rates(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
@@ -101,6 +109,9 @@ impl<M: ThermalModel + ?Sized> ThermalModel for Box<M> {
     }
     fn rates(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
         (**self).rates(flux, temps, out)
+    }
+    fn rates_fused(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
+        (**self).rates_fused(flux, temps, out)
     }
     fn heat_flows(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
         (**self).heat_flows(flux, temps, out)
@@ -227,6 +238,17 @@ pub(crate) struct Balance<T = f64> {
 }
 
 impl Balance {
+    /// The same coefficients as values of `T`.
+    #[inline(always)]
+    pub(crate) fn to<T: From<f64>>(&self) -> Balance<T> {
+        Balance {
+            heating: T::from(self.heating),
+            conduction: T::from(self.conduction),
+            radiation_front: T::from(self.radiation_front),
+            radiation_back: T::from(self.radiation_back),
+        }
+    }
+
     fn per_capacity(&self, capacity: f64) -> Self {
         Balance {
             heating: self.heating / capacity,
@@ -244,8 +266,10 @@ impl<T: Num> Balance<T> {
         let conducted = self.conduction * (t_front - t_back);
         let tf4 = (t_front * t_front) * (t_front * t_front);
         let tb4 = (t_back * t_back) * (t_back * t_back);
-        let front = self.heating * flux - conducted - self.radiation_front * tf4;
-        let back = conducted - self.radiation_back * tb4;
+        // (α C flux − conducted) − σ ε_f T_f⁴ and conducted − σ ε_b T_b⁴.
+        let absorbed = self.heating.mul_sub(flux, conducted);
+        let front = self.radiation_front.neg_mul_add(tf4, absorbed);
+        let back = self.radiation_back.neg_mul_add(tb4, conducted);
         (front, back)
     }
 }
@@ -307,6 +331,15 @@ impl ThermalModel for TwoLayer {
         let (front, back) = self.rates_of(flux, temps[0], temps[1]);
         out[0] = front;
         out[1] = back;
+    }
+    #[inline(always)]
+    fn rates_fused(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
+        let (front, back) =
+            self.rate
+                .to::<Fused>()
+                .flows(Fused(flux), Fused(temps[0]), Fused(temps[1]));
+        out[0] = front.0;
+        out[1] = back.0;
     }
     fn heat_flows(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
         let (front, back) = self.heat.flows(flux, temps[0], temps[1]);

@@ -166,6 +166,7 @@ where
 }
 
 /// Integrates one segment [a, b] on which the right-hand side is smooth; `y` goes from y(a) to y(b).
+#[inline(always)]
 pub(super) fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &S,
     a: f64,

@@ -11,18 +11,24 @@
 //! Every lane has its own step size, accept/reject decision, segments (shadow crossings),
 //! counters and observer: lanes share only the instruction stream. A lane performs for its run
 //! exactly the floating-point operations of [`super::solve`] with [`super::dopri5`], in the same
-//! order, and no fused multiply-add (Rust never contracts on its own, and no kernel enables
-//! FMA), so a run gives the same bits in any lane as alone, whatever the other lanes hold
+//! order, with the multiply-adds of the right-hand side fused exactly where the scalar kernel
+//! the lane kernel matches fuses them ([`Kernel::scalar`]; Rust never contracts on its own), so
+//! a run gives the same bits in any lane as alone, whatever the other lanes hold
 //! (`tests::lanes_equal_single_runs`). A lane whose run ends takes the next job; a lane without
 //! one computes on zeros and is ignored.
 //!
-//! The kernel is compiled three times: for the build's baseline, for AVX2 and for AVX-512F, the
-//! newest the processor has picked at run time ([`Kernel::detect`]). All give the same bits.
+//! The kernel is compiled three times: for the build's baseline, for AVX2 with FMA and for
+//! AVX-512F with FMA, the newest the processor has picked at run time ([`Kernel::detect`]).
+//! The two FMA kernels give the same bits, those of [`ScalarKernel::Fma`]; the portable one
+//! those of [`ScalarKernel::Portable`].
 
 use super::dopri5::{
     self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
 };
-use super::{check_span, solve, DenseStep, Method, Observer, OdeSystem, Stats, Tolerances};
+use super::{
+    check_span, solve_on, DenseStep, FusedRhs, Method, Observer, OdeSystem, ScalarKernel, Stats,
+    Tolerances,
+};
 use crate::dynamics::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::error::{Error, Result};
 use crate::longrun::quasi_static;
@@ -33,6 +39,7 @@ use crate::system::{Coupled, Coupling, LaneForm};
 use crate::thermal::Balance;
 use nalgebra::Vector4;
 use std::f64::consts::FRAC_PI_4;
+use std::sync::OnceLock;
 
 /// Runs advanced together on one core.
 pub const LANES: usize = crate::num::LANES;
@@ -80,41 +87,89 @@ pub struct StepReads {
     pub rising: [bool; 3],
 }
 
+/// The environment variable that picks the kernels: `portable` runs the portable scalar and
+/// lane kernels on any processor (the bits of one without FMA); unset, or `auto`, the best the
+/// processor has. Read once, at the first run.
+pub const KERNEL_VARIABLE: &str = "THERMOJITTER_KERNEL";
+
+/// What [`KERNEL_VARIABLE`] may be set to.
+pub const KERNEL_CHOICES: [&str; 2] = ["auto", "portable"];
+
 /// Which compilation of the lane kernel runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kernel {
     /// The build's baseline instruction set (SSE2 on x86-64).
     Portable,
-    /// AVX2 (x86-64 only, when the processor has it).
+    /// AVX2 and FMA (x86-64 only, when the processor has both).
     Avx2,
-    /// AVX-512F (x86-64 only, when the processor has it).
+    /// AVX-512F and FMA (x86-64 only, when the processor has both).
     Avx512,
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by [`on_portable`]: this thread's runs take the portable kernels.
+    static PORTABLE_HERE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with the portable kernels chosen on this thread (tests that pin portable bits).
+#[cfg(test)]
+pub(crate) fn on_portable<R>(f: impl FnOnce() -> R) -> R {
+    PORTABLE_HERE.with(|p| p.set(true));
+    let out = f();
+    PORTABLE_HERE.with(|p| p.set(false));
+    out
 }
 
 impl Kernel {
     /// Every kernel, oldest instruction set first.
     const ALL: [Kernel; 3] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512];
 
-    /// Whether this processor has the kernel's instruction set.
+    /// Whether this processor has the kernel's instruction sets.
     pub fn runs_here(self) -> bool {
         match self {
             Kernel::Portable => true,
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            Kernel::Avx2 => {
+                std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx512 => std::arch::is_x86_feature_detected!("avx512f"),
+            Kernel::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
             #[cfg(not(target_arch = "x86_64"))]
             _ => false,
         }
     }
 
-    /// The best kernel this processor runs.
+    /// The kernel runs use here: the best this processor runs, or the portable one when
+    /// [`KERNEL_VARIABLE`] says `portable`.
     pub fn detect() -> Self {
-        Kernel::ALL
-            .into_iter()
-            .rev()
-            .find(|k| k.runs_here())
-            .unwrap_or(Kernel::Portable)
+        #[cfg(test)]
+        if PORTABLE_HERE.with(|p| p.get()) {
+            return Kernel::Portable;
+        }
+        static CHOSEN: OnceLock<Kernel> = OnceLock::new();
+        *CHOSEN.get_or_init(|| {
+            if portable_requested() {
+                return Kernel::Portable;
+            }
+            Kernel::ALL
+                .into_iter()
+                .rev()
+                .find(|k| k.runs_here())
+                .unwrap_or(Kernel::Portable)
+        })
+    }
+
+    /// The scalar kernel whose bits this one's lanes give.
+    pub fn scalar(self) -> ScalarKernel {
+        match self {
+            Kernel::Portable => ScalarKernel::Portable,
+            Kernel::Avx2 | Kernel::Avx512 => ScalarKernel::Fma,
+        }
     }
 
     /// Every kernel this processor runs, the portable one first.
@@ -131,6 +186,11 @@ impl Kernel {
     }
 }
 
+/// Whether [`KERNEL_VARIABLE`] asks for the portable kernels.
+pub fn portable_requested() -> bool {
+    std::env::var(KERNEL_VARIABLE).is_ok_and(|v| v.trim().eq_ignore_ascii_case("portable"))
+}
+
 /// Runs every job `next` hands out, [`LANES`] at a time, and hands each observer back to `done`
 /// with the run's outcome (as [`solve`] returns it) as soon as its run ends. Jobs whose model or
 /// coupling differs from the first job's run alone, through [`solve`].
@@ -143,12 +203,12 @@ where
     match kernel {
         #[cfg(target_arch = "x86_64")]
         Kernel::Avx2 if kernel.runs_here() => {
-            // SAFETY: the processor has AVX2 (checked just above).
+            // SAFETY: the processor has AVX2 and FMA (checked just above).
             unsafe { drive_avx2(next, done) }
         }
         #[cfg(target_arch = "x86_64")]
         Kernel::Avx512 if kernel.runs_here() => {
-            // SAFETY: the processor has AVX-512F (checked just above).
+            // SAFETY: the processor has AVX-512F and FMA (checked just above).
             unsafe { drive_avx512(next, done) }
         }
         _ => drive::<Portable, O, N, F>(next, done),
@@ -156,7 +216,7 @@ where
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 unsafe fn drive_avx2<O, N, F>(next: N, done: F)
 where
     O: LaneObserver,
@@ -167,7 +227,7 @@ where
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,fma")]
 unsafe fn drive_avx512<O, N, F>(next: N, done: F)
 where
     O: LaneObserver,
@@ -507,6 +567,9 @@ struct Lane<O> {
     /// just started or entered a segment. Otherwise the pack keeps them from step to step (the
     /// lanes that accept take y_new and k7 together, [`drive`]).
     stale: bool,
+    /// The lanes' multiply-adds are fused: the run's scalar parts (its first stage at each
+    /// segment, its first step's estimate, a run alone) take the fused right-hand side too.
+    fused: bool,
 }
 
 /// How a run left its lane.
@@ -515,7 +578,7 @@ type Outcome = Result<(Stats, Vector4<f64>)>;
 impl<O: LaneObserver> Lane<O> {
     /// Sets up a run (the checks of [`super::solve`]); `Err` hands the job back with its outcome
     /// when it ends before its first step.
-    fn start(job: Job<O>) -> std::result::Result<Self, (O, Outcome)> {
+    fn start(job: Job<O>, fused: bool) -> std::result::Result<Self, (O, Outcome)> {
         let Job {
             system,
             tol,
@@ -562,6 +625,7 @@ impl<O: LaneObserver> Lane<O> {
             k1: y0,
             constant_flux: None,
             stale: true,
+            fused,
         };
         if lane.enter_segment() {
             Ok(lane)
@@ -584,18 +648,17 @@ impl<O: LaneObserver> Lane<O> {
             self.constant_flux = self.system.constant_flux();
             self.t = a;
             self.b = b;
-            self.k1 = self.system.rhs(a, &self.y);
-            self.stale = true;
+            let (y, tol, stats) = (&self.y, &self.tol, &mut self.stats);
+            let h0 = if self.fused {
+                let system = FusedRhs(&self.system);
+                self.k1 = system.rhs(a, y);
+                dopri5::initial_step(&system, a, y, &self.k1, b - a, tol, stats)
+            } else {
+                self.k1 = self.system.rhs(a, y);
+                dopri5::initial_step(&self.system, a, y, &self.k1, b - a, tol, stats)
+            };
             self.stats.n_rhs += 1;
-            let h0 = dopri5::initial_step(
-                &self.system,
-                a,
-                &self.y,
-                &self.k1,
-                b - a,
-                &self.tol,
-                &mut self.stats,
-            );
+            self.stale = true;
             self.h_abs = h0.min(self.tol.max_step);
             self.rejected = false;
             return true;
@@ -790,7 +853,8 @@ impl<V: Lanes, O: LaneObserver> Group<V, O> {
                 } = job.system.lane_form();
                 let (m, c) = *form.get_or_insert((model, coupling));
                 if (model, coupling) != (m, c) {
-                    let outcome = solve(
+                    let outcome = solve_on(
+                        kernel_of::<V>(),
                         &mut job.system,
                         &Method::Dopri5(job.tol),
                         job.t0,
@@ -801,7 +865,7 @@ impl<V: Lanes, O: LaneObserver> Group<V, O> {
                     done(job.observer, outcome);
                     continue;
                 }
-                match Lane::start(job) {
+                match Lane::start(job, V::FUSED) {
                     Ok(lane) => {
                         lane.load(&mut self.pack, l);
                         *slot = Some(lane);
@@ -859,6 +923,15 @@ impl<V: Lanes, O: LaneObserver> Group<V, O> {
                 done(lane.observer, outcome);
             }
         }
+    }
+}
+
+/// The scalar kernel whose arithmetic the lane type `V` has.
+fn kernel_of<V: Lanes>() -> ScalarKernel {
+    if V::FUSED {
+        ScalarKernel::Fma
+    } else {
+        ScalarKernel::Portable
     }
 }
 
@@ -992,12 +1065,22 @@ mod tests {
         (samples.collect(), end, stats)
     }
 
-    fn alone(jobs: Vec<Job<Tagged>>) -> Runs {
+    /// Each job run alone on `kernel`.
+    fn alone(kernel: ScalarKernel, jobs: Vec<Job<Tagged>>) -> Runs {
         jobs.into_iter()
             .map(|mut j| {
                 let method = Method::Dopri5(j.tol);
-                let (stats, y_end) =
-                    solve(&mut j.system, &method, j.t0, j.y0, j.t1, &mut j.observer.1).unwrap();
+                let (t0, y0, t1) = (j.t0, j.y0, j.t1);
+                let (stats, y_end) = solve_on(
+                    kernel,
+                    &mut j.system,
+                    &method,
+                    t0,
+                    y0,
+                    t1,
+                    &mut j.observer.1,
+                )
+                .unwrap();
                 bits(&j.observer.1, &y_end, stats)
             })
             .collect()
@@ -1013,11 +1096,11 @@ mod tests {
             (HingeModel::Nonlinear, Coupling::Frozen),
         ] {
             let ps = panels(RUNS_PER_CORE + 3);
-            let want = alone(jobs(&ps, model, coupling));
-            assert!(want
-                .iter()
-                .all(|(_, _, s)| s.n_rejected > 0 || s.n_steps > 100));
             for kernel in Kernel::available() {
+                let want = alone(kernel.scalar(), jobs(&ps, model, coupling));
+                assert!(want
+                    .iter()
+                    .all(|(_, _, s)| s.n_rejected > 0 || s.n_steps > 100));
                 let got = in_lockstep(kernel, jobs(&ps, model, coupling));
                 for (k, (g, w)) in got.iter().zip(&want).enumerate() {
                     assert_eq!(g, w, "{model:?} {coupling:?} {kernel:?}: run {k}");
@@ -1033,8 +1116,8 @@ mod tests {
         assert!(orbit.eclipses(0.0, orbit.period).len() == 1);
         let ps = panels(5);
         let (m, c) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
-        let want = alone(jobs_on(orbit, &ps, m, c));
         for kernel in Kernel::available() {
+            let want = alone(kernel.scalar(), jobs_on(orbit, &ps, m, c));
             assert_eq!(in_lockstep(kernel, jobs_on(orbit, &ps, m, c)), want);
         }
     }
@@ -1045,12 +1128,16 @@ mod tests {
         let mut js = jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea);
         js[1].tol.max_steps = 50;
         js[3].y0[0] = f64::NAN;
-        let want = alone(jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea));
+        let kernel = Kernel::detect();
+        let want = alone(
+            kernel.scalar(),
+            jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea),
+        );
         let mut errors = Vec::new();
         let mut ok = Vec::new();
         let mut queue = js.into_iter();
         solve_lockstep(
-            Kernel::detect(),
+            kernel,
             || queue.next(),
             |Tagged(k, s), outcome| match outcome {
                 Ok((stats, y)) => ok.push((k, bits(&s, &y, stats))),
@@ -1071,11 +1158,29 @@ mod tests {
     #[test]
     fn a_job_of_another_model_runs_alone() {
         let ps = panels(3);
-        let mut js = jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea);
-        let other = jobs(&ps, HingeModel::Linear, Coupling::ProjectedArea);
-        js[1] = other.into_iter().nth(1).unwrap();
-        let mut want = alone(jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea));
-        want[1] = alone(jobs(&ps, HingeModel::Linear, Coupling::ProjectedArea)).remove(1);
-        assert_eq!(in_lockstep(Kernel::detect(), js), want);
+        // Alone on the scalar kernel of the lanes' (the fused one beside fused lanes).
+        for kernel in Kernel::available() {
+            let scalar = kernel.scalar();
+            let mut want = alone(
+                scalar,
+                jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea),
+            );
+            let linear = jobs(&ps, HingeModel::Linear, Coupling::ProjectedArea);
+            want[1] = alone(scalar, linear).remove(1);
+            let js = jobs(&ps, HingeModel::Nonlinear, Coupling::ProjectedArea)
+                .into_iter()
+                .enumerate()
+                .map(|(k, j)| if k == 1 { other_job(&ps) } else { j })
+                .collect();
+            assert_eq!(in_lockstep(kernel, js), want, "{kernel:?}");
+        }
+    }
+
+    /// The second job of [`a_job_of_another_model_runs_alone`]: the linear hinge.
+    fn other_job(ps: &[Panel]) -> Job<Tagged> {
+        jobs(ps, HingeModel::Linear, Coupling::ProjectedArea)
+            .into_iter()
+            .nth(1)
+            .unwrap()
     }
 }

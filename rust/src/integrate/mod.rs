@@ -32,6 +32,14 @@ where
     /// f(t, y), of the same dimension as y.
     fn rhs(&self, t: f64, y: &State<D>) -> State<D>;
 
+    /// f(t, y) with the multiply-adds fused where the system has a fused form (the paper's
+    /// model: [`crate::system::Coupled`] of two layers on the hinge), else [`OdeSystem::rhs`].
+    /// Only the loop compiled for FMA calls it ([`ScalarKernel::Fma`]).
+    #[inline(always)]
+    fn rhs_fused(&self, t: f64, y: &State<D>) -> State<D> {
+        self.rhs(t, y)
+    }
+
     /// Times in (t0, t1) where the right-hand side is discontinuous, sorted.
     fn breakpoints(&self, _t0: f64, _t1: f64) -> Vec<f64> {
         Vec::new()
@@ -321,9 +329,86 @@ pub struct Stats {
     pub stopped: bool,
 }
 
+/// Which compilation of the scalar integration loop ([`solve`]'s loop over segments and steps,
+/// with the right-hand side inlined into it) runs.
+///
+/// The fused one differs from the portable one in the last bits: the paper model's right-hand
+/// side ([`OdeSystem::rhs_fused`]) rounds each of its multiply-adds once. Every other
+/// operation, and every other model, is the same in both. The lockstep lanes pick theirs to
+/// match ([`lockstep::Kernel::scalar`]), so a run gives the same bits alone or in a lane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScalarKernel {
+    /// The build's baseline instruction set (SSE2 on x86-64), multiply and add rounded apart:
+    /// the same bits on every processor.
+    Portable,
+    /// Compiled for AVX and FMA (x86-64 only, when the processor has both): the sin/cos
+    /// polynomials, the hinge's and the layers' balances as fused multiply-adds, which shortens
+    /// the right-hand side's chain of dependent operations.
+    Fma,
+}
+
+impl ScalarKernel {
+    /// Whether this processor has the kernel's instruction sets.
+    pub fn runs_here(self) -> bool {
+        match self {
+            ScalarKernel::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            ScalarKernel::Fma => {
+                std::arch::is_x86_feature_detected!("avx")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            ScalarKernel::Fma => false,
+        }
+    }
+
+    /// The kernel runs use here: the one matching the lockstep kernel chosen
+    /// ([`lockstep::Kernel::detect`], which [`lockstep::KERNEL_VARIABLE`] can set to portable).
+    pub fn detect() -> Self {
+        lockstep::Kernel::detect().scalar()
+    }
+
+    /// Every kernel this processor runs, the portable one first.
+    pub fn available() -> Vec<Self> {
+        [ScalarKernel::Portable, ScalarKernel::Fma]
+            .into_iter()
+            .filter(|k| k.runs_here())
+            .collect()
+    }
+
+    /// Whether the kernel's multiply-adds round once.
+    pub fn fused(self) -> bool {
+        self == ScalarKernel::Fma
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ScalarKernel::Portable => "portable",
+            ScalarKernel::Fma => "fma",
+        }
+    }
+}
+
 /// Integrates `system` from (t0, y0) to t1 with `method`, cutting at the system's breakpoints.
-/// Returns the counters and the state at `stats.t_end`.
+/// Returns the counters and the state at `stats.t_end`. Runs on [`ScalarKernel::detect`].
 pub fn solve<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
+    system: &mut S,
+    method: &Method,
+    t0: f64,
+    y0: State<D>,
+    t1: f64,
+    observer: &mut O,
+) -> Result<(Stats, State<D>)>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    solve_on(ScalarKernel::detect(), system, method, t0, y0, t1, observer)
+}
+
+/// [`solve`] on a given compilation of its loop (the portable one when the processor lacks the
+/// kernel's instruction set).
+pub fn solve_on<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
+    kernel: ScalarKernel,
     system: &mut S,
     method: &Method,
     t0: f64,
@@ -359,8 +444,61 @@ where
     let mut cuts = vec![t0];
     cuts.extend(system.breakpoints(t0, t1));
     cuts.push(t1);
+    match kernel {
+        #[cfg(target_arch = "x86_64")]
+        ScalarKernel::Fma if kernel.runs_here() => {
+            // SAFETY: the processor has AVX and FMA (checked just above).
+            unsafe { integrate_fma(system, method, &cuts, y0, observer) }
+        }
+        _ => integrate::<false, D, S, O>(system, method, &cuts, y0, observer),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+unsafe fn integrate_fma<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
+    system: &mut S,
+    method: &Method,
+    cuts: &[f64],
+    y0: State<D>,
+    observer: &mut O,
+) -> Result<(Stats, State<D>)>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    integrate::<true, D, S, O>(system, method, cuts, y0, observer)
+}
+
+/// `system` seen through its fused right-hand side ([`OdeSystem::rhs_fused`]), for the steppers.
+pub struct FusedRhs<'a, S>(pub &'a S);
+
+impl<D: Dim, S: OdeSystem<D>> OdeSystem<D> for FusedRhs<'_, S>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &State<D>) -> State<D> {
+        self.0.rhs_fused(t, y)
+    }
+}
+
+/// The segments between successive `cuts` (the span's ends and breakpoints), one after another,
+/// on the fused right-hand side when `FUSED`. Always inlined, with the steppers and the
+/// right-hand side, into each compilation.
+#[inline(always)]
+fn integrate<const FUSED: bool, D: Dim, S: OdeSystem<D>, O: Observer<D>>(
+    system: &mut S,
+    method: &Method,
+    cuts: &[f64],
+    y0: State<D>,
+    observer: &mut O,
+) -> Result<(Stats, State<D>)>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let t1 = cuts[cuts.len() - 1];
     let mut stats = Stats {
-        t_end: t0,
+        t_end: cuts[0],
         ..Stats::default()
     };
     let mut y = y0;
@@ -370,11 +508,18 @@ where
             continue;
         }
         system.enter_segment(a, b);
-        let flow = match method {
-            Method::Rk4 { dt } => rk4::segment(system, a, b, &mut y, *dt, &mut stats, observer)?,
-            Method::Dopri5(tol) => {
-                dopri5::segment(system, a, b, &mut y, tol, &mut stats, observer)?
-            }
+        let flow = if FUSED {
+            segment(
+                &FusedRhs(&*system),
+                method,
+                a,
+                b,
+                &mut y,
+                &mut stats,
+                observer,
+            )?
+        } else {
+            segment(&*system, method, a, b, &mut y, &mut stats, observer)?
         };
         if flow.is_break() {
             stats.stopped = stats.t_end < t1;
@@ -382,6 +527,26 @@ where
         }
     }
     Ok((stats, y))
+}
+
+/// One segment [a, b] by `method`.
+#[inline(always)]
+fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
+    system: &S,
+    method: &Method,
+    a: f64,
+    b: f64,
+    y: &mut State<D>,
+    stats: &mut Stats,
+    observer: &mut O,
+) -> Result<ControlFlow<()>>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    match method {
+        Method::Rk4 { dt } => rk4::segment(system, a, b, y, *dt, stats, observer),
+        Method::Dopri5(tol) => dopri5::segment(system, a, b, y, tol, stats, observer),
+    }
 }
 
 /// Loosest relative tolerance accepted.

@@ -8,6 +8,7 @@ use std::ops::ControlFlow;
 
 /// Integrates the segment [a, b] in n equal steps, n = ceil((b − a)/dt), so the last step lands
 /// exactly on b. Dense output is the cubic Hermite interpolant (slopes at both step ends).
+#[inline(always)]
 pub(super) fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &S,
     a: f64,

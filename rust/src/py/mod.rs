@@ -416,6 +416,14 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "ENSEMBLE_RUNS_PER_CORE",
         crate::integrate::lockstep::RUNS_PER_CORE,
     )?;
+    m.add(
+        "KERNEL_VARIABLE",
+        crate::integrate::lockstep::KERNEL_VARIABLE,
+    )?;
+    m.add(
+        "KERNEL_CHOICES",
+        crate::integrate::lockstep::KERNEL_CHOICES.to_vec(),
+    )?;
     m.add("MAX_THREADS", crate::montecarlo::MAX_THREADS)?;
     m.add("VALIDITY_LIMIT", crate::dynamics::VALIDITY_LIMIT)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;

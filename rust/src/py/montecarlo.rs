@@ -207,14 +207,18 @@ impl MonteCarloPool {
     }
 }
 
-/// The processor, the instruction sets it has and the build uses, and the ensemble kernel
-/// chosen on it, for benchmark reports.
+/// The processor, the instruction sets it has and the build uses, and the scalar and ensemble
+/// kernels chosen on it, for benchmark reports.
 #[pyfunction]
 fn cpu_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("model", crate::cpu::model_name())?;
     d.set_item("has", crate::cpu::detected())?;
     d.set_item("build", crate::cpu::compiled())?;
+    d.set_item(
+        "scalar_kernel",
+        crate::integrate::ScalarKernel::detect().name(),
+    )?;
     d.set_item(
         "ensemble_kernel",
         crate::integrate::lockstep::Kernel::detect().name(),
