@@ -345,20 +345,20 @@ pub(crate) fn sin_cos_kernel<T: Num>(theta: T) -> (T, T) {
         2.087572321298175e-09,
         -1.1359647557788195e-11,
     ];
-    let [s0, s1, s2, s3, s4, s5] = S.map(T::from);
-    let [c0, c1, c2, c3, c4, c5] = C.map(T::from);
     let z = theta * theta;
     let w = z * z;
     let w2 = w * w;
     // Estrin's scheme: three independent pairs, then two levels,
-    // ((k0 + z k1) + w (k2 + z k3)) + w² (k4 + z k5), in that order.
-    let estrin = |k0, k1, k2, k3, k4, k5| {
+    // ((k0 + z k1) + w (k2 + z k3)) + w² (k4 + z k5), in that order. (A function, not a
+    // closure: a closure is not always inlined, and out of line the lanes' intrinsics are calls.)
+    #[inline(always)]
+    fn estrin<T: Num>(z: T, w: T, w2: T, [k0, k1, k2, k3, k4, k5]: [T; 6]) -> T {
         let low = z.mul_add(k1, k0);
         let low = w.mul_add(z.mul_add(k3, k2), low);
         w2.mul_add(z.mul_add(k5, k4), low)
-    };
-    let ps = estrin(s0, s1, s2, s3, s4, s5);
-    let pc = estrin(c0, c1, c2, c3, c4, c5);
+    }
+    let ps = estrin(z, w, w2, S.map(T::from));
+    let pc = estrin(z, w, w2, C.map(T::from));
     (
         (theta * z).mul_add(ps, theta),
         T::from(1.0) - w.neg_mul_add(pc, T::from(0.5) * z),
