@@ -64,12 +64,12 @@ for name, make in orbits.items():
     t = np.linspace(0.0, orbit.period, 13)
     sol = tj.simulate(tj.Panel.paper(), orbit, (0.0, orbit.period), t_eval=t)
     row = {"n_steps": sol.n_steps, "n_rhs": sol.n_rhs}
-    for column in %r:
+    for column in COLUMNS:
         row[column] = [float(v).hex() for v in getattr(sol, column)[::3]]
     out[name] = row
 out["kernel"] = tj._core.cpu_info()["scalar_kernel"]
 json.dump(out, sys.stdout)
-""" % (COLUMNS,)
+""".replace("COLUMNS", repr(COLUMNS))
 
 
 def run_cases(kernel: str | None) -> dict:
