@@ -1,7 +1,7 @@
 """The machine a benchmark runs on, printed first by every script here so that figures from
 different machines are never compared blind: the processor, the instruction sets it has, those
-the build uses everywhere (baseline x86-64 for the wheels) and the scalar and ensemble kernels chosen at run
-time, the cores and their load, and the Python."""
+the build uses everywhere (baseline x86-64 for the wheels) and the scalar and ensemble kernels
+chosen at run time, the cores and their load, and the Python."""
 
 from __future__ import annotations
 

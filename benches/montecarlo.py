@@ -6,12 +6,20 @@ the same panels (the sample adds the flutter analysis, the critical damping and 
 summary). The paths alternate, so a change of load touches both alike; run it on a quiet
 machine anyway (the header prints the load average).
 
+Where the processor has FMA both paths run the fused kernel; a third row runs the scalar path in a
+child process with ``THERMOJITTER_KERNEL=portable``, the arithmetic without FMA (its frame is not
+the same bits: the kernels agree within the integration's accuracy).
+
     python benches/montecarlo.py [--n 200] [--threads 1 2] [--repeat 1] [--simulate 50]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
+import sys
 import time
 from typing import Any
 
@@ -35,13 +43,35 @@ def main() -> None:
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeat", type=int, default=1, help="runs per thread count (best)")
     parser.add_argument("--simulate", type=int, default=50, help="panels run with tj.simulate")
+    parser.add_argument("--scalar-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.n < 1 or args.simulate < 1 or args.repeat < 1 or min(args.threads) < 1:
         parser.error("--n, --simulate, --repeat and --threads must be at least 1")
 
     panel, orbit = tj.Panel.paper(), tj.Orbit.geo_equinox()
+    if args.scalar_only:
+        # The child: one scalar batch on the kernel its environment picks; (wall, cores busy).
+        cpu, start = time.process_time(), time.perf_counter()
+        mc._LOCKSTEP = False
+        tj.monte_carlo(
+            panel, orbit, vary=VARY, n=args.n, seed=1, threads=args.threads[0], rtol=RTOL,
+            atol=ATOL, progress=False,
+        )  # fmt: skip
+        wall = time.perf_counter() - start
+        print(json.dumps([wall, (time.process_time() - cpu) / wall]))
+        return
     print(machine.describe())
     print(f"{args.n} samples x 1 GEO orbit, rtol={RTOL:g}, atol={ATOL:g}, vary={list(VARY)}")
+
+    def portable_scalar(threads: int) -> tuple[float, float]:
+        """The scalar batch in a child process on the portable kernel: (wall s, cores busy)."""
+        env = {**os.environ, tj._core.KERNEL_VARIABLE: "portable"}
+        argv = [sys.executable, __file__, "--scalar-only", "--n", str(args.n), "--threads"]
+        done = subprocess.run(
+            [*argv, str(threads)], env=env, capture_output=True, text=True, check=True
+        )
+        wall, busy = json.loads(done.stdout)
+        return float(wall), float(busy)
 
     def batch(threads: int, lockstep: bool) -> Any:
         mc._LOCKSTEP = lockstep
@@ -63,6 +93,7 @@ def main() -> None:
                 wall = time.perf_counter() - start
                 busy = (time.process_time() - cpu) / wall
                 runs.setdefault((threads, path), []).append((wall, busy))
+            runs.setdefault((threads, "portable"), []).append(portable_scalar(threads))
     best = {key: min(v) for key, v in runs.items()}
     frame = frames[args.threads[0], "lockstep"]
     steps = int(frame["n_steps"].sum())
@@ -71,20 +102,21 @@ def main() -> None:
     # much of the machine the others left.
     print(
         f"{'threads':>8}{'path':>10}{'wall s':>10}{'samples/s':>11}{'cores busy':>12}"
-        f"{'per core':>10}{'ns/step':>9}{'x scalar':>10}"
+        f"{'per core':>10}{'ns/step':>9}{'x scalar':>10}{'x portable':>12}"
     )
     for threads in args.threads:
-        scalar_rate = 0.0
-        for path in ("scalar", "lockstep"):
+        rate = {}
+        for path in ("portable", "scalar", "lockstep"):
             wall, busy = best[threads, path]
-            per_core = args.n / wall / max(busy, 1e-9)
-            if path == "scalar":
-                scalar_rate = per_core
+            rate[path] = args.n / wall / max(busy, 1e-9)
             print(
                 f"{threads:>8}{path:>10}{wall:>10.2f}{args.n / wall:>11.1f}{busy:>12.2f}"
-                f"{per_core:>10.1f}{1e9 * wall * busy / steps:>9.0f}"
-                f"{per_core / scalar_rate:>10.2f}"
+                f"{rate[path]:>10.1f}{1e9 * wall * busy / steps:>9.0f}"
+                f"{rate[path] / rate.get('scalar', rate[path]):>10.2f}"
+                f"{rate[path] / rate['portable']:>12.2f}"
             )
+    print("(portable: the scalar path without FMA, in a child process; its ns/step uses the")
+    print(" lockstep frame's step count, which differs from its own by a few rejections)")
     same = all(f.equals(frame) for f in frames.values())
     print(f"identical frames across paths and thread counts: {same}")
     # CPU seconds per sample (wall x cores busy): less sensitive to other work than wall time.
