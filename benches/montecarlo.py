@@ -105,14 +105,14 @@ def main() -> None:
         f"{'per core':>10}{'ns/step':>9}{'x scalar':>10}{'x portable':>12}"
     )
     for threads in args.threads:
-        rate = {}
-        for path in ("portable", "scalar", "lockstep"):
+        paths = ("portable", "scalar", "lockstep")
+        rate = {p: args.n / best[threads, p][0] / max(best[threads, p][1], 1e-9) for p in paths}
+        for path in paths:
             wall, busy = best[threads, path]
-            rate[path] = args.n / wall / max(busy, 1e-9)
             print(
                 f"{threads:>8}{path:>10}{wall:>10.2f}{args.n / wall:>11.1f}{busy:>12.2f}"
                 f"{rate[path]:>10.1f}{1e9 * wall * busy / steps:>9.0f}"
-                f"{rate[path] / rate.get('scalar', rate[path]):>10.2f}"
+                f"{rate[path] / rate['scalar']:>10.2f}"
                 f"{rate[path] / rate['portable']:>12.2f}"
             )
     print("(portable: the scalar path without FMA, in a child process; its ns/step uses the")
