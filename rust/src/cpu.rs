@@ -2,10 +2,11 @@
 //! figures from different machines are never compared blind.
 //!
 //! The build targets baseline x86-64 (SSE2) so that one wheel runs everywhere; the scalar
-//! integration loop is compiled again for AVX ([`crate::integrate::ScalarKernel`]) and the
-//! ensemble's lockstep kernel for AVX2 and for AVX-512F
+//! integration loop is compiled again for AVX and FMA ([`crate::integrate::ScalarKernel`]) and
+//! the ensemble's lockstep kernel for AVX2 and for AVX-512F, both with FMA
 //! ([`crate::integrate::lockstep::Kernel`]), the newest the processor has picked at run time.
-//! No path uses FMA, so all give the same bits.
+//! The FMA kernels round the paper model's multiply-adds once, so their bits differ from the
+//! portable ones (within the integration's accuracy); scalar and lane kernels are picked to match.
 
 /// Instruction sets worth reporting, oldest first.
 #[cfg(target_arch = "x86_64")]

@@ -242,12 +242,7 @@ impl StructuralModel for Hinge {
     }
     #[inline(always)]
     fn rates(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
-        let (theta, theta_dot) = (q[0], q[1]);
-        let forced = generalised_moment(load, self.damping, self.stiffness, theta, theta_dot);
-        let (s, c) = sin_cos(theta);
-        out[0] = theta_dot;
-        out[1] = angular_acceleration(self.model, forced, theta_dot, s, c);
-        c
+        self.rates_as::<f64>(load, q, out)
     }
     #[inline(always)]
     fn rates_fused(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {

@@ -88,8 +88,9 @@ pub struct StepReads {
 }
 
 /// The environment variable that picks the kernels: `portable` runs the portable scalar and
-/// lane kernels on any processor (the bits of one without FMA); unset, or `auto`, the best the
-/// processor has. Read once, at the first run.
+/// lane kernels on any processor (the engine's own arithmetic without FMA; the C library may
+/// still use its FMA paths); unset, or `auto`, the best the processor has. Read once, at the
+/// first run.
 pub const KERNEL_VARIABLE: &str = "THERMOJITTER_KERNEL";
 
 /// What [`KERNEL_VARIABLE`] may be set to.
@@ -567,9 +568,24 @@ struct Lane<O> {
     /// just started or entered a segment. Otherwise the pack keeps them from step to step (the
     /// lanes that accept take y_new and k7 together, [`drive`]).
     stale: bool,
-    /// The lanes' multiply-adds are fused: the run's scalar parts (its first stage at each
-    /// segment, its first step's estimate, a run alone) take the fused right-hand side too.
-    fused: bool,
+    /// The scalar kernel whose arithmetic the lanes have: the run's scalar parts (its first
+    /// stage at each segment, its first step's estimate) take its right-hand side too.
+    kernel: ScalarKernel,
+}
+
+/// A segment's first stage f(a, y) and first step's estimate on `system`: the prologue of
+/// `dopri5::segment`.
+fn first_step<S: OdeSystem<nalgebra::U4>>(
+    system: &S,
+    a: f64,
+    b: f64,
+    y: &Vector4<f64>,
+    tol: &Tolerances,
+    stats: &mut Stats,
+) -> (Vector4<f64>, f64) {
+    let k1 = system.rhs(a, y);
+    let h0 = dopri5::initial_step(system, a, y, &k1, b - a, tol, stats);
+    (k1, h0)
 }
 
 /// How a run left its lane.
@@ -578,7 +594,7 @@ type Outcome = Result<(Stats, Vector4<f64>)>;
 impl<O: LaneObserver> Lane<O> {
     /// Sets up a run (the checks of [`super::solve`]); `Err` hands the job back with its outcome
     /// when it ends before its first step.
-    fn start(job: Job<O>, fused: bool) -> std::result::Result<Self, (O, Outcome)> {
+    fn start(job: Job<O>, kernel: ScalarKernel) -> std::result::Result<Self, (O, Outcome)> {
         let Job {
             system,
             tol,
@@ -625,7 +641,7 @@ impl<O: LaneObserver> Lane<O> {
             k1: y0,
             constant_flux: None,
             stale: true,
-            fused,
+            kernel,
         };
         if lane.enter_segment() {
             Ok(lane)
@@ -649,14 +665,12 @@ impl<O: LaneObserver> Lane<O> {
             self.t = a;
             self.b = b;
             let (y, tol, stats) = (&self.y, &self.tol, &mut self.stats);
-            let h0 = if self.fused {
-                let system = FusedRhs(&self.system);
-                self.k1 = system.rhs(a, y);
-                dopri5::initial_step(&system, a, y, &self.k1, b - a, tol, stats)
+            let (k1, h0) = if self.kernel.fused() {
+                first_step(&FusedRhs(&self.system), a, b, y, tol, stats)
             } else {
-                self.k1 = self.system.rhs(a, y);
-                dopri5::initial_step(&self.system, a, y, &self.k1, b - a, tol, stats)
+                first_step(&self.system, a, b, y, tol, stats)
             };
+            self.k1 = k1;
             self.stats.n_rhs += 1;
             self.stale = true;
             self.h_abs = h0.min(self.tol.max_step);
@@ -865,7 +879,7 @@ impl<V: Lanes, O: LaneObserver> Group<V, O> {
                     done(job.observer, outcome);
                     continue;
                 }
-                match Lane::start(job, V::FUSED) {
+                match Lane::start(job, kernel_of::<V>()) {
                     Ok(lane) => {
                         lane.load(&mut self.pack, l);
                         *slot = Some(lane);
