@@ -42,7 +42,8 @@ def test_three_nodes_of_a_plain_panel_through_spring_eclipses() -> None:
     assert_gate(full, hybrid)
     p = hybrid.propagation
     assert p["t_linear"] > 0.8 * 4 * orbit.period and p["t_exponential"] > 0.0
-    assert hybrid.n_steps * 20 < full.n_steps
+    # The guard on the linear arcs' drift hands part of each recovery to the full integration.
+    assert hybrid.n_steps * 5 < full.n_steps
     assert len(hybrid.y_end) == 5  # node temperatures, θ, θ̇: a run resumes from it
 
 

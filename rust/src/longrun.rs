@@ -287,7 +287,7 @@ impl<V: SummaryView> Collector<V> {
                 in_entry: false,
                 in_exit: false,
             },
-            eclipses: EclipseTable::new(orbit),
+            eclipses: EclipseTable::until(orbit, t_end),
         };
         collector.current = collector.open(first_index)?;
         collector.current.theta_max = theta0;
@@ -340,6 +340,15 @@ impl<V: SummaryView> Collector<V> {
     }
 
     /// One point of the solution, standing for the interval dt before it.
+    /// The RMS of the dynamic part over the current orbit so far (0 before any of it).
+    pub(crate) fn rms_so_far(&self) -> f64 {
+        if self.duration > 0.0 {
+            (self.sq_sum / self.duration).sqrt()
+        } else {
+            0.0
+        }
+    }
+
     pub(crate) fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
         let p = self.point(t, y);
         self.record(

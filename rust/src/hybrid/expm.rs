@@ -49,6 +49,25 @@ pub fn expm<const M: usize>(a: &SMatrix<f64, M, M>) -> SMatrix<f64, M, M> {
 /// the state's size (the augmented-matrix form needs one exponential of a larger matrix for
 /// each combination of vectors).
 pub fn phi_matrices<const M: usize>(a: &SMatrix<f64, M, M>) -> [SMatrix<f64, M, M>; 4] {
+    doubled_phi(a).0
+}
+
+/// φ_k(a) and φ_k(a/2), k = 0..=3: the second is the scaling and squaring's last step but one,
+/// so that a step's midpoint costs no second evaluation (one only where a needs no squaring).
+pub fn phi_matrices_and_half<const M: usize>(
+    a: &SMatrix<f64, M, M>,
+) -> [[SMatrix<f64, M, M>; 4]; 2] {
+    match doubled_phi(a) {
+        (full, Some(half)) => [full, half],
+        (full, None) => [full, phi_matrices(&(a * 0.5))],
+    }
+}
+
+/// φ_k(a) by scaling and squaring, and the φ_k(a/2) it went through (None without squarings).
+#[allow(clippy::type_complexity)]
+fn doubled_phi<const M: usize>(
+    a: &SMatrix<f64, M, M>,
+) -> ([SMatrix<f64, M, M>; 4], Option<[SMatrix<f64, M, M>; 4]>) {
     let squarings = squarings_for(a, 1.0);
     let b = a * 0.5f64.powi(squarings);
     let id = SMatrix::<f64, M, M>::identity();
@@ -76,7 +95,9 @@ pub fn phi_matrices<const M: usize>(a: &SMatrix<f64, M, M>) -> [SMatrix<f64, M, 
     let p1 = id + b * p2;
     let p0 = id + b * p1;
     let mut phi = [p0, p1, p2, p3];
+    let mut half = None;
     for _ in 0..squarings {
+        half = Some(phi);
         let [p0, p1, p2, p3] = phi;
         phi = [
             p0 * p0,
@@ -85,7 +106,7 @@ pub fn phi_matrices<const M: usize>(a: &SMatrix<f64, M, M>) -> [SMatrix<f64, M, 
             (p0 * p3 + p1 * 0.5 + p2 + p3) * 0.125,
         ];
     }
-    phi
+    (phi, half)
 }
 
 /// Degree of the Taylor polynomial of φ3 in [`phi_matrices`]: 1/(16 + 4)! is 4e-19.
@@ -160,6 +181,23 @@ mod tests {
                 );
                 let off = (0..4).filter(|&j| j != i).all(|j| phi[k][(i, j)] == 0.0);
                 assert!(off, "φ{k} row {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_half_step_matrices_are_those_of_half_the_matrix() {
+        let j = Matrix4::new(
+            -0.025, 0.01, -0.4, 0.0, 0.01, -0.012, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 4.9e-3, -4.9e-3,
+            -0.62, -3e-4,
+        );
+        for h in [0.3, 7.0, 150.0] {
+            let [full, half] = phi_matrices_and_half(&(j * h));
+            let direct = phi_matrices(&(j * (0.5 * h)));
+            for k in 0..4 {
+                assert_eq!(full[k], phi_matrices(&(j * h))[k], "h {h} k {k}");
+                let size = direct[k].amax().max(1.0);
+                assert!((half[k] - direct[k]).amax() < 1e-12 * size, "h {h} k {k}");
             }
         }
     }

@@ -14,10 +14,10 @@
 //! u⁺ = U + 2h φ3(hJ) D          (third order; U is the embedded second-order solution)
 //! ```
 
-use super::expm::phi_matrices;
+use super::expm::phi_matrices_and_half;
 use super::model::HybridModel;
 use crate::error::{Error, Result};
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 /// Error-control settings of the exponential stretches.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +41,47 @@ pub struct ExpStep<const N: usize> {
     /// The illumination factor at t0 and t1.
     pub flux0: f64,
     pub flux1: f64,
+    /// The state at the step's middle by the step's own formula over half the step: a second
+    /// evaluation, independent of the interpolant through the ends.
+    pub y_mid: SVector<f64, N>,
+    /// The Jacobian at the step's start and the time derivative of the forcing: with y0 and f0,
+    /// what [`ExpStep::state_at`] evaluates the step's formula from.
+    pub jac: SMatrix<f64, N, N>,
+    pub v: SVector<f64, N>,
+}
+
+impl<const N: usize> ExpStep<N> {
+    /// The state at t = t0 + τ by the step's own formula over τ (not the interpolant).
+    pub(crate) fn state_at<M: HybridModel<N>>(&self, system: &M, t: f64) -> SVector<f64, N> {
+        let tau = t - self.t0;
+        let phi = super::expm::phi_matrices(&(self.jac * tau));
+        advance(system, &phi, &self.jac, &self.v, &self.y0, &self.f0, t, tau).0
+    }
+}
+
+/// The exprb32 formula over τ from (t0, y0) with slope f0, Jacobian `jac`, time derivative `v`
+/// and φ_k(τ J) in `phi`: the state at t = t0 + τ, its correction (the error estimate) and the
+/// flux there.
+#[allow(clippy::too_many_arguments)]
+fn advance<const N: usize, M: HybridModel<N>>(
+    system: &M,
+    phi: &[SMatrix<f64, N, N>; 4],
+    jac: &SMatrix<f64, N, N>,
+    v: &SVector<f64, N>,
+    y0: &SVector<f64, N>,
+    f0: &SVector<f64, N>,
+    t: f64,
+    tau: f64,
+) -> (SVector<f64, N>, SVector<f64, N>, f64) {
+    let [_, phi1, phi2, phi3] = phi;
+    let du = phi1 * (f0 * tau) + phi2 * (v * (tau * tau));
+    let u_mid = y0 + du;
+    let flux = system.flux_at(t);
+    let f_mid = system.rhs_at_flux(flux, &u_mid);
+    // g(t0 + τ, U) − g(t0, u) with g(t, u) = f(t, u) − J u − v t.
+    let d = f_mid - f0 - jac * du - v * tau;
+    let corr = phi3 * (d * (2.0 * tau));
+    (u_mid + corr, corr, flux)
 }
 
 /// ∂f/∂t through the illumination (s(t) in a penumbra, the Sun's distance) inside the segment
@@ -101,15 +142,8 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
                     ),
                 });
             }
-            let [_, phi1, phi2, phi3] = phi_matrices(&(jac * hs));
-            let du = phi1 * (f0 * hs) + phi2 * (v * (hs * hs));
-            let u_mid = y0 + du;
-            let flux1 = system.flux_at(t1);
-            let f_mid = system.rhs_at_flux(flux1, &u_mid);
-            // g(t1, U) − g(t0, u) with g(t, u) = f(t, u) − J u − v t.
-            let d = f_mid - f0 - jac * du - v * hs;
-            let corr = phi3 * (d * (2.0 * hs));
-            let y1 = u_mid + corr;
+            let [phi, phi_half] = phi_matrices_and_half(&(jac * hs));
+            let (y1, corr, flux1) = advance(system, &phi, &jac, &v, &y0, &f0, t1, hs);
             let mut acc = 0.0;
             for i in 0..N {
                 let atol = if i < N - 2 {
@@ -135,6 +169,16 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
                     *h = hs * factor;
                 }
                 let f1 = system.rhs_at_flux(flux1, &y1);
+                let (y_mid, _, _) = advance(
+                    system,
+                    &phi_half,
+                    &jac,
+                    &v,
+                    &y0,
+                    &f0,
+                    t0 + 0.5 * hs,
+                    0.5 * hs,
+                );
                 let flux0 = flux;
                 flux = flux1;
                 accepted += 1;
@@ -149,6 +193,9 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
                     f1,
                     flux0,
                     flux1,
+                    y_mid,
+                    jac,
+                    v,
                 })?;
                 f0 = f1;
                 if stop {

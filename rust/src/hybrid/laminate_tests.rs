@@ -71,7 +71,13 @@ fn three_nodes_through_penumbra_eclipses_match_the_full_run() {
     let s = &hyb.split;
     assert!(s.t_linear > 2.0 * orbit.period, "{}", s.t_linear);
     assert!(s.t_exponential > 0.0, "{}", s.t_exponential);
-    assert!(hyb.run.stats.n_steps * 20 < reference.stats.n_steps);
+    // The guard on the linear arcs' drift hands part of the recovery to the full integration.
+    assert!(
+        hyb.run.stats.n_steps * 5 < reference.stats.n_steps,
+        "{} steps against {}; {s:?}",
+        hyb.run.stats.n_steps,
+        reference.stats.n_steps
+    );
     let total = s.t_linear + s.t_exponential + s.t_fallback;
     assert!((total - 3.0 * orbit.period).abs() < 1e-6 * total);
     // The end state in node temperatures (and θ) as the full run's: within 0.01 K (5e-6 rad).

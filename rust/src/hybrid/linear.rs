@@ -59,26 +59,8 @@ impl<const N: usize> Arc<N> {
             if !(lam.re.is_finite() && lam.im.is_finite()) {
                 return Err(fail("non-finite eigenvalue"));
             }
-            // Inverse iteration with a slightly perturbed shift: two solves give the eigenvector
-            // to rounding.
-            let shift =
-                lam + C64::new(1e-10 * lam.norm().max(1e-12), 1e-10 * lam.norm().max(1e-12));
-            let m = abc - SMatrix::<C64, N, N>::identity() * shift;
-            let mlu = Lu::of(&m);
-            let mut x = SVector::<C64, N>::from_fn(|i, _| start_component(i));
-            for _ in 0..3 {
-                x = mlu.solve(&x).ok_or_else(|| fail("eigenvector"))?;
-                let n = x.norm();
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(fail("eigenvector"));
-                }
-                x /= C64::new(n, 0.0);
-            }
-            let residual = (abc * x - x * lam).norm();
-            if residual > 1e-9 * ab.norm() {
-                return Err(fail("eigenvector residual too large (defective Jacobian?)"));
-            }
-            vecs[k] = x;
+            vecs[k] = eigenvector(&abc, lam)
+                .ok_or_else(|| fail("eigenvector not found to rounding (defective Jacobian?)"))?;
         }
         let v = SMatrix::<C64, N, N>::from_columns(&vecs);
         let h0 = y0 - y_ref - p0;
@@ -116,6 +98,11 @@ impl<const N: usize> Arc<N> {
         y
     }
 
+    /// The modes' part of the state at τ: y(τ) less the quasi-static drift base + slope τ.
+    pub fn transient(&self, tau: f64) -> SVector<f64, N> {
+        self.state(tau) - self.base - self.slope * tau
+    }
+
     /// The functional w·y(τ).
     pub fn signal(&self, w: &SVector<f64, N>) -> Signal<N> {
         let a = self.modes.map(|m| (0..N).map(|i| m[i] * w[i]).sum::<C64>());
@@ -126,6 +113,71 @@ impl<const N: usize> Arc<N> {
             lambda: self.lambda,
         }
     }
+}
+
+/// The hinge's oscillatory eigenpair of a Jacobian: λ (the eigenvalue of the complex pair with
+/// Im λ > 0 and the largest |Im λ|), its right eigenvector v and left eigenvector w, scaled so that
+/// w·v = 1 (bilinear). About a fixed point y*, a state's hinge coordinate is c = w·(y − y*) and
+/// its θ oscillates as 2 Re(v_θ c e^{λt}).
+#[derive(Debug, Clone, Copy)]
+pub struct HingeMode<const N: usize> {
+    pub lambda: C64,
+    pub right: SVector<C64, N>,
+    pub left: SVector<C64, N>,
+}
+
+impl<const N: usize> HingeMode<N> {
+    /// The pair of `a`, balanced by `scale` for the eigen-solve; None when `a` has no complex
+    /// pair (an over-damped hinge) or the eigenvectors cannot be found to rounding.
+    pub fn of(a: &SMatrix<f64, N, N>, scale: &SVector<f64, N>) -> Option<HingeMode<N>> {
+        let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
+        let ev = DMatrix::from_column_slice(N, N, ab.as_slice()).complex_eigenvalues();
+        let lambda = ev
+            .iter()
+            .copied()
+            .filter(|l| l.im > 1e-12 * l.norm() && l.re.is_finite())
+            .max_by(|x, y| x.im.total_cmp(&y.im))?;
+        let abc: SMatrix<C64, N, N> = ab.map(|v| C64::new(v, 0.0));
+        let x = eigenvector(&abc, lambda)?;
+        let z = eigenvector(&abc.transpose(), lambda)?;
+        let norm = z.dot(&x);
+        if norm.norm().is_nan() || norm.norm() <= 1e-12 {
+            return None;
+        }
+        Some(HingeMode {
+            lambda,
+            right: SVector::from_fn(|i, _| x[i] * scale[i]),
+            left: SVector::from_fn(|i, _| z[i] / (norm * scale[i])),
+        })
+    }
+
+    /// The hinge coordinate w·x of a (real) vector x.
+    pub fn coordinate(&self, x: &SVector<f64, N>) -> C64 {
+        (0..N).map(|i| self.left[i] * x[i]).sum()
+    }
+
+    /// Amplitude in θ (component `i`) of a hinge coordinate c: 2 |v_θ c|.
+    pub fn theta_amplitude(&self, i: usize, c: C64) -> f64 {
+        2.0 * (self.right[i] * c).norm()
+    }
+}
+
+/// The eigenvector of `m` for the eigenvalue `lam`, unit norm, by inverse iteration with a
+/// slightly perturbed shift (two solves give it to rounding); None when its residual is large.
+fn eigenvector<const N: usize>(m: &SMatrix<C64, N, N>, lam: C64) -> Option<SVector<C64, N>> {
+    let eps = 1e-10 * lam.norm().max(1e-12);
+    let shifted = m - SMatrix::<C64, N, N>::identity() * (lam + C64::new(eps, eps));
+    let lu = Lu::of(&shifted);
+    let mut x = SVector::<C64, N>::from_fn(|i, _| start_component(i));
+    for _ in 0..3 {
+        x = lu.solve(&x)?;
+        let n = x.norm();
+        if !(n.is_finite() && n > 0.0) {
+            return None;
+        }
+        x /= C64::new(n, 0.0);
+    }
+    ((m * x - x * lam).norm() <= 1e-9 * m.norm()).then_some(x)
 }
 
 /// The LU factors of an N×N matrix, computed on the run-time size (the compile-time one asks

@@ -38,7 +38,7 @@ use crate::longrun::{
 use crate::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::params::Panel;
 use exprb::{ExpStep, ExpTolerances};
-use linear::Arc;
+use linear::{Arc, HingeMode};
 use model::{HybridModel, TwoLayerModel};
 use nalgebra::{Const, SMatrix, SVector, Vector4};
 use std::cell::Cell;
@@ -125,8 +125,6 @@ struct Driver<'a, const N: usize, M: HybridModel<N>> {
     stats: Stats,
     out: HybridRun,
     judge: Judge<N, M>,
-    /// Units of the state for the modal decomposition.
-    scale: SVector<f64, N>,
     eclipses: EclipseTable,
 }
 
@@ -242,11 +240,16 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
         y0[N - 2],
     )?;
     let t_end = t_start + n_orbits as f64 * orbit.period;
-    let t_ref = model
-        .equilibrium(orbit.flux_scale(t_start), None)
-        .map(|e| e[0])
-        .unwrap_or(300.0);
+    let flux0 = orbit.flux_scale(t_start);
+    let y_eq = model.equilibrium(flux0, None).ok();
+    let t_ref = y_eq.map(|e| e[0]).unwrap_or(300.0);
     let wn = panel.natural_angular_frequency();
+    let scale = SVector::from_fn(|i, _| match N - i {
+        2 => 1.0 / t_ref,
+        1 => wn / t_ref,
+        _ => 1.0,
+    });
+    let modal = y_eq.is_some_and(|y| has_fast_thermal_mode(&model.jacobian(flux0, &y), &scale, wn));
     let mut d = Driver {
         orbit: *orbit,
         settings,
@@ -286,13 +289,11 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             settings: *settings,
             model,
             last: Cell::new(None),
+            scale,
+            modal,
+            drift_spent: Cell::new(Drift::default()),
         },
-        scale: SVector::from_fn(|i, _| match N - i {
-            2 => 1.0 / t_ref,
-            1 => wn / t_ref,
-            _ => 1.0,
-        }),
-        eclipses: EclipseTable::new(orbit),
+        eclipses: EclipseTable::until(orbit, t_end),
     };
     d.run()?;
     let Driver {
@@ -322,6 +323,83 @@ struct Judge<const N: usize, M> {
     /// The last equilibrium and its flux: the next one, at a flux that has barely changed, is
     /// found by Newton's method from it.
     last: Cell<Option<(f64, SVector<f64, N>)>>,
+    /// Units of the state for the modal decompositions.
+    scale: SVector<f64, N>,
+    /// Whether a thermal mode is not slow against the hinge (thin metal: fast conduction); the
+    /// oscillation is then measured on the hinge's own mode, not about M_T/K_el (whose rate
+    /// follows the fast thermal transient, which the hinge does not).
+    modal: bool,
+    /// The drift in θ that linear arcs have left in the state.
+    drift_spent: Cell<Drift>,
+}
+
+/// An error (rad) in the hinge's oscillation at time `at`: it decays (or grows) with the
+/// oscillation, at the rate Re λ of the hinge mode.
+#[derive(Debug, Clone, Copy, Default)]
+struct Drift {
+    error: f64,
+    at: f64,
+    rate: f64,
+}
+
+impl Drift {
+    fn at(&self, t: f64) -> f64 {
+        self.error * (self.rate * (t - self.at)).min(50.0).exp()
+    }
+}
+
+/// A linear arc ready to run: the arc, its equilibrium and flux, and the drift it leaves.
+struct ArcPlan<const N: usize> {
+    arc: Arc<N>,
+    y_ref: SVector<f64, N>,
+    flux0: f64,
+    drift: Drift,
+}
+
+/// A thermal mode faster than this fraction of the hinge's angular frequency makes the
+/// quasi-static measure of the oscillation (about M_T/K_el with its rate) unreliable: the rate
+/// it attributes to the hinge is off by about the ratio.
+const QUASI_STATIC_RATIO: f64 = 0.1;
+
+/// The largest drift in θ that linear arcs may leave, relative to the jitter the summaries read
+/// and in rad: half the accuracy gate (2 %, 1e-6 rad). The estimate is an upper bound (the
+/// largest error along the arc, and the arcs' errors added): on Table 1 near its critical
+/// damping it is about three times the drift measured against the full integration.
+const DRIFT_RTOL: f64 = 1e-2;
+const DRIFT_ATOL: f64 = 5e-7;
+
+/// How far the interpolant of an exponential step may stray from the step's own formula in what
+/// the summaries read (θ and M_T/K_el), in rad and relative to the deviation from θ_eq.
+const READ_ATOL: f64 = 1e-7;
+const READ_RTOL: f64 = 1e-3;
+
+/// Samples per hinge period of the linearisation's defect along an arc (the defect's harmonics
+/// up to the third stay apart from the first), and how often the points where it is read
+/// double in distance from the arc's start at most.
+const DRIFT_SAMPLES: usize = 8;
+const DRIFT_DOUBLINGS: f64 = 10.0;
+
+/// The jitter RMS the summaries read, the scale of the smallest error the gate holds them to:
+/// the last whole orbit's, else this orbit's so far (0 before any oscillation).
+fn gate_scale<V: crate::longrun::SummaryView>(collector: &Collector<V>) -> f64 {
+    match collector.done.last() {
+        Some(s) if s.jitter_rms.is_finite() => s.jitter_rms,
+        _ => collector.rms_so_far(),
+    }
+}
+
+/// Whether the Jacobian `a` has a real (thermal) mode faster than [`QUASI_STATIC_RATIO`] of the
+/// hinge's angular frequency `wn`.
+fn has_fast_thermal_mode<const N: usize>(
+    a: &SMatrix<f64, N, N>,
+    scale: &SVector<f64, N>,
+    wn: f64,
+) -> bool {
+    let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
+    nalgebra::DMatrix::from_column_slice(N, N, ab.as_slice())
+        .complex_eigenvalues()
+        .iter()
+        .any(|l| l.im.abs() <= 1e-9 * l.norm() && l.norm() > QUASI_STATIC_RATIO * wn)
 }
 
 impl<const N: usize, M: HybridModel<N>> Judge<N, M> {
@@ -336,9 +414,16 @@ impl<const N: usize, M: HybridModel<N>> Judge<N, M> {
         Ok((y_ref, self.model.jacobian(flux, &y_ref)))
     }
 
-    /// Amplitude of the hinge oscillation about the quasi-static deflection M_T/K_el, from the
-    /// dynamic part and its rate.
+    /// Amplitude of the hinge oscillation: about the quasi-static deflection M_T/K_el, from the
+    /// dynamic part and its rate; with fast thermal modes, the θ amplitude of the hinge mode of
+    /// the Jacobian at y, whose coordinate about the state's own fixed point y* = y − J⁻¹f is
+    /// w·J⁻¹f = (w·f)/λ.
     fn oscillation(&self, flux: f64, y: &SVector<f64, N>, f: &SVector<f64, N>) -> f64 {
+        if self.modal {
+            if let Some(mode) = HingeMode::of(&self.model.jacobian(flux, y), &self.scale) {
+                return mode.theta_amplitude(N - 2, mode.coordinate(f) / mode.lambda);
+            }
+        }
         let (quasi_static, rate) = self.model.static_angle(flux, y, f);
         let d = y[N - 2] - quasi_static;
         let d_rate = y[N - 1] - rate;
@@ -349,6 +434,114 @@ impl<const N: usize, M: HybridModel<N>> Judge<N, M> {
         };
         let w2 = self.panel.hinge_stiffness / (self.panel.hinge_inertia() * inertia);
         (d * d + d_rate * d_rate / w2).sqrt()
+    }
+
+    /// The error (rad) that the linearisation makes over a sunlit arc from t0: (the largest the
+    /// summaries see, in θ at its end, the hinge's rate Re λ at which it then decays). The arc's defect d(τ) = y_L' − f(y_L) drives the error of the
+    /// hinge coordinate c as ε' = λε − w·d. Its secular part, the mean of e^{−λτ} w·d(τ) over one
+    /// hinge period (terms of other frequencies average out), is μ c: the amplitude and phase
+    /// drift at the relative rate μ (amplitude-dependent damping and frequency, the terms the
+    /// linearisation drops, which decide a panel near its critical damping; the thermal
+    /// transient's effect on the hinge, which decays with it).
+    fn arc_drift(
+        &self,
+        arc: &Arc<N>,
+        a: &SMatrix<f64, N, N>,
+        t0: f64,
+        length: f64,
+    ) -> (f64, f64, f64) {
+        let Some(mode) = HingeMode::of(a, &self.scale) else {
+            return (0.0, 0.0, 0.0); // no oscillation to drift
+        };
+        let period = 2.0 * std::f64::consts::PI / mode.lambda.im;
+        let c0 = mode.coordinate(&arc.transient(0.0));
+        let amp0 = mode.theta_amplitude(N - 2, c0);
+        if amp0 == 0.0 || length <= 0.0 {
+            return (0.0, 0.0, 0.0);
+        }
+        // μ at τ: the mean over one period from τ of e^{−λs} w·d(s), relative to c(τ) = c0 e^{λτ}.
+        // d is the defect the oscillation itself causes: along the arc, less along the arc
+        // without its hinge part h(s) = 2 Re(v c0 e^{λs}) (the thermal transient's slow defect,
+        // which one period cannot tell from a resonance, cancels).
+        let rate_at = |p: f64| {
+            let mut mean = nalgebra::Complex::new(0.0, 0.0);
+            for j in 0..DRIFT_SAMPLES {
+                let tau = p + period * j as f64 / DRIFT_SAMPLES as f64;
+                let y = arc.state(tau);
+                let turn = c0 * (mode.lambda * tau).exp();
+                let hinge = SVector::<f64, N>::from_fn(|i, _| 2.0 * (mode.right[i] * turn).re);
+                let flux = self.orbit.flux_scale(t0 + tau);
+                let defect = a * hinge - self.model.rhs_at_flux(flux, &y)
+                    + self.model.rhs_at_flux(flux, &(y - hinge));
+                mean += (-mode.lambda * tau).exp() * mode.coordinate(&defect);
+            }
+            mean / (DRIFT_SAMPLES as f64) / c0
+        };
+        // The relative drift D(τ) = ∫ μ, by the trapezoid rule on points that double from one
+        // period (μ changes fastest early, where the thermal transient still decays), and the
+        // error a(τ)|D(τ)| it makes in θ, a(τ) = a0 e^{rτ}.
+        let amp = |tau: f64| amp0 * (mode.lambda.re * tau).exp();
+        let last = length - period;
+        let mut points = vec![0.0];
+        if last >= period {
+            let doublings = (last / period).log2().floor().min(DRIFT_DOUBLINGS) as i32;
+            points.extend((0..=doublings).rev().map(|k| last * 0.5f64.powi(k)));
+        }
+        let (mut drift, mut along) = (nalgebra::Complex::new(0.0, 0.0), 0.0f64);
+        let mut before = (0.0, rate_at(0.0));
+        for &p in &points[1..] {
+            let mu = rate_at(p);
+            drift += (before.1 + mu) * (0.5 * (p - before.0));
+            // The summaries read the amplitude along the arc (its drift, Re D); the phase (Im D)
+            // reaches them only through the state handed on at the arc's end.
+            along = along.max(amp(p) * drift.re.abs());
+            before = (p, mu);
+        }
+        drift += before.1 * (length - before.0);
+        let end = amp(length) * drift.norm();
+        (end.max(along), end, mode.lambda.re)
+    }
+
+    /// The drift a linear arc from t0 may add to what earlier arcs left in the state:
+    /// [`DRIFT_RTOL`] of the jitter the summaries read (the last whole orbit's RMS, else this
+    /// orbit's so far: the smallest value the gate holds), at least [`DRIFT_ATOL`].
+    fn drift_allowed(&self, jitter_rms: f64, t0: f64) -> f64 {
+        (DRIFT_RTOL * jitter_rms).max(DRIFT_ATOL) - self.drift_spent.get().at(t0)
+    }
+
+    /// The linear arc from (t0, y) to `end` in full Sun, with its equilibrium, flux and the drift
+    /// at its end; None where the modal decomposition fails or the linearisation would drift out
+    /// of the accuracy gate over the arc ([`Judge::arc_drift`] beyond [`Judge::drift_allowed`]
+    /// for the summaries' `jitter_rms`).
+    fn arc(
+        &self,
+        t0: f64,
+        y: &SVector<f64, N>,
+        end: f64,
+        jitter_rms: f64,
+    ) -> Result<Option<ArcPlan<N>>> {
+        let flux0 = self.orbit.flux_scale(t0);
+        let flux1 = self.orbit.flux_scale(end);
+        let (y_ref, a) = self.reference(flux0)?;
+        let b = self.model.flux_sensitivity(flux0, &y_ref) * ((flux1 - flux0) / (end - t0));
+        let Ok(arc) = Arc::new(&a, &b, &y_ref, y, end - t0, &self.scale) else {
+            return Ok(None);
+        };
+        let (largest, at_end, rate) = self.arc_drift(&arc, &a, t0, end - t0);
+        if largest > self.drift_allowed(jitter_rms, t0) {
+            return Ok(None);
+        }
+        let drift = Drift {
+            error: self.drift_spent.get().at(end) + at_end,
+            at: end,
+            rate,
+        };
+        Ok(Some(ArcPlan {
+            arc,
+            y_ref,
+            flux0,
+            drift,
+        }))
     }
 
     /// May the state at sunlit time t be propagated linearly?
@@ -386,6 +579,8 @@ struct FallbackObserver<'a, 'c, const N: usize, M: HybridModel<N>> {
     judge: &'a Judge<N, M>,
     eclipses: &'a [Eclipse],
     window: f64,
+    /// The end of the fallback's stretch.
+    end: f64,
     next_check: f64,
     released: bool,
     error: Option<Error>,
@@ -414,12 +609,26 @@ impl<const N: usize, M: HybridModel<N>> Observer<Const<N>> for FallbackObserver<
         if shadow || t1 < release {
             return ControlFlow::Continue(());
         }
-        match self.judge.regime(t1, &step.y1) {
-            Ok(Regime::Linear) => {
+        // Released only where the arc that would follow holds the gate too.
+        let arc_end = self
+            .eclipses
+            .iter()
+            .map(|e| e.outer.0)
+            .filter(|&c| c > t1)
+            .fold(self.end, f64::min);
+        let linear = self.judge.regime(t1, &step.y1).and_then(|r| match r {
+            Regime::Linear if arc_end > t1 => {
+                let jitter = gate_scale(&self.inner.collector);
+                Ok(self.judge.arc(t1, &step.y1, arc_end, jitter)?.is_some())
+            }
+            _ => Ok(false),
+        });
+        match linear {
+            Ok(true) => {
                 self.released = true;
                 ControlFlow::Break(())
             }
-            Ok(_) => ControlFlow::Continue(()),
+            Ok(false) => ControlFlow::Continue(()),
             Err(e) => {
                 self.error = Some(e);
                 ControlFlow::Break(())
@@ -502,11 +711,14 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
     /// stop early for the fallback (oscillation too large, decomposition ill-conditioned).
     fn linear(&mut self, end: f64) -> Result<Option<()>> {
         let t0 = self.t;
-        let flux0 = self.orbit.flux_scale(t0);
-        let flux1 = self.orbit.flux_scale(end);
-        let (y_ref, a) = self.judge.reference(flux0)?;
-        let b = self.judge.model.flux_sensitivity(flux0, &y_ref) * ((flux1 - flux0) / (end - t0));
-        let Ok(arc) = Arc::new(&a, &b, &y_ref, &self.y, end - t0, &self.scale) else {
+        let jitter = gate_scale(&self.obs.collector);
+        let Some(ArcPlan {
+            arc,
+            y_ref,
+            flux0,
+            drift,
+        }) = self.judge.arc(t0, &self.y, end, jitter)?
+        else {
             return Ok(Some(()));
         };
         let theta = arc.signal(&SVector::from_fn(|i, _| if i == N - 2 { 1.0 } else { 0.0 }));
@@ -555,6 +767,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             )?;
             self.y = arc.state(length);
             self.t = if early { t0 + length } else { end };
+            self.judge.drift_spent.set(drift);
             self.out.t_linear += length;
             self.out.n_arcs += 1;
         }
@@ -570,6 +783,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             judge: &self.judge,
             eclipses,
             window,
+            end,
             next_check: self.t + CHECK_EVERY,
             released: false,
             error: None,
@@ -701,13 +915,42 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             self.judge.oscillation(st.flux0, &st.y0, &st.f0),
             self.judge.oscillation(st.flux1, &st.y1, &st.f1),
         );
-        for j in 1..=4 {
-            let t = if j == 4 { st.t1 } else { st.t0 + j as f64 * h };
-            let y = if j == 4 { st.y1 } else { dense.eval(t) };
-            if resolved {
-                self.obs.collector.read(t, y.as_slice(), h)?;
+        // The cubic through the ends against the step's own formula at its middle: where they
+        // differ in what the summaries read (a fast thermal transient after a flux jump, which
+        // a cubic overshoots), every point is read off the formula instead.
+        let t_mid = st.t0 + 2.0 * h;
+        let flux_mid = 0.5 * (st.flux0 + st.flux1);
+        let cubic = dense.eval(t_mid);
+        let reads = |y: &SVector<f64, N>| (y[N - 2], self.judge.model.quasi_static(flux_mid, y));
+        let ((th_c, qs_c), (th_f, qs_f)) = (reads(&cubic), reads(&st.y_mid));
+        let eq = self.obs.collector.current.theta_eq;
+        let tol = READ_ATOL + READ_RTOL * (qs_f - eq).abs().max((th_f - eq).abs());
+        let formula = (th_c - th_f).abs().max((qs_c - qs_f).abs()) > tol;
+        // Read at the quarters; off the formula, also just after the start, where a fast
+        // transient has settled but the hinge's ringing has not yet decayed.
+        let fractions: &[f64] = if formula {
+            &[1.0 / 64.0, 1.0 / 16.0, 0.25, 0.5, 0.75, 1.0]
+        } else {
+            &[0.25, 0.5, 0.75, 1.0]
+        };
+        let mut before = 0.0;
+        for &frac in fractions {
+            let dt = (frac - before) * 4.0 * h;
+            before = frac;
+            let t = if frac == 1.0 {
+                st.t1
             } else {
-                let frac = j as f64 / 4.0;
+                st.t0 + frac * 4.0 * h
+            };
+            let y = match frac {
+                1.0 => st.y1,
+                0.5 if formula => st.y_mid,
+                _ if formula => st.state_at(&self.system, t),
+                _ => dense.eval(t),
+            };
+            if resolved {
+                self.obs.collector.read(t, y.as_slice(), dt)?;
+            } else {
                 let amp = a0 + (a1 - a0) * frac;
                 let flux = st.flux0 + (st.flux1 - st.flux0) * frac;
                 let quasi_static = self.judge.model.quasi_static(flux, &y);
@@ -716,8 +959,8 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
                     quasi_static - amp,
                     quasi_static + amp,
                     amp,
-                    0.5 * amp * amp * h,
-                    h,
+                    0.5 * amp * amp * dt,
+                    dt,
                 )?;
             }
         }
@@ -813,7 +1056,8 @@ mod tests {
         let hyb = hybrid(&panel, &orbit, 3, y0);
         compare(&full.summaries, &hyb.run.summaries);
         assert!(hyb.t_linear > 2.0 * orbit.period, "{}", hyb.t_linear);
-        assert!(hyb.t_exponential > 0.0 && hyb.t_fallback == 0.0);
+        // The guard of the linear arcs' drift hands a few minutes to the full integration.
+        assert!(hyb.t_exponential > 0.0 && hyb.t_fallback < 0.01 * 3.0 * orbit.period);
         assert!(hyb.run.stats.n_steps * 50 < full.stats.n_steps);
         let total = hyb.t_linear + hyb.t_exponential + hyb.t_fallback;
         assert!((total - 3.0 * orbit.period).abs() < 1e-6 * total);
