@@ -402,7 +402,8 @@ def shown(frame: Any, name: str) -> tuple[Array, str]:
 
 
 def _counted(frame: Any) -> str:
-    """ "200 samples", or "200 samples, 3 failed (not shown)"."""
+    """The count in a Monte Carlo figure's title: '200 samples', or '200 samples, 3 failed (not
+    shown)' (a failed sample has no metric to plot)."""
     failed = int(frame["error"].notna().sum())
     text = f"{len(frame)} samples"
     return f"{text}, {failed} failed (not shown)" if failed else text
