@@ -3,6 +3,7 @@ kill-and-resume, refusal of bad inputs, and metrics checked against single runs.
 
 from __future__ import annotations
 
+import json
 import math
 import signal
 import subprocess
@@ -175,13 +176,102 @@ def test_sweep_is_full_factorial_in_order() -> None:
         tj.sweep(PAPER, LOW, {"damping": [1.0, -1.0]}, **FAST)
 
 
-def test_failed_samples_are_kept_with_their_error() -> None:
-    # The hybrid's cost is not known up front (rk45's would be refused before it starts): each
-    # sample runs into the budget.
-    frame = run(n=3, max_steps=10, method="hybrid")
-    assert frame["error"].str.contains("integration failed").all()
-    assert frame["theta_abs_max"].isna().all()
-    assert len(frame) == 3
+# Samples that fail for real: the hybrid propagator's cost is not known up front (an rk45 design
+# beyond its budget is refused before it starts), so each sample runs into max_steps by itself.
+# Its steps are those of the shadow, where the step follows the hinge period: about 9,700 at
+# K_el = 1000 N m/rad and 42,000 at 20,000, so a budget of 12,000 stops the stiff panels only.
+# Damping 100 makes the soft panel stable (c_d* ~ 52), damping 3 lets it flutter.
+BUDGET = 12_000
+FAILING: dict[str, Any] = {"method": "hybrid", "max_steps": BUDGET, **FAST}
+GRID = {"hinge_stiffness": [1000.0, 20000.0], "damping": [3.0, 100.0]}
+
+
+def test_failed_samples_are_missing_not_flutter() -> None:
+    free = tj.sweep(PAPER, LOW, GRID, method="hybrid", **FAST)  # the default budget: all finish
+    expected_failed = (free["n_steps"] > BUDGET).to_numpy()
+    assert free["error"].isna().all() and free["stable"].all() == False  # noqa: E712
+    assert 0 < expected_failed.sum() < len(free)
+    with pytest.warns(tj.SampleFailureWarning) as record:
+        frame = tj.sweep(PAPER, LOW, GRID, **FAILING)
+    assert len(record) == 1
+    failed = frame["error"].notna().to_numpy()
+    np.testing.assert_array_equal(failed, expected_failed)
+    first = int(np.flatnonzero(failed)[0])
+    message = str(record[0].message)
+    assert message.startswith(f"{failed.sum()} of {len(frame)} samples failed")
+    assert f"sample {first}: {frame['error'].iloc[first]}" in message
+    assert frame["error"][failed].str.contains(f"max_steps = {BUDGET} reached").all()
+    # Failed: stable and n_steps missing, numbers NaN; finished: the budget-free run's values.
+    assert frame["stable"].dtype == "boolean" and frame["n_steps"].dtype == "Int64"
+    assert frame["stable"][failed].isna().all() and frame["n_steps"][failed].isna().all()
+    assert frame.loc[failed, ["theta_eq", "growth_rate", "exit_peak"]].isna().all().all()
+    done = ~failed
+    np.testing.assert_array_equal(frame["stable"][done], free["stable"][done])
+    np.testing.assert_array_equal(frame["n_steps"][done], free["n_steps"][done])
+    assert frame.attrs["n_failed"] == failed.sum()
+    json.dumps(frame.attrs)  # attrs stay JSON, for Parquet
+    # The README's flutter share counts the finished samples only: NA is skipped.
+    assert (~frame["stable"]).mean() == pytest.approx((~free["stable"][done]).mean())
+    assert (~frame["stable"]).mean() != pytest.approx((~frame["stable"].fillna(False)).mean())
+
+
+def test_a_monte_carlo_study_counts_its_failures() -> None:
+    vary = {"hinge_stiffness": ("loguniform", 500.0, 20000.0)}
+    free = tj.monte_carlo(PAPER, LOW, vary=vary, n=8, seed=5, method="hybrid", **FAST)
+    expected_failed = (free["n_steps"] > BUDGET).to_numpy()
+    assert 0 < expected_failed.sum() < len(free)
+    with pytest.warns(tj.SampleFailureWarning, match=f"{expected_failed.sum()} of 8 samples"):
+        frame = tj.monte_carlo(PAPER, LOW, vary=vary, n=8, seed=5, **FAILING)
+    np.testing.assert_array_equal(frame["stable"].isna().to_numpy(), expected_failed)
+    assert frame.attrs["n_failed"] == expected_failed.sum()
+
+
+def test_failed_samples_survive_the_checkpoint_and_dask(tmp_path: Path) -> None:
+    with pytest.warns(tj.SampleFailureWarning):
+        straight = tj.sweep(PAPER, LOW, GRID, **FAILING)
+    with pytest.warns(tj.SampleFailureWarning):
+        tj.sweep(PAPER, LOW, GRID, checkpoint=tmp_path, chunk_size=1, **FAILING)
+    # The second call reads every chunk back from Parquet and runs nothing.
+    with pytest.warns(tj.SampleFailureWarning):
+        resumed = tj.sweep(PAPER, LOW, GRID, checkpoint=tmp_path, chunk_size=1, **FAILING)
+    assert len(list(tmp_path.glob("chunk-*.parquet"))) == len(straight)
+    pd.testing.assert_frame_equal(resumed, straight, check_exact=True)
+    assert resumed.attrs["n_failed"] == straight.attrs["n_failed"] > 0
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    )
+    try:
+        with distributed.Client(cluster) as client, pytest.warns(tj.SampleFailureWarning):
+            on_dask = tj.sweep(PAPER, LOW, GRID, backend=client, chunk_size=2, **FAILING)
+    finally:
+        cluster.close()
+    pd.testing.assert_frame_equal(on_dask, straight, check_exact=True)
+
+
+def test_a_study_whose_every_sample_failed_raises() -> None:
+    stiff = {"hinge_stiffness": [20000.0, 40000.0]}
+    with pytest.raises(tj.AllSamplesFailedError) as caught:
+        tj.sweep(PAPER, LOW, stiff, **FAILING)
+    exc = caught.value
+    assert isinstance(exc, tj.IntegrationError)  # caught by code that catches a failed run
+    assert exc.n == 2 and exc.first_sample == 0
+    assert f"max_steps = {BUDGET} reached" in exc.first_error and exc.first_error in str(exc)
+    assert exc.samples["stable"].isna().all() and exc.samples.attrs["n_failed"] == 2
+    with pytest.raises(tj.AllSamplesFailedError, match="all 3 samples"):
+        run(n=3, max_steps=10, method="hybrid")
+
+
+def test_sensitivity_of_stability_refuses_failed_samples() -> None:
+    pytest.importorskip("SALib")
+    # Stiffness on both sides of the budget's limit (~1,500 N m/rad): some of the 16 fail. Their
+    # stable must not enter the indices as flutter (0).
+    vary = {"hinge_stiffness": ("loguniform", 500.0, 5000.0), "damping": ("uniform", 1, 4)}
+    with (
+        pytest.warns(tj.SampleFailureWarning),
+        pytest.raises(ValueError, match=r"stable is not defined for \d+ of 16 samples.*max_steps"),
+    ):
+        tj.sensitivity(PAPER, LOW, vary, metric="stable", n=4, **FAILING)
 
 
 @pytest.mark.parametrize(

@@ -19,7 +19,7 @@ from thermojitter.distributed import (
     distributed_frequencies,
     simulate_distributed,
 )
-from thermojitter.errors import InternalError, ParameterError
+from thermojitter.errors import InternalError, ParameterError, SampleFailureWarning
 from thermojitter.flutter import (
     FlutterResult,
     LinearThermalResponse,
@@ -30,7 +30,13 @@ from thermojitter.flutter import (
 )
 from thermojitter.laminate import Laminate, Layer
 from thermojitter.longrun import OrbitSummaries, simulate_orbits
-from thermojitter.montecarlo import SensitivityResult, monte_carlo, sensitivity, sweep
+from thermojitter.montecarlo import (
+    AllSamplesFailedError,
+    SensitivityResult,
+    monte_carlo,
+    sensitivity,
+    sweep,
+)
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
@@ -64,6 +70,7 @@ def _check_kernel_variable() -> None:
 _check_kernel_variable()
 
 __all__ = [
+    "AllSamplesFailedError",
     "BeamComparison",
     "CalibrationResult",
     "CheckpointError",
@@ -83,6 +90,7 @@ __all__ = [
     "OrbitSummaries",
     "Panel",
     "ParameterError",
+    "SampleFailureWarning",
     "SensitivityResult",
     "Solution",
     "SolverSettings",

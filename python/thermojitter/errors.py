@@ -9,6 +9,10 @@
   that could not finish, a solve that did not converge.
 - :class:`InternalError` (``RuntimeError``): a defect caught at the engine's boundary (a panic);
   the call's result is lost but the process lives on.
+- :class:`SampleFailureWarning` (a ``RuntimeWarning``): some samples of a study (Monte Carlo,
+  sweep, sensitivity) failed; their rows are kept with the reason and no numbers.
+  ``thermojitter.montecarlo.AllSamplesFailedError`` (an ``IntegrationError``, defined beside the
+  studies because this module does not import the engine): every sample of a study failed.
 
 This module imports nothing from the engine: the engine's binding layer builds its
 ``ParameterError`` from here.
@@ -59,6 +63,12 @@ def _shown(value: Any) -> str:
 class InternalError(RuntimeError):
     """A defect in thermojitter caught at the engine's boundary (a Rust panic). Please report it
     with the call that raised it."""
+
+
+class SampleFailureWarning(RuntimeWarning):
+    """Some samples of a study could not be computed. The study goes on: each failed sample keeps
+    its row, with the reason in its ``error`` column, ``stable`` missing (pandas NA) and its numbers
+    NaN; ``frame.attrs["n_failed"]`` counts them."""
 
 
 def type_name(value: Any) -> str:

@@ -34,7 +34,7 @@ from scipy.stats import qmc
 from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
-from thermojitter.errors import ParameterError
+from thermojitter.errors import ParameterError, SampleFailureWarning
 from thermojitter.longrun import DEFAULT_THETA_LIMIT, orbit_count, refuse_beyond_budget
 from thermojitter.orbit import Orbit
 from thermojitter.panel import LAYUP_FIELDS, Panel
@@ -54,7 +54,9 @@ METRICS = (
 
 - ``theta_eq``: sunlit equilibrium angle at full Sun;
 - ``growth_rate``, ``frequency_hz``, ``stable``: linear stability of that equilibrium
-  (``tj.flutter``); ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
+  (``tj.flutter``); ``stable`` is a nullable boolean (pandas ``"boolean"``), missing (NA) for a
+  sample that failed, so that ``(~frame.stable).mean()`` is the share of the finished samples
+  that flutter; ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
 - ``theta_abs_max``: max abs(θ) over the horizon; ``amplitude``: max abs(θ − θ_eq);
 - ``entry_peak``/``exit_peak``: max abs(θ − θ_eq) within ``window`` s after a shadow entry / exit;
 - ``jitter_rms``/``jitter_peak``: of θ − M_T/K_el (the oscillation about the quasi-static
@@ -67,8 +69,13 @@ METRICS = (
 - ``t_nonlinear``: simulated time integrated with the full non-linear model, s (the whole run
   unless ``method="hybrid"``);
 - ``t_reached``: where the integration ended (the horizon, unless stopped at the threshold);
-- ``n_steps``: accepted integrator steps; ``error``: why a sample failed (None when it did not;
-  its numbers are then NaN).
+- ``n_steps``: accepted integrator steps (nullable ``"Int64"``, NA for a failed sample);
+  ``error``: why a sample failed (None when it did not; its numbers are then NaN, its ``stable``
+  and ``n_steps`` NA).
+
+A study counts its failed samples in ``frame.attrs["n_failed"]`` and warns with a
+:class:`thermojitter.SampleFailureWarning` naming the first; a study whose every sample failed
+raises :class:`AllSamplesFailedError`.
 """
 
 _FLOAT_METRICS = tuple(m for m in METRICS if m not in ("stable", "n_steps", "error"))
@@ -76,6 +83,30 @@ _FLOAT_METRICS = tuple(m for m in METRICS if m not in ("stable", "n_steps", "err
 _UNIT_INTERVAL = ("emissivity_front", "emissivity_back", "absorptivity")
 
 FORMAT_VERSION = 1
+
+
+class AllSamplesFailedError(_core.IntegrationError):
+    """Every sample of a study failed: there is no result to give. An ``IntegrationError``, so
+    that code catching a failed run catches this too.
+
+    ``n``: the samples run; ``first_sample`` and ``first_error``: the first failed sample's number
+    and its reason; ``samples``: the study's frame, every row with its ``error``.
+    """
+
+    def __init__(self, n: int, first_sample: int, first_error: str, samples: Any = None) -> None:
+        self.n = n
+        self.first_sample = first_sample
+        self.first_error = first_error
+        self.samples = samples
+        every = "the only sample" if n == 1 else f"all {n} samples"
+        super().__init__(
+            f"{every} of the study failed, nothing was computed (sample {first_sample}: "
+            f"{first_error}); every reason is in the 'error' column of the exception's .samples"
+        )
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Crosses process boundaries with its numbers; the frame stays behind.
+        return (type(self), (self.n, self.first_sample, self.first_error))
 
 
 # --- distributions --------------------------------------------------------------------------
@@ -606,14 +637,17 @@ def _frame(
     if rows is None:
         rows = np.arange(len(values))
     data: dict[str, Any] = {name: values[rows, j] for j, name in enumerate(names)}
+    errors = [e for c in chunks for e in c["error"]]
     for m in METRICS:
         if m == "error":
-            errors = [e for c in chunks for e in c["error"]]
             data[m] = pd.Series(errors, dtype=object)
         else:
             data[m] = np.concatenate([np.asarray(c[m]) for c in chunks] or [np.empty(0)])
-    data["stable"] = data["stable"].astype(bool)
-    data["n_steps"] = data["n_steps"].astype(np.int64)
+    # The engine (and the chunks stored from it) gives a failed sample stable = False and no
+    # steps; both would read as answers (flutter, a run of 0 steps), so they are missing here.
+    failed = np.array([e is not None for e in errors], dtype=bool)
+    data["stable"] = pd.arrays.BooleanArray(np.asarray(data["stable"], dtype=bool), failed)
+    data["n_steps"] = pd.arrays.IntegerArray(np.asarray(data["n_steps"], dtype=np.int64), failed)
     frame = pd.DataFrame(data)
     frame.index = (
         pd.RangeIndex(len(values), name="sample")
@@ -752,7 +786,29 @@ def _run_design(
             )
         else:
             report_interrupted(kept, "pass checkpoint=DIR to make a run resumable")
+    _report_failures(frame)
     return frame
+
+
+def _report_failures(frame: Any) -> None:
+    """Counts the failed samples in ``frame.attrs["n_failed"]``; warns once when some failed
+    (stacklevel: the caller of the study), raises AllSamplesFailedError when all did."""
+    failed = frame["error"].notna().to_numpy()
+    n_failed = int(failed.sum())
+    frame.attrs["n_failed"] = n_failed
+    if n_failed == 0:
+        return
+    first = int(np.flatnonzero(failed)[0])
+    first_sample, first_error = int(frame.index[first]), str(frame["error"].iloc[first])
+    if n_failed == len(frame):
+        raise AllSamplesFailedError(len(frame), first_sample, first_error, frame)
+    warnings.warn(
+        f"{n_failed} of {len(frame)} samples failed (sample {first_sample}: {first_error}); "
+        "their rows have stable = NA and NaN numbers, the 'error' column says why, "
+        "frame.attrs['n_failed'] counts them",
+        SampleFailureWarning,
+        stacklevel=4,  # _report_failures < _run_design < the study < its caller
+    )
 
 
 def solver_of(frame: Any) -> SolverSettings:
@@ -880,6 +936,13 @@ def monte_carlo(
       sample's panel as one homogeneous layer. The N-node model is integrated in full (rk45 in
       place of the hybrid propagator). A sample is the single run of its panel.
 
+    A sample that fails (its integration cannot finish, e.g. it runs into ``max_steps``) keeps
+    its row: the reason in ``error``, ``stable`` and ``n_steps`` missing (NA), its numbers NaN.
+    The study then warns (:class:`thermojitter.SampleFailureWarning`, naming how many failed and
+    the first reason) and counts them in ``frame.attrs["n_failed"]``; when every sample fails it
+    raises :class:`AllSamplesFailedError` (an ``IntegrationError``; the frame is its
+    ``.samples``).
+
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
     check_inputs(panel, orbit)
@@ -938,7 +1001,8 @@ def sweep(
 ) -> Any:
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
-    arguments (``layers`` too) are the same."""
+    arguments (``layers`` too) are the same, and so is the handling of failed samples (a
+    warning and ``frame.attrs["n_failed"]``; :class:`AllSamplesFailedError` when all failed)."""
     check_inputs(panel, orbit)
     if not isinstance(grid, Mapping) or not grid:
         raise ValueError("grid must be a non-empty mapping of panel parameter names to values")
@@ -1020,6 +1084,12 @@ def sensitivity(
     a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
     arguments (``layers`` too) these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``,
     ``ST_conf`` per parameter (first-order and total indices, 95 % confidence half-widths).
+
+    The indices need the metric of every sample: a study in which some sample failed (or whose
+    metric is NaN somewhere) is refused with a ValueError naming the first, after the warning
+    every study gives of its failed samples; one in which all failed raises
+    :class:`AllSamplesFailedError`. With ``metric="stable"`` the indices are those of the
+    0/1 indicator of stability.
     """
     try:
         from SALib.analyze import sobol as sobol_analyze
@@ -1035,7 +1105,8 @@ def sensitivity(
     n = _check_n(n, 2)
     seed = _check_seed(seed, None)
     if metric not in _FLOAT_METRICS and metric != "stable":
-        raise ValueError(f"metric = {metric!r} is invalid: choose from {', '.join(_FLOAT_METRICS)}")
+        choices = ", ".join((*_FLOAT_METRICS, "stable"))
+        raise ValueError(f"metric = {metric!r} is invalid: choose from {choices}")
     options = _options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
         threshold, stop_at_threshold,
@@ -1069,7 +1140,8 @@ def sensitivity(
             index=pd.Index(names, name="parameter"),
         )
         return SensitivityResult(indices=indices, metric=metric, samples=samples, interrupted=True)
-    y = samples[metric].to_numpy(dtype=float)
+    # A failed sample's stable is NA: NaN here, refused below like a missing number.
+    y = samples[metric].to_numpy(dtype=float, na_value=np.nan)
     missing = np.flatnonzero(~np.isfinite(y))
     if missing.size:
         k = int(missing[0])

@@ -401,6 +401,14 @@ def shown(frame: Any, name: str) -> tuple[Array, str]:
     return values, f"{name} [{unit}]" if unit else name
 
 
+def _counted(frame: Any) -> str:
+    """The count in a Monte Carlo figure's title: '200 samples', or '200 samples, 3 failed (not
+    shown)' (a failed sample has no metric to plot)."""
+    failed = int(frame["error"].notna().sum())
+    text = f"{len(frame)} samples"
+    return f"{text}, {failed} failed (not shown)" if failed else text
+
+
 def monte_carlo_figures(frame: Any, names: Sequence[str], out: Path) -> list[Path]:
     """``histograms.png`` (each metric over the samples) and ``scatter.png`` (metrics against
     the varied parameters, stable and fluttering samples apart)."""
@@ -421,7 +429,7 @@ def monte_carlo_figures(frame: Any, names: Sequence[str], out: Path) -> list[Pat
         ax.tick_params(axis="x", labelsize=8)
     for ax in list(axes.flat)[len(metrics) :]:
         ax.set_visible(False)
-    fig.suptitle(f"Monte Carlo: {len(frame)} samples")
+    fig.suptitle(f"Monte Carlo: {_counted(frame)}")
     written.append(save(fig, out / "histograms.png"))
 
     fig, axes = plt.subplots(
@@ -431,18 +439,22 @@ def monte_carlo_figures(frame: Any, names: Sequence[str], out: Path) -> list[Pat
         squeeze=False,
         layout="constrained",
     )
-    stable = frame["stable"].to_numpy(bool)
+    # A failed sample's stable is missing (NA): it is neither stable nor flutter, and it has no
+    # metric to plot. astype reads a frame saved before stable could be NA too.
+    verdict = frame["stable"].astype("boolean")
+    stable = verdict.fillna(False).to_numpy(bool)
+    flutter = (~verdict).fillna(False).to_numpy(bool)
     for i, name in enumerate(names):
         for j, m in enumerate(SCATTER_METRICS):
             ax = axes[i, j]
             (x, xlabel), (y, ylabel) = shown(frame, name), shown(frame, m)
             ax.scatter(x[stable], y[stable], s=6, label="stable", color="tab:blue")
-            ax.scatter(x[~stable], y[~stable], s=6, label="flutter", color="tab:red")
+            ax.scatter(x[flutter], y[flutter], s=6, label="flutter", color="tab:red")
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
             tidy_ticks(ax)
             ax.tick_params(labelsize=8)
-    fig.suptitle(f"Monte Carlo: metrics against the varied parameters ({len(frame)} samples)")
+    fig.suptitle(f"Monte Carlo: metrics against the varied parameters ({_counted(frame)})")
     legend(fig)
     written.append(save(fig, out / "scatter.png"))
     return written

@@ -7,8 +7,9 @@
     thermojitter mc SCENARIO.toml --out DIR   Monte Carlo study of a scenario's [vary] table
 
 One error path: user errors (bad files, values, folders) are one line on stderr and exit code 2;
-Ctrl-C stops within about a second with exit code 130, keeps what finished and says in one line
-what was kept and how to resume.
+a Monte Carlo study with failed samples is one line on stderr and exit code 3 (``mc
+--allow-failures`` accepts some failed samples, never all); Ctrl-C stops within about a second
+with exit code 130, keeps what finished and says in one line what was kept and how to resume.
 """
 
 from __future__ import annotations
@@ -22,10 +23,12 @@ from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.cli import beam, flutter, mc, paper, run
 from thermojitter.cli.common import (
     EXIT_INTERRUPTED,
+    EXIT_SAMPLES_FAILED,
     EXIT_USER_ERROR,
     STOP,
     Interrupted,
     Parser,
+    SamplesFailed,
     UserError,
 )
 from thermojitter.cli.run import MAX_ORBITS, MAX_ROWS, simulate_scenario
@@ -33,6 +36,7 @@ from thermojitter.scenario import ScenarioError
 
 __all__ = [
     "EXIT_INTERRUPTED",
+    "EXIT_SAMPLES_FAILED",
     "EXIT_USER_ERROR",
     "MAX_ORBITS",
     "MAX_ROWS",
@@ -60,9 +64,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _fail(message: str) -> int:
+def _fail(message: str, code: int = EXIT_USER_ERROR) -> int:
     print(f"thermojitter: error: {message}", file=sys.stderr)
-    return EXIT_USER_ERROR
+    return code
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -88,6 +92,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     except (ScenarioError, UserError) as exc:
         return _fail(str(exc))
+    except SamplesFailed as exc:
+        return _fail(" ".join(str(exc).split()), EXIT_SAMPLES_FAILED)
     except (ValueError, TypeError, IntegrationError, ConvergenceError) as exc:
         return _fail(" ".join(str(exc).split()))
     except ImportError as exc:

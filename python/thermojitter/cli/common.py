@@ -13,11 +13,17 @@ from thermojitter.checkpoint import write_atomic
 from thermojitter.progress import SigintHandler
 
 EXIT_USER_ERROR = 2
+EXIT_SAMPLES_FAILED = 3
 EXIT_INTERRUPTED = 130
 
 
 class UserError(Exception):
     """A problem with what the user asked for: reported in one line, exit code 2."""
+
+
+class SamplesFailed(Exception):
+    """Samples of a study failed (``thermojitter mc``): reported in one line, exit code 3, after
+    what finished was written and summarised."""
 
 
 class Interrupted(KeyboardInterrupt):

@@ -15,20 +15,34 @@ The scenario format of ``thermojitter run`` with two more tables:
 
 Writes DIR/samples.parquet (one row a sample), DIR/checkpoint/ (finished chunks: run the same
 command again to resume a killed run), DIR/histograms.png and DIR/scatter.png.
+
+A sample that fails keeps its row (the reason in ``error``, ``stable`` empty); the summary counts
+the failed samples and the flutter share is of those that finished. Exit code 3 when samples
+failed, unless ``--allow-failures``; always 3 (with samples.parquet and no plots) when every
+sample failed.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from thermojitter.cli.common import Interrupted, add_out, out_dir, write_output
-from thermojitter.montecarlo import monte_carlo
+from thermojitter.cli.common import (
+    EXIT_SAMPLES_FAILED,
+    Interrupted,
+    SamplesFailed,
+    add_out,
+    out_dir,
+    write_output,
+)
+from thermojitter.errors import SampleFailureWarning
+from thermojitter.montecarlo import AllSamplesFailedError, monte_carlo
 from thermojitter.scenario import ScenarioError, load_scenario
 
 SETTING_KEYS = ("n", "seed", "sampler", "truncate")
@@ -84,7 +98,9 @@ def add_parser(sub: Any) -> None:
         description="Monte Carlo study of a scenario file: panels drawn from the [vary] "
         "distributions, each run over whole orbits; writes samples.parquet, histograms.png and "
         "scatter.png, and resumes a killed run from DIR/checkpoint/.",
-        epilog="Example: thermojitter mc examples/montecarlo.toml --n 200 --out out/mc",
+        epilog="Example: thermojitter mc examples/montecarlo.toml --n 200 --out out/mc. "
+        f"Exit codes: 0 done, 2 bad input, {EXIT_SAMPLES_FAILED} samples failed (see "
+        "--allow-failures), 130 Ctrl-C.",
     )
     p.add_argument("scenario", help="scenario TOML with [panel], [orbit], [vary] tables")
     add_out(p, required=True, help="output folder (created)")
@@ -104,6 +120,13 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--truncate", action="store_true", help="truncate to the valid ranges")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="write no plots")
+    p.add_argument(
+        "--allow-failures",
+        action="store_true",
+        help="exit 0 when some samples failed (they are counted in the summary and kept in "
+        f"samples.parquet with their error); without it the exit code is {EXIT_SAMPLES_FAILED}. "
+        f"A study whose every sample failed exits {EXIT_SAMPLES_FAILED} all the same",
+    )
     # No stop flag: Ctrl-C reaches monte_carlo, which stops at once and keeps finished chunks.
     p.set_defaults(handler=run, stop_flag=False)
 
@@ -116,30 +139,55 @@ def run(args: argparse.Namespace) -> int:
     for key in ("horizon", "threshold"):
         if getattr(args, key) is not None:
             run[key] = getattr(args, key)
-    frame = monte_carlo(
-        scenario["panel"],
-        scenario["orbit"],
-        vary={k: tuple(v) if isinstance(v, list) else v for k, v in scenario["vary"].items()},
-        n=args.n if args.n is not None else int(s.get("n", 1000)),
-        seed=args.seed if args.seed is not None else int(s.get("seed", 0)),
-        sampler=args.sampler or s.get("sampler", "random"),
-        truncate=args.truncate or bool(s.get("truncate", False)),
-        threads=args.threads,
-        backend=args.dask,
-        checkpoint=out / "checkpoint",
-        progress=not args.no_progress,
-        **run,
-    )
+    samples = out / "samples.parquet"
+    try:
+        with warnings.catch_warnings():
+            # The summary below counts the failed samples; the warning would say it again.
+            warnings.simplefilter("ignore", SampleFailureWarning)
+            frame = monte_carlo(
+                scenario["panel"],
+                scenario["orbit"],
+                vary={
+                    k: tuple(v) if isinstance(v, list) else v for k, v in scenario["vary"].items()
+                },
+                n=args.n if args.n is not None else int(s.get("n", 1000)),
+                seed=args.seed if args.seed is not None else int(s.get("seed", 0)),
+                sampler=args.sampler or s.get("sampler", "random"),
+                truncate=args.truncate or bool(s.get("truncate", False)),
+                threads=args.threads,
+                backend=args.dask,
+                checkpoint=out / "checkpoint",
+                progress=not args.no_progress,
+                **run,
+            )
+    except AllSamplesFailedError as exc:
+        failed_frame = exc.samples  # the study's frame, every row with its error
+        if failed_frame.attrs["interrupted"]:
+            raise Interrupted from None  # monte_carlo said what it kept and how to resume
+        write_output(samples, lambda fh: failed_frame.to_parquet(fh))
+        every_sample = "the only sample" if exc.n == 1 else f"all {exc.n} samples"
+        raise SamplesFailed(
+            f"{every_sample} failed (sample {exc.first_sample}: {exc.first_error}); "
+            f"every error is in {samples}"
+        ) from None
     if frame.attrs["interrupted"]:
         raise Interrupted  # monte_carlo said what it kept and how to resume
-    write_output(out / "samples.parquet", lambda fh: frame.to_parquet(fh))
+    write_output(samples, lambda fh: frame.to_parquet(fh))
     names = list(scenario["vary"])
+    failed = int(frame.attrs["n_failed"])
+    finished = len(frame) - failed
+    # stable is NA for a failed sample, and the sum skips NA: flutter among the finished ones.
     flutter = int((~frame["stable"]).sum())
-    failed = int(frame["error"].notna().sum())
-    print(f"{len(frame)} samples -> {out / 'samples.parquet'}")
-    print(f"unstable equilibrium (flutter): {flutter} ({100.0 * flutter / len(frame):.1f} %)")
+    print(f"{len(frame)} samples -> {samples}")
+    first = ""
     if failed:
-        print(f"failed samples: {failed} (see the 'error' column)")
+        k = int(np.flatnonzero(frame["error"].notna().to_numpy())[0])
+        first = f"sample {frame.index[k]}: {frame['error'].iloc[k]}"
+    print(f"failed: {failed} of {len(frame)} samples" + (f" ({first})" if failed else ""))
+    print(
+        f"unstable equilibrium (flutter): {flutter} of {finished} finished samples "
+        f"({100.0 * flutter / finished:.1f} %)"
+    )
     for m in ("exit_peak", "jitter_rms", "theta_abs_max"):
         q = np.nanpercentile(frame[m].to_numpy(float), [5, 50, 95])
         print(f"{m:>14}: 5% {q[0]:.4g}  median {q[1]:.4g}  95% {q[2]:.4g} rad")
@@ -148,4 +196,10 @@ def run(args: argparse.Namespace) -> int:
 
         for path in monte_carlo_figures(frame, names, out):
             print(f"wrote {path}")
+    if failed and not args.allow_failures:
+        raise SamplesFailed(
+            f"{failed} of {len(frame)} samples failed ({first}); the summary above is of the "
+            f"{finished} that finished, every error is in {samples}; pass --allow-failures to "
+            "accept a study with failed samples"
+        )
     return 0
