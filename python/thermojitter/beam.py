@@ -16,7 +16,6 @@ model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly 
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import errors as checks
 from thermojitter.checkpoint import write_bytes_atomic
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
@@ -76,8 +76,8 @@ class FreeFreeBeam:
 
     def __init__(self, panel: Panel, n_elements: int = 100) -> None:
         check_inputs(panel)
-        if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)):
-            raise TypeError(f"n_elements must be an int, not {type(n_elements).__name__}")
+        # Bounded here so that no integer overflows on its way (the engine wants it even, too).
+        n_elements = checks.integer("n_elements", n_elements, 2, _core.BEAM_MAX_ELEMENTS)
         self.panel = panel
         self.n_elements = int(n_elements)
         self._modes = _core.beam_modes(panel.as_dict(), self.n_elements, 1)
@@ -306,6 +306,14 @@ def compare_with_beam(
     FFT of each signal above ``f_min`` (Hz).
     """
     check_inputs(panel, orbit)
+    # Every argument checked before any work (the runs below would check some, too late).
+    scale_moment = checks.flag("scale_moment", scale_moment)
+    coupled = checks.flag("coupled", coupled)
+    model = checks.choice("model", model, ("nonlinear", "linear"))  # type: ignore[assignment]
+    dt_out = checks.positive("dt_out", dt_out)
+    f_min = checks.positive("f_min", f_min)
+    if damping_ratio is not None:
+        damping_ratio = checks.finite("damping_ratio", damping_ratio)
     hinge_panel = panel
     if criterion is not None:
         hinge_panel = panel.replace(hinge_stiffness=hinge_stiffness(panel, criterion))
@@ -313,10 +321,12 @@ def compare_with_beam(
         chi = _core.derived(hinge_panel.as_dict())["matching_moment_scale"]
         hinge_panel = hinge_panel.replace(moment_scale=chi)
     span = eclipse_window(orbit) if t_span is None else time_span(t_span)
-    if not (math.isfinite(dt_out) and dt_out > 0):
-        raise ValueError(f"dt_out = {dt_out!r} is invalid: must be finite and > 0")
     if span[1] - span[0] < 16 * dt_out:
         raise ValueError(f"t_span = {span!r} is invalid: shorter than 16 samples of dt_out")
+    if (span[1] - span[0]) / dt_out > _core.MAX_SAMPLES:
+        raise checks.ParameterError(
+            "dt_out", dt_out, f"would keep more than {_core.MAX_SAMPLES} samples of t_span"
+        )
     # Uniform samples (the FFT needs them): the last one may fall short of t_span[1].
     samples = span[0] + dt_out * np.arange(int((span[1] - span[0]) / dt_out) + 1)
     sol = simulate(
