@@ -124,6 +124,7 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
 
     series = _series()
     sandwich = _sandwich()
+    beam = tj.FreeFreeBeam(panel, n_elements=20)
 
     return {
         "Panel": (tj.Panel, {"length": 50.0, "damping": 3.0, "specific_heat": 900.0}),
@@ -284,6 +285,25 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
             {"path": CSV, "degrees": False, "fit": ("damping",), "diff_step": 1e-3, **fast},
         ),
         "FreeFreeBeam": (tj.FreeFreeBeam, {"panel": panel, "n_elements": 20}),
+        "FreeFreeBeam.natural_frequencies": (
+            lambda _self, **kw: _self.natural_frequencies(**kw),
+            {"_self": beam, "n": 2},
+        ),
+        "FreeFreeBeam.static_tip_deflection": (
+            lambda _self, **kw: _self.static_tip_deflection(**kw),
+            {"_self": beam, "moment": 400.0},
+        ),
+        "FreeFreeBeam.response": (
+            lambda _self, **kw: _self.response(**kw),
+            {
+                "_self": beam,
+                "times": [0.0, 10.0, 20.0],
+                "moments": [400.0, 350.0, 300.0],
+                "damping_ratio": 0.01,
+                "residual": True,
+                **fast,
+            },
+        ),
         "compare_with_beam": (
             tj.compare_with_beam,
             {
@@ -626,6 +646,15 @@ SPECS: dict[str, dict[str, str]] = {
     },
     "calibrate_from_csv": {"path": "path?", "degrees": "flag", "diff_step": "positive"},
     "FreeFreeBeam": {"panel": "panel", "n_elements": "count"},
+    "FreeFreeBeam.natural_frequencies": {"n": "count"},
+    "FreeFreeBeam.static_tip_deflection": {"moment": "real"},
+    "FreeFreeBeam.response": {
+        "times": "reals",
+        "moments": "reals",
+        "damping_ratio": "nonneg?",
+        "residual": "flag",
+        **_SOLVER,
+    },
     "compare_with_beam": {
         "panel": "panel",
         "orbit": "orbit",

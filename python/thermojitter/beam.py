@@ -86,9 +86,8 @@ class FreeFreeBeam:
         return f"FreeFreeBeam(n_elements={self.n_elements}, L={self.panel.length} m)"
 
     def _check_n(self, n: int) -> int:
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-            raise TypeError(f"n must be an int, not {type(n).__name__}")
-        return int(n)
+        # At most the mesh's degrees of freedom (the engine checks the exact count).
+        return checks.integer("n", n, 1, 2 * self.n_elements)
 
     def natural_frequencies(self, n: int = 3) -> Array:
         """The first ``n`` elastic free–free frequencies, Hz (rigid-body modes excluded)."""
@@ -118,7 +117,8 @@ class FreeFreeBeam:
 
     def static_tip_deflection(self, moment: float) -> float:
         """η (m) under steady end moments ±``moment`` (N m); exact value M L²/(8EI)."""
-        return float(_core.beam_static(self.panel.as_dict(), self.n_elements, float(moment)))
+        moment = checks.finite("moment", moment)
+        return float(_core.beam_static(self.panel.as_dict(), self.n_elements, moment))
 
     def response(
         self,
@@ -146,8 +146,8 @@ class FreeFreeBeam:
         (default :func:`default_damping_ratio`, from the panel's c_d). ``residual=False`` drops
         the quasi-static part of the modes not integrated.
         """
-        ts = np.ascontiguousarray(np.asarray(times, dtype=float).ravel())
-        ms = np.ascontiguousarray(np.asarray(moments, dtype=float).ravel())
+        ts = checks.real_array("times", times)
+        ms = checks.real_array("moments", moments)
         if ts.size < 2 or ts.size != ms.size:
             raise ValueError(
                 f"times/moments hold {ts.size}/{ms.size} values: need two or more, equal lengths"
@@ -155,7 +155,12 @@ class FreeFreeBeam:
         t0, t1 = (float(ts[0]), float(ts[-1])) if t_span is None else time_span(t_span)
         if t_eval is None and dt_out is None:
             t_eval = ts[(ts >= t0) & (ts <= t1)]
-        zeta = default_damping_ratio(self.panel) if damping_ratio is None else damping_ratio
+        zeta = (
+            default_damping_ratio(self.panel)
+            if damping_ratio is None
+            else checks.finite("damping_ratio", damping_ratio)
+        )
+        residual = checks.flag("residual", residual)
         used = SolverSettings.of(
             solver,
             method=method,
