@@ -288,8 +288,15 @@ impl StructuralModel for Hinge {
         out[0] = (moment - self.hinge_stiffness * positions[0]) / self.hinge_stiffness;
     }
     fn check_start(&self, offset: usize, states: &[f64]) -> Result<()> {
-        check_hinge_angle(&format!("y0[{offset}]"), states[0])?;
-        let (rate, most) = (states[1], self.max_start_rate());
+        let &[theta, rate, ..] = states else {
+            return Err(Error::invalid(
+                "y0",
+                format!("{} components", offset + states.len()),
+                &format!("must hold θ and θ̇ after its {offset} temperatures"),
+            ));
+        };
+        check_hinge_angle(&format!("y0[{offset}]"), theta)?;
+        let most = self.max_start_rate();
         if !(rate.is_finite() && rate.abs() <= most) {
             return Err(Error::invalid(
                 &format!("y0[{}]", offset + 1),
@@ -475,6 +482,8 @@ mod tests {
         }
         // Temperatures alone (a thermal model): no hinge to check.
         check_start_state(&[300.0, 290.0], 2, None).unwrap();
+        // A hinge asked for but missing is an error, not a panic.
+        assert!(check_start_state(&[300.0, 290.0, 0.0], 2, Some(&hinge)).is_err());
     }
 
     #[test]
