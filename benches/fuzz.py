@@ -1,7 +1,9 @@
 """The long run of the fuzz harness (tests/fuzzing.py): N generated hostile calls of the public API
-and the scenario parser, and damaged scenario files and long-run checkpoints, each in a worker
-process under a watchdog (20 s of the worker's CPU time, or 6x that of wall time); prints the
-count of each outcome, the share of refusals that name the parameter, and every failure.
+and the scenario parser, known-invalid arguments of every public function (which must be refused
+naming them: "accepted_invalid" and "wrong_name" are failures), and damaged scenario files and
+long-run checkpoints, each in a worker process under a watchdog (20 s of the worker's CPU time,
+or 6x that of wall time); prints the count of each outcome, the share of refusals that name the
+parameter, and every failure.
 
     python benches/fuzz.py --n 10000
 """
@@ -39,6 +41,7 @@ def main() -> int:
     args = parser.parse_args()
 
     counts: collections.Counter[str] = collections.Counter()
+    invalid: collections.Counter[str] = collections.Counter()  # the known-invalid calls alone
     by_target: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
     failures: list[tuple[Example, str, str]] = []
     unnamed: list[tuple[Example, str]] = []
@@ -62,6 +65,9 @@ def main() -> int:
             slowest = (runner.last_cpu, runner.last_wall, example)
         counts[outcome] += 1
         by_target[example.target][outcome] += 1
+        if example.invalid:
+            invalid["total"] += 1
+            invalid[outcome] += 1
         if outcome in FAILURES:
             failures.append((example, outcome, detail))
         elif outcome == "refused_unnamed":
@@ -82,6 +88,11 @@ def main() -> int:
         print(f"  {outcome:16s} {counts[outcome]:6d}")
     if refusals:
         print(f"refusals naming the parameter: {100.0 * counts['refused_named'] / refusals:.2f} %")
+    print(
+        f"known-invalid calls: {invalid['total']} (refused naming the argument: "
+        f"{invalid['refused_named']}, accepted: {invalid['accepted_invalid']}, "
+        f"refused naming another: {invalid['wrong_name']})"
+    )
     print(f"limits per call: {runner.limit:g} s CPU, {runner.wall_limit:g} s wall")
     print(f"slowest call: {slowest[0]:.2f} s CPU, {slowest[1]:.2f} s wall ({slowest[2]})")
     print("per entry point (ok / refused / runtime error):")

@@ -10,12 +10,19 @@ answer within the CPU-time limit, see ``Runner``) is counted, not fatal.
 
 Outcomes:
 
+Besides hostile values, an example may be *known invalid* (``Example.invalid``): one argument
+replaced by a value its kind (``SPECS``, ``INVALID``) never accepts — out of range, non-finite, a
+bool for a number, a string for a bool, an integer too large, an empty path, an unphysical start
+state. Such a call must be refused, naming that argument.
+
 - ``ok``: a result whose every number is finite (NaN only where documented: no eclipse, no umbra,
   a failed Monte Carlo sample with its error; +inf only for ``max_step``, "no cap");
 - ``refused_named``: ValueError/TypeError naming the parameter (a ``ParameterError``'s
   ``.parameter``, or the argument's name in the message); ``refused_unnamed`` otherwise;
 - ``runtime_error``: IntegrationError or ConvergenceError (a clear error from the engine);
-- failures: ``silent_nan`` (a non-finite number returned), ``wrong_result`` (a run resumed
+- failures: ``accepted_invalid`` (a known-invalid example answered, not refused),
+  ``wrong_name`` (a known-invalid example refused naming another parameter), ``silent_nan`` (a
+  non-finite number returned), ``wrong_result`` (a run resumed
   from a damaged checkpoint that differs from the run itself), ``internal_error`` (a panic caught at
   the boundary), ``panic`` (a BaseException from the engine), ``other_exception`` (any other
   type), ``abort`` (the worker died), ``hang`` (past the time limit).
@@ -36,7 +43,8 @@ import hypothesis.strategies as st
 import numpy as np
 
 FAILURES = (
-    "silent_nan", "wrong_result", "internal_error", "panic", "other_exception", "abort", "hang",
+    "accepted_invalid", "wrong_name", "silent_nan", "wrong_result", "internal_error", "panic",
+    "other_exception", "abort", "hang",
 )  # fmt: skip
 OUTCOMES = ("ok", "refused_named", "refused_unnamed", "runtime_error", *FAILURES)
 
@@ -113,6 +121,10 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
 
     def scenario(**tables: Any) -> Any:
         return parse_scenario({k: v for k, v in tables.items() if v is not None}, "fuzz.toml")
+
+    series = _series()
+    sandwich = _sandwich()
+    beam = tj.FreeFreeBeam(panel, n_elements=20)
 
     return {
         "Panel": (tj.Panel, {"length": 50.0, "damping": 3.0, "specific_heat": 900.0}),
@@ -237,10 +249,511 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
                 "output": {"format": "csv"},
             },
         ),
+        "sensitivity": (
+            tj.sensitivity,
+            {
+                "panel": panel,
+                "orbit": low,
+                "vary": {"damping": ("uniform", 1.0, 4.0)},
+                "n": 2,
+                "seed": 1,
+                "horizon": 1,
+                "threads": 1,
+                "progress": False,
+                **fast,
+                **budget,
+            },
+        ),
+        "calibrate": (
+            tj.calibrate,
+            {
+                "t": series[0],
+                "theta": series[1],
+                "panel": panel,
+                "orbit": geo,
+                "fit": ("damping",),
+                "initial": {"damping": 2.5},
+                "y0": None,
+                "model": "nonlinear",
+                "coupled": True,
+                "diff_step": 1e-3,
+                **fast,
+            },
+        ),
+        "calibrate_from_csv": (
+            _calibrate_csv,
+            {"path": CSV, "degrees": False, "fit": ("damping",), "diff_step": 1e-3, **fast},
+        ),
+        "FreeFreeBeam": (tj.FreeFreeBeam, {"panel": panel, "n_elements": 20}),
+        "FreeFreeBeam.natural_frequencies": (
+            lambda _self, **kw: _self.natural_frequencies(**kw),
+            {"_self": beam, "n": 2},
+        ),
+        "FreeFreeBeam.static_tip_deflection": (
+            lambda _self, **kw: _self.static_tip_deflection(**kw),
+            {"_self": beam, "moment": 400.0},
+        ),
+        "FreeFreeBeam.response": (
+            lambda _self, **kw: _self.response(**kw),
+            {
+                "_self": beam,
+                "times": [0.0, 10.0, 20.0],
+                "moments": [400.0, 350.0, 300.0],
+                "damping_ratio": 0.01,
+                "residual": True,
+                **fast,
+            },
+        ),
+        "compare_with_beam": (
+            tj.compare_with_beam,
+            {
+                "panel": panel,
+                "orbit": geo,
+                "t_span": (0.0, 30.0),
+                "dt_out": 1.0,
+                "n_elements": 10,
+                "model": "nonlinear",
+                "coupled": True,
+                **fast,
+            },
+        ),
+        "distributed_defaults": (tj.distributed_defaults, {"panel": panel}),
+        "distributed_frequencies": (
+            tj.distributed_frequencies,
+            {"panel": panel, "support": "free-free", "elements": 8, "modes": 2},
+        ),
+        "distributed_flutter": (
+            tj.distributed_flutter,
+            {"panel": panel, "elements": 8, "modes": 2, "flux": 1.0, "sun_angle": 0.0},
+        ),
+        "simulate_distributed": (
+            tj.simulate_distributed,
+            {
+                "panel": panel,
+                "orbit": geo,
+                "t_span": (0.0, 10.0),
+                "elements": 4,
+                "modes": 2,
+                "coupled": True,
+                "dt_out": 1.0,
+                **fast,
+                **budget,
+            },
+        ),
+        "Layer": (
+            tj.Layer,
+            {
+                "thickness": 5e-4,
+                "conductivity": 100.0,
+                "density": 1650.0,
+                "specific_heat": 900.0,
+                "youngs_modulus": 1e11,
+                "expansion_coeff": -1e-6,
+                "name": "skin",
+            },
+        ),
+        "Laminate": (
+            tj.Laminate,
+            {
+                "layers": sandwich.layers,
+                "emissivity_front": 0.8,
+                "emissivity_back": 0.3,
+                "absorptivity": 0.8,
+                "reference_temperature": 293.15,
+            },
+        ),
+        "Panel.from_laminate": (
+            tj.Panel.from_laminate,
+            {"laminate": sandwich, "length": 20.0, "criterion": "frequency", "damping": 1.0},
+        ),
+        "materials.get": (tj.materials.get, {"key": "kapton"}),
+        "Material.layer": (
+            lambda _self, **kw: _self.layer(**kw),
+            {"_self": tj.materials.CFRP_M55J_QI, "thickness": 5e-4},
+        ),
+        "SolverSettings": (
+            tj.SolverSettings,
+            {"method": "rk45", "rtol": 1e-8, "atol": 1e-10, "max_steps": 1000},
+        ),
         # Damaged files: the bytes of a good one, mutated (see ``damaged``).
         "scenario file": (_scenario_file, {"text": SCENARIO_TEXT}),
         "checkpoint": (_resume, {"text": b""}),
     }
+
+
+_SERIES: list[Any] = []
+
+
+def _series() -> tuple[np.ndarray, np.ndarray]:
+    """A short angle series to calibrate against (21 samples over 60 s of the paper panel on
+    GEO, from a kick off its equilibrium), made once per process."""
+    if not _SERIES:
+        import thermojitter as tj
+
+        panel = tj.Panel.paper()
+        eq = tj.steady_state(panel)
+        t = np.linspace(0.0, 60.0, 21)
+        y0 = (eq.T_front, eq.T_back, eq.theta + 1e-3, 0.0)
+        sol = tj.simulate(panel, tj.Orbit.geo_equinox(), (0.0, 60.0), t_eval=t, y0=y0)
+        _SERIES.extend([t, np.asarray(sol.theta)])
+    return _SERIES[0], _SERIES[1]
+
+
+def _sandwich() -> Any:
+    """CFRP skins on an aluminium honeycomb core, from the package's materials: a real layup
+    whose expansion coefficient is negative."""
+    import thermojitter as tj
+    from thermojitter import materials
+
+    skin, core = materials.CFRP_M55J_QI, materials.ALUMINIUM_HONEYCOMB
+    layers = (skin.layer(5e-4, "front"), core.layer(0.02, "core"), skin.layer(5e-4, "back"))
+    return tj.Laminate(layers, emissivity_front=0.8, emissivity_back=0.3, absorptivity=0.8)
+
+
+CSV: Any = type("CsvFile", (), {"__repr__": lambda self: "<the series as a CSV file>"})()
+"""Stands for the path of a CSV file of the series, written for the call (``_calibrate_csv``)."""
+
+
+def _calibrate_csv(path: Any, **kwargs: Any) -> Any:
+    import tempfile
+    from pathlib import Path
+
+    import thermojitter as tj
+
+    t, theta = _series()
+    with tempfile.TemporaryDirectory() as folder:
+        file = Path(folder) / "series.csv"
+        rows = "\n".join(f"{a:.17g},{b:.17g}" for a, b in zip(t, theta, strict=True))
+        file.write_text("t,theta\n" + rows + "\n")
+        return tj.calibrate_from_csv(file if path is CSV else path, **kwargs)
+
+
+# --- known-invalid arguments ----------------------------------------------------------------
+
+# Values no argument of the kind accepts. A scalar real number: not a bool, a string, a
+# sequence, a complex, None (where it is not optional), nor non-finite or beyond a float.
+_NOT_REAL: list[Any] = [True, False, "1.0", "abc", [1.0, 2.0], complex(1.0, 1.0), object()]
+_HUGE: list[Any] = [10**400, -(10**400)]
+_REAL = [*_NOT_REAL, *_HUGE, math.nan, math.inf, -math.inf, np.float64(math.nan)]
+_POSITIVE = [*_REAL, 0.0, -0.0, -1.0, -1e-300, np.int64(-5)]
+_CAP = [*_NOT_REAL, math.nan, 10**400, 0.0, -1.0]  # > 0, +inf allowed ("no cap")
+_COUNT = [True, False, 1.5, "2", math.nan, 0, -1, 10**400, -(10**400), np.float64(3.0)]
+_FLAG = ["False", "true", "", 0, 1, 1.0, np.float64(1.0), [True]]
+_CHOICE = ["bogus", "", 1, True, 2.5]
+_PATH = ["", 1.5, True, b"run"]
+_SPAN = [(math.nan, 1.0), (True, 60.0), (0.0, -1.0), (0.0, 0.0), (0.0,), "ab", (0.0, math.inf),
+         (0.0, 10**400), (0.0, 1.0, 2.0)]  # fmt: skip
+_TIMES = [[0.0, math.nan], [True, False], "abc", [[0.0, 1.0], [2.0, 3.0]], [math.inf]]
+_REALS = [[math.nan], "abc", [True, False], [[1.0, 2.0], [3.0, 4.0]], None, [10**400]]
+_PANEL = [{"damping": 1.0}, "paper", 1.0, True]
+_ORBIT = ["GEO", 1.0, True, {"radius": 7e6}]
+
+INVALID: dict[str, list[Any]] = {
+    "real": [*_REAL, None],
+    "real?": _REAL,
+    "positive": [*_POSITIVE, None],
+    "positive?": _POSITIVE,
+    "nonneg": [*_REAL, None, -1.0, -1e-300],
+    "nonneg?": [*_REAL, -1.0],
+    "unit": [*_POSITIVE, None, 1.5],
+    "expansion": [*_REAL, None, 0.01, -0.01],  # any sign, |a| <= 1e-3 1/K
+    "angle": [*_POSITIVE, 2.0, 20.0],  # a limit in (0, π/2] rad
+    "sun_angle": [*_REAL, None, 2.0, -1.6],  # |ψ| < π/2
+    "cap": [*_CAP, None],
+    "count": [*_COUNT, None],
+    "count?": _COUNT,
+    # A count with no upper bound (beyond the need it does no harm: one chunk, one call).
+    "many": [v for v in _COUNT if v is not _COUNT[7]],  # all but 10**400
+    "seed": [True, 1.5, "2", math.nan, -1, np.float64(3.0)],
+    "nodes?": [*_COUNT, 1, 10**7],
+    "layers12": [*_COUNT, None, 3],
+    "flag": [*_FLAG, None],
+    "flag?": _FLAG,
+    "choice": [*_CHOICE, None],
+    "choice?": _CHOICE,
+    "path?": _PATH,
+    "span": [*_SPAN, None],
+    "span?": _SPAN,
+    "times?": _TIMES,
+    "reals": _REALS,
+    "panel": [*_PANEL, None],
+    "panel?": _PANEL,
+    "orbit": [*_ORBIT, None],
+    "orbit?": _ORBIT,
+    # Unphysical or malformed start states.
+    "y0_4?": [(-10.0, 290.0, 0.0, 0.0), (0.0, 290.0, 0.0, 0.0), (300.0, 0.0, 0.0, 0.0),
+              (300.0, 290.0, 0.0, 1e6), (300.0, 290.0, 0.0, -50.0), (300.0, 290.0, 4.89, 0.0),
+              (300.0, math.nan, 0.0, 0.0), (300.0, 290.0, 0.0), "abcd", (True, 290.0, 0.0, 0.0)],
+    "y0_2": [(0.0, 1e6), (0.0, -3.0), (4.89, 0.0), (math.nan, 0.0), (0.0,), "ab", None],
+    "y0_T2?": [(-10.0, 290.0), (0.0, 290.0), (300.0, -1.0), (math.nan, 290.0), (300.0,)],
+    "y0_dist?": [[-10.0] * 8 + [0.0] * 4, [0.0] * 12, [300.0] * 3, "abc", [math.nan] * 12],
+    "grid": [{"damping": [True, False]}, {"damping": []}, {"damping": [math.nan]},
+             {"damping": "abc"}, {"colour": [1.0]}, {}, None, "damping"],
+    "vary": [{}, None, "damping", {"colour": ("uniform", 1.0, 2.0)},
+             {"damping": ("uniform", True, 2.0)}, {"damping": ("bogus", 1.0, 2.0)}],
+    "axis": ["damping", ("damping",), ("colour", [1.0]), ("damping", [True, False]),
+             ("damping", []), None, ("damping", [math.nan])],
+    "fit": ["damping", None, (), ("colour",), 1.0, ("damping", "damping")],
+    "initial": [{"damping": True}, {"damping": "3"}, "damping", {"colour": 1.0},
+                {"damping": math.nan}, 1.0],
+    "material": ["nope", 1, None, True],
+    "name": [1, None, True],
+    "name?": [1, True, 2.5],
+    "date": ["2026-13-01", "", True, None, math.nan],  # a number is a day of the year
+    "laminate": ["x", None, 1.0],
+    "layers": ["x", None, [], [1.0], 1.0],
+    "support": [*_CHOICE, None],
+}  # fmt: skip
+
+_SOLVER = {"rtol": "positive", "atol": "positive", "max_steps": "count"}
+_STUDY = {
+    "horizon": "count", "threads": "count?", "progress": "flag", "coupled": "flag",
+    "model": "choice", "method": "choice?", "window": "positive", "threshold": "positive?",
+    "stop_at_threshold": "flag", "layers": "nodes?", "checkpoint": "path?",
+    "chunk_size": "many", "panel": "panel", "orbit": "orbit", **_SOLVER,
+}  # fmt: skip
+_ORBIT_SPAN = {"t0": "real", "t1": "real"}
+
+SPECS: dict[str, dict[str, str]] = {
+    "Panel": {
+        "length": "positive",
+        "damping": "nonneg",
+        "specific_heat": "positive",
+        "expansion_coeff": "expansion",
+        "emissivity_front": "unit",
+        "moment_scale": "positive",
+        "width": "positive",
+    },
+    "Panel.replace": {
+        "conductance": "positive",
+        "youngs_modulus": "positive",
+        "absorptivity": "unit",
+        "colour": "real",
+    },
+    "Orbit": {
+        "radius": "positive",
+        "period": "positive",
+        "phase0": "real",
+        "shadow": "choice",
+        "season": "flag",
+        "eccentric_sun": "flag",
+        "epoch_day": "real",
+    },
+    "Orbit.leo": {"altitude": "positive"},
+    "Orbit.geo_year": {"start_date": "date"},
+    "shadow_intervals": _ORBIT_SPAN,
+    "umbra_intervals": _ORBIT_SPAN,
+    "breakpoints": _ORBIT_SPAN,
+    "eclipse_durations": _ORBIT_SPAN,
+    "eclipses": _ORBIT_SPAN,
+    "illumination": {"t": "reals"},
+    "flux_scale": {"t": "reals"},
+    "steady_state": {"panel": "panel", "coupled": "flag", "flux": "real"},
+    "simulate": {
+        "panel": "panel",
+        "orbit": "orbit",
+        "t_span": "span",
+        "model": "choice",
+        "coupled": "flag",
+        "method": "choice?",
+        "dt_out": "positive?",
+        "y0": "y0_4?",
+        "max_step": "cap",
+        "layers": "nodes?",
+        **_SOLVER,
+    },
+    "simulate rk4": {"dt": "positive", "t_eval": "times?", "y0": "y0_4?"},
+    "simulate_thermal": {"t_span": "span", "layers": "layers12", "y0": "y0_T2?", **_SOLVER},
+    "simulate_hinge": {
+        "panel": "panel",
+        "moment": "reals",
+        "t_span": "span",
+        "y0": "y0_2",
+        "model": "choice",
+        **_SOLVER,
+    },
+    "hinge_energy": {"theta": "reals", "theta_dot": "reals", "moment": "real", "model": "choice"},
+    "hinge_stiffness": {"panel": "panel", "criterion": "choice"},
+    "natural_frequency": {"panel": "panel"},
+    "beam_frequency": {"panel": "panel"},
+    "flutter": {
+        "panel": "panel",
+        "coupled": "flag",
+        "flux": "real?",
+        "model": "choice",
+        "layers": "nodes?",
+        "orbit": "orbit?",
+        "t": "real",
+    },
+    "stability_map": {
+        "x": "axis",
+        "y": "axis",
+        "flux": "real",
+        "progress": "flag",
+        "coupled": "flag",
+        "model": "choice",
+    },
+    "linear_thermal_response": {"omega": "real?", "T_star": "positive?", "flux": "real"},
+    "simulate_orbits": {
+        "panel": "panel",
+        "orbit": "orbit",
+        "n_orbits": "count",
+        "t_start": "real",
+        "window": "positive",
+        "theta_limit": "angle",
+        "coupled": "flag",
+        "model": "choice",
+        "method": "choice",
+        "checkpoint": "path?",
+        "checkpoint_every": "real",
+        "orbits_per_call": "many",
+        "progress": "flag?",
+        "y0": "y0_4?",
+        "layers": "nodes?",
+        "steps_per_period": "real",
+        **_SOLVER,
+    },
+    "monte_carlo": {
+        **_STUDY,
+        "vary": "vary",
+        "n": "count",
+        "seed": "seed",
+        "sampler": "choice",
+        "truncate": "flag",
+    },
+    "sweep": {**_STUDY, "grid": "grid"},
+    "sensitivity": {
+        **_STUDY,
+        "vary": "vary",
+        "n": "count",
+        "seed": "seed",
+        "metric": "choice",
+        "second_order": "flag",
+        "truncate": "flag",
+    },
+    "calibrate": {
+        "t": "reals",
+        "theta": "reals",
+        "panel": "panel?",
+        "orbit": "orbit?",
+        "fit": "fit",
+        "initial": "initial",
+        "y0": "y0_4?",
+        "model": "choice",
+        "coupled": "flag",
+        "diff_step": "positive",
+        **_SOLVER,
+    },
+    "calibrate_from_csv": {"path": "path?", "degrees": "flag", "diff_step": "positive"},
+    "FreeFreeBeam": {"panel": "panel", "n_elements": "count"},
+    "FreeFreeBeam.natural_frequencies": {"n": "count"},
+    "FreeFreeBeam.static_tip_deflection": {"moment": "real"},
+    "FreeFreeBeam.response": {
+        "times": "reals",
+        "moments": "reals",
+        "damping_ratio": "nonneg?",
+        "residual": "flag",
+        **_SOLVER,
+    },
+    "compare_with_beam": {
+        "panel": "panel",
+        "orbit": "orbit",
+        "t_span": "span?",
+        "dt_out": "positive",
+        "n_elements": "count",
+        "model": "choice",
+        "coupled": "flag",
+        "scale_moment": "flag",
+        "criterion": "choice?",
+        "damping_ratio": "nonneg?",
+        "f_min": "positive",
+        **_SOLVER,
+    },
+    "distributed_defaults": {"panel": "panel?"},
+    "distributed_frequencies": {
+        "panel": "panel",
+        "support": "support",
+        "elements": "count?",
+        "modes": "count?",
+    },
+    "distributed_flutter": {
+        "panel": "panel",
+        "support": "support",
+        "elements": "count?",
+        "modes": "count?",
+        "flux": "real",
+        "sun_angle": "sun_angle",
+        "damping_ratio": "nonneg?",
+        "layers": "count",
+    },
+    "simulate_distributed": {
+        "panel": "panel",
+        "orbit": "orbit",
+        "t_span": "span",
+        "coupled": "flag",
+        "y0": "y0_dist?",
+        "sun_angle": "sun_angle",
+        "elements": "count?",
+        "modes": "count?",
+        "dt_out": "positive?",
+        "layers": "count",
+        **_SOLVER,
+    },
+    "Layer": {
+        "thickness": "positive",
+        "conductivity": "positive",
+        "density": "positive",
+        "specific_heat": "positive",
+        "youngs_modulus": "nonneg",
+        "expansion_coeff": "expansion",
+        "name": "name",
+    },
+    "Laminate": {
+        "layers": "layers",
+        "emissivity_front": "unit",
+        "emissivity_back": "unit",
+        "absorptivity": "unit",
+        "reference_temperature": "positive",
+    },
+    "Panel.from_laminate": {
+        "laminate": "laminate",
+        "length": "positive",
+        "criterion": "choice",
+        "damping": "nonneg",
+        "hinge_stiffness": "positive?",
+        "width": "positive",
+    },
+    "materials.get": {"key": "material"},
+    "Material.layer": {"thickness": "positive", "name": "name?"},
+    "SolverSettings": {"method": "choice", "dt": "positive?", "max_step": "cap", **_SOLVER},
+    # Keys of a scenario file's tables (dotted), as the parser receives them.
+    "scenario": {
+        "simulation.coupled": "flag",
+        "simulation.t_end": "positive",
+        "simulation.rtol": "positive",
+        "simulation.dt_out": "positive",
+        "simulation.method": "choice",
+        "panel.damping": "nonneg",
+        "panel.length": "positive",
+        "orbit.altitude": "positive",
+        "output.plots": "flag",
+        "output.format": "choice",
+    },
+}
+"""The kind of each argument (see ``INVALID``) that the invalid-input fuzz replaces."""
+
+
+def names_parameter(exc: BaseException, name: str) -> bool:
+    """Whether the refusal ``exc`` names the argument ``name``: its ``.parameter`` (or a scenario
+    error's ``.key``) is the argument or a part of it (``y0[2]``, ``grid.damping``, ``layer
+    'core': density``), or, for an error that carries none, its message says the name."""
+    import re
+
+    named = getattr(exc, "parameter", None) or getattr(exc, "key", None)
+    if named:
+        p = str(named)
+        return p == name or p.startswith((f"{name}[", f"{name}.")) or p.endswith(f": {name}")
+    return re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", str(exc)) is not None
 
 
 SCENARIO_TEXT = b"""# a scenario file
@@ -350,6 +863,8 @@ class Example:
 
     target: str
     changes: dict[str, Any] = field(default_factory=dict)
+    invalid: bool = False
+    """The one change is known invalid (see ``SPECS``): it must be refused, naming it."""
 
 
 @st.composite
@@ -357,6 +872,11 @@ def examples(draw: st.DrawFn, targets: list[str] | None = None) -> Example:
     calls = _base_calls()
     name = draw(st.sampled_from(sorted(targets or calls)))
     base = calls[name][1]
+    if name in SPECS and draw(st.integers(0, 2)) == 0:
+        # One argument replaced by a value its kind never accepts: it must be refused.
+        arg = draw(st.sampled_from(sorted(SPECS[name])))
+        value = draw(st.sampled_from(INVALID[SPECS[name][arg]]))
+        return Example(name, {arg: value}, invalid=True)
     # The receiver of a method ("_self") is not an argument a user passes: it stays valid.
     keys = sorted(k for k in base if not k.startswith("_"))
     if name == "scenario file":
@@ -488,9 +1008,17 @@ def classify(example: Example) -> tuple[str, str]:
     except tj.InternalError as exc:
         return "internal_error", str(exc)[:200]
     except (tj.IntegrationError, tj.ConvergenceError) as exc:
+        if example.invalid:  # a run began: the boundary let the value through
+            return "accepted_invalid", f"ran, then {type(exc).__name__}: {exc}"[:200]
         return "runtime_error", str(exc)[:200]
     except (ValueError, TypeError) as exc:
         message = str(exc)
+        if example.invalid:
+            (arg,) = example.changes
+            if names_parameter(exc, arg):
+                return "refused_named", message[:200]
+            named = getattr(exc, "parameter", None)
+            return "wrong_name", f"{type(exc).__name__} naming {named!r}: {message}"[:200]
         named = getattr(exc, "parameter", None) or getattr(exc, "key", None)
         if not named and example.target == "scenario file":
             named = getattr(exc, "path", None)  # the file itself is what is wrong
@@ -506,6 +1034,8 @@ def classify(example: Example) -> tuple[str, str]:
         if type(exc).__name__ == "PanicException":
             return "panic", str(exc)[:200]
         raise
+    if example.invalid:
+        return "accepted_invalid", f"returned {type(result).__name__}"
     bad = _eclipse_rows(result) if example.target == "eclipses" else _non_finite(result)
     if bad:
         return "silent_nan", f"{bad} is not finite"

@@ -85,12 +85,14 @@ def test_refuses_bad_series() -> None:
         tj.calibrate(backwards, theta)
     holed = theta.copy()
     holed[3] = np.nan
-    with pytest.raises(ValueError, match="theta holds NaN"):
+    with pytest.raises(tj.ParameterError, match="theta = nan .* must be finite"):
         tj.calibrate(T, holed)
     t_nan = T.copy()
     t_nan[0] = np.nan
-    with pytest.raises(ValueError, match="t holds NaN"):
+    with pytest.raises(tj.ParameterError, match="t = nan .* must be finite"):
         tj.calibrate(t_nan, theta)
+    with pytest.raises(TypeError, match="theta"):  # a bool is not an angle
+        tj.calibrate(T, [False] * T.size)
     with pytest.raises(ValueError, match="theta has shape"):
         tj.calibrate(T, theta[:-1])
     with pytest.raises(ValueError, match="fit"):

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import thermojitter as tj
-from conftest import wing_layup
+from conftest import ENTRY, wing_layup
 from thermojitter import materials as mat
 
 GEO = tj.Orbit.geo_equinox()
@@ -174,3 +174,88 @@ def test_the_laminate_bends_with_a_uniform_temperature_like_a_bimetal() -> None:
     eqn = tj.flutter(p, layers=20).equilibrium
     assert eqn.thermal_moment > eq2.thermal_moment > 0.0
     assert math.isclose(eqn.theta, eqn.thermal_moment / p.hinge_stiffness, rel_tol=1e-3)
+
+
+def _sandwich() -> tj.Laminate:
+    """CFRP face sheets on an aluminium honeycomb core, every value from the package's own
+    materials: a layup whose net expansion coefficient is negative (the CFRP's)."""
+    skin, core = mat.CFRP_M55J_QI, mat.ALUMINIUM_HONEYCOMB
+    return tj.Laminate(
+        [skin.layer(0.5e-3, "front"), core.layer(20e-3, "core"), skin.layer(0.5e-3, "back")],
+        emissivity_front=0.8,
+        emissivity_back=0.3,
+        absorptivity=0.8,
+    )
+
+
+def test_cfrp_honeycomb_sandwich_from_the_library_runs() -> None:
+    # Refused before: its equivalent expansion coefficient (−2.4e-8 1/K) is negative.
+    panel = tj.Panel.from_laminate(_sandwich(), length=20.0)
+    assert panel.expansion_coeff < 0.0
+    sol = tj.simulate(panel, GEO, (0.0, 120.0), dt_out=10.0)
+    assert np.all(np.isfinite(sol.theta)) and np.all(sol.theta < 0.0)  # bends towards the Sun
+    nodes = tj.simulate(panel, GEO, (0.0, 120.0), dt_out=10.0, layers=8)
+    assert np.all(np.isfinite(nodes.theta))
+    result = tj.flutter(panel)
+    assert math.isfinite(result.growth_rate) and result.critical_damping >= 0.0
+    assert math.isfinite(tj.flutter(panel, layers=8).critical_damping)
+
+
+@pytest.mark.parametrize("a", [-1e-6, -2.5e-5, -1e-3, 0.0, 1e-3])
+def test_expansion_of_either_sign_is_accepted(a: float) -> None:
+    assert tj.Panel.paper().replace(expansion_coeff=a).expansion_coeff == a
+    assert tj.Layer(1e-3, 1.0, 1600.0, 800.0, 1e11, a).expansion_coeff == a
+
+
+@pytest.mark.parametrize("a", [1.01e-3, -1.01e-3])
+def test_expansion_beyond_any_solid_is_refused(a: float) -> None:
+    with pytest.raises(tj.ParameterError, match="expansion_coeff") as info:
+        tj.Panel.paper().replace(expansion_coeff=a)
+    assert info.value.parameter == "expansion_coeff"
+
+
+def test_a_panel_that_does_not_expand_bends_by_nothing() -> None:
+    flat = tj.Panel.paper().replace(expansion_coeff=0.0)
+    eq = tj.steady_state(flat)
+    assert eq.theta == 0.0 and eq.thermal_moment == 0.0
+    sol = tj.simulate(flat, GEO, (ENTRY - 60.0, ENTRY + 240.0), dt_out=10.0)
+    assert np.all(sol.theta == 0.0) and np.all(sol.thermal_moment == 0.0)
+    assert np.all(tj.simulate(flat, GEO, (0.0, 60.0), layers=6, dt_out=10.0).theta == 0.0)
+    # The deflection criterion has no moment to match: its small-angle limit 4 E I / L, no 0/0.
+    assert tj.hinge_stiffness(flat, "deflection") == tj.hinge_stiffness(
+        flat, "deflection_small_angle"
+    )
+    # Nothing drives the hinge: no damping is needed against flutter.
+    assert abs(tj.flutter(flat).critical_damping) < 1e-9
+
+
+def test_a_symmetric_layup_of_zero_net_moment_bends_by_nothing() -> None:
+    # Invar-like skins (a = 0) on a core: the layup decides a = 0, so θ stays at rest.
+    skin = tj.Layer(0.5e-3, 10.0, 8000.0, 500.0, 1.4e11, 0.0, name="skin")
+    core = mat.ALUMINIUM_HONEYCOMB.layer(20e-3, "core")
+    lam = tj.Laminate([skin, core, skin], 0.8, 0.3, 0.8)
+    panel = tj.Panel.from_laminate(lam, length=20.0)
+    assert panel.expansion_coeff == 0.0
+    assert tj.steady_state(panel).theta == 0.0
+    assert np.all(tj.simulate(panel, GEO, (0.0, 60.0), dt_out=10.0, layers=7).theta == 0.0)
+
+
+def test_negative_expansion_bends_the_other_way() -> None:
+    # Steady static angle, closed form: θ = a E I (T_f − T_b) / (d K_el) with χ = 1. With the
+    # area frozen (coupled=False) the temperatures do not depend on a; coupled, cos θ is even in
+    # θ, so the mirrored state is the equilibrium too.
+    warm = tj.Panel.paper()
+    cold = warm.replace(expansion_coeff=-warm.expansion_coeff)
+    for coupled in (False, True):
+        up, down = tj.steady_state(warm, coupled=coupled), tj.steady_state(cold, coupled=coupled)
+        assert up.theta > 0.0 > down.theta
+        assert down.theta == pytest.approx(-up.theta, rel=1e-12)
+        assert (down.T_front, down.T_back) == pytest.approx((up.T_front, up.T_back), rel=1e-12)
+        p = cold
+        closed = (
+            p.expansion_coeff * p.youngs_modulus * p.bending_inertia
+            * (down.T_front - down.T_back) / (p.thickness * p.hinge_stiffness)
+        )  # fmt: skip
+        assert down.theta == pytest.approx(closed, rel=1e-9)
+    sol = tj.simulate(cold, GEO, (0.0, 60.0), dt_out=10.0)
+    assert np.all(sol.theta < 0.0)

@@ -31,7 +31,11 @@ __all__ = [
     "MAX_THREADS",
     "LINEAR_FIELDS",
     "MAX_TIME",
+    "MAX_NODES",
+    "MAX_SAMPLES",
+    "BEAM_MAX_ELEMENTS",
     "PANEL_FIELDS",
+    "PANEL_RANGES",
     "PAPER_PANEL",
     "ENSEMBLE_LANES",
     "ENSEMBLE_RUNS_PER_CORE",
@@ -90,6 +94,10 @@ __all__ = [
 ]
 
 PANEL_FIELDS: list[str]
+PANEL_RANGES: dict[str, tuple[float, float, bool]]  # name: (low, high, low end open); high closed
+MAX_NODES: int  # most nodes of the N-node through-thickness model
+BEAM_MAX_ELEMENTS: int  # most elements of the free-free beam
+MAX_SAMPLES: int  # most samples one run may keep
 LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 ENSEMBLE_LANES: int  # SIMD lanes of one lockstep group

@@ -16,7 +16,6 @@ model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly 
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import errors as checks
 from thermojitter.checkpoint import write_bytes_atomic
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
@@ -76,8 +76,8 @@ class FreeFreeBeam:
 
     def __init__(self, panel: Panel, n_elements: int = 100) -> None:
         check_inputs(panel)
-        if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)):
-            raise TypeError(f"n_elements must be an int, not {type(n_elements).__name__}")
+        # Bounded here so that no integer overflows on its way (the engine wants it even, too).
+        n_elements = checks.integer("n_elements", n_elements, 2, _core.BEAM_MAX_ELEMENTS)
         self.panel = panel
         self.n_elements = int(n_elements)
         self._modes = _core.beam_modes(panel.as_dict(), self.n_elements, 1)
@@ -86,9 +86,8 @@ class FreeFreeBeam:
         return f"FreeFreeBeam(n_elements={self.n_elements}, L={self.panel.length} m)"
 
     def _check_n(self, n: int) -> int:
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-            raise TypeError(f"n must be an int, not {type(n).__name__}")
-        return int(n)
+        # At most the mesh's degrees of freedom (the engine checks the exact count).
+        return checks.integer("n", n, 1, 2 * self.n_elements)
 
     def natural_frequencies(self, n: int = 3) -> Array:
         """The first ``n`` elastic free–free frequencies, Hz (rigid-body modes excluded)."""
@@ -118,7 +117,8 @@ class FreeFreeBeam:
 
     def static_tip_deflection(self, moment: float) -> float:
         """η (m) under steady end moments ±``moment`` (N m); exact value M L²/(8EI)."""
-        return float(_core.beam_static(self.panel.as_dict(), self.n_elements, float(moment)))
+        moment = checks.finite("moment", moment)
+        return float(_core.beam_static(self.panel.as_dict(), self.n_elements, moment))
 
     def response(
         self,
@@ -146,8 +146,8 @@ class FreeFreeBeam:
         (default :func:`default_damping_ratio`, from the panel's c_d). ``residual=False`` drops
         the quasi-static part of the modes not integrated.
         """
-        ts = np.ascontiguousarray(np.asarray(times, dtype=float).ravel())
-        ms = np.ascontiguousarray(np.asarray(moments, dtype=float).ravel())
+        ts = checks.real_array("times", times)
+        ms = checks.real_array("moments", moments)
         if ts.size < 2 or ts.size != ms.size:
             raise ValueError(
                 f"times/moments hold {ts.size}/{ms.size} values: need two or more, equal lengths"
@@ -155,7 +155,12 @@ class FreeFreeBeam:
         t0, t1 = (float(ts[0]), float(ts[-1])) if t_span is None else time_span(t_span)
         if t_eval is None and dt_out is None:
             t_eval = ts[(ts >= t0) & (ts <= t1)]
-        zeta = default_damping_ratio(self.panel) if damping_ratio is None else damping_ratio
+        zeta = (
+            default_damping_ratio(self.panel)
+            if damping_ratio is None
+            else checks.finite("damping_ratio", damping_ratio)
+        )
+        residual = checks.flag("residual", residual)
         used = SolverSettings.of(
             solver,
             method=method,
@@ -306,6 +311,14 @@ def compare_with_beam(
     FFT of each signal above ``f_min`` (Hz).
     """
     check_inputs(panel, orbit)
+    # Every argument checked before any work (the runs below would check some, too late).
+    scale_moment = checks.flag("scale_moment", scale_moment)
+    coupled = checks.flag("coupled", coupled)
+    model = checks.choice("model", model, ("nonlinear", "linear"))  # type: ignore[assignment]
+    dt_out = checks.positive("dt_out", dt_out)
+    f_min = checks.positive("f_min", f_min)
+    if damping_ratio is not None:
+        damping_ratio = checks.finite("damping_ratio", damping_ratio)
     hinge_panel = panel
     if criterion is not None:
         hinge_panel = panel.replace(hinge_stiffness=hinge_stiffness(panel, criterion))
@@ -313,10 +326,12 @@ def compare_with_beam(
         chi = _core.derived(hinge_panel.as_dict())["matching_moment_scale"]
         hinge_panel = hinge_panel.replace(moment_scale=chi)
     span = eclipse_window(orbit) if t_span is None else time_span(t_span)
-    if not (math.isfinite(dt_out) and dt_out > 0):
-        raise ValueError(f"dt_out = {dt_out!r} is invalid: must be finite and > 0")
     if span[1] - span[0] < 16 * dt_out:
         raise ValueError(f"t_span = {span!r} is invalid: shorter than 16 samples of dt_out")
+    if (span[1] - span[0]) / dt_out > _core.MAX_SAMPLES:
+        raise checks.ParameterError(
+            "dt_out", dt_out, f"would keep more than {_core.MAX_SAMPLES} samples of t_span"
+        )
     # Uniform samples (the FFT needs them): the last one may fall short of t_span[1].
     samples = span[0] + dt_out * np.arange(int((span[1] - span[0]) / dt_out) + 1)
     sol = simulate(

@@ -14,7 +14,8 @@ cov = s² (JᵀJ)⁻¹ with s² = Σr²/(n − p).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+import warnings
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
+from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.simulate import Model, check_inputs, simulate
@@ -70,18 +72,13 @@ class CalibrationResult:
 
 
 def _series(t: ArrayLike, theta: ArrayLike) -> tuple[Array, Array]:
-    ts = np.asarray(t, dtype=float)
-    th = np.asarray(theta, dtype=float)
-    if ts.ndim != 1:
-        raise ValueError(f"t must be one-dimensional, not of shape {ts.shape}")
+    # Real numbers, one-dimensional and finite (a bool or a string is refused, not converted).
+    ts = checks.real_array("t", t)
+    th = checks.real_array("theta", theta)
     if th.shape != ts.shape:
         raise ValueError(f"theta has shape {th.shape}; must match t's {ts.shape}")
     if ts.size < MIN_POINTS:
         raise ValueError(f"t holds {ts.size} samples: the series is too short (need {MIN_POINTS})")
-    if not np.all(np.isfinite(ts)):
-        raise ValueError("t holds NaN or infinite values")
-    if not np.all(np.isfinite(th)):
-        raise ValueError("theta holds NaN or infinite values")
     if np.any(np.diff(ts) <= 0):
         i = int(np.argmax(np.diff(ts) <= 0)) + 1
         raise ValueError(f"t must be strictly increasing (t[{i}] = {ts[i]} does not increase)")
@@ -116,6 +113,13 @@ def calibrate(
     base = Panel.paper() if panel is None else panel
     orb = Orbit.geo_equinox() if orbit is None else orbit
     check_inputs(base, orb)
+    checks.choice("model", model, ("nonlinear", "linear"))
+    checks.flag("coupled", coupled)
+    diff_step = checks.positive("diff_step", diff_step)
+    if isinstance(fit, str) or not isinstance(fit, Iterable):
+        raise TypeError(f"fit must be a sequence of parameter names, not {type(fit).__name__}")
+    if initial is not None and not isinstance(initial, Mapping):
+        raise TypeError(f"initial must be a mapping of names to values, not {type(initial)}")
     names = list(fit)
     if not names or len(set(names)) != len(names) or any(n not in FITTABLE for n in names):
         raise ValueError(f"fit = {fit!r} is invalid: a non-empty set of {', '.join(FITTABLE)}")
@@ -125,7 +129,7 @@ def calibrate(
     for key, value in (initial or {}).items():
         if key not in names:
             raise ValueError(f"initial names {key!r}, which is not fitted (fit = {names})")
-        start[key] = float(value)
+        start[key] = checks.finite(f"initial.{key}", value)
     trial0 = base.replace(**start)  # validates the starting values
     x0 = np.array([start[n] for n in names])
     scale = np.array([max(abs(v), 1e-3) for v in x0])
@@ -170,9 +174,11 @@ def calibrate(
         cov_scaled = (vt.T / sv**2) @ vt * s2
     cov = cov_scaled * np.outer(scale, scale)
     params = {nm: float(v) for nm, v in zip(names, res.x, strict=True)}
+    errors = {nm: float(math.sqrt(cov[i, i])) for i, nm in enumerate(names)}
+    _warn_unidentified(names, errors, sv, vt)
     return CalibrationResult(
         parameters=params,
-        standard_errors={nm: float(math.sqrt(cov[i, i])) for i, nm in enumerate(names)},
+        standard_errors=errors,
         residual_rms=float(np.sqrt(np.mean(res.fun**2))),
         covariance=cov,
         panel=trial0.replace(**params),
@@ -186,6 +192,26 @@ def calibrate(
     )
 
 
+def _warn_unidentified(names: list[str], errors: dict[str, float], sv: Array, vt: Array) -> None:
+    """Warns when a standard error is not finite: the series does not determine the fit (the
+    Jacobian is singular, e.g. a panel that does not bend, or two parameters that trade off).
+    The fit is still returned (its residual is meaningful); the warning names the parameters
+    along the undetermined directions, those of the right singular vectors whose singular value
+    is negligible."""
+    if all(math.isfinite(v) for v in errors.values()):
+        return
+    flat = vt[sv <= sv[0] * 1e-12] if sv[0] > 0 else vt
+    weight = np.max(np.abs(flat), axis=0) if len(flat) else np.zeros(len(names))
+    blamed = [nm for nm, w in zip(names, weight, strict=True) if w > 0.1]
+    blamed = blamed or [nm for nm, v in errors.items() if not math.isfinite(v)]
+    warnings.warn(
+        f"calibrate: the series does not determine {', '.join(blamed)} (singular Jacobian): "
+        "their standard errors are infinite; fit fewer parameters or a series that excites them",
+        RuntimeWarning,
+        stacklevel=3,
+    )
+
+
 def calibrate_from_csv(
     path: str | Path,
     *,
@@ -196,7 +222,8 @@ def calibrate_from_csv(
 ) -> CalibrationResult:
     """:func:`calibrate` on telemetry from a CSV file with a header row: ``time_column`` (s) and
     ``angle_column`` (rad, or degrees with ``degrees=True``). Other keywords go to calibrate."""
-    p = Path(path)
+    p = checks.path("path", path)
+    degrees = checks.flag("degrees", degrees)
     if not p.is_file():
         raise ValueError(f"path = {str(p)!r} is invalid: no such file")
     data = np.genfromtxt(p, delimiter=",", names=True, dtype=float, encoding="utf-8")

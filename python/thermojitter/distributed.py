@@ -38,7 +38,7 @@ from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import Run
-from thermojitter.simulate import Method, check_inputs, solver_args, time_span
+from thermojitter.simulate import Method, check_inputs, solver_args, start_state, time_span
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Array = NDArray[np.float64]
@@ -238,7 +238,8 @@ def simulate_distributed(
         solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
     )
     args = solver_args(used, t_eval, dt_out)
-    start = None if y0 is None else np.ascontiguousarray(np.asarray(y0, dtype=float).ravel())
+    y = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
+    start = None if y is None else np.asarray(y, dtype=float)
     raw = _core.simulate_distributed(
         panel.as_dict(), orbit.as_dict(), settings, t0, t1, y0=start, **args
     )

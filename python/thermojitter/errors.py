@@ -23,7 +23,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import os
 from collections.abc import Collection, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -145,10 +147,26 @@ def choice(name: str, value: Any, allowed: tuple[str, ...]) -> str:
     return value
 
 
+def path(name: str, value: Any) -> Path:
+    """A file or directory path (a string or an ``os.PathLike``). An empty string is refused:
+    ``Path("")`` is the current directory, where a run would silently write its files."""
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"{name} must be a path (str or os.PathLike), not {type_name(value)}")
+    text = os.fspath(value)
+    if isinstance(text, bytes) or not text.strip():
+        raise ParameterError(name, value, "must be a non-empty path (str or os.PathLike)")
+    return Path(text)
+
+
 def real_array(name: str, value: Any, *, finite_only: bool = True) -> np.ndarray:
     """A 1-D contiguous float array from a number or a sequence of real numbers."""
     if isinstance(value, (str, bytes)) or value is None:
         raise TypeError(f"{name} must be numbers, not {type_name(value)}")
+    if isinstance(value, (list, tuple)):
+        # NumPy would read [True, 290.0] as [1.0, 290.0]: a bool in a sequence is no number.
+        for i, v in enumerate(value):
+            if isinstance(v, (bool, np.bool_, str, bytes)):
+                raise TypeError(f"{name}[{i}] must be a real number, not {type_name(v)} {v!r:.60}")
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError) as exc:

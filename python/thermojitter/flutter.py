@@ -72,12 +72,14 @@ def flutter(
     """
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    # t is checked even without an orbit: a t of the wrong type is a mistake either way.
+    t = checks.finite("t", t)
     if orbit is not None:
-        if flux is not None:
-            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
         if not isinstance(orbit, Orbit):
             raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
-        flux = float(orbit.flux_scale(checks.real("t", t))[0])
+        if flux is not None:
+            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
+        flux = float(orbit.flux_scale(t)[0])
     elif flux is None:
         flux = 1.0
     flux = checks.real("flux", flux)

@@ -12,12 +12,7 @@ from functools import cached_property
 from typing import Any
 
 from thermojitter import _core
-
-
-def _number(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise TypeError(f"{name} must be a real number, not {type(value).__name__}")
-    return float(value)
+from thermojitter import errors as checks
 
 
 @dataclass(frozen=True)
@@ -50,7 +45,7 @@ class Layer:
         for f in fields(self):
             if f.name != "name":
                 label = f"layer '{self.name}': {f.name}"
-                object.__setattr__(self, f.name, _number(label, getattr(self, f.name)))
+                object.__setattr__(self, f.name, checks.real(label, getattr(self, f.name)))
         _core.validate_layer(self.as_dict())
 
     def as_dict(self) -> dict[str, Any]:
@@ -93,7 +88,7 @@ class Laminate:
             "absorptivity",
             "reference_temperature",
         ):
-            object.__setattr__(self, name, _number(name, getattr(self, name)))
+            object.__setattr__(self, name, checks.real(name, getattr(self, name)))
         _core.validate_laminate(self.as_dict())
 
     def as_dict(self) -> dict[str, Any]:

@@ -119,6 +119,13 @@ def orbit_count(name: str, value: Any, orbit: Orbit, t_start: float = 0.0) -> in
     the engine's MAX_TIME), checked before any product that would overflow a float."""
     n = checks.integer(name, value, 1)
     most = (_core.MAX_TIME - abs(t_start)) / orbit.period
+    if most < 1.0:  # not one orbit fits after the start: the start is what is wrong
+        raise checks.ParameterError(
+            "t_start",
+            t_start,
+            f"must leave room for one orbit ({orbit.period:g} s) before |t| = "
+            f"{_core.MAX_TIME:g} s, the longest time a run may reach",
+        )
     if n > most:  # exact for any int, even 10**400
         raise checks.ParameterError(
             name,
@@ -397,7 +404,7 @@ def simulate_orbits(
     if method == "hybrid":
         counters.update({name: 0 for name in HYBRID_COUNTERS})
     crossing: tuple[float, int, float] | None = None
-    path = Path(checkpoint) if checkpoint is not None else None
+    path = checks.path("checkpoint", checkpoint) if checkpoint is not None else None
     if path is not None:
         saved = checkpoints.load(path, settings)
         if saved is not None:

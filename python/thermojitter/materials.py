@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from thermojitter import _core
+from thermojitter.errors import ParameterError
 from thermojitter.laminate import Layer
 
 
@@ -52,11 +53,12 @@ KAPTON = LIBRARY["kapton"]
 
 
 def get(key: str) -> Material:
-    """A material by key (``ValueError`` listing the keys if unknown)."""
-    try:
-        return LIBRARY[key]
-    except KeyError:
-        raise ValueError(f"material {key!r} is not in the library ({', '.join(LIBRARY)})") from None
+    """A material by key (a ``ParameterError`` naming ``key`` and listing the keys if unknown)."""
+    if not isinstance(key, str):
+        raise TypeError(f"key must be a string, not {type(key).__name__}")
+    if key not in LIBRARY:
+        raise ParameterError("key", key, f"not in the library ({', '.join(LIBRARY)})")
+    return LIBRARY[key]
 
 
 __doc__ = (__doc__ or "") + "".join(

@@ -80,8 +80,6 @@ raises :class:`AllSamplesFailedError`.
 
 _FLOAT_METRICS = tuple(m for m in METRICS if m not in ("stable", "n_steps", "error"))
 
-_UNIT_INTERVAL = ("emissivity_front", "emissivity_back", "absorptivity")
-
 FORMAT_VERSION = 1
 
 
@@ -113,12 +111,10 @@ class AllSamplesFailedError(_core.IntegrationError):
 
 
 def _valid_range(name: str) -> tuple[float, float, bool, bool]:
-    """(lo, hi, lo open, hi open) of a panel parameter, as Panel validation checks it."""
-    if name in _UNIT_INTERVAL:
-        return 0.0, 1.0, True, False
-    if name == "damping":
-        return 0.0, math.inf, False, True
-    return 0.0, math.inf, True, True
+    """(lo, hi, lo open, hi open) of a panel parameter: the engine's range, which Panel
+    validation checks (its high end is closed)."""
+    lo, hi, lo_open = _core.PANEL_RANGES[name]
+    return lo, hi, lo_open, False
 
 
 def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[float]:
@@ -333,21 +329,19 @@ def _options(
         max_steps=max_steps,
     )  # fmt: skip
     horizon = orbit_count("horizon", horizon, orbit)
-    if threshold is not None and not (math.isfinite(threshold) and threshold > 0):
-        raise ValueError(f"threshold = {threshold!r} is invalid: must be a finite angle > 0 (rad)")
-    if not (isinstance(window, (int, float)) and math.isfinite(window) and window > 0):
-        raise ValueError(f"window = {window!r} is invalid: must be finite and > 0 (s)")
+    threshold = checks.optional_positive("threshold", threshold)
+    window = checks.positive("window", window)
     hybrid = chosen == "hybrid"
     return {
         "orbit": orbit.as_dict(),
-        "model": str(model),
-        "coupled": bool(coupled),
+        "model": checks.choice("model", model, ("nonlinear", "linear")),
+        "coupled": checks.flag("coupled", coupled),
         # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
         "solver": (full.replace(method="rk45") if hybrid else full).as_dict(),
         "n_orbits": int(horizon),
         "window": float(window),
         "threshold": None if threshold is None else float(threshold),
-        "stop_at_threshold": bool(stop_at_threshold),
+        "stop_at_threshold": checks.flag("stop_at_threshold", stop_at_threshold),
         "validity_limit": DEFAULT_THETA_LIMIT,
         "hybrid": {} if hybrid else None,
     }
@@ -364,6 +358,8 @@ def _with_layers(
     if layers is None:
         return options
     nodes = check_layers(layers)
+    # Run-wide: a node count the layup cannot take is refused here, not by every sample.
+    _core.conduction_grid(panel.as_dict(), layup_dict(panel), nodes)
     if panel.layup is not None:
         fixed = [name for name in names if name in LAYUP_FIELDS]
         if fixed:
@@ -699,15 +695,15 @@ def _run_design(
     _refuse_beyond_budget(matrix, options, settings)
     if chunk_size is None:
         chunk_size = _default_chunk_size(n)
-    elif isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
-        raise ValueError(f"chunk_size = {chunk_size!r} is invalid: must be an integer >= 1")
+    else:
+        chunk_size = checks.integer("chunk_size", chunk_size, 1)
     settings = {
         **settings,
         "format": FORMAT_VERSION,
         "run": options,
         "design_sha256": hashlib.sha256(np.ascontiguousarray(matrix).tobytes()).hexdigest(),
     }
-    directory = Path(checkpoint) if checkpoint is not None else None
+    directory = checks.path("checkpoint", checkpoint) if checkpoint is not None else None
     request = checkpoints.digest(settings)
     if directory is not None:
         chunk_size = _open_checkpoint(directory, settings, n, chunk_size)
@@ -824,9 +820,7 @@ def _check_seed(seed: Any, checkpoint: Any) -> int:
         if checkpoint is not None:
             raise ValueError("seed is required with checkpoint (a resumed run must redraw it)")
         return int(np.random.SeedSequence().entropy % (2**63))  # type: ignore[operator]
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed = {seed!r} is invalid: must be an integer >= 0")
-    return int(seed)
+    return checks.integer("seed", seed, 0)
 
 
 MAX_SAMPLES = 10**7
@@ -949,8 +943,8 @@ def monte_carlo(
     vary = _check_vary(vary)
     n = _check_n(n)
     seed = _check_seed(seed, checkpoint)
-    if sampler not in ("random", "lhs", "sobol"):
-        raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
+    sampler = checks.choice("sampler", sampler, ("random", "lhs", "sobol"))  # type: ignore[assignment]
+    truncate = checks.flag("truncate", truncate)
     options = _options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
         threshold, stop_at_threshold,
@@ -1009,9 +1003,9 @@ def sweep(
     _check_names(list(grid), "grid")
     axes: list[list[float]] = []
     for name, vals in grid.items():
-        arr = np.atleast_1d(np.asarray(vals, dtype=float))
-        if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
-            raise ValueError(f"grid[{name!r}] = {vals!r} is invalid: must be finite numbers")
+        arr = checks.real_array(f"grid.{name}", vals)  # numbers: not bools, not strings
+        if arr.size == 0:
+            raise ParameterError(f"grid.{name}", vals, "must hold at least one value")
         axes.append(arr.tolist())
     options = _options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
@@ -1104,6 +1098,10 @@ def sensitivity(
     vary = _check_vary(vary)
     n = _check_n(n, 2)
     seed = _check_seed(seed, None)
+    second_order = checks.flag("second_order", second_order)
+    truncate = checks.flag("truncate", truncate)
+    if not isinstance(metric, str):
+        raise TypeError(f"metric must be a string, not {type(metric).__name__}")
     if metric not in _FLOAT_METRICS and metric != "stable":
         choices = ", ".join((*_FLOAT_METRICS, "stable"))
         raise ValueError(f"metric = {metric!r} is invalid: choose from {choices}")

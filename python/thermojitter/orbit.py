@@ -66,6 +66,12 @@ _BOOLS = ("season", "eccentric_sun")
 DateLike = str | _dt.date | float | int
 
 
+def _time(name: str, value: Any) -> float:
+    """A time on the orbit's clock, s, within the engine's reach (|t| <= MAX_TIME), checked here
+    so that the error names the method's own argument."""
+    return checks.in_range(name, value, -_core.MAX_TIME, _core.MAX_TIME, "s")
+
+
 def day_of_year(date: DateLike) -> float:
     """Days since 1 January 00:00 UTC of the date's year, fractional.
 
@@ -200,27 +206,21 @@ class Orbit:
 
         Cylinder: shadow entry and exit. Penumbra: first and last contact, where s starts to fall
         below 1 and where it is back to 1 (see :meth:`umbra_intervals` for s = 0)."""
-        return list(
-            _core.shadow_intervals(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
-        )
+        return list(_core.shadow_intervals(self.as_dict(), _time("t0", t0), _time("t1", t1)))
 
     def umbra_intervals(self, t0: float, t1: float) -> list[tuple[float, float]]:
         """Intervals where s = 0, s, clipped to [t0, t1] (the shadow intervals for the cylinder)."""
-        return list(
-            _core.umbra_intervals(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
-        )
+        return list(_core.umbra_intervals(self.as_dict(), _time("t0", t0), _time("t1", t1)))
 
     def breakpoints(self, t0: float, t1: float) -> list[float]:
         """Times in (t0, t1) where s jumps (cylinder) or has a kink (penumbra contacts and umbra
         boundaries); the integrators stop on each."""
-        return list(
-            _core.orbit_breakpoints(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
-        )
+        return list(_core.orbit_breakpoints(self.as_dict(), _time("t0", t0), _time("t1", t1)))
 
     def eclipses(self, t0: float, t1: float) -> NDArray[np.float64]:
         """Eclipses overlapping [t0, t1], unclipped, one row each: (deepest point, first contact,
         last contact, umbra entry, umbra exit), s; NaN where there is no umbra."""
-        rows = _core.eclipses(self.as_dict(), checks.real("t0", t0), checks.real("t1", t1))
+        rows = _core.eclipses(self.as_dict(), _time("t0", t0), _time("t1", t1))
         return np.asarray(rows, dtype=float).reshape(-1, 5)
 
     def eclipse_durations(

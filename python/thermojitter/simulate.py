@@ -34,7 +34,11 @@ def time_span(t_span: Sequence[float]) -> tuple[float, float]:
         )
     if len(t_span) != 2:
         raise ParameterError("t_span", t_span, "must be two numbers (t0, t1) in s")
-    return checks.real("t_span[0]", t_span[0]), checks.real("t_span[1]", t_span[1])
+    # Finite and within the engine's reach, checked before any arithmetic on them.
+    reach = (-_core.MAX_TIME, _core.MAX_TIME)
+    return checks.in_range("t_span[0]", t_span[0], *reach, "s"), checks.in_range(
+        "t_span[1]", t_span[1], *reach, "s"
+    )
 
 
 def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
@@ -43,12 +47,13 @@ def _times(t_eval: ArrayLike | None) -> np.ndarray | None:
     return checks.real_array("t_eval", t_eval)
 
 
-def start_state(y0: Any, size: int) -> list[float] | None:
-    """A start state of ``size`` real numbers (the engine checks their ranges)."""
+def start_state(y0: Any, size: int | None) -> list[float] | None:
+    """A start state of ``size`` real numbers (None: any size, the engine knows it); the engine
+    checks their values (temperatures > 0 K, θ and θ̇ in the hinge's range)."""
     if y0 is None:
         return None
     arr = checks.real_array("y0", y0, finite_only=False)
-    if arr.size != size:
+    if size is not None and arr.size != size:
         raise ParameterError("y0", y0, f"must hold {size} numbers")
     return [float(v) for v in arr]
 
@@ -87,16 +92,9 @@ def check_inputs(panel: Panel, orbit: Orbit = _NO_ORBIT) -> None:
 
 
 def check_layers(layers: Any) -> int:
-    """``layers`` as a node count (an int >= 2; the engine checks it against the layup)."""
-    if isinstance(layers, bool) or not isinstance(layers, (int, np.integer)):
-        raise TypeError(
-            f"layers must be an int (nodes through the thickness), not {type(layers).__name__}"
-        )
-    if layers < 2:
-        raise ValueError(
-            f"layers = {layers!r} is invalid: must be >= 2 (nodes through the thickness)"
-        )
-    return int(layers)
+    """``layers`` as a node count through the thickness: an int in [2, MAX_NODES] (the engine
+    checks it against the layup)."""
+    return checks.integer("layers", layers, 2, _core.MAX_NODES)
 
 
 def layup_dict(panel: Panel) -> dict[str, Any] | None:
@@ -182,9 +180,9 @@ def simulate(
             orbit.as_dict(),
             t0,
             t1,
-            model=model,
-            coupled=bool(coupled),
-            y0=None if y0 is None else [float(v) for v in y0],
+            model=checks.choice("model", model, _MODELS),
+            coupled=checks.flag("coupled", coupled),
+            y0=start_state(y0, None),
             **args,
         )
         temps = np.asarray(raw["T_nodes"])

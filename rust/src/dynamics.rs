@@ -38,6 +38,27 @@ pub fn check_hinge_angle(name: &str, theta: f64) -> crate::Result<()> {
     Err(crate::Error::invalid(name, theta, &reason))
 }
 
+/// Checks a start state `y0` of (temperatures…, then, with `hinge`, θ and θ̇): the one check
+/// of every run that takes a start state. A temperature is absolute: finite and > 0 K (the
+/// radiation T⁴ and every material value assume a body above absolute zero). θ is within
+/// ±π/2 ([`check_hinge_angle`]) and θ̇ within the hinge's fastest rate
+/// ([`Hinge::max_start_rate`]). Components are named by their index, `y0[i]`.
+pub fn check_start_state(y0: &[f64], temperatures: usize, hinge: Option<&Hinge>) -> Result<()> {
+    for (i, &t) in y0.iter().enumerate().take(temperatures) {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::invalid(
+                &format!("y0[{i}]"),
+                t,
+                "must be a temperature, finite and > 0 K",
+            ));
+        }
+    }
+    if let Some(hinge) = hinge {
+        hinge.check_start(temperatures, &y0[temperatures..])?;
+    }
+    Ok(())
+}
+
 /// The static angle M/K_el of a moment on the hinge, checked against the hinge model's range:
 /// a larger moment would fold the panel beyond what the model describes.
 pub fn check_moment(panel: &Panel, moment: f64) -> crate::Result<()> {
@@ -207,6 +228,16 @@ impl Hinge {
 }
 
 impl Hinge {
+    /// The largest |θ̇| a start state may have, rad/s: (π/2) · max(ω_n, c_d/I_B). From θ̇ alone
+    /// the hinge travels at most θ̇/ω_n (the undamped swing; damping only shortens it) and at
+    /// most θ̇ I_B/c_d (the pure drag; the spring only shortens it): beyond this bound it would
+    /// cross the model's whole range (π/2) within the time of its fastest structural motion, a
+    /// start the hinge model does not describe (a unit slip, deg/s or rpm for rad/s). The
+    /// non-linear hinge's inertia I_B (1 + 3 sin²θ) is never smaller, so the bound holds for it.
+    pub fn max_start_rate(&self) -> f64 {
+        std::f64::consts::FRAC_PI_2 * self.stiffness.sqrt().max(self.damping)
+    }
+
     /// (model, c_d / I_B, K_el / I_B): what [`StructuralModel::rates`] uses of the hinge.
     pub(crate) fn rate_form(&self) -> (HingeModel, f64, f64) {
         (self.model, self.damping, self.stiffness)
@@ -257,7 +288,26 @@ impl StructuralModel for Hinge {
         out[0] = (moment - self.hinge_stiffness * positions[0]) / self.hinge_stiffness;
     }
     fn check_start(&self, offset: usize, states: &[f64]) -> Result<()> {
-        check_hinge_angle(&format!("y0[{offset}]"), states[0])
+        let &[theta, rate, ..] = states else {
+            return Err(Error::invalid(
+                "y0",
+                format!("{} components", offset + states.len()),
+                &format!("must hold θ and θ̇ after its {offset} temperatures"),
+            ));
+        };
+        check_hinge_angle(&format!("y0[{offset}]"), theta)?;
+        let most = self.max_start_rate();
+        if !(rate.is_finite() && rate.abs() <= most) {
+            return Err(Error::invalid(
+                &format!("y0[{}]", offset + 1),
+                rate,
+                &format!(
+                    "θ̇ must be within ±{most:.4e} rad/s: (π/2) max(ω_n, c_d/I_B), beyond which \
+                     the start alone would swing the hinge past its range of ±π/2"
+                ),
+            ));
+        }
+        Ok(())
     }
     fn check_static(&self, positions: &[f64]) -> Result<()> {
         let theta = positions[0];
@@ -407,6 +457,34 @@ pub fn checked_hinge_energy(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn start_states_out_of_the_model_are_refused_by_component() {
+        let p = Panel::paper();
+        let hinge = Hinge::new(&p, HingeModel::Nonlinear);
+        let most = hinge.max_start_rate();
+        let w = p
+            .natural_angular_frequency()
+            .max(p.damping / p.hinge_inertia());
+        assert_eq!(most, std::f64::consts::FRAC_PI_2 * w);
+        let ok = [360.0, 350.0, 0.1, 0.99 * most];
+        check_start_state(&ok, 2, Some(&hinge)).unwrap();
+        for (bad, name) in [
+            ([0.0, 350.0, 0.0, 0.0], "y0[0]"),
+            ([360.0, -4.0, 0.0, 0.0], "y0[1]"),
+            ([360.0, f64::NAN, 0.0, 0.0], "y0[1]"),
+            ([360.0, 350.0, 2.0, 0.0], "y0[2]"),
+            ([360.0, 350.0, 0.0, 1.01 * most], "y0[3]"),
+            ([360.0, 350.0, 0.0, -1e6], "y0[3]"),
+        ] {
+            let err = check_start_state(&bad, 2, Some(&hinge)).unwrap_err();
+            assert!(err.to_string().starts_with(name), "{err}");
+        }
+        // Temperatures alone (a thermal model): no hinge to check.
+        check_start_state(&[300.0, 290.0], 2, None).unwrap();
+        // A hinge asked for but missing is an error, not a panic.
+        assert!(check_start_state(&[300.0, 290.0, 0.0], 2, Some(&hinge)).is_err());
+    }
 
     #[test]
     fn a_half_of_the_hinge_model_stays_rigid() {

@@ -7,7 +7,7 @@
 //! beam of unit width (Poisson coupling left out, as in the panel's E I).
 
 use crate::error::{require_non_negative, require_positive, Error, Result};
-use crate::params::Panel;
+use crate::params::{Panel, MAX_EXPANSION};
 
 /// One layer of a laminate (all SI).
 #[derive(Debug, Clone, PartialEq)]
@@ -55,11 +55,13 @@ impl Layer {
         }
         require_non_negative(&named("youngs_modulus"), self.youngs_modulus)?;
         crate::error::require_finite(&named("expansion_coeff"), self.expansion_coeff)?;
-        if self.expansion_coeff.abs() > 1e-3 {
+        if self.expansion_coeff.abs() > MAX_EXPANSION {
             return Err(Error::invalid(
                 &named("expansion_coeff"),
                 self.expansion_coeff,
-                "must be within ±1e-3 1/K (an expansion coefficient, not a percentage)",
+                &format!(
+                    "must be within ±{MAX_EXPANSION:e} 1/K (an expansion coefficient, not a percentage)"
+                ),
             ));
         }
         Ok(())

@@ -16,7 +16,7 @@
 //! against radiation). Measured against the full nodal model in docs/laminates.md.
 
 use crate::conduction::{Conduction, Modes};
-use crate::dynamics::{sin_cos, HingeModel};
+use crate::dynamics::{sin_cos, Hinge, HingeModel};
 use crate::error::{Error, Result};
 use crate::hybrid::model::HybridModel;
 use crate::integrate::{Dyn, OdeSystem, State};
@@ -816,7 +816,7 @@ pub fn simulate(
     let n = conduction.nodes();
     let start: Vec<f64> = match y0 {
         Some(v) => {
-            check_start(v, n)?;
+            check_start(panel, v, n)?;
             v.to_vec()
         }
         None => start_state(panel, &conduction, coupling, orbit, t_span.0)?,
@@ -1003,7 +1003,7 @@ fn run_orbits_reading(
     cancel: &crate::cancel::Cancel,
     slope_reads: bool,
 ) -> Result<LayeredSummaries> {
-    check_start(&req.y0, req.conduction.nodes())?;
+    check_start(&req.panel, &req.y0, req.conduction.nodes())?;
     let (system, start) = req.system()?;
     let mut view = LayeredView::new(system.clone(), req.panel, req.orbit, req.coupling);
     view.slope_reads = slope_reads;
@@ -1136,8 +1136,9 @@ where
     Ok(run.into())
 }
 
-/// Checks a start state of node temperatures, θ and θ̇.
-fn check_start(v: &[f64], n: usize) -> Result<()> {
+/// Checks a start state of node temperatures, θ and θ̇: its size here, its values as every
+/// start state's ([`crate::dynamics::check_start_state`]).
+fn check_start(panel: &Panel, v: &[f64], n: usize) -> Result<()> {
     if v.len() != n + 2 {
         return Err(Error::invalid(
             "y0",
@@ -1148,10 +1149,9 @@ fn check_start(v: &[f64], n: usize) -> Result<()> {
             ),
         ));
     }
-    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-        return Err(Error::invalid("y0", x, "every component must be finite"));
-    }
-    Ok(())
+    // The bound on θ̇ is the same for both hinge models: the linear one stands for either.
+    let hinge = Hinge::new(panel, HingeModel::Linear);
+    crate::dynamics::check_start_state(v, n, Some(&hinge))
 }
 
 /// The steady state of the coupled N-node system under a constant illumination factor: node
@@ -1567,7 +1567,7 @@ pub fn run_orbits_hybrid(
     cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredHybrid> {
     let (y0, n) = (&req.y0, req.conduction.nodes());
-    check_start(y0, n)?;
+    check_start(&req.panel, y0, n)?;
     crate::hybrid::check_request(
         &req.orbit,
         &req.method,
@@ -1578,7 +1578,6 @@ pub fn run_orbits_hybrid(
         settings,
         cancel,
     )?;
-    crate::dynamics::check_hinge_angle("y0[θ]", y0[n])?;
     if req.conduction.two_layer {
         // Two nodes on a plain panel are eq. 2: the two-layer hybrid run, to the bit.
         let out = crate::hybrid::run_orbits_hybrid(&req.two_layer(), settings, cancel)?;

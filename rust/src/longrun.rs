@@ -852,7 +852,7 @@ pub(crate) fn prepare_orbits<'c>(
         &orbit,
         &req.method,
         (t_start, req.first_index, req.n_orbits),
-        (2, y0[2]),
+        (2, [y0[2], y0[3]]),
         req.options,
         cancel,
     )?;
@@ -883,7 +883,8 @@ where
 }
 
 /// The checks of a summarised run of orbits `first_index .. first_index + n_orbits` from
-/// `t_start` (`span`) whose start state has θ = `theta.1` at component `theta.0`, and what it
+/// `t_start` (`span`) whose start state has θ and θ̇ = `hinge.1` at components `hinge.0` and
+/// the next (its temperatures, if any, checked by the caller), and what it
 /// integrates with: `method` with its step capped as `options` ask, the end time, the observer.
 #[allow(clippy::too_many_arguments)]
 fn prepare_summarised<'c, V: SummaryView>(
@@ -892,7 +893,7 @@ fn prepare_summarised<'c, V: SummaryView>(
     orbit: &Orbit,
     method: &Method,
     span: (f64, u64, u64),
-    theta: (usize, f64),
+    hinge: (usize, [f64; 2]),
     options: SummaryOptions,
     cancel: &'c Cancel,
 ) -> Result<(Method, f64, SummaryObserver<'c, V>)> {
@@ -900,7 +901,11 @@ fn prepare_summarised<'c, V: SummaryView>(
     cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
-    crate::dynamics::check_hinge_angle(&format!("y0[{}]", theta.0), theta.1)?;
+    // The start's θ and θ̇ (at `hinge.0` and after it); the bound on θ̇ is the same for both
+    // hinge models (Hinge::max_start_rate), so the linear one stands for either.
+    let (index, start) = hinge;
+    let bound = crate::dynamics::Hinge::new(panel, HingeModel::Linear);
+    crate::dynamics::StructuralModel::check_start(&bound, index, &start)?;
     if !(0.0..=MAX_STEPS_PER_PERIOD).contains(&options.steps_per_period) {
         return Err(crate::Error::invalid(
             "steps_per_period",
@@ -920,7 +925,7 @@ fn prepare_summarised<'c, V: SummaryView>(
         t_start,
         first_index,
         n_orbits,
-        theta.1,
+        start[0],
     )?;
     let observer = SummaryObserver {
         collector,
@@ -969,7 +974,7 @@ where
         orbit,
         method,
         (t_start, first_index, n_orbits),
-        (theta_index, y0[theta_index]),
+        (theta_index, [y0[theta_index], y0[theta_index + 1]]),
         options,
         cancel,
     )?;

@@ -19,7 +19,8 @@ pub struct Panel {
     pub specific_heat: f64,
     /// m, mass per unit length (unit width, so also per unit area), kg/m.
     pub mass_per_length: f64,
-    /// a, coefficient of thermal expansion, 1/K.
+    /// a, coefficient of thermal expansion, 1/K: any sign within ±[`MAX_EXPANSION`] (carbon
+    /// fibre shrinks when heated; 0 bends by nothing).
     pub expansion_coeff: f64,
     /// L, panel length, m (hinge half-arm l = L/4).
     pub length: f64,
@@ -165,7 +166,8 @@ impl Panel {
         ("absorptivity", 0.0, 1.0, true),
         ("specific_heat", 10.0, 1e5, false),
         ("mass_per_length", 1e-3, 1e4, false),
-        ("expansion_coeff", 0.0, 1e-3, true),
+        // Negative and zero are physical: CFRP booms are designed around a ≈ −1e-6 1/K.
+        ("expansion_coeff", -MAX_EXPANSION, MAX_EXPANSION, false),
         ("length", 0.1, 1e4, false),
         ("youngs_modulus", 1e6, 1e13, false),
         ("thickness", 1e-5, 10.0, false),
@@ -283,6 +285,10 @@ impl Panel {
     }
 }
 
+/// |a| of a panel or a laminate layer at most, 1/K: ten times that of any solid (the largest,
+/// of rubbers, are ~2e-4); beyond it the value is a percentage or a unit slip.
+pub const MAX_EXPANSION: f64 = 1e-3;
+
 /// How K_el is chosen (paper Sec. 4 and 4.3; MODEL.md "Choosing K_el").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StiffnessCriterion {
@@ -340,6 +346,27 @@ mod tests {
     #[test]
     fn paper_panel_is_valid() {
         Panel::paper().validate().unwrap();
+    }
+
+    #[test]
+    fn expansion_of_either_sign_is_physical() {
+        for a in [-MAX_EXPANSION, -2.4e-8, 0.0, MAX_EXPANSION] {
+            let p = Panel {
+                expansion_coeff: a,
+                ..Panel::paper()
+            };
+            p.validate().unwrap();
+            // The deflection criterion divides by no moment: none gives 4 E I / L.
+            let k = hinge_stiffness(&p, StiffnessCriterion::Deflection, 0.0).unwrap();
+            assert_eq!(k, p.flexural_stiffness());
+        }
+        for a in [-1.01 * MAX_EXPANSION, 1.01 * MAX_EXPANSION] {
+            let p = Panel {
+                expansion_coeff: a,
+                ..Panel::paper()
+            };
+            assert!(p.validate().is_err());
+        }
     }
 
     #[test]

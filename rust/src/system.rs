@@ -198,9 +198,11 @@ where
         self.thermal.moment(&y.as_slice()[..self.thermal.size()])
     }
 
-    /// Refuses a start state the structural model does not describe (the hinge beyond ±π/2).
+    /// Refuses a start state the models do not describe: a temperature not above 0 K, the hinge
+    /// beyond ±π/2 or faster than it can move ([`crate::dynamics::check_start_state`]).
     pub fn check_start(&self, y: &State<D>) -> Result<()> {
         let n = self.thermal.size();
+        crate::dynamics::check_start_state(y.as_slice(), n, None)?;
         self.structure.check_start(n, &y.as_slice()[n..])
     }
 

@@ -90,6 +90,8 @@ pub fn simulate(
                     ),
                 ));
             }
+            // Its temperatures as every start state's; the modal amplitudes have no such range.
+            crate::dynamics::check_start_state(&v, model.layers() * model.n(), None)?;
             v
         }
         None => model.equilibrium(orbit.flux_scale(t0))?,

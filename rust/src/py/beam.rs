@@ -137,6 +137,7 @@ fn beam_response<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("BEAM_MAX_ELEMENTS", crate::beam::MAX_ELEMENTS)?;
     m.add_function(wrap_pyfunction!(beam_modes, m)?)?;
     m.add_function(wrap_pyfunction!(beam_static, m)?)?;
     m.add_function(wrap_pyfunction!(beam_response, m)?)?;

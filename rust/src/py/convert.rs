@@ -141,6 +141,10 @@ pub fn method(
     max_step: f64,
     max_steps: u64,
 ) -> PyResult<Method> {
+    // rk45 does not use dt, but a dt no method could use is a mistake all the same.
+    if let Some(dt) = dt {
+        crate::error::require_positive("dt", dt)?;
+    }
     let m = match name {
         "rk45" => Method::Dopri5(Tolerances {
             rtol,

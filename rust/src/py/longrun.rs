@@ -4,6 +4,7 @@ use super::cancel::{token, CancelToken};
 use super::convert::{hinge_model, orbit_from, panel_from, solver_dict, solver_from, state};
 use super::error::shield;
 use super::laminate::conduction_from;
+use crate::dynamics::Hinge;
 use crate::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::layered;
 use crate::longrun::{run_orbits_cancellable as run, OrbitRunRequest, SummaryOptions};
@@ -94,11 +95,11 @@ fn run_orbits<'py>(
             y0: state(&y0, U4)?,
             options,
         };
+        crate::dynamics::check_start_state(req.y0.as_slice(), 2, Some(&Hinge::new(&p, hinge)))?;
         let Some(settings) = settings else {
             let run = py.detach(|| run(&req, &cancel))?;
             return summary_dict(py, &run.into(), &req.method);
         };
-        crate::dynamics::check_hinge_angle("y0[2]", req.y0[2])?;
         let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
         // The run is copied (one summary per orbit) so that the counters stay with `out`.
         let d = summary_dict(py, &out.run.clone().into(), &req.method)?;

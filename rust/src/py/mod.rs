@@ -378,7 +378,8 @@ fn simulate_hinge<'py>(
         history.validate()?;
         history.check_against(&p)?;
         let y_start = state(&y0, U2)?;
-        crate::dynamics::check_hinge_angle("y0[0]", y_start[0])?;
+        let start_hinge = Hinge::new(&p, hinge);
+        crate::dynamics::check_start_state(y_start.as_slice(), 0, Some(&start_hinge))?;
         let traj = py.detach(|| {
             let mut sys = DrivenHinge {
                 panel: p,
@@ -400,6 +401,15 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
     m.add("ConvergenceError", m.py().get_type::<ConvergenceError>())?;
     m.add("PANEL_FIELDS", crate::Panel::FIELDS.to_vec())?;
+    // The valid range of every panel field, name: (low, high, low end open), for the Python
+    // layer (truncated distributions) to read rather than restate.
+    let ranges = PyDict::new(m.py());
+    for (name, low, high, open) in crate::Panel::RANGES {
+        ranges.set_item(name, (low, high, open))?;
+    }
+    m.add("PANEL_RANGES", ranges)?;
+    m.add("MAX_NODES", crate::conduction::MAX_NODES)?;
+    m.add("MAX_SAMPLES", crate::simulate::MAX_SAMPLES)?;
     m.add("PAPER_PANEL", panel_dict(m.py(), &crate::Panel::paper())?)?;
     m.add(
         "SOLVER_DEFAULTS",
