@@ -116,7 +116,17 @@ mod runs {
         // The moment is sampled finely (it is interpolated linearly by the comparator) and at
         // the shadow exit, where its slope jumps.
         let ts = times(span, 0.1, &[b]);
-        let run = simulate(&m, orbit, &method, span, None, &Output::Times(ts.clone())).unwrap();
+        let run = simulate(
+            &m,
+            orbit,
+            &method,
+            span,
+            None,
+            &Output::Times(ts.clone()),
+            None,
+            &crate::cancel::Cancel::new(),
+        )
+        .unwrap();
         for sample in &run.temperatures {
             for row in sample {
                 assert!(row.iter().all(|v| *v == row[0]), "temperatures differ");
@@ -136,6 +146,7 @@ mod runs {
             &method,
             span,
             &Output::Times(ts),
+            &crate::cancel::Cancel::new(),
         )
         .unwrap();
         let worst = run
@@ -174,7 +185,17 @@ mod runs {
         y0[nt] += 1e-4 / m.reduction.rise_modal[0].abs() * m.reduction.mesh.arm();
         let span = (0.0, 8000.0);
         let ts = times(span, 0.05, &[]);
-        let run = simulate(&m, orbit, &tight(1e-11), span, Some(y0), &Output::Times(ts)).unwrap();
+        let run = simulate(
+            &m,
+            orbit,
+            &tight(1e-11),
+            span,
+            Some(y0),
+            &Output::Times(ts),
+            None,
+            &crate::cancel::Cancel::new(),
+        )
+        .unwrap();
         let x: Vec<f64> = run.theta_f.iter().map(|v| v - theta_eq).collect();
         let (mut tp, mut lp) = (Vec::new(), Vec::new());
         for i in 1..x.len() - 1 {
