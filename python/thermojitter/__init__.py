@@ -19,7 +19,7 @@ from thermojitter.distributed import (
     distributed_frequencies,
     simulate_distributed,
 )
-from thermojitter.errors import InternalError, ParameterError
+from thermojitter.errors import InternalError, ParameterError, ValidityLimitWarning
 from thermojitter.flutter import (
     FlutterResult,
     LinearThermalResponse,
@@ -33,7 +33,13 @@ from thermojitter.longrun import OrbitSummaries, simulate_orbits
 from thermojitter.montecarlo import SensitivityResult, monte_carlo, sensitivity, sweep
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
-from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
+from thermojitter.results import (
+    Equilibrium,
+    HingeSolution,
+    LimitCrossing,
+    Solution,
+    ThermalSolution,
+)
 from thermojitter.simulate import (
     hinge_energy,
     simulate,
@@ -78,6 +84,7 @@ __all__ = [
     "Laminate",
     "Layer",
     "InternalError",
+    "LimitCrossing",
     "LinearThermalResponse",
     "Orbit",
     "OrbitSummaries",
@@ -88,6 +95,7 @@ __all__ = [
     "SolverSettings",
     "StabilityMap",
     "ThermalSolution",
+    "ValidityLimitWarning",
     "beam",
     "beam_frequency",
     "flutter",

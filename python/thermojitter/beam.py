@@ -29,6 +29,7 @@ from thermojitter import _core
 from thermojitter.checkpoint import write_bytes_atomic
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.progress import interruptible
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
 from thermojitter.simulate import Method, Model, check_inputs, simulate, solver_args, time_span
@@ -166,7 +167,8 @@ class FreeFreeBeam:
             max_steps=max_steps,
         )
         args = solver_args(used, t_eval, dt_out)
-        raw = _core.beam_response(
+        raw = interruptible(
+            _core.beam_response,
             self.panel.as_dict(),
             self.n_elements,
             ts,

@@ -9,6 +9,8 @@
   that could not finish, a solve that did not converge.
 - :class:`InternalError` (``RuntimeError``): a defect caught at the engine's boundary (a panic);
   the call's result is lost but the process lives on.
+- :class:`ValidityLimitWarning` (a warning, not an error): a run's angle passed ``theta_limit``,
+  beyond which the hinge model means nothing; the result says where (``limit_crossing``).
 
 This module imports nothing from the engine: the engine's binding layer builds its
 ``ParameterError`` from here.
@@ -59,6 +61,13 @@ def _shown(value: Any) -> str:
 class InternalError(RuntimeError):
     """A defect in thermojitter caught at the engine's boundary (a Rust panic). Please report it
     with the call that raised it."""
+
+
+class ValidityLimitWarning(UserWarning):
+    """A run's hinge angle (θ, or θ_f of the distributed panel) passed ``theta_limit``: the hinge
+    model is not trusted beyond it (its rigid halves and cos θ coupling are meant for modest
+    angles). Issued once per call; the result's ``limit_crossing`` says when and where. Silence
+    it with ``on_limit="ignore"`` or :mod:`warnings` filters."""
 
 
 def type_name(value: Any) -> str:
