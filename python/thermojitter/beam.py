@@ -145,7 +145,8 @@ class FreeFreeBeam:
         Starts at rest in the static deflection under M(t0). ``t_span`` defaults to the sample
         span and the output to the sample times. ``damping_ratio`` ζ applies to every mode
         (default :func:`default_damping_ratio`, from the panel's c_d). ``residual=False`` drops
-        the quasi-static part of the modes not integrated.
+        the quasi-static part of the modes not integrated. Ctrl-C stops the run within one
+        integration step (``KeyboardInterrupt``).
         """
         ts = np.ascontiguousarray(np.asarray(times, dtype=float).ravel())
         ms = np.ascontiguousarray(np.asarray(moments, dtype=float).ravel())

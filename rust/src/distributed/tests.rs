@@ -234,3 +234,23 @@ mod runs {
         }
     }
 }
+
+/// The limit's affine reading of the state is the tip rise θ_f is taken from, whatever the state
+/// (here the equilibrium, shifted in every component), and its bound is arm · sin(θ_limit).
+#[test]
+fn the_limit_reads_the_tip_rise() {
+    for support in [Support::FreeFree, Support::Cantilever] {
+        let m = model(support, 9, 3, Coupling::ProjectedArea);
+        let on = crate::simulate::OnLimit::new(0.3, false).unwrap();
+        let limit = m.limit(on);
+        let mut y = m.equilibrium(1.0).unwrap();
+        for (i, v) in y.iter_mut().enumerate() {
+            *v += 1e-3 * ((i * 7 % 5) as f64 - 2.0);
+        }
+        let rise = limit.value(&y);
+        let theta_f = m.theta_f(&y, 0.0).unwrap();
+        let arm = m.reduction.mesh.arm();
+        assert!((theta_f - (rise / arm).asin()).abs() < 1e-12, "{support:?}");
+        assert_eq!(limit.bound, arm * 0.3f64.sin());
+    }
+}
