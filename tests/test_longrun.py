@@ -34,7 +34,8 @@ def test_summaries_agree_with_the_sampled_solution() -> None:
 
 def test_undamped_panel_is_stopped_at_the_validity_limit() -> None:
     limit = math.radians(15.0)
-    runs = tj.simulate_orbits(PAPER.replace(damping=0.0), GEO, 5, theta_limit=limit)
+    with pytest.warns(tj.ValidityLimitWarning, match="stopped there"):
+        runs = tj.simulate_orbits(PAPER.replace(damping=0.0), GEO, 5, theta_limit=limit)
     assert runs.limit_crossing is not None
     t, orbit, theta = runs.limit_crossing
     assert abs(theta) > limit and orbit == runs.index[-1]

@@ -230,3 +230,57 @@ def test_a_programs_own_sigint_handler_is_kept() -> None:
         assert seen == [signal.SIGINT]
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+# Ctrl-C of every long engine call: each runs for several seconds of CPU in a child, is sent
+# SIGINT half a second in, and must end at once with a plain KeyboardInterrupt (before, the run
+# went on to its end and the first one of a process ended in an InternalError from NumPy).
+
+LONG_CALLS = {
+    "simulate": "tj.simulate(P, O, (0, 10 * O.period), max_step=0.05, dt_out=100.0)",
+    "simulate_rk4": "tj.simulate(P, O, (0, 10 * O.period), method='rk4', dt=0.02, dt_out=100.0)",
+    "simulate_layers": (
+        "tj.simulate(P.replace(damping=10.0), O, (0, 60 * O.period), layers=8, dt_out=100.0)"
+    ),
+    "simulate_thermal": (
+        "tj.simulate_thermal(P, O, (0, 100 * O.period), max_step=0.01, dt_out=100.0)"
+    ),
+    "simulate_distributed": "tj.simulate_distributed(P, O, (0, O.period), dt_out=100.0)",
+    "stability_map": (
+        "tj.stability_map(P, ('damping', np.linspace(0.5, 5.0, 1_000_000)),"
+        " ('conductance', [20.0]), progress=False)"
+    ),
+    "calibrate": (
+        "tj.calibrate(np.linspace(0, 10 * O.period, 100), np.zeros(100), panel=P, orbit=O)"
+    ),
+    "beam_response": (
+        "tj.FreeFreeBeam(P, 100).response(np.linspace(0, 2e4, 2001),"
+        " 5 * np.sin(np.linspace(0, 400, 2001)), max_step=0.002)"
+    ),
+    "compare_with_beam": "tj.compare_with_beam(P, O, t_span=(0, 30 * O.period), dt_out=5.0)",
+}
+
+
+@pytest.mark.parametrize("call", sorted(LONG_CALLS))
+def test_ctrl_c_stops_every_long_engine_call_with_a_plain_keyboard_interrupt(call: str) -> None:
+    child = Child(
+        python(f"""
+            import sys
+            import numpy as np
+            import thermojitter as tj
+            P, O = tj.Panel.paper(), tj.Orbit.geo_equinox()
+            print("running", file=sys.stderr, flush=True)
+            try:
+                {LONG_CALLS[call]}
+            except BaseException as exc:
+                print(type(exc).__module__, type(exc).__name__)
+            else:
+                print("finished")
+        """)
+    )
+    child.wait_for("running")
+    time.sleep(0.5)  # inside the engine
+    cpu, out = child.interrupt()
+    assert out.split() == ["builtins", "KeyboardInterrupt"], (out, child.err[-800:])
+    assert cpu < 1.5
+    assert "panicked" not in child.err and "Traceback" not in child.err

@@ -98,6 +98,7 @@ def test_sunlit_equilibrium_is_a_fixed_point(panel: tj.Panel, coupled: bool, mod
             dt_out=100.0,
             rtol=rtol,
             atol=rtol * 1e-2,
+            on_limit="ignore",  # a fixed point is one at any angle the model takes
         )
         return (
             float(np.max(np.abs(sol.theta - eq.theta))),

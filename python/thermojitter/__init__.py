@@ -19,7 +19,12 @@ from thermojitter.distributed import (
     distributed_frequencies,
     simulate_distributed,
 )
-from thermojitter.errors import InternalError, ParameterError, SampleFailureWarning
+from thermojitter.errors import (
+    InternalError,
+    ParameterError,
+    SampleFailureWarning,
+    ValidityLimitWarning,
+)
 from thermojitter.flutter import (
     FlutterResult,
     LinearThermalResponse,
@@ -39,7 +44,13 @@ from thermojitter.montecarlo import (
 )
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
-from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
+from thermojitter.results import (
+    Equilibrium,
+    HingeSolution,
+    LimitCrossing,
+    Solution,
+    ThermalSolution,
+)
 from thermojitter.simulate import (
     hinge_energy,
     simulate,
@@ -85,6 +96,7 @@ __all__ = [
     "Laminate",
     "Layer",
     "InternalError",
+    "LimitCrossing",
     "LinearThermalResponse",
     "Orbit",
     "OrbitSummaries",
@@ -96,6 +108,7 @@ __all__ = [
     "SolverSettings",
     "StabilityMap",
     "ThermalSolution",
+    "ValidityLimitWarning",
     "beam",
     "beam_frequency",
     "flutter",

@@ -161,6 +161,9 @@ def simulate(
     dt_out: float | None,
     y0: list[float] | None,
     layers: int = 2,
+    theta_limit: float = ...,
+    on_limit: str = "flag",
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def simulate_thermal(
     panel: dict[str, float],
@@ -173,6 +176,7 @@ def simulate_thermal(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float] | None,
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def simulate_hinge(
     panel: dict[str, float],
@@ -186,6 +190,7 @@ def simulate_hinge(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float],
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- flutter analysis ---------------------------------------------------------------------------
@@ -232,6 +237,7 @@ def beam_response(
     solver: dict[str, Any],
     t_eval: _F | None,
     dt_out: float | None,
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- distributed panel (rust/src/py/distributed.rs) ---
@@ -253,6 +259,9 @@ def simulate_distributed(
     t_eval: _F | None,
     dt_out: float | None,
     y0: _F | None,
+    theta_limit: float = ...,
+    on_limit: str = "flag",
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- orbit options (issue 4)
@@ -284,6 +293,8 @@ def stability_map(
     model: str,
     coupled: bool,
     flux: float,
+    *,
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
 # --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
@@ -370,5 +381,8 @@ def simulate_layers(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float] | None,
+    theta_limit: float = ...,
+    on_limit: str = "flag",
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def cpu_info() -> dict[str, Any]: ...

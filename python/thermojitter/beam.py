@@ -29,6 +29,7 @@ from thermojitter import errors as checks
 from thermojitter.checkpoint import write_bytes_atomic
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.progress import interruptible
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
 from thermojitter.simulate import Method, Model, check_inputs, simulate, solver_args, time_span
@@ -144,7 +145,8 @@ class FreeFreeBeam:
         Starts at rest in the static deflection under M(t0). ``t_span`` defaults to the sample
         span and the output to the sample times. ``damping_ratio`` ζ applies to every mode
         (default :func:`default_damping_ratio`, from the panel's c_d). ``residual=False`` drops
-        the quasi-static part of the modes not integrated.
+        the quasi-static part of the modes not integrated. Ctrl-C stops the run within one
+        integration step (``KeyboardInterrupt``).
         """
         ts = checks.real_array("times", times)
         ms = checks.real_array("moments", moments)
@@ -171,7 +173,8 @@ class FreeFreeBeam:
             max_steps=max_steps,
         )
         args = solver_args(used, t_eval, dt_out)
-        raw = _core.beam_response(
+        raw = interruptible(
+            _core.beam_response,
             self.panel.as_dict(),
             self.n_elements,
             ts,

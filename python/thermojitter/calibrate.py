@@ -9,6 +9,10 @@ cov = s² (JᵀJ)⁻¹ with s² = Σr²/(n − p).
 
     fit = tj.calibrate(t, theta, panel=tj.Panel.paper(), orbit=tj.Orbit.geo_equinox())
     fit.parameters["hinge_stiffness"], fit.standard_errors["hinge_stiffness"], fit.residual_rms
+
+The validity limit (``theta_limit``, ``on_limit``) concerns the answer, the fitted model: the
+trial runs of the fit are not checked (a trial panel on the way may well swing beyond it); the
+fitted panel's run over the series is, once the fit is done.
 """
 
 from __future__ import annotations
@@ -27,7 +31,17 @@ from scipy.optimize import least_squares
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.simulate import Model, check_inputs, simulate
+from thermojitter.results import LimitCrossing
+from thermojitter.simulate import (
+    DEFAULT_THETA_LIMIT,
+    Model,
+    OnLimit,
+    _simulate,
+    check_inputs,
+    limit_args,
+    warn_crossing,
+)
+from thermojitter.solver import MAX_STEP, MAX_STEPS
 
 Array = NDArray[np.float64]
 
@@ -54,6 +68,8 @@ class CalibrationResult:
     message: str
     nfev: int
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
+    limit_crossing: LimitCrossing | None = None
+    """Where the fitted model's θ first passed ``theta_limit`` over the series, or None."""
 
     @property
     def residual_rms_deg(self) -> float:
@@ -99,6 +115,8 @@ def calibrate(
     rtol: float = 1e-10,
     atol: float = 1e-12,
     diff_step: float = 1e-6,
+    theta_limit: float = DEFAULT_THETA_LIMIT,
+    on_limit: OnLimit = "flag",
 ) -> CalibrationResult:
     """Fits the hinge parameters named in ``fit`` to the angle series ``theta`` (rad) at times
     ``t`` (s, strictly increasing, at least :data:`MIN_POINTS` samples, no NaN).
@@ -108,7 +126,18 @@ def calibrate(
     clock (t = 0 at the subsolar point). ``y0`` = (T_f, T_b, θ, θ̇) at ``t[0]``; default the
     sunlit equilibrium of each trial panel. The forward runs use ``rtol``/``atol``, tight enough
     for the finite-difference Jacobian (relative step ``diff_step``).
+
+    ``theta_limit`` (rad) and ``on_limit`` check the fitted model, not the trials of the fit: its
+    run over the series is watched as :func:`thermojitter.simulate` watches one. ``"flag"``
+    (default): ``limit_crossing`` says where its θ first passed the limit and a
+    :class:`thermojitter.errors.ValidityLimitWarning` says so; ``"stop"``: the same, and
+    ``theta_model`` is NaN after the crossing (the fitted model means nothing there);
+    ``"ignore"``: no check.
+
+    Ctrl-C stops the fit within one integration step of the run under way
+    (``KeyboardInterrupt``).
     """
+    limits = limit_args(theta_limit, on_limit)
     ts, th = _series(t, theta)
     base = Panel.paper() if panel is None else panel
     orb = Orbit.geo_equinox() if orbit is None else orbit
@@ -137,20 +166,31 @@ def calibrate(
         [0.0 if n == "damping" else 1e-9 * s for n, s in zip(names, scale, strict=True)]
     )
 
-    def forward(x: Array) -> Array:
+    def run(x: Array, on_limit: OnLimit) -> Any:
         trial = trial0.replace(**dict(zip(names, (float(v) for v in x), strict=True)))
-        sol = simulate(
+        return _simulate(
             trial,
             orb,
             (ts[0], ts[-1]),
             model=model,
             coupled=coupled,
-            t_eval=ts,
-            y0=y0,
+            method="rk45",
             rtol=rtol,
             atol=atol,
+            dt=None,
+            t_eval=ts,
+            dt_out=None,
+            y0=y0,
+            max_step=MAX_STEP,
+            max_steps=MAX_STEPS,
+            layers=None,
+            solver=None,
+            theta_limit=limits["theta_limit"],
+            on_limit=on_limit,
         )
-        return np.asarray(sol.theta)
+
+    def forward(x: Array) -> Array:
+        return np.asarray(run(x, "ignore").theta)
 
     def residual(x: Array) -> Array:
         return forward(x) - th
@@ -176,6 +216,13 @@ def calibrate(
     params = {nm: float(v) for nm, v in zip(names, res.x, strict=True)}
     errors = {nm: float(math.sqrt(cov[i, i])) for i, nm in enumerate(names)}
     _warn_unidentified(names, errors, sv, vt)
+    theta_model = res.fun + th
+    crossing = None
+    if on_limit != "ignore":
+        crossing = run(res.x, on_limit).limit_crossing
+        if crossing is not None and on_limit == "stop":
+            theta_model = np.where(ts > crossing.t, np.nan, theta_model)
+        warn_crossing(crossing, limits["theta_limit"], on_limit)
     return CalibrationResult(
         parameters=params,
         standard_errors=errors,
@@ -183,12 +230,21 @@ def calibrate(
         covariance=cov,
         panel=trial0.replace(**params),
         t=ts,
-        theta_model=res.fun + th,
+        theta_model=theta_model,
         n_points=n,
         success=bool(res.success),
         message=str(res.message),
         nfev=int(res.nfev),
-        settings={"model": model, "coupled": coupled, "fit": names, "rtol": rtol, "atol": atol},
+        settings={
+            "model": model,
+            "coupled": coupled,
+            "fit": names,
+            "rtol": rtol,
+            "atol": atol,
+            "theta_limit": limits["theta_limit"],
+            "on_limit": on_limit,
+        },
+        limit_crossing=crossing,
     )
 
 

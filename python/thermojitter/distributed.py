@@ -37,8 +37,19 @@ from thermojitter import _core
 from thermojitter.errors import flag, real, type_name
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.results import Run
-from thermojitter.simulate import Method, check_inputs, solver_args, start_state, time_span
+from thermojitter.progress import interruptible
+from thermojitter.results import LimitCrossing, Run
+from thermojitter.simulate import (
+    DEFAULT_THETA_LIMIT,
+    Method,
+    OnLimit,
+    check_inputs,
+    limit_args,
+    solver_args,
+    start_state,
+    time_span,
+    warn_crossing,
+)
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Array = NDArray[np.float64]
@@ -133,6 +144,10 @@ class DistributedSolution(_FaceTemperatures, Run):
     frequencies_hz: Array = field(default_factory=lambda: np.empty(0))
     """The kept elastic modes' frequencies, Hz."""
     damping_ratio: float = 0.0
+    limit_crossing: LimitCrossing | None = None
+    """Where abs(θ_f) first passed ``theta_limit`` (its ``theta`` is θ_f, rad), or None."""
+    stopped_at_limit: bool = False
+    """True when ``on_limit="stop"`` ended the run at the crossing."""
 
     @property
     def theta_f_deg(self) -> Array:
@@ -206,6 +221,8 @@ def simulate_distributed(
     dt_out: float | None = None,
     y0: ArrayLike | None = None,
     solver: SolverSettings | None = None,
+    theta_limit: float = DEFAULT_THETA_LIMIT,
+    on_limit: OnLimit = "flag",
 ) -> DistributedSolution:
     """Integrates the distributed panel over ``t_span`` (s) on ``orbit``, through its eclipses
     and penumbrae.
@@ -221,6 +238,12 @@ def simulate_distributed(
     - Integrator and output as :func:`thermojitter.simulate`; ``y0`` the state (the
       temperatures of element 0, of element 1, ..., then q[k] and q̇[k]), default the sunlit
       equilibrium at the start's flux.
+    - ``theta_limit``, ``on_limit``: the validity limit on abs(θ_f), as
+      :func:`thermojitter.simulate` watches θ (checked on every step; ``"flag"`` records the
+      first crossing in ``sol.limit_crossing`` and warns, ``"stop"`` also ends the run there,
+      ``"ignore"`` checks nothing).
+
+    Ctrl-C stops the run within one integration step (``KeyboardInterrupt``).
     """
     check_inputs(panel, orbit)
     t0, t1 = time_span(t_span)
@@ -237,12 +260,21 @@ def simulate_distributed(
     used = SolverSettings.of(
         solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
     )
-    args = solver_args(used, t_eval, dt_out)
+    args = {**solver_args(used, t_eval, dt_out), **limit_args(theta_limit, on_limit)}
     y = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
-    start = None if y is None else np.asarray(y, dtype=float)
-    raw = _core.simulate_distributed(
-        panel.as_dict(), orbit.as_dict(), settings, t0, t1, y0=start, **args
+    start = None if y is None else np.ascontiguousarray(np.asarray(y, dtype=float))
+    raw = interruptible(
+        _core.simulate_distributed,
+        panel.as_dict(),
+        orbit.as_dict(),
+        settings,
+        t0,
+        t1,
+        y0=start,
+        **args,
     )
+    crossing = LimitCrossing.of(raw["crossing"])
+    warn_crossing(crossing, args["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(
         t=raw["t"],
         n_steps=int(raw["n_steps"]),
@@ -256,6 +288,8 @@ def simulate_distributed(
             "atol": used.atol,
             "dt": used.dt,
             "solver": used.as_dict(),
+            "theta_limit": args["theta_limit"],
+            "on_limit": on_limit,
         },
         x=raw["x"],
         x_node=raw["x_node"],
@@ -269,6 +303,8 @@ def simulate_distributed(
         support=support,
         frequencies_hz=raw["frequencies_hz"],
         damping_ratio=float(raw["damping_ratio"]),
+        limit_crossing=crossing,
+        stopped_at_limit=bool(raw["stopped"]),
     )
 
 

@@ -13,6 +13,8 @@
   sweep, sensitivity) failed; their rows are kept with the reason and no numbers.
   ``thermojitter.montecarlo.AllSamplesFailedError`` (an ``IntegrationError``, defined beside the
   studies because this module does not import the engine): every sample of a study failed.
+- :class:`ValidityLimitWarning` (a warning, not an error): a run's angle passed ``theta_limit``,
+  beyond which the hinge model means nothing; the result says where (``limit_crossing``).
 
 This module imports nothing from the engine: the engine's binding layer builds its
 ``ParameterError`` from here.
@@ -71,6 +73,13 @@ class SampleFailureWarning(RuntimeWarning):
     """Some samples of a study could not be computed. The study goes on: each failed sample keeps
     its row, with the reason in its ``error`` column, ``stable`` missing (pandas NA) and its numbers
     NaN; ``frame.attrs["n_failed"]`` counts them."""
+
+
+class ValidityLimitWarning(UserWarning):
+    """A run's hinge angle (θ, or θ_f of the distributed panel) passed ``theta_limit``: the hinge
+    model is not trusted beyond it (its rigid halves and cos θ coupling are meant for modest
+    angles). Issued once per call; the result's ``limit_crossing`` says when and where. Silence
+    it with ``on_limit="ignore"`` or :mod:`warnings` filters."""
 
 
 def type_name(value: Any) -> str:

@@ -13,7 +13,7 @@ from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.progress import progress_bar
+from thermojitter.progress import interruptible, progress_bar
 from thermojitter.results import Equilibrium
 
 MAP_BLOCK = 20_000
@@ -195,7 +195,7 @@ def stability_map(
     fields keep the values of ``panel``. The grid is analysed in parallel by the engine (one
     eigen-analysis per point, the same as :func:`flutter`); the result does not depend on the
     number of threads. A grid that takes more than a second shows a progress bar (``progress``);
-    Ctrl-C stops it between blocks of rows and raises ``KeyboardInterrupt``.
+    Ctrl-C stops it within a grid point and raises ``KeyboardInterrupt``.
     """
     if not isinstance(panel, Panel):
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
@@ -219,7 +219,8 @@ def stability_map(
     try:
         for start in range(0, ys.size, rows_per_block):
             block = ys[start : start + rows_per_block]
-            raw = _core.stability_map(
+            raw = interruptible(
+                _core.stability_map,
                 panel.as_dict(),
                 x_name,
                 xs.tolist(),

@@ -29,11 +29,14 @@ from thermojitter.progress import (
     progress_bar,
     report_interrupted,
 )
+from thermojitter.results import LimitCrossing
 from thermojitter.simulate import (
+    DEFAULT_THETA_LIMIT,
     check_inputs,
     check_layers,
     layup_dict,
     start_state,
+    warn_crossing,
 )
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
@@ -49,10 +52,6 @@ HYBRID_COUNTERS = (
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model and the hinge-resolved fallback."""
-
-DEFAULT_THETA_LIMIT: float = _core.VALIDITY_LIMIT
-"""abs(θ) beyond which the hinge model is not trusted, rad (20°; its rigid halves and cos θ
-coupling are meant for modest angles): the engine's ``dynamics::VALIDITY_LIMIT``."""
 
 
 @dataclass
@@ -72,8 +71,9 @@ class OrbitSummaries:
     t_end: float
     n_steps: int = 0
     n_rhs: int = 0
-    limit_crossing: tuple[float, int, float] | None = None
-    """(t s, orbit index, θ rad) where abs(θ) first passed theta_limit, or None."""
+    limit_crossing: LimitCrossing | None = None
+    """(t s, orbit index, θ rad) where abs(θ) first passed theta_limit, or None (always with
+    ``on_limit="ignore"``): a :class:`thermojitter.results.LimitCrossing`, a named tuple."""
     interrupted: bool = False
     """True when Ctrl-C ended the run early; the columns hold the finished orbits."""
     settings: dict[str, Any] = field(default_factory=dict)
@@ -162,7 +162,7 @@ def _save_checkpoint(
     y: list[float],
     next_index: int,
     counters: dict[str, int],
-    crossing: tuple[float, int, float] | None,
+    crossing: LimitCrossing | None,
 ) -> bool:
     """Writes the checkpoint atomically; on failure (a full disk, a read-only folder) warns and
     returns False, leaving the previous checkpoint and no partial file: the run and its result
@@ -236,7 +236,7 @@ def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
         )
     if len(y) != 4 or any(len(v) != len(rows) for v in columns.values()):
         raise checkpoints.CheckpointError("checkpoint", path, "has columns of unequal length")
-    return columns, y, next_index, counters, None if crossing is None else tuple(crossing)
+    return columns, y, next_index, counters, LimitCrossing.of(crossing)
 
 
 def simulate_orbits(
@@ -254,7 +254,7 @@ def simulate_orbits(
     y0: tuple[float, ...] | None = None,
     window: float = 600.0,
     theta_limit: float = DEFAULT_THETA_LIMIT,
-    on_limit: Literal["stop", "flag"] = "stop",
+    on_limit: Literal["stop", "flag", "ignore"] = "stop",
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: float = 10.0,
     orbits_per_call: int = 1,
@@ -271,7 +271,9 @@ def simulate_orbits(
     Memory grows with the number of orbits, not of steps (a 10-year GEO run keeps ~3650 rows).
 
     - ``theta_limit`` (rad): the hinge model's range of validity; when abs(θ) passes it the run
-      stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``).
+      stops (``on_limit="stop"``) or records the first crossing and goes on (``"flag"``), and
+      either way says so in ``limit_crossing`` and one
+      :class:`thermojitter.errors.ValidityLimitWarning`; ``"ignore"`` reports nothing.
     - ``checkpoint``: a file written every ``checkpoint_every`` s of wall time, at Ctrl-C and at
       the end; if it exists (same settings) the run resumes from it and gives identical results.
     - Ctrl-C stops within one integration step and returns the finished orbits with
@@ -305,7 +307,7 @@ def simulate_orbits(
     check_inputs(panel, orbit)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
     orbits_per_call = checks.integer("orbits_per_call", orbits_per_call, 1)
-    on_limit = checks.choice("on_limit", on_limit, ("stop", "flag"))  # type: ignore[assignment]
+    on_limit = checks.choice("on_limit", on_limit, ("stop", "flag", "ignore"))  # type: ignore[assignment]
     model = checks.choice("model", model, ("nonlinear", "linear"))  # type: ignore[assignment]
     coupled = checks.flag("coupled", coupled)
     t_start = checks.finite("t_start", t_start)
@@ -403,7 +405,7 @@ def simulate_orbits(
     counters: dict[str, Any] = {"n_steps": 0, "n_rhs": 0}
     if method == "hybrid":
         counters.update({name: 0 for name in HYBRID_COUNTERS})
-    crossing: tuple[float, int, float] | None = None
+    crossing: LimitCrossing | None = None
     path = checks.path("checkpoint", checkpoint) if checkpoint is not None else None
     if path is not None:
         saved = checkpoints.load(path, settings)
@@ -446,8 +448,8 @@ def simulate_orbits(
                     counters["n_rhs"] += int(raw["n_rhs"])
                     for name in HYBRID_COUNTERS if method == "hybrid" else ():
                         counters[name] += raw[name]
-                    if crossing is None and raw["crossing"] is not None:
-                        crossing = tuple(raw["crossing"])  # type: ignore[assignment]
+                    if crossing is None and on_limit != "ignore":
+                        crossing = LimitCrossing.of(raw["crossing"])
                     if raw["stopped"]:
                         stopped = True
                         next_index = int(columns["index"][-1]) + 1
@@ -480,6 +482,7 @@ def simulate_orbits(
                     _save_checkpoint(
                         path, settings, n_orbits, columns, y, next_index, counters, crossing
                     )
+    warn_crossing(crossing, theta_limit, on_limit)
     if report:
         kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
         if path is not None:

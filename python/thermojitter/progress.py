@@ -7,6 +7,8 @@ One home for how a long call looks while it runs and how it stops:
 - :class:`Interruptible` runs engine calls in a worker thread with a cancellation token, so that
   Ctrl-C reaches the waiting thread at once, the engine stops within one integration step, and
   the caller keeps what finished.
+- :func:`interruptible` does the same for one engine call (a run, a map block): every long call
+  of the package goes through it, so that Ctrl-C stops it with a plain ``KeyboardInterrupt``.
 - :class:`DeferredInterrupt` holds Ctrl-C back while a write that must not be cut runs (a
   checkpoint chunk), and raises it once the write is whole.
 - :func:`report_interrupted` is the one line a stopped call prints: what was kept and how to go on.
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import os
 import signal
 import sys
 import threading
@@ -99,6 +102,43 @@ class Interruptible:
     def __exit__(self, *exc: object) -> None:
         self.token.cancel()  # whatever is still running stops; nothing new starts
         self._executor.shutdown(wait=True)
+
+
+_worker: cf.ThreadPoolExecutor | None = None
+"""The thread that runs the main thread's engine calls (made at the first call)."""
+
+
+def _forget_worker() -> None:
+    # A forked child has no copy of the worker thread: it makes its own.
+    global _worker
+    _worker = None
+
+
+os.register_at_fork(after_in_child=_forget_worker)
+
+
+def interruptible(fn: Callable[..., T], /, *args: Any, **kwargs: Any) -> T:
+    """``fn(*args, cancel=token, **kwargs)``, an engine call, stopped by Ctrl-C.
+
+    Python runs its SIGINT handler only in the main thread and only between bytecodes, so a call
+    that holds the main thread inside the engine would notice Ctrl-C at its end. Called from the
+    main thread, the engine call runs in one shared worker thread while the main thread waits:
+    Ctrl-C interrupts the wait at once, cancels the token, the engine stops within one step (or
+    one grid point), and ``KeyboardInterrupt`` is raised once the worker is idle again. From
+    another thread (which Ctrl-C never reaches) the call runs in place."""
+    token = _core.CancelToken()
+    if threading.current_thread() is not threading.main_thread():
+        return fn(*args, cancel=token, **kwargs)
+    global _worker
+    if _worker is None:
+        _worker = cf.ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermojitter-engine")
+    future = _worker.submit(fn, *args, cancel=token, **kwargs)
+    try:
+        return future.result()
+    except KeyboardInterrupt:
+        token.cancel()
+        cf.wait([future])
+        raise
 
 
 H = TypeVar("H", bound="SigintHandler")

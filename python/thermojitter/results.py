@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -12,6 +12,25 @@ from numpy.typing import NDArray
 from thermojitter.solver import SolverSettings
 
 Array = NDArray[np.float64]
+
+
+class LimitCrossing(NamedTuple):
+    """Where a run's angle first passed its ``theta_limit``: the time ``t`` (s), the ``orbit``
+    it falls in (whole orbits since the run's start, as :func:`thermojitter.simulate_orbits`
+    numbers them) and the angle ``theta`` there (rad: θ, or θ_f of the distributed panel)."""
+
+    t: float
+    orbit: int
+    theta: float
+
+    @property
+    def theta_deg(self) -> float:
+        return math.degrees(self.theta)
+
+    @classmethod
+    def of(cls, raw: Any) -> LimitCrossing | None:
+        """The engine's (t, orbit, θ), or None."""
+        return None if raw is None else cls(float(raw[0]), int(raw[1]), float(raw[2]))
 
 
 @dataclass(frozen=True)
@@ -106,6 +125,11 @@ class Solution(_Run):
     y_end: Array = field(default_factory=lambda: np.empty(0))
     T_nodes: Array | None = None
     """With ``layers=N``: the temperature of every node (time × node), K."""
+    limit_crossing: LimitCrossing | None = None
+    """Where abs(θ) first passed ``theta_limit`` (None: it did not, or ``on_limit="ignore"``)."""
+    stopped_at_limit: bool = False
+    """True when ``on_limit="stop"`` ended the run at the crossing: no sample after it, and
+    ``y_end`` is the state there."""
     depth: Array | None = None
     """With ``layers=N``: each node's depth below the front face, m."""
     node_labels: tuple[str, ...] | None = None

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import warnings
 from collections.abc import Sequence
 from typing import Any, Literal
 
@@ -10,14 +12,30 @@ from numpy.typing import ArrayLike
 
 from thermojitter import _core
 from thermojitter import errors as checks
-from thermojitter.errors import ParameterError
+from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
-from thermojitter.results import Equilibrium, HingeSolution, Solution, ThermalSolution
+from thermojitter.progress import interruptible
+from thermojitter.results import (
+    Equilibrium,
+    HingeSolution,
+    LimitCrossing,
+    Solution,
+    ThermalSolution,
+)
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Model = Literal["nonlinear", "linear"]
 Method = Literal["rk45", "rk4"]
+OnLimit = Literal["flag", "stop", "ignore"]
+
+DEFAULT_THETA_LIMIT: float = _core.VALIDITY_LIMIT
+"""abs(θ) beyond which the hinge model is not trusted, rad (20°; its rigid halves and cos θ
+coupling are meant for modest angles): the engine's ``dynamics::VALIDITY_LIMIT``."""
+
+ON_LIMIT = ("flag", "stop", "ignore")
+"""What a run does when its angle passes ``theta_limit``: record the first crossing and warn
+(``"flag"``), also end the run there (``"stop"``), or nothing (``"ignore"``)."""
 
 DEFAULT_DT_OUT = 0.5
 """Default reporting interval, s: 16 samples per period of the paper panel's ~8 s jitter."""
@@ -79,6 +97,37 @@ def solver_settings(
     return SolverSettings(method, rtol, atol, dt, max_step, max_steps).as_dict()  # type: ignore[arg-type]
 
 
+def limit_args(theta_limit: Any, on_limit: Any) -> dict[str, Any]:
+    """The engine's keyword arguments of the validity limit, their types checked (the engine
+    checks theta_limit's range, 0 < theta_limit <= π/2, whatever on_limit)."""
+    return {
+        "theta_limit": checks.real("theta_limit", theta_limit),
+        "on_limit": checks.choice("on_limit", on_limit, ON_LIMIT),
+    }
+
+
+def warn_crossing(
+    crossing: LimitCrossing | None,
+    theta_limit: float,
+    on_limit: str,
+    angle: str = "θ",
+    *,
+    stacklevel: int = 3,
+) -> None:
+    """The one :class:`ValidityLimitWarning` of a call whose run passed ``theta_limit``."""
+    if crossing is None:
+        return
+    then = "the run stopped there" if on_limit == "stop" else "the result beyond means nothing"
+    warnings.warn(
+        f"{angle} passed theta_limit = {math.degrees(theta_limit):.4g}° at "
+        f"t = {crossing.t:.6g} s (orbit {crossing.orbit}): {angle} = "
+        f"{crossing.theta_deg:.4g}°, beyond the hinge model's range of validity; {then} "
+        "(result.limit_crossing; on_limit='ignore' silences this)",
+        ValidityLimitWarning,
+        stacklevel=stacklevel,
+    )
+
+
 _NO_ORBIT: Any = object()
 
 
@@ -133,6 +182,8 @@ def simulate(
     max_steps: int = MAX_STEPS,
     layers: int | None = None,
     solver: SolverSettings | None = None,
+    theta_limit: float = DEFAULT_THETA_LIMIT,
+    on_limit: OnLimit = "flag",
 ) -> Solution:
     """Integrates the coupled thermo-structural model over ``t_span`` (s).
 
@@ -160,20 +211,78 @@ def simulate(
     ``solver``: a :class:`thermojitter.SolverSettings` in place of ``method``, ``rtol``, ``atol``,
     ``dt``, ``max_step`` and ``max_steps``; ``sol.solver`` is what the engine used.
 
+    ``theta_limit`` (rad, in (0, π/2]; default 20°): the hinge model's range of validity, checked
+    by the engine on every step (on the interpolant, so a crossing between two samples is found
+    where it happens). When abs(θ) passes it, ``on_limit="flag"`` (default) records the first
+    crossing in ``sol.limit_crossing`` (t, orbit, θ) and issues one
+    :class:`thermojitter.errors.ValidityLimitWarning`; ``"stop"`` does so and ends the run there
+    (``sol.stopped_at_limit``: no sample after the crossing, ``y_end`` the state at it);
+    ``"ignore"`` checks nothing.
+
+    Ctrl-C stops the run within one integration step (``KeyboardInterrupt``).
+
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
     """
+    sol = _simulate(
+        panel,
+        orbit,
+        t_span,
+        model=model,
+        coupled=coupled,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        dt=dt,
+        t_eval=t_eval,
+        dt_out=dt_out,
+        y0=y0,
+        max_step=max_step,
+        max_steps=max_steps,
+        layers=layers,
+        solver=solver,
+        theta_limit=theta_limit,
+        on_limit=on_limit,
+    )
+    warn_crossing(sol.limit_crossing, theta_limit, on_limit)
+    return sol
+
+
+def _simulate(
+    panel: Panel,
+    orbit: Orbit,
+    t_span: Sequence[float],
+    *,
+    model: Model,
+    coupled: bool,
+    method: Method,
+    rtol: float,
+    atol: float,
+    dt: float | None,
+    t_eval: ArrayLike | None,
+    dt_out: float | None,
+    y0: Sequence[float] | None,
+    max_step: float,
+    max_steps: int,
+    layers: int | None,
+    solver: SolverSettings | None,
+    theta_limit: float,
+    on_limit: OnLimit,
+) -> Solution:
+    """:func:`simulate` without its warning (for callers that issue their own)."""
     check_inputs(panel, orbit)
     t0, t1 = time_span(t_span)
     used = SolverSettings.of(
         solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
     )
-    args = solver_args(used, t_eval, dt_out)
-    settings = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt, "model": model}
-    settings["coupled"] = coupled
+    args = {**solver_args(used, t_eval, dt_out), **limit_args(theta_limit, on_limit)}
+    settings: dict[str, Any] = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt}
+    settings.update(model=model, coupled=coupled)
+    settings.update(theta_limit=args["theta_limit"], on_limit=on_limit)
     if layers is not None:
         nodes = check_layers(layers)
-        raw = _core.simulate_layers(
+        raw = interruptible(
+            _core.simulate_layers,
             panel.as_dict(),
             layup_dict(panel),
             nodes,
@@ -203,8 +312,11 @@ def simulate(
             T_nodes=temps,
             depth=raw["depth"],
             node_labels=tuple(raw["node_labels"]),
+            limit_crossing=LimitCrossing.of(raw["crossing"]),
+            stopped_at_limit=bool(raw["stopped"]),
         )
-    raw = _core.simulate(
+    raw = interruptible(
+        _core.simulate,
         panel.as_dict(),
         orbit.as_dict(),
         t0,
@@ -228,6 +340,8 @@ def simulate(
         thermal_moment=raw["thermal_moment"],
         sunlit=raw["sunlit"],
         y_end=raw["y_end"],
+        limit_crossing=LimitCrossing.of(raw["crossing"]),
+        stopped_at_limit=bool(raw["stopped"]),
     )
 
 
@@ -257,7 +371,8 @@ def simulate_thermal(
         solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
     )
     args = solver_args(used, t_eval, dt_out)
-    raw = _core.simulate_thermal(
+    raw = interruptible(
+        _core.simulate_thermal,
         panel.as_dict(),
         orbit.as_dict(),
         t0,
@@ -309,7 +424,8 @@ def simulate_hinge(
     args = solver_args(used, t_eval, dt_out)
     m = checks.real_array("moment", moment)
     mt = None if moment_t is None else checks.real_array("moment_t", moment_t)
-    raw = _core.simulate_hinge(
+    raw = interruptible(
+        _core.simulate_hinge,
         panel.as_dict(),
         t0,
         t1,

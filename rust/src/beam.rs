@@ -15,10 +15,11 @@
 //! contribution of every other elastic mode (residual flexibility, the "mode acceleration"
 //! correction), so a slowly varying moment gives the exact static deflection.
 
+use crate::cancel::Cancel;
 use crate::error::{require_finite, require_non_negative, Error, Result};
-use crate::integrate::{solve, Const, Method, OdeSystem, Recorder, Stats};
+use crate::integrate::{Const, Method, OdeSystem, State, Stats};
 use crate::params::{beam_first_angular_frequency, Panel};
-use crate::simulate::Output;
+use crate::simulate::{run_watched, Output};
 use crate::system::MomentHistory;
 use nalgebra::{DMatrix, DVector, SVector, SymmetricEigen};
 
@@ -395,6 +396,7 @@ pub struct BeamResponse {
 
 /// Modal transient response of `beam` to end moments ±`moment`(t), starting at rest in the
 /// static deflection under M(t0). `residual` adds the quasi-static part of the modes not kept.
+#[allow(clippy::too_many_arguments)]
 pub fn respond(
     beam: &FreeFreeBeam,
     moment: MomentHistory,
@@ -403,17 +405,18 @@ pub fn respond(
     method: &Method,
     t_span: (f64, f64),
     output: &Output,
+    cancel: &Cancel,
 ) -> Result<BeamResponse> {
     require_non_negative("damping_ratio", damping_ratio)?;
     moment.validate()?;
     let (t0, t1) = t_span;
     crate::integrate::check_span(t0, t1)?;
-    let times = output.sample_times(t0, t1)?;
+    output.sample_times(t0, t1)?;
     let modes = beam.end_moment_modes()?;
     let mut system = ModalBeam::new(&modes, damping_ratio, moment);
-    let y0 = system.static_state(system.moment.at(t0));
-    let mut recorder = Recorder::<Const<BEAM_STATE>>::new(times);
-    let (stats, _) = solve(&mut system, method, t0, y0, t1, &mut recorder)?;
+    let y0: State<Const<BEAM_STATE>> = system.static_state(system.moment.at(t0));
+    let recorder = run_watched(&mut system, method, t_span, y0, output, None, cancel)?;
+    let stats = recorder.stats;
     let residual_flex = if residual {
         modes.residual_flexibility
     } else {
@@ -581,7 +584,17 @@ mod tests {
             moment: vec![0.0, 100.0],
         };
         let out = Output::Times(vec![0.0, 200.0]);
-        let r = respond(&b, history, 0.3, true, &method, (0.0, 200.0), &out).unwrap();
+        let r = respond(
+            &b,
+            history,
+            0.3,
+            true,
+            &method,
+            (0.0, 200.0),
+            &out,
+            &Cancel::new(),
+        )
+        .unwrap();
         let exact = 100.0 * 50.0 * 50.0 / (8.0 * b.flexural_rigidity);
         assert_eq!(r.eta[0], 0.0);
         assert!((r.eta[1] - exact).abs() < 1e-6 * exact, "{}", r.eta[1]);
@@ -611,6 +624,7 @@ mod tests {
             &method,
             (0.0, 40.0),
             &Output::Times(ts.clone()),
+            &Cancel::new(),
         )
         .unwrap();
         for (k, t) in ts.iter().enumerate() {

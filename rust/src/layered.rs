@@ -797,10 +797,13 @@ pub struct LayeredRun {
     pub y_end: Vec<f64>,
     /// The integrator settings the run used.
     pub method: crate::integrate::Method,
+    /// Where |θ| first passed the validity limit, when one was watched.
+    pub crossing: Option<crate::longrun::LimitCrossing>,
 }
 
 /// Integrates the N-node system over `t_span` from `y0` (node temperatures, θ, θ̇; default the
-/// sunlit equilibrium at the start's solar flux) and samples it as `output` asks.
+/// sunlit equilibrium at the start's solar flux) and samples it as `output` asks, watching
+/// `limit` (see [`crate::simulate::run_watched`]) and stopping within a step of `cancel`.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     panel: &Panel,
@@ -812,6 +815,8 @@ pub fn simulate(
     t_span: (f64, f64),
     y0: Option<&[f64]>,
     output: &crate::simulate::Output,
+    limit: Option<crate::simulate::OnLimit>,
+    cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredRun> {
     let n = conduction.nodes();
     let start: Vec<f64> = match y0 {
@@ -825,9 +830,14 @@ pub fn simulate(
     let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
     let size = y_start.len();
     let orb = LayeredOrbit::new(system.clone(), *orbit);
-    let (t, y, stats, y_end, used) =
-        on_fastest_state!(orb, size, sample_run(method, t_span, &y_start, output))?;
     let m = system.thermal_size();
+    // θ is the state's component m in every form of the system.
+    let watch = limit.map(|l| l.on_component(m));
+    let (t, y, stats, y_end, used, crossing) = on_fastest_state!(
+        orb,
+        size,
+        sample_run(method, t_span, &y_start, output, watch.as_ref(), cancel)
+    )?;
     let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
     let mut run = LayeredRun {
         theta: y.iter().map(|v| v[m]).collect(),
@@ -838,6 +848,8 @@ pub fn simulate(
         stats,
         y_end: Vec::new(),
         method: used,
+        crossing: crossing
+            .map(|(t, y)| crate::longrun::LimitCrossing::in_run(orbit, t_span.0, t, y[m])),
     };
     for (t, y) in run.t.iter().zip(&y) {
         let temps = system.node_temperatures(area_free(*t), y);
@@ -851,13 +863,15 @@ pub fn simulate(
     Ok(run)
 }
 
-/// Samples of one run of `system`: times, states, counters, the end state and the settings used.
+/// Samples of one run of `system`: times, states, counters, the end state, the settings used
+/// and where the limit was first passed (t, state).
 type Samples = (
     Vec<f64>,
     Vec<Vec<f64>>,
     crate::integrate::Stats,
     Vec<f64>,
     crate::integrate::Method,
+    Option<(f64, Vec<f64>)>,
 );
 
 fn sample_run<D: Dim, S: OdeSystem<D>>(
@@ -866,11 +880,21 @@ fn sample_run<D: Dim, S: OdeSystem<D>>(
     t_span: (f64, f64),
     y0: &[f64],
     output: &crate::simulate::Output,
+    limit: Option<&crate::simulate::Limit>,
+    cancel: &crate::cancel::Cancel,
 ) -> Result<Samples>
 where
     DefaultAllocator: Allocator<D>,
 {
-    let traj = crate::simulate::run(system, method, t_span, state_of::<D>(y0), output)?;
+    let traj = crate::simulate::run_watched(
+        system,
+        method,
+        t_span,
+        state_of::<D>(y0),
+        output,
+        limit,
+        cancel,
+    )?;
     let y = traj.y.iter().map(|v| v.as_slice().to_vec()).collect();
     Ok((
         traj.t,
@@ -878,6 +902,7 @@ where
         traj.stats,
         traj.y_end.as_slice().to_vec(),
         traj.method,
+        traj.crossing.map(|(t, y)| (t, y.as_slice().to_vec())),
     ))
 }
 
@@ -1964,6 +1989,8 @@ mod tests {
             span,
             Some(&start),
             &out,
+            None,
+            &crate::cancel::Cancel::new(),
         )
         .unwrap();
         let two = run(
@@ -2028,6 +2055,8 @@ mod tests {
             span,
             Some(&start),
             &out,
+            None,
+            &crate::cancel::Cancel::new(),
         )
         .unwrap();
         let theirs = run(&mut generic, &method, span, DVector::from_vec(start), &out).unwrap();
@@ -2373,6 +2402,8 @@ mod tests {
                 span,
                 None,
                 &self.out,
+                None,
+                &crate::cancel::Cancel::new(),
             )
             .unwrap()
         }

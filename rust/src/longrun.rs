@@ -164,6 +164,18 @@ pub struct LimitCrossing {
     pub theta: f64,
 }
 
+impl LimitCrossing {
+    /// The crossing at t of a run that began at `t_start`: `orbit` counts the whole orbits
+    /// since then, as the long runs number theirs from their start.
+    pub fn in_run(orbit: &Orbit, t_start: f64, t: f64, theta: f64) -> Self {
+        LimitCrossing {
+            t,
+            orbit: ((t - t_start) / orbit.period).floor().max(0.0) as u64,
+            theta,
+        }
+    }
+}
+
 /// Settings of a summarised run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SummaryOptions {

@@ -57,6 +57,7 @@ pub fn stability_map(
     flux: f64,
     x: &Axis,
     y: &Axis,
+    cancel: &crate::cancel::Cancel,
 ) -> Result<StabilityMap> {
     check_flux(flux)?;
     check_axis("x", x)?;
@@ -82,7 +83,11 @@ pub fn stability_map(
     }
     let results: Vec<(f64, f64)> = panels
         .par_iter()
-        .map(|p| analyse(p, model, coupling, flux).map(|a| (a.growth_rate, a.frequency_hz)))
+        .map(|p| {
+            // Polled once a grid point (an eigen-analysis, well under a millisecond).
+            cancel.check()?;
+            analyse(p, model, coupling, flux).map(|a| (a.growth_rate, a.frequency_hz))
+        })
         .collect::<Result<_>>()?;
     let (growth_rate, frequency_hz) = results.into_iter().unzip();
     Ok(StabilityMap {
@@ -96,6 +101,8 @@ pub fn stability_map(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use crate::cancel::Cancel;
 
     fn axis(name: &str, values: &[f64]) -> Axis {
         Axis {
@@ -116,6 +123,7 @@ mod tests {
             1.0,
             &x,
             &y,
+            &Cancel::new(),
         )
         .unwrap();
         assert_eq!((m.nx, m.ny), (3, 2));
@@ -151,6 +159,7 @@ mod tests {
                         1.0,
                         &x,
                         &y,
+                        &Cancel::new(),
                     )
                     .unwrap()
                 })
@@ -162,9 +171,18 @@ mod tests {
     fn bad_axes_are_refused_by_name() {
         let p = Panel::paper();
         let run = |x: &Axis, y: &Axis| {
-            stability_map(&p, HingeModel::Linear, Coupling::ProjectedArea, 1.0, x, y)
-                .unwrap_err()
-                .to_string()
+            let c = Cancel::new();
+            stability_map(
+                &p,
+                HingeModel::Linear,
+                Coupling::ProjectedArea,
+                1.0,
+                x,
+                y,
+                &c,
+            )
+            .unwrap_err()
+            .to_string()
         };
         let good = axis("damping", &[1.0]);
         assert!(run(&axis("dampng", &[1.0]), &good).contains("dampng"));

@@ -8,13 +8,14 @@ import json
 import math
 import textwrap
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_dir, write_output
-from thermojitter.errors import ParameterError
+from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.scenario import (
     LAMINATE_KEYS,
@@ -226,22 +227,25 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
     check_writer(fmt)
     started = time.perf_counter()
     try:
-        runs = simulate_orbits(
-            scenario.panel,
-            scenario.orbit,
-            n_orbits,
-            t_start=sim.t_start,
-            model=sim.model,  # type: ignore[arg-type]
-            coupled=sim.coupled,
-            method=sim.method,  # type: ignore[arg-type]
-            solver=sim.solver,
-            theta_limit=math.radians(sim.theta_limit_deg),
-            on_limit=sim.on_limit,  # type: ignore[arg-type]
-            layers=sim.layers,
-            checkpoint=out / "checkpoint.json",
-            progress=not args.no_progress,
-            stop=STOP,
-        )
+        with warnings.catch_warnings():
+            # The command says where |θ| passed the limit in its own last line.
+            warnings.simplefilter("ignore", ValidityLimitWarning)
+            runs = simulate_orbits(
+                scenario.panel,
+                scenario.orbit,
+                n_orbits,
+                t_start=sim.t_start,
+                model=sim.model,  # type: ignore[arg-type]
+                coupled=sim.coupled,
+                method=sim.method,  # type: ignore[arg-type]
+                solver=sim.solver,
+                theta_limit=math.radians(sim.theta_limit_deg),
+                on_limit=sim.on_limit,  # type: ignore[arg-type]
+                layers=sim.layers,
+                checkpoint=out / "checkpoint.json",
+                progress=not args.no_progress,
+                stop=STOP,
+            )
     except ParameterError as exc:
         if exc.parameter != "n_orbits":
             raise

@@ -306,6 +306,37 @@ impl DistributedPanel {
         self.reduction.theta_f(rise, t)
     }
 
+    /// The validity limit on θ_f as the integrators watch it: |tip rise| <= arm · sin(θ_limit),
+    /// the rise an affine function of the state (the modes' share, and the element moments',
+    /// which are linear in the temperatures: read off unit temperatures).
+    pub fn limit(&self, on: crate::simulate::OnLimit) -> crate::simulate::Limit {
+        let s = self.layers();
+        let r = &self.reduction;
+        let zero = vec![0.0; s];
+        let m0 = self.thermal.moment(&zero);
+        let mut weights = Vec::with_capacity(self.state_size());
+        let mut unit = zero.clone();
+        for e in 0..self.n() {
+            for i in 0..s {
+                unit[i] = 1.0;
+                weights.push((
+                    e * s + i,
+                    r.rise_residual[e] * (self.thermal.moment(&unit) - m0),
+                ));
+                unit[i] = 0.0;
+            }
+        }
+        for j in 0..self.k() {
+            weights.push((self.temps() + j, r.rise_modal[j]));
+        }
+        crate::simulate::Limit {
+            weights,
+            offset: r.rise_residual.sum() * m0,
+            bound: r.mesh.arm() * on.theta_limit.sin(),
+            stop: on.stop,
+        }
+    }
+
     /// Nodal deflections and slopes of a state.
     pub fn nodal(&self, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let w = self.reduction.deflection(self.modal(y), &self.moments(y));

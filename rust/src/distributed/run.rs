@@ -2,11 +2,13 @@
 //! the generic integrators through eclipses and penumbrae, and its sampled fields.
 
 use super::DistributedPanel;
+use crate::cancel::Cancel;
 use crate::error::{Error, Result};
 use crate::integrate::Stats;
 use crate::integrate::{Dyn, Method, OdeSystem, State};
+use crate::longrun::LimitCrossing;
 use crate::orbit::Orbit;
-use crate::simulate::{run, Output};
+use crate::simulate::{run_watched, OnLimit, Output};
 use crate::system::Sunlight;
 use nalgebra::DVector;
 
@@ -60,10 +62,14 @@ pub struct DistributedRun {
     pub sunlit: Vec<f64>,
     pub stats: Stats,
     pub y_end: Vec<f64>,
+    /// Where |θ_f| first passed the validity limit, when one was watched.
+    pub crossing: Option<LimitCrossing>,
 }
 
 /// Integrates `model` on `orbit` over `t_span` from `y0` (default: the sunlit equilibrium at the
-/// start's flux scale) and samples it as `output` asks.
+/// start's flux scale) and samples it as `output` asks, watching θ_f against `limit` (see
+/// [`crate::simulate::run_watched`]) and stopping within a step of `cancel`.
+#[allow(clippy::too_many_arguments)]
 pub fn simulate(
     model: &DistributedPanel,
     orbit: Orbit,
@@ -71,6 +77,8 @@ pub fn simulate(
     t_span: (f64, f64),
     y0: Option<Vec<f64>>,
     output: &Output,
+    limit: Option<OnLimit>,
+    cancel: &Cancel,
 ) -> Result<DistributedRun> {
     orbit.validate()?;
     let (t0, _) = t_span;
@@ -97,13 +105,23 @@ pub fn simulate(
         None => model.equilibrium(orbit.flux_scale(t0))?,
     };
     let mut system = DistributedSystem::new(model.clone(), orbit);
-    let traj = run(
+    let watch = limit.map(|on| model.limit(on));
+    let traj = run_watched(
         &mut system,
         method,
         t_span,
         DVector::from_vec(start),
         output,
+        watch.as_ref(),
+        cancel,
     )?;
+    let crossing = match &traj.crossing {
+        Some((t, y)) => {
+            let theta = model.theta_f(y.as_slice(), *t)?;
+            Some(LimitCrossing::in_run(&orbit, t0, *t, theta))
+        }
+        None => None,
+    };
     let mut out = DistributedRun {
         t: traj.t.clone(),
         names: model.temperature_names(),
@@ -115,6 +133,7 @@ pub fn simulate(
         sunlit: Vec::with_capacity(traj.t.len()),
         stats: traj.stats,
         y_end: traj.y_end.as_slice().to_vec(),
+        crossing,
     };
     for (t, y) in traj.t.iter().zip(&traj.y) {
         let y = y.as_slice();

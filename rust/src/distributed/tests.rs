@@ -116,7 +116,17 @@ mod runs {
         // The moment is sampled finely (it is interpolated linearly by the comparator) and at
         // the shadow exit, where its slope jumps.
         let ts = times(span, 0.1, &[b]);
-        let run = simulate(&m, orbit, &method, span, None, &Output::Times(ts.clone())).unwrap();
+        let run = simulate(
+            &m,
+            orbit,
+            &method,
+            span,
+            None,
+            &Output::Times(ts.clone()),
+            None,
+            &crate::cancel::Cancel::new(),
+        )
+        .unwrap();
         for sample in &run.temperatures {
             for row in sample {
                 assert!(row.iter().all(|v| *v == row[0]), "temperatures differ");
@@ -136,6 +146,7 @@ mod runs {
             &method,
             span,
             &Output::Times(ts),
+            &crate::cancel::Cancel::new(),
         )
         .unwrap();
         let worst = run
@@ -174,7 +185,17 @@ mod runs {
         y0[nt] += 1e-4 / m.reduction.rise_modal[0].abs() * m.reduction.mesh.arm();
         let span = (0.0, 8000.0);
         let ts = times(span, 0.05, &[]);
-        let run = simulate(&m, orbit, &tight(1e-11), span, Some(y0), &Output::Times(ts)).unwrap();
+        let run = simulate(
+            &m,
+            orbit,
+            &tight(1e-11),
+            span,
+            Some(y0),
+            &Output::Times(ts),
+            None,
+            &crate::cancel::Cancel::new(),
+        )
+        .unwrap();
         let x: Vec<f64> = run.theta_f.iter().map(|v| v - theta_eq).collect();
         let (mut tp, mut lp) = (Vec::new(), Vec::new());
         for i in 1..x.len() - 1 {
@@ -211,5 +232,25 @@ mod runs {
             );
             assert_eq!(measured > 0.0, zeta < zeta_star);
         }
+    }
+}
+
+/// The limit's affine reading of the state is the tip rise θ_f is taken from, whatever the state
+/// (here the equilibrium, shifted in every component), and its bound is arm · sin(θ_limit).
+#[test]
+fn the_limit_reads_the_tip_rise() {
+    for support in [Support::FreeFree, Support::Cantilever] {
+        let m = model(support, 9, 3, Coupling::ProjectedArea);
+        let on = crate::simulate::OnLimit::new(0.3, false).unwrap();
+        let limit = m.limit(on);
+        let mut y = m.equilibrium(1.0).unwrap();
+        for (i, v) in y.iter_mut().enumerate() {
+            *v += 1e-3 * ((i * 7 % 5) as f64 - 2.0);
+        }
+        let rise = limit.value(&y);
+        let theta_f = m.theta_f(&y, 0.0).unwrap();
+        let arm = m.reduction.mesh.arm();
+        assert!((theta_f - (rise / arm).asin()).abs() < 1e-12, "{support:?}");
+        assert_eq!(limit.bound, arm * 0.3f64.sin());
     }
 }

@@ -194,6 +194,18 @@ where
         }
     }
 
+    /// f(t0, y0), the slope at the step's start, when the integrator evaluated it
+    /// (Dormand–Prince's k1, the Hermite step's f0); None for a step built from given
+    /// coefficients.
+    #[inline]
+    pub fn start_slope(&self) -> Option<&State<D>> {
+        match &self.slopes {
+            Slopes::Hermite([f0, _]) => Some(f0),
+            Slopes::Dopri5(k) => Some(&k[0]),
+            Slopes::Given => None,
+        }
+    }
+
     /// Value of the interpolant at t in [t0, t1].
     pub fn eval(&self, t: f64) -> State<D> {
         if t == self.t1 {

@@ -60,8 +60,14 @@ where
     /// Keeps the requested times inside `step` (the slow path, out of the step loop).
     #[inline(never)]
     fn sample(&mut self, step: &DenseStep<D>) {
+        self.sample_through(step, step.t1);
+    }
+
+    /// Keeps the requested times of `step` up to `t_last` (<= its end): a run that stops inside
+    /// a step keeps no sample beyond where it stopped.
+    pub fn sample_through(&mut self, step: &DenseStep<D>, t_last: f64) {
         self.skip_before(step.t0);
-        while self.next < self.times.len() && self.times[self.next] <= step.t1 {
+        while self.next < self.times.len() && self.times[self.next] <= t_last {
             let t = self.times[self.next];
             self.t.push(t);
             self.y.push(if t == step.t0 {

@@ -1,5 +1,6 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{output, panel_from, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
@@ -95,9 +96,10 @@ fn beam_static(
     })
 }
 
-/// Modal transient response to end moments ±M(t) given as samples (`moment_t`, `moment`).
+/// Modal transient response to end moments ±M(t) given as samples (`moment_t`, `moment`);
+/// stops with KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, n_elements, moment_t, moment, t0, t1, *, damping_ratio, residual, solver, t_eval, dt_out))]
+#[pyo3(signature = (panel, n_elements, moment_t, moment, t0, t1, *, damping_ratio, residual, solver, t_eval, dt_out, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn beam_response<'py>(
     py: Python<'py>,
@@ -112,7 +114,9 @@ fn beam_response<'py>(
     solver: &Bound<'py, PyDict>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let beam = beam_from(panel, n_elements)?;
         let m = solver_from(solver)?;
@@ -122,8 +126,19 @@ fn beam_response<'py>(
             moment: moment.as_array().to_vec(),
         };
         history.validate()?;
-        let r =
-            py.detach(|| respond(&beam, history, damping_ratio, residual, &m, (t0, t1), &out))?;
+        let r = py.detach(|| {
+            let span = (t0, t1);
+            respond(
+                &beam,
+                history,
+                damping_ratio,
+                residual,
+                &m,
+                span,
+                &out,
+                &cancel,
+            )
+        })?;
         let d = PyDict::new(py);
         d.set_item("t", PyArray1::from_vec(py, r.t))?;
         d.set_item("eta", PyArray1::from_vec(py, r.eta))?;

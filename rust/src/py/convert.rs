@@ -176,6 +176,32 @@ pub fn method(
 
 /// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
 /// run function receives it.
+/// The validity limit a run watches: `theta_limit` (rad, checked whatever `on_limit`) with
+/// `on_limit` "flag" (record the first crossing), "stop" (end the run there) or "ignore" (None).
+pub fn on_limit(theta_limit: f64, on_limit: &str) -> PyResult<Option<crate::simulate::OnLimit>> {
+    let stop = match on_limit {
+        "flag" => false,
+        "stop" => true,
+        "ignore" => {
+            crate::simulate::check_theta_limit(theta_limit)?;
+            return Ok(None);
+        }
+        other => {
+            return Err(invalid(
+                "on_limit",
+                format!("{other:?}"),
+                "must be 'flag', 'stop' or 'ignore'",
+            ))
+        }
+    };
+    Ok(Some(crate::simulate::OnLimit::new(theta_limit, stop)?))
+}
+
+/// A limit crossing as the long runs report theirs: (t s, orbit index, θ rad).
+pub fn crossing_tuple(c: Option<crate::longrun::LimitCrossing>) -> Option<(f64, u64, f64)> {
+    c.map(|c| (c.t, c.orbit, c.theta))
+}
+
 pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
     let name: String = required_item(d, "method", "a string")?;
     let dt = match d.get_item("dt")? {

@@ -1,6 +1,9 @@
 //! Bindings of the distributed panel: its settings, modes, and flutter analysis.
 
-use super::convert::{coupling, orbit_from, output, panel_from, required_item, solver_from};
+use super::cancel::{token, CancelToken};
+use super::convert::{
+    coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item, solver_from,
+};
 use super::error::{invalid, shield};
 use crate::distributed::{DistributedPanel, Settings, Support};
 use crate::flutter::check_flux;
@@ -153,9 +156,11 @@ fn matrix<'py>(
     PyArray2::from_vec2(py, rows).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// Integrates the distributed panel on an orbit; fields sampled at the requested times.
+/// Integrates the distributed panel on an orbit; fields sampled at the requested times. Watches
+/// |θ_f| against `theta_limit` as `on_limit` says ("flag", "stop", "ignore") and stops with
+/// KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, settings, t0, t1, *, solver, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, orbit, settings, t0, t1, *, solver, t_eval, dt_out, y0, theta_limit=crate::dynamics::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_distributed<'py>(
     py: Python<'py>,
@@ -168,12 +173,17 @@ fn simulate_distributed<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Option<PyReadonlyArray1<'py, f64>>,
+    theta_limit: f64,
+    on_limit: &str,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let m = model_from(panel, settings)?;
         let o = orbit_from(orbit)?;
         let method = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
+        let limit = self::on_limit(theta_limit, on_limit)?;
         let start = match y0 {
             Some(v) => {
                 let v = v.as_array().to_vec();
@@ -185,7 +195,10 @@ fn simulate_distributed<'py>(
             None => None,
         };
         let r = py
-            .detach(|| crate::distributed::run::simulate(&m, o, &method, (t0, t1), start, &out))
+            .detach(|| {
+                let span = (t0, t1);
+                crate::distributed::run::simulate(&m, o, &method, span, start, &out, limit, &cancel)
+            })
             .map_err(PyErr::from)?;
         let mesh = &m.reduction.mesh;
         let (n, nodes) = (m.n(), m.n() + 1);
@@ -209,6 +222,12 @@ fn simulate_distributed<'py>(
         d.set_item("n_steps", r.stats.n_steps)?;
         d.set_item("n_rejected", r.stats.n_rejected)?;
         d.set_item("n_rhs", r.stats.n_rhs)?;
+        d.set_item("t_end", r.stats.t_end)?;
+        d.set_item("crossing", crossing_tuple(r.crossing))?;
+        d.set_item(
+            "stopped",
+            r.crossing.is_some() && limit.is_some_and(|l| l.stop),
+        )?;
         modal_info(py, &m, &d)?;
         Ok(d)
     })

@@ -1,5 +1,6 @@
 //! Bindings of the flutter analysis.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{coupling, hinge_model, panel_from};
 use super::error::shield;
 use crate::flutter::{analyse, check_flux, critical_damping};
@@ -44,9 +45,10 @@ fn flutter<'py>(
     })
 }
 
-/// Growth rate and frequency over a grid of two panel parameters (rows: y, columns: x).
+/// Growth rate and frequency over a grid of two panel parameters (rows: y, columns: x); stops
+/// with KeyboardInterrupt within a grid point of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, x_name, x_values, y_name, y_values, model, coupled, flux))]
+#[pyo3(signature = (panel, x_name, x_values, y_name, y_values, model, coupled, flux, *, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn stability_map<'py>(
     py: Python<'py>,
@@ -58,7 +60,9 @@ fn stability_map<'py>(
     model: &str,
     coupled: bool,
     flux: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
         let m = hinge_model(model)?;
@@ -71,7 +75,7 @@ fn stability_map<'py>(
             name: y_name,
             values: y_values,
         };
-        let map = py.detach(|| crate::stability::stability_map(&p, m, c, flux, &x, &y))?;
+        let map = py.detach(|| crate::stability::stability_map(&p, m, c, flux, &x, &y, &cancel))?;
         let grid = |v: &[f64]| -> Vec<Vec<f64>> { v.chunks(map.nx).map(|r| r.to_vec()).collect() };
         let d = PyDict::new(py);
         d.set_item(

@@ -1,5 +1,6 @@
 //! Bindings of the laminate layups and the N-node through-thickness model.
 
+use super::cancel::{token, CancelToken};
 use super::convert::{
     coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_dict, solver_from,
     type_error,
@@ -269,9 +270,9 @@ fn layered_flutter<'py>(
 }
 
 /// Integrates the N-node laminate coupled to the hinge; node temperatures as a (time × node)
-/// array.
+/// array. The validity limit and Ctrl-C as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, layup, nodes, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, theta_limit=crate::dynamics::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_layers<'py>(
     py: Python<'py>,
@@ -287,19 +288,38 @@ fn simulate_layers<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
+    theta_limit: f64,
+    on_limit: &str,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let hinge = hinge_model(model)?;
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
+        let limit = super::convert::on_limit(theta_limit, on_limit)?;
         let c = conduction_from(&p, layup, nodes)?;
         let depth = c.depth.clone();
         let labels = c.node_labels();
         let k = coupling(coupled);
-        let run = py
-            .detach(|| layered::simulate(&p, c, &o, hinge, k, &m, (t0, t1), y0.as_deref(), &out))?;
+        let span = (t0, t1);
+        let run = py.detach(|| {
+            layered::simulate(
+                &p,
+                c,
+                &o,
+                hinge,
+                k,
+                &m,
+                span,
+                y0.as_deref(),
+                &out,
+                limit,
+                &cancel,
+            )
+        })?;
         let n_t = run.t.len();
         let d = PyDict::new(py);
         let sunlit: Vec<f64> = run.t.iter().map(|&t| o.illumination(t)).collect();
@@ -318,6 +338,9 @@ fn simulate_layers<'py>(
         d.set_item("t_end", run.stats.t_end)?;
         d.set_item("y_end", PyArray1::from_vec(py, run.y_end))?;
         d.set_item("solver", solver_dict(py, &run.method)?)?;
+        d.set_item("crossing", super::convert::crossing_tuple(run.crossing))?;
+        let stopped = run.crossing.is_some() && limit.is_some_and(|l| l.stop);
+        d.set_item("stopped", stopped)?;
         Ok(d)
     })
 }

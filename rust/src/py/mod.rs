@@ -16,11 +16,15 @@ use crate::dynamics::checked_hinge_energy;
 use crate::dynamics::{thermal_moment, Hinge, StructuralModel};
 use crate::integrate::State;
 use crate::params::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
-use crate::simulate::{run, Trajectory};
+use crate::simulate::{run_watched, OnLimit, Trajectory};
 use crate::steady::equilibrium;
 use crate::system::{Coupled, DrivenHinge, MomentHistory};
 use crate::thermal::ThermalModel;
-use convert::{coupling, hinge_model, orbit_from, output, panel_from, solver_from, state};
+use cancel::{token, CancelToken};
+use convert::{
+    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_from, solver_from,
+    state,
+};
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, Dyn, U2};
@@ -234,9 +238,11 @@ fn energy<'py>(
     })
 }
 
-/// Integrates the coupled thermo-structural system: the thermal model with `layers`, the hinge.
+/// Integrates the coupled thermo-structural system: the thermal model with `layers`, the hinge;
+/// watches |θ| against `theta_limit` as `on_limit` says ("flag", "stop", "ignore") and stops
+/// with KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, layers=2))]
+#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, layers=2, theta_limit=crate::dynamics::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -251,7 +257,11 @@ fn simulate<'py>(
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
     layers: u32,
+    theta_limit: f64,
+    on_limit: &str,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
@@ -259,22 +269,25 @@ fn simulate<'py>(
         let coupling = coupling(coupled);
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
+        let limit = self::on_limit(theta_limit, on_limit)?;
         if layers == 2 {
             // The paper's model, its state size known at compile time.
             let sys = Coupled::new(p, o, hinge, coupling);
-            return run_coupled(py, sys, &m, (t0, t1), y0, &out);
+            return run_coupled(py, sys, &m, (t0, t1), y0, &out, limit, &cancel);
         }
         let thermal = crate::thermal::model(&p, layers)?;
         let n = thermal.size() + 2;
         let structure = Hinge::new(&p, hinge);
         let sys = Coupled::compose(thermal, structure, o, coupling, Dyn(n))?;
-        run_coupled(py, sys, &m, (t0, t1), y0, &out)
+        run_coupled(py, sys, &m, (t0, t1), y0, &out, limit, &cancel)
     })
 }
 
 /// Runs a coupled system (or a thermal model alone) from `y0` (default: its steady state at t0's
 /// flux) and returns every state component under its model's name, the thermal moment and the
-/// illumination.
+/// illumination; with `limit`, where θ first passed it ("crossing": (t, orbit, θ) or None) and
+/// whether the run stopped there ("stopped").
+#[allow(clippy::too_many_arguments)]
 fn run_coupled<'py, T, S, D>(
     py: Python<'py>,
     mut sys: Coupled<T, S, D>,
@@ -282,6 +295,8 @@ fn run_coupled<'py, T, S, D>(
     span: (f64, f64),
     y0: Option<Vec<f64>>,
     out: &crate::simulate::Output,
+    limit: Option<OnLimit>,
+    cancel: &crate::cancel::Cancel,
 ) -> PyResult<Bound<'py, PyDict>>
 where
     T: ThermalModel + Send,
@@ -299,9 +314,24 @@ where
         }
         None => sys.steady_state(orbit.flux_scale(span.0))?,
     };
-    let traj = py.detach(|| run(&mut sys, method, span, y_start, out))?;
+    let names = sys.names();
+    // The limit is on θ, the structure's first state (a thermal model alone has none).
+    let theta = names.iter().position(|n| n == "theta");
+    let watch = limit.zip(theta).map(|(l, i)| l.on_component(i));
+    let traj =
+        py.detach(|| run_watched(&mut sys, method, span, y_start, out, watch.as_ref(), cancel))?;
     let d = run_info(py, &traj)?;
-    for (i, name) in sys.names().iter().enumerate() {
+    let crossing = traj
+        .crossing
+        .as_ref()
+        .zip(theta)
+        .map(|((t, y), i)| crate::longrun::LimitCrossing::in_run(&orbit, span.0, *t, y[i]));
+    d.set_item(intern!(py, "crossing"), crossing_tuple(crossing))?;
+    d.set_item(
+        intern!(py, "stopped"),
+        crossing.is_some() && watch.is_some_and(|l| l.stop),
+    )?;
+    for (i, name) in names.iter().enumerate() {
         d.set_item(name, array(py, column(&traj, i)))?;
     }
     let moment: Vec<f64> = traj.y.iter().map(|y| sys.moment(y)).collect();
@@ -313,7 +343,7 @@ where
 
 /// Integrates a thermal model alone: one node (eq. 1) or two layers (eq. 2, θ = 0).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, layers, solver, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, orbit, t0, t1, *, layers, solver, t_eval, dt_out, y0, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_thermal<'py>(
     py: Python<'py>,
@@ -326,7 +356,9 @@ fn simulate_thermal<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Option<Vec<f64>>,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
@@ -334,13 +366,13 @@ fn simulate_thermal<'py>(
         let out = output(t_eval, dt_out, t0, t1)?;
         let thermal = crate::thermal::model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o);
-        run_coupled(py, sys, &m, (t0, t1), y0, &out)
+        run_coupled(py, sys, &m, (t0, t1), y0, &out, None, &cancel)
     })
 }
 
 /// Integrates the hinge alone under a prescribed moment: a constant, or samples (t, M).
 #[pyfunction]
-#[pyo3(signature = (panel, t0, t1, *, model, moment, moment_t, solver, t_eval, dt_out, y0))]
+#[pyo3(signature = (panel, t0, t1, *, model, moment, moment_t, solver, t_eval, dt_out, y0, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_hinge<'py>(
     py: Python<'py>,
@@ -354,7 +386,9 @@ fn simulate_hinge<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
     y0: Vec<f64>,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
         let hinge = hinge_model(model)?;
@@ -386,7 +420,7 @@ fn simulate_hinge<'py>(
                 model: hinge,
                 moment: history,
             };
-            run(&mut sys, &m, (t0, t1), y_start, &out)
+            run_watched(&mut sys, &m, (t0, t1), y_start, &out, None, &cancel)
         })?;
         let d = run_info(py, &traj)?;
         d.set_item("theta", array(py, column(&traj, 0)))?;
@@ -395,9 +429,33 @@ fn simulate_hinge<'py>(
     })
 }
 
+/// Loads NumPy's array API now, at import. rust-numpy loads it on the first array made, and
+/// loading runs Python code, which raises a Ctrl-C pending since the engine call began: rust-numpy
+/// then panics, and the call's result became an InternalError instead of KeyboardInterrupt.
+fn load_numpy_api(py: Python<'_>) -> PyResult<()> {
+    let loaded = std::panic::catch_unwind(|| {
+        PyArray1::<f64>::zeros(py, 0, false);
+    });
+    let Err(payload) = loaded else {
+        return Ok(());
+    };
+    let what = payload
+        .downcast_ref::<String>()
+        .cloned()
+        .unwrap_or_default();
+    if what.contains("KeyboardInterrupt") {
+        // Ctrl-C during the import itself.
+        return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(""));
+    }
+    Err(pyo3::exceptions::PyImportError::new_err(format!(
+        "thermojitter could not load NumPy's array API: {what}"
+    )))
+}
+
 #[pymodule]
 #[pyo3(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    load_numpy_api(m.py())?;
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
     m.add("ConvergenceError", m.py().get_type::<ConvergenceError>())?;
     m.add("PANEL_FIELDS", crate::Panel::FIELDS.to_vec())?;
