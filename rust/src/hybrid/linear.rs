@@ -49,9 +49,7 @@ impl<const N: usize> Arc<N> {
         let lu = Lu::of(a);
         let p1 = -lu.solve(b).ok_or_else(|| fail("singular Jacobian"))?;
         let p0 = lu.solve(&p1).ok_or_else(|| fail("singular Jacobian"))?;
-        // Balanced: ab = D⁻¹ A D, so that kelvin and radian rows have comparable sizes.
-        let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
-        let ev = DMatrix::from_column_slice(N, N, ab.as_slice()).complex_eigenvalues();
+        let (ab, ev) = balanced_eigenvalues(a, scale);
         let abc: SMatrix<C64, N, N> = ab.map(|v| C64::new(v, 0.0));
         let mut vecs: [SVector<C64, N>; N] = [SVector::zeros(); N];
         for k in 0..N {
@@ -115,6 +113,17 @@ impl<const N: usize> Arc<N> {
     }
 }
 
+/// The matrix balanced by `scale`, ab = D⁻¹ A D (so that kelvin and radian rows have comparable
+/// sizes for the eigen-solve), and its eigenvalues (those of A).
+pub fn balanced_eigenvalues<const N: usize>(
+    a: &SMatrix<f64, N, N>,
+    scale: &SVector<f64, N>,
+) -> (SMatrix<f64, N, N>, nalgebra::DVector<C64>) {
+    let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
+    let ev = DMatrix::from_column_slice(N, N, ab.as_slice()).complex_eigenvalues();
+    (ab, ev)
+}
+
 /// The hinge's oscillatory eigenpair of a Jacobian: λ (the eigenvalue of the complex pair with
 /// Im λ > 0 and the largest |Im λ|), its right eigenvector v and left eigenvector w, scaled so that
 /// w·v = 1 (bilinear). About a fixed point y*, a state's hinge coordinate is c = w·(y − y*) and
@@ -130,8 +139,7 @@ impl<const N: usize> HingeMode<N> {
     /// The pair of `a`, balanced by `scale` for the eigen-solve; None when `a` has no complex
     /// pair (an over-damped hinge) or the eigenvectors cannot be found to rounding.
     pub fn of(a: &SMatrix<f64, N, N>, scale: &SVector<f64, N>) -> Option<HingeMode<N>> {
-        let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
-        let ev = DMatrix::from_column_slice(N, N, ab.as_slice()).complex_eigenvalues();
+        let (ab, ev) = balanced_eigenvalues(a, scale);
         let lambda = ev
             .iter()
             .copied()

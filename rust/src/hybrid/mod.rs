@@ -395,9 +395,8 @@ fn has_fast_thermal_mode<const N: usize>(
     scale: &SVector<f64, N>,
     wn: f64,
 ) -> bool {
-    let ab = SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)] * scale[j] / scale[i]);
-    nalgebra::DMatrix::from_column_slice(N, N, ab.as_slice())
-        .complex_eigenvalues()
+    linear::balanced_eigenvalues(a, scale)
+        .1
         .iter()
         .any(|l| l.im.abs() <= 1e-9 * l.norm() && l.norm() > QUASI_STATIC_RATIO * wn)
 }
