@@ -26,7 +26,7 @@ from typing import Any
 import machine  # benches/machine.py
 
 import thermojitter as tj
-import thermojitter.montecarlo as mc
+import thermojitter.montecarlo.backends as mc
 
 RTOL, ATOL = 1e-8, 1e-10
 VARY = {

@@ -57,7 +57,7 @@ def test_lockstep_lanes_give_the_frame_of_one_sample_at_a_time(
     def both(study: Any, **kwargs: Any) -> tuple[pd.DataFrame, pd.DataFrame]:
         frames = []
         for lockstep in (True, False):
-            monkeypatch.setattr(montecarlo, "_LOCKSTEP", lockstep)
+            monkeypatch.setattr(montecarlo.backends, "_LOCKSTEP", lockstep)
             frames.append(study(PAPER, LOW, **FAST, threads=2, **kwargs))
         return frames[0], frames[1]
 
@@ -88,8 +88,8 @@ def test_same_frame_on_a_dask_cluster() -> None:
         cluster.close()
     assert {w["nthreads"] for w in workers.values()} == {1}
     # The chunks ran on the workers, each on a rayon pool of the worker's one thread.
-    used = [key for key in montecarlo._WORKER_POOLS if key[0] in workers]
-    assert used and all(montecarlo._WORKER_POOLS[key].threads == 1 for key in used)
+    used = [key for key in montecarlo.backends._WORKER_POOLS if key[0] in workers]
+    assert used and all(montecarlo.backends._WORKER_POOLS[key].threads == 1 for key in used)
     pd.testing.assert_frame_equal(local, on_dask, check_exact=True)
     pd.testing.assert_frame_equal(local, by_address, check_exact=True)
 

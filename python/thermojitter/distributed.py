@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 from thermojitter.errors import flag, real, type_name
-from thermojitter.orbit import Orbit
+from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
 from thermojitter.progress import interruptible
 from thermojitter.results import LimitCrossing, Run
@@ -458,8 +458,6 @@ def distributed_convergence(
     p = log(|Δ₁| / |Δ₂|) / log(r), Δ the largest change between successive runs and r the ratio
     of successive values (constant). ``t_span`` defaults to the first eclipse with 1200 s of
     sunlight either side."""
-    from thermojitter.beam import eclipse_window
-
     values = [int(v) for v in values]
     if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:], strict=False)):
         raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")

@@ -15,6 +15,7 @@ from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import interruptible, progress_bar
 from thermojitter.results import Equilibrium
+from thermojitter.simulate import check_layers, layup_dict
 
 MAP_BLOCK = 20_000
 """Grid points per engine call of :func:`stability_map` (about 40 ms each)."""
@@ -98,8 +99,6 @@ def _layered_flutter(
     panel: Panel, model: str, coupled: bool, flux: float, layers: int
 ) -> FlutterResult:
     """The N-node model's flutter analysis: the Jacobian over (node temperatures…, θ, θ̇)."""
-    from thermojitter.simulate import check_layers, layup_dict
-
     nodes = check_layers(layers)
     raw = _core.layered_flutter(panel.as_dict(), layup_dict(panel), nodes, model, coupled, flux)
     temps = raw["temperatures"]

@@ -252,3 +252,18 @@ class Orbit:
     def time_of(self, date: DateLike) -> float:
         """Seconds from t = 0 (``epoch_day``) to ``date`` within the same year's day count."""
         return (day_of_year(date) - self.epoch_day) * 86400.0
+
+
+ECLIPSE_MARGIN = 1200.0
+"""Sunlight either side of the first eclipse in :func:`eclipse_window`, s."""
+
+
+def eclipse_window(orbit: Orbit, margin: float = ECLIPSE_MARGIN) -> tuple[float, float]:
+    """The first eclipse of the orbit with ``margin`` seconds of sunlight on each side, s."""
+    intervals = orbit.shadow_intervals(0.0, orbit.period)
+    if not intervals:
+        raise checks.ParameterError(
+            "orbit", orbit, message="orbit has no eclipse in its first period: give t_span"
+        )
+    enter, leave = intervals[0]
+    return max(0.0, enter - margin), leave + margin

@@ -5,13 +5,14 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, fields
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
+
+import numpy as np
 
 from thermojitter import _core
 from thermojitter import errors as checks
-
-if TYPE_CHECKING:
-    from thermojitter.laminate import Laminate
+from thermojitter.laminate import Laminate
+from thermojitter.results import Equilibrium
 
 PANEL_UNITS = {
     "emissivity_front": "-",
@@ -165,8 +166,6 @@ class Panel:
         The existing models run on these fields; ``layers=N`` runs the N-node model on the
         layup itself. ``hinge_stiffness`` defaults to K_el by ``criterion``.
         """
-        from thermojitter.laminate import Laminate
-
         if not isinstance(laminate, Laminate):
             raise TypeError(
                 f"laminate must be a thermojitter.Laminate, not {type(laminate).__name__}"
@@ -182,9 +181,7 @@ class Panel:
         fields_ = dict(_core.equivalent_panel(laminate.as_dict(), base.as_dict()))
         panel = cls(**fields_)
         if hinge_stiffness is None:
-            from thermojitter import panel as this_module
-
-            k_el = this_module.hinge_stiffness(panel, criterion)
+            k_el = _hinge_stiffness(panel, criterion)
             panel = cls(**{**fields_, "hinge_stiffness": k_el})
         object.__setattr__(panel, "_layup", laminate)
         return panel
@@ -220,6 +217,19 @@ def _check_panel(panel: Any) -> None:
         raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
 
 
+def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:
+    """The sunlit equilibrium of the coupled system (θ̇ = 0, all rates zero).
+
+    ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
+    (1: nominal; e.g. 1.033 at perihelion).
+    """
+    _check_panel(panel)
+    pd = panel.as_dict()
+    tf, tb, th = _core.steady_state(pd, checks.flag("coupled", coupled), checks.real("flux", flux))
+    moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
+    return Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
+
+
 def natural_frequency(panel: Panel) -> float:
     """Natural frequency of the linearised hinge, sqrt(K_el/I_B)/2π, Hz."""
     _check_panel(panel)
@@ -244,7 +254,8 @@ def hinge_stiffness(panel: Panel, criterion: StiffnessCriterion = "deflection") 
     checks.choice("criterion", criterion, ("deflection", "deflection_small_angle", "frequency"))
     moment = 0.0
     if criterion == "deflection":
-        from thermojitter.simulate import steady_state
-
         moment = steady_state(panel).thermal_moment
     return float(_core.stiffness(panel.as_dict(), criterion, moment))
+
+
+_hinge_stiffness = hinge_stiffness  # for Panel.from_laminate, whose keyword shadows the name

@@ -15,9 +15,9 @@ from thermojitter import errors as checks
 from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.panel import steady_state as steady_state  # its home before panel.py
 from thermojitter.progress import interruptible
 from thermojitter.results import (
-    Equilibrium,
     HingeSolution,
     LimitCrossing,
     Solution,
@@ -149,19 +149,6 @@ def check_layers(layers: Any) -> int:
 def layup_dict(panel: Panel) -> dict[str, Any] | None:
     """The panel's layup as the engine takes it (None: one homogeneous layer)."""
     return None if panel.layup is None else panel.layup.as_dict()
-
-
-def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:
-    """The sunlit equilibrium of the coupled system (θ̇ = 0, all rates zero).
-
-    ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
-    (1: nominal; e.g. 1.033 at perihelion).
-    """
-    check_inputs(panel)
-    pd = panel.as_dict()
-    tf, tb, th = _core.steady_state(pd, checks.flag("coupled", coupled), checks.real("flux", flux))
-    moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
-    return Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
 
 
 def simulate(

@@ -44,7 +44,7 @@ def add_parser(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from thermojitter.beam import write_beam_comparison
+    from thermojitter.reports.beam import write_beam_comparison
 
     return write_beam_comparison(
         out_dir(args.out, args.overwrite),

@@ -189,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     out = out_dir(args.out, args.overwrite)
     png = out / "stability_map.png"
     if not args.no_plot:
-        from thermojitter.plots import stability_map_figure
+        from thermojitter.reports.plots import stability_map_figure
 
         stability_map_figure(smap, panel, png)
     record = {

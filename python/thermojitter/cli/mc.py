@@ -192,7 +192,7 @@ def run(args: argparse.Namespace) -> int:
         q = np.nanpercentile(frame[m].to_numpy(float), [5, 50, 95])
         print(f"{m:>14}: 5% {q[0]:.4g}  median {q[1]:.4g}  95% {q[2]:.4g} rad")
     if not args.no_plots:
-        from thermojitter.plots import monte_carlo_figures
+        from thermojitter.reports.plots import monte_carlo_figures
 
         for path in monte_carlo_figures(frame, names, out):
             print(f"wrote {path}")

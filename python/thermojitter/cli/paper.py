@@ -47,7 +47,7 @@ def add_parser(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from thermojitter.paper import PaperOptions, run_paper
+    from thermojitter.reports.paper import PaperOptions, run_paper
 
     base = (
         PaperOptions(dt_out=1.0, thermal_dt_out=5.0, flutter_hours=6.0)

@@ -253,7 +253,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         raise ScenarioError(scenario.source, span_key, f"{n_orbits} orbits {exc.allowed}") from None
     written = [write_series(out / "orbits", dict(runs.columns), fmt).name]
     if scenario.output.plots and not args.no_plots and len(runs) > 1 and not runs.interrupted:
-        from thermojitter.plots import orbit_summary_figure
+        from thermojitter.reports.plots import orbit_summary_figure
 
         written.append(orbit_summary_figure(out, runs.columns, Path(scenario.source).stem).name)
     crossing = runs.limit_crossing
@@ -315,7 +315,7 @@ def run_command(args: argparse.Namespace) -> int:
         written.append(write_series(out / "timeseries", columns, fmt).name)
     intervals = scenario.orbit.shadow_intervals(float(t[0]), float(t[-1])) if len(t) else []
     if make_plots and len(t) > 1 and not interrupted:
-        from thermojitter.plots import run_figures
+        from thermojitter.reports.plots import run_figures
 
         title = Path(scenario.source).stem
         written += [p.name for p in run_figures(out, t, columns, scenario.orbit, title=title)]

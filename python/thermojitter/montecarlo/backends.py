@@ -1,0 +1,117 @@
+"""Where the chunks of a study run: a rayon pool on this machine, or Dask workers (each with its
+own pool). Each takes and gives plain data, so that a chunk's rows are the same wherever it ran."""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import threading
+from collections.abc import Generator
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from thermojitter import _core
+from thermojitter.montecarlo.metrics import (
+    FLOAT_METRICS,
+)
+
+_LOCKSTEP = True
+
+
+def run_chunk(
+    pool: Any, panels: NDArray[np.float64], options: dict[str, Any], cancel: Any = None
+) -> dict[str, Any]:
+    opts = dict(options)
+    orbit = opts.pop("orbit")
+    raw = pool.run(panels, orbit, cancel=cancel, lockstep=_LOCKSTEP, **opts)
+    out: dict[str, Any] = {m: np.asarray(raw[m], dtype=float) for m in FLOAT_METRICS}
+    out["stable"] = np.asarray(raw["stable"], dtype=bool)
+    out["n_steps"] = np.asarray(raw["n_steps"], dtype=np.int64)
+    out["error"] = list(raw["error"])
+    out["solver"] = dict(raw["solver"])  # the settings the engine reports it ran with
+    return out
+
+
+_WORKER_POOLS: dict[tuple[str, int], Any] = {}
+_WORKER_POOLS_LOCK = threading.Lock()
+
+
+def dask_chunk(panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str, Any]:
+    """Runs one chunk on a Dask worker, on a rayon pool of as many threads as the worker has.
+
+    Tasks that run at once on one worker share its pool, so the worker's cores are not
+    oversubscribed. Takes and returns plain data (a NumPy array, dicts, lists).
+    """
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+        key = (str(worker.address), int(worker.state.nthreads))
+    except (ImportError, ValueError):  # called outside a worker
+        key = ("local", 0)
+    with _WORKER_POOLS_LOCK:
+        pool = _WORKER_POOLS.get(key)
+        if pool is None:
+            pool = _core.MonteCarloPool(key[1] or None)
+            _WORKER_POOLS[key] = pool
+    return run_chunk(pool, panels, options)
+
+
+def local_chunks(
+    matrix: NDArray[np.float64],
+    todo: list[tuple[int, int, int]],
+    options: dict[str, Any],
+    threads: int | None,
+) -> Generator[tuple[int, dict[str, Any]], None, None]:
+    """Yields (chunk, metrics) as chunks finish. Two chunks are in flight at once on one rayon
+    pool, so the pool's threads stay busy while a chunk finishes its last samples. Leaving early
+    (Ctrl-C in the consumer) cancels the engine's token: the running chunks stop within one
+    integration step and are dropped."""
+    pool = _core.MonteCarloPool(threads)
+    token = _core.CancelToken()
+    with cf.ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermojitter") as ex:
+        futures = {ex.submit(run_chunk, pool, matrix[a:b], options, token): k for k, a, b in todo}
+        try:
+            for fut in cf.as_completed(futures):
+                yield futures[fut], fut.result()
+        finally:
+            token.cancel()
+            for fut in futures:
+                fut.cancel()
+
+
+def dask_client(backend: Any) -> tuple[Any, bool]:
+    """(client, owned): a Client given, one connected to an address, or a new LocalCluster."""
+    if callable(getattr(backend, "submit", None)) and hasattr(backend, "scheduler_info"):
+        return backend, False
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as exc:
+        raise ImportError(
+            "backend='dask' needs dask.distributed: pip install 'thermojitter[dask]'"
+        ) from exc
+    if backend == "dask":
+        return Client(LocalCluster(dashboard_address=":0")), True  # any free port
+    if isinstance(backend, str):
+        return Client(backend), True
+    raise ValueError(
+        f"backend = {backend!r} is invalid: must be None, 'dask', a scheduler address "
+        "('tcp://host:8786') or a dask.distributed Client"
+    )
+
+
+def dask_chunks(
+    client: Any,
+    matrix: NDArray[np.float64],
+    todo: list[tuple[int, int, int]],
+    options: dict[str, Any],
+) -> Generator[tuple[int, dict[str, Any]], None, None]:
+    from distributed import as_completed
+
+    futures = {client.submit(dask_chunk, matrix[a:b], options, pure=False): k for k, a, b in todo}
+    try:
+        for fut in as_completed(list(futures)):
+            yield futures[fut], fut.result()
+    finally:
+        client.cancel([f for f in futures if not f.done()])

@@ -1,0 +1,257 @@
+"""The design of a study: distributions of panel parameters, unit-cube samplers, and the rows of
+panels they map to, each checked against the engine's ranges before anything runs."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+from scipy.stats import qmc
+
+from thermojitter import _core
+from thermojitter import errors as checks
+from thermojitter.errors import ParameterError
+from thermojitter.panel import Panel
+
+Sampler = Literal["random", "lhs", "sobol"]
+
+
+def valid_range(name: str) -> tuple[float, float, bool, bool]:
+    """(lo, hi, lo open, hi open) of a panel parameter: the engine's range, which Panel
+    validation checks (its high end is closed)."""
+    lo, hi, lo_open = _core.PANEL_RANGES[name]
+    return lo, hi, lo_open, False
+
+
+def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[float]:
+    args = list(spec[1:])
+    if len(args) != count:
+        raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: expected {usage}")
+    out = []
+    for a in args:
+        if isinstance(a, bool) or not isinstance(a, (int, float, np.floating, np.integer)):
+            raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not a number")
+        if not math.isfinite(float(a)):
+            raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not finite")
+        out.append(float(a))
+    return out
+
+
+def _shorthand(name: str, spec: Sequence[Any]) -> Any:
+    kind = spec[0]
+
+    def bad(reason: str) -> ValueError:
+        return ValueError(f"vary[{name!r}] = {tuple(spec)!r} is invalid: {reason}")
+
+    if kind == "uniform":
+        lo, hi = _numbers(name, spec, 2, "('uniform', lo, hi)")
+        if not hi > lo:
+            raise bad("needs lo < hi")
+        return stats.uniform(loc=lo, scale=hi - lo)
+    if kind == "normal":
+        mean, sd = _numbers(name, spec, 2, "('normal', mean, sd)")
+        if not sd > 0:
+            raise bad("needs sd > 0")
+        return stats.norm(loc=mean, scale=sd)
+    if kind == "lognormal":
+        median, sigma = _numbers(name, spec, 2, "('lognormal', median, sigma of the log)")
+        if not (median > 0 and sigma > 0):
+            raise bad("needs median > 0 and sigma > 0")
+        return stats.lognorm(s=sigma, scale=median)
+    if kind == "loguniform":
+        lo, hi = _numbers(name, spec, 2, "('loguniform', lo, hi)")
+        if not 0 < lo < hi:
+            raise bad("needs 0 < lo < hi")
+        return stats.loguniform(lo, hi)
+    if kind == "truncnorm":
+        mean, sd, lo, hi = _numbers(name, spec, 4, "('truncnorm', mean, sd, lo, hi)")
+        if not sd > 0:
+            raise bad("needs sd > 0")
+        if not hi > lo:
+            raise bad("needs lo < hi")
+        return stats.truncnorm((lo - mean) / sd, (hi - mean) / sd, loc=mean, scale=sd)
+    if kind == "triangular":
+        lo, mode, hi = _numbers(name, spec, 3, "('triangular', lo, mode, hi)")
+        if not (hi > lo and lo <= mode <= hi):
+            raise bad("needs lo <= mode <= hi and lo < hi")
+        return stats.triang(c=(mode - lo) / (hi - lo), loc=lo, scale=hi - lo)
+    raise bad(
+        f"unknown distribution {kind!r}: use 'uniform', 'normal', 'lognormal', 'loguniform', "
+        "'truncnorm', 'triangular' or a frozen scipy.stats distribution"
+    )
+
+
+def distribution(name: str, spec: Any) -> Any:
+    """A frozen scipy.stats distribution from ``spec``: a frozen distribution itself, or a
+    shorthand ``("uniform", lo, hi)``, ``("normal", mean, sd)``, ``("lognormal", median, sigma)``
+    (sigma of the natural log), ``("loguniform", lo, hi)``, ``("truncnorm", mean, sd, lo, hi)``
+    or ``("triangular", lo, mode, hi)``."""
+    if isinstance(spec, (tuple, list)) and spec and isinstance(spec[0], str):
+        return _shorthand(name, spec)
+    if callable(getattr(spec, "ppf", None)) and callable(getattr(spec, "cdf", None)):
+        with np.errstate(all="ignore"):
+            mid = np.asarray(spec.ppf(0.5), dtype=float)
+        if mid.shape != () or not np.isfinite(mid):
+            raise ValueError(
+                f"vary[{name!r}] = {spec!r} is invalid: not a proper univariate distribution "
+                "(its median is not a finite number; check its parameters)"
+            )
+        return spec
+    raise ValueError(
+        f"vary[{name!r}] = {spec!r} is invalid: give a frozen scipy.stats distribution or a "
+        "shorthand such as ('uniform', lo, hi) or ('normal', mean, sd)"
+    )
+
+
+def describe(spec: Any) -> Any:
+    """A JSON form of a distribution spec, for the settings fingerprint."""
+    if isinstance(spec, (tuple, list)):
+        return [v if isinstance(v, str) else float(v) for v in spec]
+    dist = getattr(spec, "dist", None)
+    return {
+        "dist": getattr(dist, "name", type(spec).__name__),
+        "args": [float(a) for a in getattr(spec, "args", ())],
+        "kwds": {k: float(v) for k, v in sorted(getattr(spec, "kwds", {}).items())},
+    }
+
+
+def check_names(names: Sequence[Any], what: str) -> None:
+    fields = Panel.field_names()
+    for name in names:
+        if not isinstance(name, str) or name not in fields:
+            raise ValueError(
+                f"{what}: {name!r} is not a panel parameter; choose from {', '.join(fields)}"
+            )
+
+
+def unit_design(sampler: str, n: int, d: int, seed: int) -> NDArray[np.float64]:
+    """n points of the unit cube [0, 1)^d, deterministic in (sampler, n, d, seed)."""
+    rng = np.random.default_rng(seed)
+    if sampler == "random":
+        return rng.random((n, d))
+    if sampler == "lhs":
+        engine: qmc.QMCEngine = _qmc(qmc.LatinHypercube, d, rng)
+    elif sampler == "sobol":
+        engine = _qmc(qmc.Sobol, d, rng, scramble=True)
+    else:
+        raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
+    with warnings.catch_warnings():
+        # Sobol prefers powers of 2; other sizes are still valid designs.
+        warnings.simplefilter("ignore", UserWarning)
+        return np.asarray(engine.random(n), dtype=float)
+
+
+def _qmc(cls: Any, d: int, rng: np.random.Generator, **kwargs: Any) -> qmc.QMCEngine:
+    try:
+        return cls(d, rng=rng, **kwargs)  # type: ignore[no-any-return]
+    except TypeError:  # scipy < 1.15 names it seed
+        return cls(d, seed=rng, **kwargs)  # type: ignore[no-any-return]
+
+
+def _open_unit(u: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Keeps points off 0 and 1, where unbounded distributions have infinite quantiles."""
+    return np.clip(u, np.finfo(float).tiny, np.nextafter(1.0, 0.0))
+
+
+def quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> NDArray[np.float64]:
+    """Maps unit points through the distribution's ppf; with ``truncate``, through the ppf
+    restricted to the parameter's valid range."""
+    u = _open_unit(u)
+    if not truncate:
+        with np.errstate(all="ignore"):
+            return np.asarray(dist.ppf(u), dtype=float)
+    lo, hi, lo_open, hi_open = valid_range(name)
+    with np.errstate(all="ignore"):
+        a, b = float(dist.cdf(lo)), float(dist.cdf(hi))
+    if not b - a > 0:
+        raise ValueError(
+            f"vary[{name!r}]: the distribution has no probability inside the valid range of "
+            f"{name} ({lo:g}, {hi:g}); truncation is impossible"
+        )
+    with np.errstate(all="ignore"):
+        x = np.asarray(dist.ppf(a + u * (b - a)), dtype=float)
+    # Rounding at the ends of the interval must not step outside the range.
+    low = np.nextafter(lo, math.inf) if lo_open else lo
+    high = np.nextafter(hi, -math.inf) if hi_open else hi
+    return np.clip(x, low, high)
+
+
+def panel_matrix(panel: Panel, names: Sequence[str], values: NDArray[np.float64]) -> Any:
+    """Rows of every panel field (PANEL_FIELDS order): the base panel with ``names`` replaced."""
+    fields = list(_core.PANEL_FIELDS)
+    base = panel.as_dict()
+    rows = np.tile(np.array([base[f] for f in fields], dtype=float), (len(values), 1))
+    for j, name in enumerate(names):
+        rows[:, fields.index(name)] = values[:, j]
+    return np.ascontiguousarray(rows)
+
+
+def refuse_invalid(matrix: NDArray[np.float64], hint: str) -> None:
+    """Runs the panel validation on every row; refuses the design naming the parameter."""
+    bad = _core.check_panels(matrix)
+    if not bad:
+        return
+    by_name: dict[str, list[tuple[int, str]]] = {}
+    for row, name, message in bad:
+        by_name.setdefault(name, []).append((row, message))
+    name, rows = next(iter(by_name.items()))
+    row, message = rows[0]
+    value = matrix[row, list(_core.PANEL_FIELDS).index(name)]
+    raise ParameterError(
+        name,
+        float(value),
+        message=f"{name}: {len(rows)} of {len(matrix)} samples are outside its valid range "
+        f"(sample {row}: {message}){hint}",
+    )
+
+
+def check_seed(seed: Any, checkpoint: Any) -> int:
+    if seed is None:
+        if checkpoint is not None:
+            raise ValueError("seed is required with checkpoint (a resumed run must redraw it)")
+        return int(np.random.SeedSequence().entropy % (2**63))  # type: ignore[operator]
+    return checks.integer("seed", seed, 0)
+
+
+MAX_SAMPLES = 10**7
+"""Most samples of one study: its design is held in memory (about 140 bytes a sample, over a
+gigabyte at the limit), and so many runs of even one orbit take CPU-days."""
+
+
+def check_n(n: Any, least: int = 1) -> int:
+    return checks.integer("n", n, least, MAX_SAMPLES)
+
+
+def sampled(
+    panel: Panel,
+    vary: Mapping[str, Any],
+    u: NDArray[np.float64],
+    truncate: bool,
+) -> tuple[list[str], NDArray[np.float64], NDArray[np.float64]]:
+    """(names, sampled values, full panel rows) of unit points ``u`` mapped through ``vary``."""
+    names = list(vary)
+    dists = [distribution(name, vary[name]) for name in names]
+    values = np.column_stack(
+        [
+            quantiles(name, dist, u[:, j], truncate)
+            for j, (name, dist) in enumerate(zip(names, dists, strict=True))
+        ]
+    )
+    matrix = panel_matrix(panel, names, values)
+    hint = "" if truncate else "; narrow the distribution or pass truncate=True"
+    refuse_invalid(matrix, hint)
+    return names, values, matrix
+
+
+def check_vary(vary: Any) -> Mapping[str, Any]:
+    if not isinstance(vary, Mapping) or not vary:
+        raise ValueError(
+            "vary must be a non-empty mapping of panel parameter names to distributions"
+        )
+    check_names(list(vary), "vary")
+    return vary
