@@ -22,6 +22,7 @@ from thermojitter.distributed import (
 from thermojitter.errors import (
     InternalError,
     ParameterError,
+    ParameterTypeError,
     SampleFailureWarning,
     ValidityLimitWarning,
 )
@@ -102,6 +103,7 @@ __all__ = [
     "OrbitSummaries",
     "Panel",
     "ParameterError",
+    "ParameterTypeError",
     "SampleFailureWarning",
     "SensitivityResult",
     "Solution",

@@ -148,8 +148,11 @@ class FreeFreeBeam:
         ts = checks.real_array("times", times)
         ms = checks.real_array("moments", moments)
         if ts.size < 2 or ts.size != ms.size:
-            raise ValueError(
-                f"times/moments hold {ts.size}/{ms.size} values: need two or more, equal lengths"
+            raise checks.ParameterError(
+                "times" if ts.size < 2 else "moments",
+                times if ts.size < 2 else moments,
+                message=f"times/moments hold {ts.size}/{ms.size} values: need two or more, equal "
+                "lengths",
             )
         t0, t1 = (float(ts[0]), float(ts[-1])) if t_span is None else time_span(t_span)
         if t_eval is None and dt_out is None:
@@ -318,7 +321,7 @@ def compare_with_beam(
         hinge_panel = hinge_panel.replace(moment_scale=chi)
     span = eclipse_window(orbit) if t_span is None else time_span(t_span)
     if span[1] - span[0] < 16 * dt_out:
-        raise ValueError(f"t_span = {span!r} is invalid: shorter than 16 samples of dt_out")
+        raise checks.ParameterError("t_span", span, "shorter than 16 samples of dt_out")
     if (span[1] - span[0]) / dt_out > _core.MAX_SAMPLES:
         raise checks.ParameterError(
             "dt_out", dt_out, f"would keep more than {_core.MAX_SAMPLES} samples of t_span"

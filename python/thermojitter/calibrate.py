@@ -92,12 +92,22 @@ def _series(t: ArrayLike, theta: ArrayLike) -> tuple[Array, Array]:
     ts = checks.real_array("t", t)
     th = checks.real_array("theta", theta)
     if th.shape != ts.shape:
-        raise ValueError(f"theta has shape {th.shape}; must match t's {ts.shape}")
+        raise checks.ParameterError(
+            "theta", theta, message=f"theta has shape {th.shape}; must match t's {ts.shape}"
+        )
     if ts.size < MIN_POINTS:
-        raise ValueError(f"t holds {ts.size} samples: the series is too short (need {MIN_POINTS})")
+        raise checks.ParameterError(
+            "t",
+            t,
+            message=f"t holds {ts.size} samples: the series is too short (need {MIN_POINTS})",
+        )
     if np.any(np.diff(ts) <= 0):
         i = int(np.argmax(np.diff(ts) <= 0)) + 1
-        raise ValueError(f"t must be strictly increasing (t[{i}] = {ts[i]} does not increase)")
+        raise checks.ParameterError(
+            f"t[{i}]",
+            float(ts[i]),
+            message=f"t must be strictly increasing (t[{i}] = {ts[i]} does not increase)",
+        )
     return ts, th
 
 
@@ -146,18 +156,24 @@ def calibrate(
     checks.flag("coupled", coupled)
     diff_step = checks.positive("diff_step", diff_step)
     if isinstance(fit, str) or not isinstance(fit, Iterable):
-        raise TypeError(f"fit must be a sequence of parameter names, not {type(fit).__name__}")
+        raise checks.wrong_type("fit", fit, "a sequence of parameter names")
     if initial is not None and not isinstance(initial, Mapping):
-        raise TypeError(f"initial must be a mapping of names to values, not {type(initial)}")
+        raise checks.wrong_type("initial", initial, "a mapping of names to values")
     names = list(fit)
     if not names or len(set(names)) != len(names) or any(n not in FITTABLE for n in names):
-        raise ValueError(f"fit = {fit!r} is invalid: a non-empty set of {', '.join(FITTABLE)}")
+        raise checks.ParameterError("fit", fit, f"a non-empty set of {', '.join(FITTABLE)}")
     if ts.size <= len(names):
-        raise ValueError(f"t holds {ts.size} samples: too short to fit {len(names)} parameters")
+        raise checks.ParameterError(
+            "t", t, message=f"t holds {ts.size} samples: too short to fit {len(names)} parameters"
+        )
     start = {n: float(getattr(base, n)) for n in names}
     for key, value in (initial or {}).items():
         if key not in names:
-            raise ValueError(f"initial names {key!r}, which is not fitted (fit = {names})")
+            raise checks.ParameterError(
+                f"initial.{key}",
+                value,
+                message=f"initial names {key!r}, which is not fitted (fit = {names})",
+            )
         start[key] = checks.finite(f"initial.{key}", value)
     trial0 = base.replace(**start)  # validates the starting values
     x0 = np.array([start[n] for n in names])
@@ -281,12 +297,14 @@ def calibrate_from_csv(
     p = checks.path("path", path)
     degrees = checks.flag("degrees", degrees)
     if not p.is_file():
-        raise ValueError(f"path = {str(p)!r} is invalid: no such file")
+        raise checks.ParameterError(
+            "path", path, message=f"path = {str(p)!r} is invalid: no such file"
+        )
     data = np.genfromtxt(p, delimiter=",", names=True, dtype=float, encoding="utf-8")
     columns = data.dtype.names or ()
     for name, col in (("time_column", time_column), ("angle_column", angle_column)):
         if col not in columns:
-            raise ValueError(f"{name} = {col!r} is invalid: the file's columns are {columns}")
+            raise checks.ParameterError(name, col, f"the file's columns are {columns}")
     theta = np.atleast_1d(data[angle_column]).astype(float)
     if degrees:
         theta = np.radians(theta)

@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
-from thermojitter.errors import flag, real, type_name
+from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
 from thermojitter.progress import interruptible
@@ -59,7 +59,7 @@ Support = Literal["free-free", "cantilever"]
 def _count(name: str, value: Any) -> int:
     """An integer setting (its range is the engine's to check)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, not {type_name(value)}")
+        raise wrong_type(name, value, "an integer")
     return int(value)
 
 
@@ -78,7 +78,7 @@ def distributed_settings(
     :func:`distributed_defaults`). The engine checks the values and names any bad one."""
     check_inputs(panel)
     if not isinstance(support, str):
-        raise TypeError(f"support must be a string, not {type_name(support)}")
+        raise wrong_type("support", support, "a string")
     defaults = _core.distributed_defaults(panel.as_dict())
     counts = {}
     for name, value in (("elements", elements), ("modes", modes)):
@@ -460,7 +460,7 @@ def distributed_convergence(
     sunlight either side."""
     values = [int(v) for v in values]
     if len(values) < 3 or any(b <= a for a, b in zip(values, values[1:], strict=False)):
-        raise ValueError(f"values = {values!r} is invalid: need three or more, ascending")
+        raise ParameterError("values", values, "need three or more, ascending")
     span = eclipse_window(orbit) if t_span is None else time_span(t_span)
     runs = []
     for v in values:

@@ -3,8 +3,14 @@
 - :class:`ParameterError` (a ``ValueError``): a value outside its allowed range. It carries the
   parameter's name, the value and the allowed range as attributes, so that callers (the scenario
   parser, Monte Carlo) never read them out of the message.
-- ``TypeError``: a value of the wrong type. Types are checked, not coerced: a bool is not a number,
-  None is not False, a string is not a number.
+- :class:`ParameterTypeError` (a ``ParameterError`` and a ``TypeError``): a value of the wrong
+  type, with the same attributes. Types are checked, not coerced: a bool is not a number, None is
+  not False, a string is not a number. ``except TypeError`` and ``except ParameterError`` both
+  catch it.
+
+Every refusal of the package is one of these two, raised here or through the helpers below (the
+test oracle ``reference.py`` aside): ``parameter`` is the argument's name as the caller wrote it,
+``value`` the value itself (a number stays a number).
 - :class:`IntegrationError`, :class:`ConvergenceError` (``RuntimeError``, from the engine): a run
   that could not finish, a solve that did not converge.
 - :class:`InternalError` (``RuntimeError``): a defect caught at the engine's boundary (a panic);
@@ -57,6 +63,23 @@ class ParameterError(ValueError):
         return (type(self), (self.parameter, self.value, self.allowed, str(self)))
 
 
+class ParameterTypeError(ParameterError, TypeError):
+    """A value of the wrong type (a string for a number, None for a flag, a dict for a panel).
+
+    A :class:`ParameterError` (``parameter``, ``value``, ``allowed``: here the type expected, in
+    words) and a ``TypeError``, so that ``except TypeError`` keeps catching it."""
+
+
+def wrong_type(
+    name: str, value: Any, expected: str, message: str | None = None
+) -> ParameterTypeError:
+    """The refusal of ``value`` for ``name``, which must be ``expected`` (words: "a real number",
+    "a thermojitter.Panel"); the message says what was given."""
+    if message is None:
+        message = f"{name} must be {expected}, not {type_name(value)}"
+    return ParameterTypeError(name, value, expected, message)
+
+
 def _shown(value: Any) -> str:
     """``value`` as a message shows it: a repr of hundreds of characters (an integer of 400
     digits) is cut, saying how long it was."""
@@ -91,7 +114,12 @@ def real(name: str, value: Any) -> float:
     string, not None); a TypeError naming ``name`` otherwise, a ParameterError for an integer
     too large for a float."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, not {type_name(value)} {value!r:.60}")
+        raise wrong_type(
+            name,
+            value,
+            "a real number",
+            f"{name} must be a real number, not {type_name(value)} {value!r:.60}",
+        )
     try:
         return float(value)
     except OverflowError:
@@ -123,6 +151,14 @@ def in_range(name: str, value: Any, low: float, high: float, unit: str = "") -> 
     return x
 
 
+def instance(name: str, value: Any, cls: type | tuple[type, ...], expected: str) -> Any:
+    """``value`` if it is an instance of ``cls``; a :class:`ParameterTypeError` naming ``name``
+    otherwise (``expected`` in words: "a thermojitter.Panel")."""
+    if not isinstance(value, cls):
+        raise wrong_type(name, value, expected)
+    return value
+
+
 def optional_positive(name: str, value: Any) -> float | None:
     return None if value is None else positive(name, value)
 
@@ -130,7 +166,12 @@ def optional_positive(name: str, value: Any) -> float | None:
 def integer(name: str, value: Any, minimum: int = 1, maximum: int | None = None) -> int:
     """An int (Python or NumPy, not bool) in [minimum, maximum]."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, not {type_name(value)} {value!r:.60}")
+        raise wrong_type(
+            name,
+            value,
+            "an integer",
+            f"{name} must be an integer, not {type_name(value)} {value!r:.60}",
+        )
     n = int(value)
     if n < minimum or (maximum is not None and n > maximum):
         allowed = f"must be an integer >= {minimum}"
@@ -143,14 +184,24 @@ def integer(name: str, value: Any, minimum: int = 1, maximum: int | None = None)
 def flag(name: str, value: Any) -> bool:
     """A bool (or NumPy bool): None, 0/1 and strings are refused, not read as truth values."""
     if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} must be True or False, not {type_name(value)} {value!r:.60}")
+        raise wrong_type(
+            name,
+            value,
+            "True or False",
+            f"{name} must be True or False, not {type_name(value)} {value!r:.60}",
+        )
     return bool(value)
 
 
 def choice(name: str, value: Any, allowed: tuple[str, ...]) -> str:
     """One of the strings ``allowed``."""
     if not isinstance(value, str):
-        raise TypeError(f"{name} must be a string, not {type_name(value)} {value!r:.60}")
+        raise wrong_type(
+            name,
+            value,
+            "a string",
+            f"{name} must be a string, not {type_name(value)} {value!r:.60}",
+        )
     if value not in allowed:
         raise ParameterError(name, value, "must be " + " or ".join(repr(a) for a in allowed))
     return value
@@ -160,7 +211,7 @@ def path(name: str, value: Any) -> Path:
     """A file or directory path (a string or an ``os.PathLike``). An empty string is refused:
     ``Path("")`` is the current directory, where a run would silently write its files."""
     if not isinstance(value, (str, os.PathLike)):
-        raise TypeError(f"{name} must be a path (str or os.PathLike), not {type_name(value)}")
+        raise wrong_type(name, value, "a path (str or os.PathLike)")
     text = os.fspath(value)
     if isinstance(text, bytes) or not text.strip():
         raise ParameterError(name, value, "must be a non-empty path (str or os.PathLike)")
@@ -170,22 +221,34 @@ def path(name: str, value: Any) -> Path:
 def real_array(name: str, value: Any, *, finite_only: bool = True) -> np.ndarray:
     """A 1-D contiguous float array from a number or a sequence of real numbers."""
     if isinstance(value, (str, bytes)) or value is None:
-        raise TypeError(f"{name} must be numbers, not {type_name(value)}")
+        raise wrong_type(name, value, "numbers")
     if isinstance(value, (list, tuple)):
         # NumPy would read [True, 290.0] as [1.0, 290.0]: a bool in a sequence is no number.
         for i, v in enumerate(value):
             if isinstance(v, (bool, np.bool_, str, bytes)):
-                raise TypeError(f"{name}[{i}] must be a real number, not {type_name(v)} {v!r:.60}")
+                raise wrong_type(
+                    f"{name}[{i}]",
+                    v,
+                    "a real number",
+                    f"{name}[{i}] must be a real number, not {type_name(v)} {v!r:.60}",
+                )
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name} must be numbers: {exc}") from None
+        raise wrong_type(name, value, "numbers", f"{name} must be numbers: {exc}") from None
     if arr.dtype == np.bool_ or not (
         np.issubdtype(arr.dtype, np.integer) or np.issubdtype(arr.dtype, np.floating)
     ):
-        raise TypeError(f"{name} must be real numbers, not an array of {arr.dtype}")
+        raise wrong_type(
+            name, value, "real numbers", f"{name} must be real numbers, not an array of {arr.dtype}"
+        )
     if arr.ndim > 1:
-        raise ParameterError(name, f"array of shape {arr.shape}", "must be one-dimensional")
+        raise ParameterError(
+            name,
+            value,
+            "must be one-dimensional",
+            f"{name} = an array of shape {arr.shape} is invalid: must be one-dimensional",
+        )
     with np.errstate(over="ignore"):
         out = np.ascontiguousarray(np.atleast_1d(arr).astype(float))
     if finite_only and not np.all(np.isfinite(out)):

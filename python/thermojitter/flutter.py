@@ -71,13 +71,11 @@ def flutter(
     ``layers=N`` analyses the N-node through-thickness model on the panel's layup (or one
     homogeneous layer for a plain panel); ``jacobian`` is then over (node temperatures…, θ, θ̇).
     """
-    if not isinstance(panel, Panel):
-        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     # t is checked even without an orbit: a t of the wrong type is a mistake either way.
     t = checks.finite("t", t)
     if orbit is not None:
-        if not isinstance(orbit, Orbit):
-            raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
+        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
         if flux is not None:
             raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
         flux = float(orbit.flux_scale(t)[0])
@@ -166,7 +164,12 @@ class StabilityMap:
 
 def _axis(which: str, axis: object) -> tuple[str, NDArray[np.float64]]:
     if not (isinstance(axis, tuple) and len(axis) == 2 and isinstance(axis[0], str)):
-        raise TypeError(f"{which} must be a (parameter name, values) tuple")
+        raise checks.wrong_type(
+            which,
+            axis,
+            "a (parameter name, values) tuple",
+            f"{which} must be a (parameter name, values) tuple",
+        )
     name, raw = axis
     if name not in _core.PANEL_FIELDS:
         raise checks.ParameterError(
@@ -196,8 +199,7 @@ def stability_map(
     number of threads. A grid that takes more than a second shows a progress bar (``progress``);
     Ctrl-C stops it within a grid point and raises ``KeyboardInterrupt``.
     """
-    if not isinstance(panel, Panel):
-        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     x_name, xs = _axis("x", x)
     y_name, ys = _axis("y", y)
     if x_name == y_name:
@@ -356,8 +358,7 @@ def linear_thermal_response(
     sunlit equilibrium under ``flux``). The paper assumes ε_f = ε_b; for other panels ε is taken
     as their mean, an approximation.
     """
-    if not isinstance(panel, Panel):
-        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     raw = _core.linear_thermal(
         panel.as_dict(),
         checks.positive("flux", flux),

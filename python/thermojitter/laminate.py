@@ -41,7 +41,7 @@ class Layer:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
-            raise TypeError(f"name must be a string, not {type(self.name).__name__}")
+            raise checks.wrong_type("name", self.name, "a string")
         for f in fields(self):
             if f.name != "name":
                 label = f"layer '{self.name}': {f.name}"
@@ -74,13 +74,16 @@ class Laminate:
     def __post_init__(self) -> None:
         layers = self.layers
         if isinstance(layers, Layer) or not isinstance(layers, Iterable):
-            raise TypeError("layers must be a sequence of thermojitter.Layer")
+            raise checks.wrong_type(
+                "layers",
+                layers,
+                "a sequence of thermojitter.Layer",
+                "layers must be a sequence of thermojitter.Layer",
+            )
         layers = tuple(layers)
         for i, layer in enumerate(layers):
             if not isinstance(layer, Layer):
-                raise TypeError(
-                    f"layers[{i}] must be a thermojitter.Layer, not {type(layer).__name__}"
-                )
+                raise checks.wrong_type(f"layers[{i}]", layer, "a thermojitter.Layer")
         object.__setattr__(self, "layers", layers)
         for name in (
             "emissivity_front",

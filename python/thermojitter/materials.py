@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from thermojitter import _core
-from thermojitter.errors import ParameterError
+from thermojitter.errors import ParameterError, wrong_type
 from thermojitter.laminate import Layer
 
 
@@ -55,7 +55,7 @@ KAPTON = LIBRARY["kapton"]
 def get(key: str) -> Material:
     """A material by key (a ``ParameterError`` naming ``key`` and listing the keys if unknown)."""
     if not isinstance(key, str):
-        raise TypeError(f"key must be a string, not {type(key).__name__}")
+        raise wrong_type("key", key, "a string")
     if key not in LIBRARY:
         raise ParameterError("key", key, f"not in the library ({', '.join(LIBRARY)})")
     return LIBRARY[key]

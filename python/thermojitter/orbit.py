@@ -80,15 +80,20 @@ def day_of_year(date: DateLike) -> float:
     as the day of the year already.
     """
     if isinstance(date, bool):
-        raise TypeError("start_date must be a date, an ISO date string or a day of the year")
+        raise checks.wrong_type(
+            "start_date",
+            date,
+            "a date, an ISO date string or a day of the year",
+            "start_date must be a date, an ISO date string or a day of the year",
+        )
     if isinstance(date, (int, float, np.integer, np.floating)):
         return checks.finite("start_date", date)
     if isinstance(date, str):
         try:
             parsed: _dt.date = _dt.datetime.fromisoformat(date)
         except ValueError:
-            raise ValueError(
-                f"start_date = {date!r} is invalid: not an ISO date (YYYY-MM-DD[THH:MM[:SS]])"
+            raise checks.ParameterError(
+                "start_date", date, "not an ISO date (YYYY-MM-DD[THH:MM[:SS]])"
             ) from None
         date = parsed
     if isinstance(date, _dt.datetime):
@@ -98,10 +103,7 @@ def day_of_year(date: DateLike) -> float:
         return (date - start).total_seconds() / 86400.0
     if isinstance(date, _dt.date):
         return float((date - _dt.date(date.year, 1, 1)).days)
-    raise TypeError(
-        f"start_date must be a date, an ISO date string or a day of the year, "
-        f"not {type(date).__name__}"
-    )
+    raise checks.wrong_type("start_date", date, "a date, an ISO date string or a day of the year")
 
 
 @dataclass(frozen=True)

@@ -112,7 +112,7 @@ class Panel:
     def from_dict(cls, values: dict[str, Any]) -> Panel:
         """A panel from a mapping of parameter names (missing ones take Table 1 values)."""
         if not isinstance(values, dict):
-            raise TypeError(f"values must be a dict, not {type(values).__name__}")
+            raise checks.wrong_type("values", values, "a dict")
         unknown = sorted(set(values) - set(cls.field_names()))
         if unknown:
             raise checks.ParameterError(
@@ -135,9 +135,11 @@ class Panel:
         if self.layup is not None:
             fixed = sorted(set(changes) & set(LAYUP_FIELDS))
             if fixed:
-                raise ValueError(
-                    f"{', '.join(fixed)} of a laminate panel follow from its layup: change the "
-                    "Laminate and call Panel.from_laminate again"
+                raise checks.ParameterError(
+                    fixed[0],
+                    changes[fixed[0]],
+                    message=f"{', '.join(fixed)} of a laminate panel follow from its layup: change "
+                    "the Laminate and call Panel.from_laminate again",
                 )
         copy = dataclasses.replace(self, **changes)
         object.__setattr__(copy, "_layup", self.layup)
@@ -166,10 +168,7 @@ class Panel:
         The existing models run on these fields; ``layers=N`` runs the N-node model on the
         layup itself. ``hinge_stiffness`` defaults to K_el by ``criterion``.
         """
-        if not isinstance(laminate, Laminate):
-            raise TypeError(
-                f"laminate must be a thermojitter.Laminate, not {type(laminate).__name__}"
-            )
+        checks.instance("laminate", laminate, Laminate, "a thermojitter.Laminate")
         base = cls(
             length=length,
             width=width,
@@ -213,8 +212,7 @@ class Panel:
 
 
 def _check_panel(panel: Any) -> None:
-    if not isinstance(panel, Panel):
-        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
+    checks.instance("panel", panel, Panel, "a thermojitter.Panel")
 
 
 def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:

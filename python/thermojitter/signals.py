@@ -9,6 +9,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from thermojitter.errors import ParameterError
+
 Array = NDArray[np.float64]
 
 DEFAULT_F_MIN = 0.02
@@ -37,12 +39,14 @@ def spectrum(t: ArrayLike, x: ArrayLike, *, pad: int = 1) -> tuple[Array, Array]
     ts = np.asarray(t, dtype=float)
     xs = np.asarray(x, dtype=float)
     if ts.size < 8 or ts.size != xs.size:
-        raise ValueError(f"t holds {ts.size} samples: need 8 or more, as many as x")
+        raise ParameterError(
+            "t", t, message=f"t holds {ts.size} samples: need 8 or more, as many as x"
+        )
     steps = np.diff(ts)
     if not np.allclose(steps, steps[0], rtol=1e-6, atol=0.0):
-        raise ValueError("t must be uniformly spaced for the FFT")
+        raise ParameterError("t", t, message="t must be uniformly spaced for the FFT")
     if isinstance(pad, bool) or not isinstance(pad, int) or pad < 1:
-        raise ValueError(f"pad = {pad!r} is invalid: must be an integer >= 1")
+        raise ParameterError("pad", pad, "must be an integer >= 1")
     size = xs.size if pad == 1 else 1 << math.ceil(math.log2(pad * xs.size))
     taper = np.hanning(xs.size)
     amp = np.abs(np.fft.rfft((xs - xs.mean()) * taper, size)) * 2.0 / taper.sum()
@@ -58,7 +62,7 @@ def dominant_frequency(
     f, a = spectrum(t, x, pad=pad)
     idx = np.nonzero(f >= f_min)[0]
     if idx.size < 3:
-        raise ValueError(f"f_min = {f_min} is invalid: leaves fewer than 3 frequency bins")
+        raise ParameterError("f_min", f_min, "leaves fewer than 3 frequency bins")
     k = int(idx[np.argmax(a[idx])])
     if 0 < k < a.size - 1:
         y0, y1, y2 = np.log(a[k - 1 : k + 2] + 1e-300)

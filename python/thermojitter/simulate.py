@@ -47,9 +47,7 @@ _METHODS = ("rk45", "rk4")
 
 def time_span(t_span: Sequence[float]) -> tuple[float, float]:
     if isinstance(t_span, (str, bytes)) or not isinstance(t_span, (Sequence, np.ndarray)):
-        raise TypeError(
-            f"t_span must be a pair of numbers (t0, t1) in s, not {type(t_span).__name__}"
-        )
+        raise checks.wrong_type("t_span", t_span, "a pair of numbers (t0, t1) in s")
     if len(t_span) != 2:
         raise ParameterError("t_span", t_span, "must be two numbers (t0, t1) in s")
     # Finite and within the engine's reach, checked before any arithmetic on them.
@@ -134,10 +132,9 @@ _NO_ORBIT: Any = object()
 def check_inputs(panel: Panel, orbit: Orbit = _NO_ORBIT) -> None:
     """TypeError unless ``panel`` is a Panel (and ``orbit``, when the call takes one, an Orbit:
     None is not an orbit)."""
-    if not isinstance(panel, Panel):
-        raise TypeError(f"panel must be a thermojitter.Panel, not {type(panel).__name__}")
-    if orbit is not _NO_ORBIT and not isinstance(orbit, Orbit):
-        raise TypeError(f"orbit must be a thermojitter.Orbit, not {type(orbit).__name__}")
+    checks.instance("panel", panel, Panel, "a thermojitter.Panel")
+    if orbit is not _NO_ORBIT:
+        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
 
 
 def check_layers(layers: Any) -> int:

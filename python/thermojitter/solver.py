@@ -84,9 +84,7 @@ class SolverSettings:
                     raise
                 return cls(**given)
         if not isinstance(solver, SolverSettings):
-            raise TypeError(
-                f"solver must be a thermojitter.SolverSettings, not {checks.type_name(solver)}"
-            )
+            raise checks.wrong_type("solver", solver, "a thermojitter.SolverSettings")
         default = cls.__dataclass_fields__
         clash = [k for k, v in given.items() if v != default[k].default and v != getattr(solver, k)]
         if clash:

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import _core
+from thermojitter.errors import ParameterError
 from thermojitter.montecarlo.metrics import (
     FLOAT_METRICS,
 )
@@ -95,9 +96,11 @@ def dask_client(backend: Any) -> tuple[Any, bool]:
         return Client(LocalCluster(dashboard_address=":0")), True  # any free port
     if isinstance(backend, str):
         return Client(backend), True
-    raise ValueError(
-        f"backend = {backend!r} is invalid: must be None, 'dask', a scheduler address "
-        "('tcp://host:8786') or a dask.distributed Client"
+    raise ParameterError(
+        "backend",
+        backend,
+        "must be None, 'dask', a scheduler address ('tcp://host:8786') or a "
+        "dask.distributed Client",
     )
 
 

@@ -15,7 +15,7 @@ from scipy.stats import qmc
 
 from thermojitter import _core
 from thermojitter import errors as checks
-from thermojitter.errors import ParameterError
+from thermojitter.errors import ParameterError, ParameterTypeError
 from thermojitter.panel import Panel
 
 Sampler = Literal["random", "lhs", "sobol"]
@@ -31,13 +31,24 @@ def valid_range(name: str) -> tuple[float, float, bool, bool]:
 def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[float]:
     args = list(spec[1:])
     if len(args) != count:
-        raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: expected {usage}")
+        raise ParameterError(
+            f"vary.{name}", spec, message=f"vary[{name!r}] = {spec!r} is invalid: expected {usage}"
+        )
     out = []
     for a in args:
         if isinstance(a, bool) or not isinstance(a, (int, float, np.floating, np.integer)):
-            raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not a number")
+            raise ParameterTypeError(
+                f"vary.{name}",
+                spec,
+                "numbers",
+                f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not a number",
+            )
         if not math.isfinite(float(a)):
-            raise ValueError(f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not finite")
+            raise ParameterError(
+                f"vary.{name}",
+                spec,
+                message=f"vary[{name!r}] = {spec!r} is invalid: {a!r} is not finite",
+            )
         out.append(float(a))
     return out
 
@@ -45,8 +56,9 @@ def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[flo
 def _shorthand(name: str, spec: Sequence[Any]) -> Any:
     kind = spec[0]
 
-    def bad(reason: str) -> ValueError:
-        return ValueError(f"vary[{name!r}] = {tuple(spec)!r} is invalid: {reason}")
+    def bad(reason: str) -> ParameterError:
+        message = f"vary[{name!r}] = {tuple(spec)!r} is invalid: {reason}"
+        return ParameterError(f"vary.{name}", spec, message=message)
 
     if kind == "uniform":
         lo, hi = _numbers(name, spec, 2, "('uniform', lo, hi)")
@@ -97,14 +109,18 @@ def distribution(name: str, spec: Any) -> Any:
         with np.errstate(all="ignore"):
             mid = np.asarray(spec.ppf(0.5), dtype=float)
         if mid.shape != () or not np.isfinite(mid):
-            raise ValueError(
-                f"vary[{name!r}] = {spec!r} is invalid: not a proper univariate distribution "
-                "(its median is not a finite number; check its parameters)"
+            raise ParameterError(
+                f"vary.{name}",
+                spec,
+                message=f"vary[{name!r}] = {spec!r} is invalid: not a proper univariate "
+                "distribution (its median is not a finite number; check its parameters)",
             )
         return spec
-    raise ValueError(
-        f"vary[{name!r}] = {spec!r} is invalid: give a frozen scipy.stats distribution or a "
-        "shorthand such as ('uniform', lo, hi) or ('normal', mean, sd)"
+    raise ParameterError(
+        f"vary.{name}",
+        spec,
+        message=f"vary[{name!r}] = {spec!r} is invalid: give a frozen scipy.stats distribution "
+        "or a shorthand such as ('uniform', lo, hi) or ('normal', mean, sd)",
     )
 
 
@@ -124,8 +140,11 @@ def check_names(names: Sequence[Any], what: str) -> None:
     fields = Panel.field_names()
     for name in names:
         if not isinstance(name, str) or name not in fields:
-            raise ValueError(
-                f"{what}: {name!r} is not a panel parameter; choose from {', '.join(fields)}"
+            raise ParameterError(
+                what,
+                name,
+                message=f"{what}: {name!r} is not a panel parameter; "
+                f"choose from {', '.join(fields)}",
             )
 
 
@@ -139,7 +158,7 @@ def unit_design(sampler: str, n: int, d: int, seed: int) -> NDArray[np.float64]:
     elif sampler == "sobol":
         engine = _qmc(qmc.Sobol, d, rng, scramble=True)
     else:
-        raise ValueError(f"sampler = {sampler!r} is invalid: must be 'random', 'lhs' or 'sobol'")
+        raise ParameterError("sampler", sampler, "must be 'random', 'lhs' or 'sobol'")
     with warnings.catch_warnings():
         # Sobol prefers powers of 2; other sizes are still valid designs.
         warnings.simplefilter("ignore", UserWarning)
@@ -169,9 +188,11 @@ def quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> N
     with np.errstate(all="ignore"):
         a, b = float(dist.cdf(lo)), float(dist.cdf(hi))
     if not b - a > 0:
-        raise ValueError(
-            f"vary[{name!r}]: the distribution has no probability inside the valid range of "
-            f"{name} ({lo:g}, {hi:g}); truncation is impossible"
+        raise ParameterError(
+            f"vary.{name}",
+            dist,
+            message=f"vary[{name!r}]: the distribution has no probability inside the valid range "
+            f"of {name} ({lo:g}, {hi:g}); truncation is impossible",
         )
     with np.errstate(all="ignore"):
         x = np.asarray(dist.ppf(a + u * (b - a)), dtype=float)
@@ -213,7 +234,11 @@ def refuse_invalid(matrix: NDArray[np.float64], hint: str) -> None:
 def check_seed(seed: Any, checkpoint: Any) -> int:
     if seed is None:
         if checkpoint is not None:
-            raise ValueError("seed is required with checkpoint (a resumed run must redraw it)")
+            raise ParameterError(
+                "seed",
+                seed,
+                message="seed is required with checkpoint (a resumed run must redraw it)",
+            )
         return int(np.random.SeedSequence().entropy % (2**63))  # type: ignore[operator]
     return checks.integer("seed", seed, 0)
 
@@ -250,8 +275,10 @@ def sampled(
 
 def check_vary(vary: Any) -> Mapping[str, Any]:
     if not isinstance(vary, Mapping) or not vary:
-        raise ValueError(
-            "vary must be a non-empty mapping of panel parameter names to distributions"
+        raise ParameterError(
+            "vary",
+            vary,
+            message="vary must be a non-empty mapping of panel parameter names to distributions",
         )
     check_names(list(vary), "vary")
     return vary

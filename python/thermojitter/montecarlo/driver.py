@@ -146,7 +146,7 @@ def _refuse_beyond_budget(
     refuse_beyond_budget("horizon", horizon, float(least.max()), budget, per)
     size = "grid" if settings["study"] == "sweep" else "n"
     what = f"{len(matrix)} samples of {horizon} orbits, {per}"
-    value = settings.get(size, len(matrix)) if size == "n" else f"{len(matrix)} panels"
+    value = settings.get(size, len(matrix)) if size == "n" else len(matrix)  # panels of the grid
     refuse_beyond_budget(size, value, float(least.sum()), budget, what)
 
 

@@ -175,7 +175,11 @@ def sweep(
     warning and ``frame.attrs["n_failed"]``; :class:`AllSamplesFailedError` when all failed)."""
     check_inputs(panel, orbit)
     if not isinstance(grid, Mapping) or not grid:
-        raise ValueError("grid must be a non-empty mapping of panel parameter names to values")
+        raise ParameterError(
+            "grid",
+            grid,
+            message="grid must be a non-empty mapping of panel parameter names to values",
+        )
     check_names(list(grid), "grid")
     axes: list[list[float]] = []
     for name, vals in grid.items():
@@ -190,7 +194,11 @@ def sweep(
     names = list(grid)
     size = math.prod(len(a) for a in axes)
     if size > MAX_SAMPLES:
-        raise ParameterError("grid", f"{size} panels", f"must hold at most {MAX_SAMPLES} panels")
+        raise ParameterError(
+            "grid",
+            size,
+            message=f"grid = {size} panels is invalid: must hold at most {MAX_SAMPLES} panels",
+        )
     options = with_layers(options, panel, layers, names)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
     matrix = panel_matrix(panel, names, values)
@@ -276,11 +284,10 @@ def sensitivity(
     seed = check_seed(seed, None)
     second_order = checks.flag("second_order", second_order)
     truncate = checks.flag("truncate", truncate)
-    if not isinstance(metric, str):
-        raise TypeError(f"metric must be a string, not {type(metric).__name__}")
+    checks.instance("metric", metric, str, "a string")
     if metric not in FLOAT_METRICS and metric != "stable":
         choices = ", ".join((*FLOAT_METRICS, "stable"))
-        raise ValueError(f"metric = {metric!r} is invalid: choose from {choices}")
+        raise ParameterError("metric", metric, f"choose from {choices}")
     options = run_options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
         threshold, stop_at_threshold,
@@ -320,9 +327,11 @@ def sensitivity(
     if missing.size:
         k = int(missing[0])
         why = samples["error"].iloc[k] or "no value"
-        raise ValueError(
-            f"{metric} is not defined for {missing.size} of {len(y)} samples (sample {k}: "
-            f"{why}); Sobol indices need a value for every sample"
+        raise ParameterError(
+            "metric",
+            metric,
+            message=f"{metric} is not defined for {missing.size} of {len(y)} samples (sample {k}: "
+            f"{why}); Sobol indices need a value for every sample",
         )
     res = sobol_analyze.analyze(problem, y, calc_second_order=second_order, seed=seed)
     indices = pd.DataFrame(

@@ -27,6 +27,7 @@ from thermojitter.distributed import (
     distributed_flutter,
     simulate_distributed,
 )
+from thermojitter.errors import ParameterError
 from thermojitter.flutter import flutter
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel, hinge_stiffness
@@ -80,7 +81,7 @@ def compare_hinge_with_distributed(
     elif criterion == "frequency":
         hinge_panel = panel.replace(hinge_stiffness=hinge_stiffness(panel, "frequency"))
     else:
-        raise ValueError(f"criterion = {criterion!r} is invalid: 'deflection' or 'frequency'")
+        raise ParameterError("criterion", criterion, "'deflection' or 'frequency'")
     span = eclipse_window(orbit) if t_span is None else (float(t_span[0]), float(t_span[1]))
     times = span[0] + dt_out * np.arange(int((span[1] - span[0]) / dt_out) + 1)
     hinge = simulate(hinge_panel, orbit, span, t_eval=times, rtol=rtol, atol=atol)
