@@ -67,3 +67,46 @@ def test_monte_carlo_refusal_names_the_parameter() -> None:
         )
     assert info.value.parameter == "emissivity_back"
     assert info.value.value > 1.0
+
+
+def test_wrong_types_are_parameter_type_errors() -> None:
+    """A wrong type is a TypeError (what callers catch) and a ParameterError (the argument, the
+    value given and the type expected as attributes), and crosses processes as one."""
+    assert issubclass(tj.ParameterTypeError, TypeError)
+    assert issubclass(tj.ParameterTypeError, tj.ParameterError)
+    cases = [
+        (lambda: tj.Panel(length="2"), "length", "2"),  # type: ignore[arg-type]
+        (lambda: tj.simulate("panel", tj.Orbit.sunlit(), (0, 1)), "panel", "panel"),  # type: ignore[arg-type]
+        (lambda: tj.steady_state(tj.Panel.paper(), coupled=None), "coupled", None),  # type: ignore[arg-type]
+        (lambda: tj.materials.get(3), "key", 3),  # type: ignore[arg-type]
+    ]
+    for call, parameter, value in cases:
+        with pytest.raises(tj.ParameterTypeError) as info:
+            call()
+        assert (info.value.parameter, info.value.value) == (parameter, value)
+        copy = pickle.loads(pickle.dumps(info.value))
+        assert type(copy) is tj.ParameterTypeError and copy.parameter == parameter
+
+
+def test_no_plain_value_or_type_error_is_raised_in_the_package() -> None:
+    """Every refusal goes through errors.py (the test oracle, reference.py, aside)."""
+    import re
+
+    package = Path(tj.__file__).parent
+    plain = re.compile(r"raise (ValueError|TypeError)\b|return (ValueError|TypeError)\(")
+    found = [
+        f"{path.relative_to(package)}:{number}"
+        for path in sorted(package.rglob("*.py"))
+        if path.name not in ("errors.py", "reference.py")
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if plain.search(line)
+    ]
+    assert found == []
+
+
+def test_numbers_stay_numbers() -> None:
+    with pytest.raises(tj.ParameterError) as info:
+        tj.sweep(
+            tj.Panel.paper(), tj.Orbit.sunlit(), {"damping": [1.0] * 4000, "length": [8.0] * 4000}
+        )
+    assert info.value.parameter == "grid" and info.value.value == 16_000_000

@@ -59,7 +59,7 @@ from thermojitter.simulate import (
     simulate_thermal,
     steady_state,
 )
-from thermojitter.solver import SolverSettings
+from thermojitter.solver import HybridSettings, SolverSettings
 
 __version__ = "0.1.0"
 
@@ -93,6 +93,7 @@ __all__ = [
     "FlutterResult",
     "FreeFreeBeam",
     "HingeSolution",
+    "HybridSettings",
     "IntegrationError",
     "Laminate",
     "Layer",

@@ -38,7 +38,7 @@ from thermojitter.simulate import (
     start_state,
     warn_crossing,
 )
-from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
+from thermojitter.solver import ATOL, MAX_STEPS, RTOL, HybridSettings, SolverSettings
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -262,7 +262,7 @@ def simulate_orbits(
     max_steps: int = MAX_STEPS,
     stop: Callable[[], bool] | None = None,
     steps_per_period: float = 40.0,
-    hybrid: dict[str, float] | None = None,
+    hybrid: HybridSettings | dict[str, float] | None = None,
     layers: int | None = None,
     solver: SolverSettings | None = None,
 ) -> OrbitSummaries:
@@ -291,8 +291,9 @@ def simulate_orbits(
       summaries agree with rk45's within 2 % and it is hundreds of times faster on GEO.
       ``result.propagation`` says how the simulated time was split. ``"rk45"``/``"rk4"``
       integrate everything (rk45 resolves the hinge period, see ``steps_per_period``).
-      ``hybrid``: optional engine settings (``rtol``, ``atol_temperature``, ``atol_angle``,
-      ``max_step``, ``linear_tolerance``, ``linear_amplitude``, ``resolved_amplitude``).
+      ``hybrid``: a :class:`thermojitter.HybridSettings`, or a dict of its fields (``rtol``,
+      ``atol_temperature``, ``atol_angle``, ``max_step``, ``linear_tolerance``,
+      ``linear_amplitude``, ``resolved_amplitude``); unset ones keep the engine's defaults.
     - ``steps_per_period``: rk45's step is capped at T_n/steps_per_period, T_n the hinge's natural
       period (0: error control alone). Without the cap the step grows, once the oscillation is
       small against ``atol``, to where the method's own dissipation exceeds a weak flutter's
@@ -318,7 +319,7 @@ def simulate_orbits(
     if progress is not None:
         checks.flag("progress", progress)
     if stop is not None and not callable(stop):
-        raise TypeError(f"stop must be callable, not {type(stop).__name__}")
+        raise checks.wrong_type("stop", stop, "callable")
     # Each chunk is checked by the engine; the whole run is checked here, before any work.
     n_orbits = orbit_count("n_orbits", n_orbits, orbit, t_start)
     method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
@@ -335,8 +336,6 @@ def simulate_orbits(
         # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
         used = used.replace(method="rk45")
     full = used.as_dict()
-    if hybrid is not None and not isinstance(hybrid, dict):
-        raise TypeError(f"hybrid must be a dict of engine settings, not {type(hybrid).__name__}")
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
     if y0 is None and nodes is None:
@@ -370,7 +369,7 @@ def simulate_orbits(
     if nodes is not None:
         settings["layers"] = nodes
         settings["layup"] = layup_dict(panel)
-    hybrid_settings = {k: checks.real(f"hybrid[{k!r}]", v) for k, v in (hybrid or {}).items()}
+    hybrid_settings = HybridSettings.of(hybrid).as_dict()
     if method == "hybrid":
         settings["hybrid"] = hybrid_settings
     core_args: dict[str, Any] = {

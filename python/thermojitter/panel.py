@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from functools import cached_property
-from typing import Any, Literal
+from types import MappingProxyType
+from typing import Any, ClassVar, Literal, NamedTuple
 
 import numpy as np
 
@@ -13,26 +15,6 @@ from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.laminate import Laminate
 from thermojitter.results import Equilibrium
-
-PANEL_UNITS = {
-    "emissivity_front": "-",
-    "emissivity_back": "-",
-    "absorptivity": "-",
-    "specific_heat": "J/(kg K)",
-    "mass_per_length": "kg/m",
-    "expansion_coeff": "1/K",
-    "length": "m",
-    "youngs_modulus": "Pa",
-    "thickness": "m",
-    "width": "m",
-    "conductance": "W/(m² K)",
-    "hinge_stiffness": "N m/rad",
-    "bending_inertia": "m⁴",
-    "damping": "N m s/rad",
-    "solar_constant": "W/m²",
-    "moment_scale": "-",
-}
-"""SI unit of each Panel field, for axis labels and tables."""
 
 StiffnessCriterion = Literal["deflection", "deflection_small_angle", "frequency"]
 
@@ -53,45 +35,75 @@ _TABLE_1: dict[str, float] = dict(_core.PAPER_PANEL)
 """The paper's Table 1 (Case B), C = 1361 W/m², χ = 1: defined once, in the engine."""
 
 
+class PanelRange(NamedTuple):
+    """The valid range of a panel parameter, the engine's: ``low`` to ``high`` (SI), ``high``
+    included, ``low`` included unless ``low_open``."""
+
+    low: float
+    high: float
+    low_open: bool
+
+    def contains(self, value: float) -> bool:
+        above = value > self.low if self.low_open else value >= self.low
+        return above and value <= self.high
+
+
+RANGES: Mapping[str, PanelRange] = MappingProxyType(
+    {name: PanelRange(*bounds) for name, bounds in _core.PANEL_RANGES.items()}
+)
+"""Every panel parameter's valid range, as the engine checks it (``Panel.RANGES`` too)."""
+
+
+def _parameter(name: str, unit: str) -> Any:
+    """A Panel field: its default from Table 1 (the engine's), its SI unit in the metadata. The
+    field's name, default, unit and range are then each written once (range and default in the
+    engine); adding a parameter adds one line here."""
+    return dataclasses.field(default=_TABLE_1[name], metadata={"unit": unit})
+
+
 @dataclass(frozen=True)
 class Panel:
     """A long, thin, Sun-pointing plate of unit width; every value SI.
 
-    Immutable and validated on construction: a bad value raises ``ValueError`` naming it.
-    Defaults are the paper's Table 1 (Case B), with C = 1361 W/m² and χ = 1.
+    Immutable and validated on construction: a bad value raises ``ParameterError`` naming it.
+    Defaults are the paper's Table 1 (Case B), with C = 1361 W/m² and χ = 1; the valid range of
+    each parameter is ``Panel.RANGES[name]`` (the engine's, a :class:`PanelRange`).
     """
 
-    emissivity_front: float = _TABLE_1["emissivity_front"]
+    RANGES: ClassVar[Mapping[str, PanelRange]] = RANGES
+    """The engine's range of each parameter, by name (read-only)."""
+
+    emissivity_front: float = _parameter("emissivity_front", "-")
     """ε_f, emissivity of the Sun-facing side, in (0, 1]."""
-    emissivity_back: float = _TABLE_1["emissivity_back"]
+    emissivity_back: float = _parameter("emissivity_back", "-")
     """ε_b, emissivity of the back side, in (0, 1]."""
-    absorptivity: float = _TABLE_1["absorptivity"]
+    absorptivity: float = _parameter("absorptivity", "-")
     """α, solar absorptivity of the front side, in (0, 1]."""
-    specific_heat: float = _TABLE_1["specific_heat"]
+    specific_heat: float = _parameter("specific_heat", "J/(kg K)")
     """c, J/(kg K)."""
-    mass_per_length: float = _TABLE_1["mass_per_length"]
+    mass_per_length: float = _parameter("mass_per_length", "kg/m")
     """m, kg/m (unit width, so also kg/m²)."""
-    expansion_coeff: float = _TABLE_1["expansion_coeff"]
+    expansion_coeff: float = _parameter("expansion_coeff", "1/K")
     """a, coefficient of thermal expansion, 1/K."""
-    length: float = _TABLE_1["length"]
+    length: float = _parameter("length", "m")
     """L, m; the hinge model's half-arm is l = L/4."""
-    youngs_modulus: float = _TABLE_1["youngs_modulus"]
+    youngs_modulus: float = _parameter("youngs_modulus", "Pa")
     """E, Pa."""
-    thickness: float = _TABLE_1["thickness"]
+    thickness: float = _parameter("thickness", "m")
     """d, m."""
-    width: float = _TABLE_1["width"]
+    width: float = _parameter("width", "m")
     """w, m."""
-    conductance: float = _TABLE_1["conductance"]
+    conductance: float = _parameter("conductance", "W/(m² K)")
     """K, conductance through the thickness per unit area, W/(m² K)."""
-    hinge_stiffness: float = _TABLE_1["hinge_stiffness"]
+    hinge_stiffness: float = _parameter("hinge_stiffness", "N m/rad")
     """K_el, N m/rad."""
-    bending_inertia: float = _TABLE_1["bending_inertia"]
+    bending_inertia: float = _parameter("bending_inertia", "m⁴")
     """I, second moment of area, m⁴."""
-    damping: float = _TABLE_1["damping"]
+    damping: float = _parameter("damping", "N m s/rad")
     """c_d, N m s/rad (>= 0)."""
-    solar_constant: float = _TABLE_1["solar_constant"]
+    solar_constant: float = _parameter("solar_constant", "W/m²")
     """C, solar flux at 1 au, W/m²."""
-    moment_scale: float = _TABLE_1["moment_scale"]
+    moment_scale: float = _parameter("moment_scale", "-")
     """χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3)."""
 
     def __post_init__(self) -> None:
@@ -209,6 +221,10 @@ class Panel:
     def hinge_inertia(self) -> float:
         """I_B = 2 m l³/3, kg m²."""
         return float(_core.derived(self.as_dict())["hinge_inertia"])
+
+
+PANEL_UNITS: dict[str, str] = {f.name: f.metadata["unit"] for f in fields(Panel)}
+"""SI unit of each Panel field, for axis labels and tables."""
 
 
 def _check_panel(panel: Any) -> None:

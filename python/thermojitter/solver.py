@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Mapping
 from typing import Any, Literal
 
 from thermojitter import _core
@@ -99,3 +100,71 @@ def _checked(key: tuple[tuple[str, type, Any], ...]) -> SolverSettings:
     """The settings of ``key`` ((name, type, value) triples), checked once (a refused set is not
     cached: its error is raised again on every call)."""
     return SolverSettings(**{name: value for name, _, value in key})
+
+
+@dataclasses.dataclass(frozen=True)
+class HybridSettings:
+    """How ``method="hybrid"`` propagates (see :func:`thermojitter.simulate_orbits`): every
+    field None keeps the engine's own default (``HybridSettings::default`` in the engine, the
+    one home of those numbers).
+
+    - ``rtol``, ``atol_temperature`` (K), ``atol_angle`` (rad), ``max_step`` (s): error control
+      of the exponential integrator through the shadows;
+    - ``linear_tolerance`` (rad): largest non-linear remainder, as a static angle error, at which
+      the state is handed back to the exact linear arcs;
+    - ``linear_amplitude`` (rad): largest oscillation about the equilibrium propagated linearly;
+    - ``resolved_amplitude`` (rad): largest oscillation left to the exponential integrator.
+
+    Immutable; the types are checked here (a real number or None), the values by the engine
+    (each > 0) when a run starts, naming ``hybrid.<field>``. ``simulate_orbits`` takes it as
+    ``hybrid=``, or the same keys as a dict.
+    """
+
+    rtol: float | None = None
+    atol_temperature: float | None = None
+    atol_angle: float | None = None
+    max_step: float | None = None
+    linear_tolerance: float | None = None
+    linear_amplitude: float | None = None
+    resolved_amplitude: float | None = None
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if value is not None:
+                object.__setattr__(self, f.name, checks.real(f"hybrid.{f.name}", value))
+
+    def as_dict(self) -> dict[str, float]:
+        """The settings given (None left out: the engine's default), as the engine takes them."""
+        return {
+            f.name: getattr(self, f.name)
+            for f in dataclasses.fields(self)
+            if getattr(self, f.name) is not None
+        }
+
+    def replace(self, **changes: Any) -> HybridSettings:
+        """A checked copy with ``changes``."""
+        return dataclasses.replace(self, **changes)
+
+    @classmethod
+    def of(cls, hybrid: HybridSettings | Mapping[str, Any] | None) -> HybridSettings:
+        """``hybrid`` as settings: a HybridSettings as it is, None as the engine's defaults, a
+        mapping by its keys (a key that is no setting is refused, naming it)."""
+        if hybrid is None:
+            return cls()
+        if isinstance(hybrid, HybridSettings):
+            return hybrid
+        if not isinstance(hybrid, Mapping):
+            raise checks.wrong_type(
+                "hybrid", hybrid, "a thermojitter.HybridSettings or a dict of its fields"
+            )
+        known = [f.name for f in dataclasses.fields(cls)]
+        for key, value in hybrid.items():
+            if key not in known:
+                raise checks.ParameterError(
+                    f"hybrid.{key}",
+                    value,
+                    message=f"hybrid = {{{key!r}: ...}} is invalid: not a hybrid setting; "
+                    f"the settings are {', '.join(known)}",
+                )
+        return cls(**hybrid)

@@ -21,13 +21,6 @@ from thermojitter.panel import Panel
 Sampler = Literal["random", "lhs", "sobol"]
 
 
-def valid_range(name: str) -> tuple[float, float, bool, bool]:
-    """(lo, hi, lo open, hi open) of a panel parameter: the engine's range, which Panel
-    validation checks (its high end is closed)."""
-    lo, hi, lo_open = _core.PANEL_RANGES[name]
-    return lo, hi, lo_open, False
-
-
 def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[float]:
     args = list(spec[1:])
     if len(args) != count:
@@ -184,7 +177,7 @@ def quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> N
     if not truncate:
         with np.errstate(all="ignore"):
             return np.asarray(dist.ppf(u), dtype=float)
-    lo, hi, lo_open, hi_open = valid_range(name)
+    lo, hi, lo_open = Panel.RANGES[name]  # the engine's range, high end closed
     with np.errstate(all="ignore"):
         a, b = float(dist.cdf(lo)), float(dist.cdf(hi))
     if not b - a > 0:
@@ -198,8 +191,7 @@ def quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> N
         x = np.asarray(dist.ppf(a + u * (b - a)), dtype=float)
     # Rounding at the ends of the interval must not step outside the range.
     low = np.nextafter(lo, math.inf) if lo_open else lo
-    high = np.nextafter(hi, -math.inf) if hi_open else hi
-    return np.clip(x, low, high)
+    return np.clip(x, low, hi)
 
 
 def panel_matrix(panel: Panel, names: Sequence[str], values: NDArray[np.float64]) -> Any:
