@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 
 import hypothesis.strategies as st
+import pytest
 from hypothesis import settings
 
 import thermojitter as tj
@@ -13,6 +14,20 @@ from thermojitter import materials as mat
 settings.register_profile("ci", deadline=None, print_blob=True, derandomize=True)
 settings.register_profile("dev", deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "dev"))
+
+SLOW = bool(os.environ.get("THERMOJITTER_SLOW"))
+"""The slow tier: cases of minutes (``@pytest.mark.slow``) run only with THERMOJITTER_SLOW=1; the
+default tier checks the same things on shorter spans."""
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if SLOW:
+        return
+    skip = pytest.mark.skip(reason="minutes-long case: set THERMOJITTER_SLOW=1 to run it")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
+
 
 PAPER = tj.Panel.paper()
 GEO = tj.Orbit.geo_equinox()

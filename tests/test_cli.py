@@ -193,23 +193,23 @@ def test_summary_flutter(summary: dict) -> None:
     assert c_neg < p.damping
 
 
-def test_module_entry_point_and_help() -> None:
-    for args in ([], ["paper"], ["run"]):
-        done = subprocess.run(
-            [sys.executable, "-m", "thermojitter", *args, "--help"],
-            capture_output=True,
-            text=True,
-            timeout=60,
-        )
-        assert done.returncode == 0, done.stderr
-        assert "usage: thermojitter" in done.stdout
-    top = subprocess.run(
-        [sys.executable, "-m", "thermojitter", "--help"], capture_output=True, text=True
-    ).stdout
-    assert "paper" in top and "run" in top
+def test_module_entry_point_and_help(capsys: pytest.CaptureFixture[str]) -> None:
+    """The entry point once as a process (tests/test_installed.py runs the console script);
+    each command's help in this process."""
+    done = subprocess.run(
+        [sys.executable, "-m", "thermojitter", "--help"], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert "usage: thermojitter" in done.stdout
+    assert "paper" in done.stdout and "run" in done.stdout
+    for args in (["paper"], ["run"]):
+        with pytest.raises(SystemExit) as stop:
+            cli.main([*args, "--help"])
+        assert stop.value.code == 0
+        assert "usage: thermojitter" in capsys.readouterr().out
     # no command: help on stderr, exit 2
-    done = subprocess.run([sys.executable, "-m", "thermojitter"], capture_output=True, text=True)
-    assert done.returncode == 2
+    assert cli.main([]) == 2
+    assert "usage: thermojitter" in capsys.readouterr().err
 
 
 # --------------------------------------------------------------------------------------------
