@@ -29,7 +29,7 @@ from thermojitter.panel import Panel, hinge_stiffness, natural_frequency
 from thermojitter.progress import interruptible
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
-from thermojitter.simulate import Method, Model, check_inputs, simulate, solver_args, time_span
+from thermojitter.simulate import Method, Model, check_inputs, run_settings, simulate, time_span
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 Array = NDArray[np.float64]
@@ -163,16 +163,10 @@ class FreeFreeBeam:
             else checks.finite("damping_ratio", damping_ratio)
         )
         residual = checks.flag("residual", residual)
-        used = SolverSettings.of(
-            solver,
-            method=method,
-            rtol=rtol,
-            atol=atol,
-            dt=dt,
-            max_step=max_step,
-            max_steps=max_steps,
-        )
-        args = solver_args(used, t_eval, dt_out)
+        used, args = run_settings(
+            solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+            max_step=max_step, max_steps=max_steps,
+        )  # fmt: skip
         raw = interruptible(
             _core.beam_response,
             self.panel.as_dict(),

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
 from thermojitter import errors as checks
+from thermojitter.errors import ValidityLimitWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.results import LimitCrossing
@@ -36,12 +37,11 @@ from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
     Model,
     OnLimit,
-    _simulate,
     check_inputs,
     limit_args,
+    simulate,
     warn_crossing,
 )
-from thermojitter.solver import MAX_STEP, MAX_STEPS
 
 Array = NDArray[np.float64]
 
@@ -184,26 +184,22 @@ def calibrate(
 
     def run(x: Array, on_limit: OnLimit) -> Any:
         trial = trial0.replace(**dict(zip(names, (float(v) for v in x), strict=True)))
-        return _simulate(
-            trial,
-            orb,
-            (ts[0], ts[-1]),
-            model=model,
-            coupled=coupled,
-            method="rk45",
-            rtol=rtol,
-            atol=atol,
-            dt=None,
-            t_eval=ts,
-            dt_out=None,
-            y0=y0,
-            max_step=MAX_STEP,
-            max_steps=MAX_STEPS,
-            layers=None,
-            solver=None,
-            theta_limit=limits["theta_limit"],
-            on_limit=on_limit,
-        )
+        with warnings.catch_warnings():
+            # The fit warns once, itself, of a crossing of the fitted run.
+            warnings.simplefilter("ignore", ValidityLimitWarning)
+            return simulate(
+                trial,
+                orb,
+                (ts[0], ts[-1]),
+                model=model,
+                coupled=coupled,
+                rtol=rtol,
+                atol=atol,
+                t_eval=ts,
+                y0=y0,
+                theta_limit=limits["theta_limit"],
+                on_limit=on_limit,
+            )
 
     def forward(x: Array) -> Array:
         return np.asarray(run(x, "ignore").theta)

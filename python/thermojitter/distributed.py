@@ -45,7 +45,9 @@ from thermojitter.simulate import (
     OnLimit,
     check_inputs,
     limit_args,
-    solver_args,
+    limit_record,
+    run_record,
+    run_settings,
     start_state,
     time_span,
     warn_crossing,
@@ -257,10 +259,11 @@ def simulate_distributed(
         coupled=coupled,
         layers=layers,
     )
-    used = SolverSettings.of(
-        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
-    )
-    args = {**solver_args(used, t_eval, dt_out), **limit_args(theta_limit, on_limit)}
+    used, args = run_settings(
+        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
+        max_steps=max_steps,
+    )  # fmt: skip
+    args.update(limit_args(theta_limit, on_limit))
     y = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
     start = None if y is None else np.ascontiguousarray(np.asarray(y, dtype=float))
     raw = interruptible(
@@ -273,14 +276,10 @@ def simulate_distributed(
         y0=start,
         **args,
     )
-    crossing = LimitCrossing.of(raw["crossing"])
-    warn_crossing(crossing, args["theta_limit"], on_limit, "θ_f")
+    limit = limit_record(raw)
+    warn_crossing(limit["limit_crossing"], args["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(
-        t=raw["t"],
-        n_steps=int(raw["n_steps"]),
-        n_rejected=int(raw["n_rejected"]),
-        n_rhs=int(raw["n_rhs"]),
-        method=used.method,
+        **run_record(raw, used),
         settings={
             **settings,
             "damping_ratio": float(raw["damping_ratio"]),
@@ -303,8 +302,7 @@ def simulate_distributed(
         support=support,
         frequencies_hz=raw["frequencies_hz"],
         damping_ratio=float(raw["damping_ratio"]),
-        limit_crossing=crossing,
-        stopped_at_limit=bool(raw["stopped"]),
+        **limit,
     )
 
 

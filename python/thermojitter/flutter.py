@@ -206,7 +206,10 @@ def stability_map(
         raise checks.ParameterError("y", y_name, "must differ from the x parameter")
     if xs.size * ys.size > MAX_GRID_POINTS:
         raise checks.ParameterError(
-            "x", f"{xs.size} x {ys.size} points", f"the grid may hold at most {MAX_GRID_POINTS}"
+            "x",
+            xs.size * ys.size,
+            message=f"x = {xs.size} x {ys.size} points is invalid: the grid may hold at most "
+            f"{MAX_GRID_POINTS}",
         )
     coupled = checks.flag("coupled", coupled)
     flux = checks.real("flux", flux)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -85,6 +85,43 @@ def solver_args(
         "t_eval": _times(t_eval),
         "dt_out": None if dt_out is None else checks.real("dt_out", dt_out),
     }
+
+
+def run_settings(
+    solver: SolverSettings | None, t_eval: ArrayLike | None, dt_out: float | None, **keywords: Any
+) -> tuple[SolverSettings, dict[str, Any]]:
+    """The integrator settings of one run (``solver``, or the run function's ``keywords``: see
+    :meth:`SolverSettings.of`) and the engine's keyword arguments for them and the reporting
+    times."""
+    used = SolverSettings.of(solver, **keywords)
+    return used, solver_args(used, t_eval, dt_out)
+
+
+def run_record(raw: Mapping[str, Any], used: SolverSettings) -> dict[str, Any]:
+    """The fields every run's result takes from the engine's answer: the times, the step and
+    right-hand-side counts, and the method."""
+    return {
+        "t": raw["t"],
+        "n_steps": int(raw["n_steps"]),
+        "n_rejected": int(raw["n_rejected"]),
+        "n_rhs": int(raw["n_rhs"]),
+        "method": used.method,
+    }
+
+
+def limit_record(raw: Mapping[str, Any]) -> dict[str, Any]:
+    """The validity limit's fields of a run's result: where it was first crossed, and whether
+    the run stopped there."""
+    return {
+        "limit_crossing": LimitCrossing.of(raw["crossing"]),
+        "stopped_at_limit": bool(raw["stopped"]),
+    }
+
+
+def _hinge_columns(raw: Mapping[str, Any]) -> dict[str, Any]:
+    """The columns of a coupled run beside its temperatures, and its limit."""
+    columns = ("theta", "theta_dot", "thermal_moment", "sunlit", "y_end")
+    return {**{name: raw[name] for name in columns}, **limit_record(raw)}
 
 
 def solver_settings(
@@ -208,58 +245,13 @@ def simulate(
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
     """
-    sol = _simulate(
-        panel,
-        orbit,
-        t_span,
-        model=model,
-        coupled=coupled,
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        dt=dt,
-        t_eval=t_eval,
-        dt_out=dt_out,
-        y0=y0,
-        max_step=max_step,
-        max_steps=max_steps,
-        layers=layers,
-        solver=solver,
-        theta_limit=theta_limit,
-        on_limit=on_limit,
-    )
-    warn_crossing(sol.limit_crossing, theta_limit, on_limit)
-    return sol
-
-
-def _simulate(
-    panel: Panel,
-    orbit: Orbit,
-    t_span: Sequence[float],
-    *,
-    model: Model,
-    coupled: bool,
-    method: Method,
-    rtol: float,
-    atol: float,
-    dt: float | None,
-    t_eval: ArrayLike | None,
-    dt_out: float | None,
-    y0: Sequence[float] | None,
-    max_step: float,
-    max_steps: int,
-    layers: int | None,
-    solver: SolverSettings | None,
-    theta_limit: float,
-    on_limit: OnLimit,
-) -> Solution:
-    """:func:`simulate` without its warning (for callers that issue their own)."""
     check_inputs(panel, orbit)
     t0, t1 = time_span(t_span)
-    used = SolverSettings.of(
-        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
-    )
-    args = {**solver_args(used, t_eval, dt_out), **limit_args(theta_limit, on_limit)}
+    used, args = run_settings(
+        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
+        max_steps=max_steps,
+    )  # fmt: skip
+    args.update(limit_args(theta_limit, on_limit))
     settings: dict[str, Any] = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt}
     settings.update(model=model, coupled=coupled)
     settings.update(theta_limit=args["theta_limit"], on_limit=on_limit)
@@ -279,26 +271,18 @@ def _simulate(
             **args,
         )
         temps = np.asarray(raw["T_nodes"])
-        return Solution(
-            t=raw["t"],
-            n_steps=raw["n_steps"],
-            n_rejected=raw["n_rejected"],
-            n_rhs=raw["n_rhs"],
-            method=used.method,
+        sol = Solution(
+            **run_record(raw, used),
             settings={**settings, "layers": nodes, "solver": dict(raw["solver"])},
             T_front=temps[:, 0],
             T_back=temps[:, -1],
-            theta=raw["theta"],
-            theta_dot=raw["theta_dot"],
-            thermal_moment=raw["thermal_moment"],
-            sunlit=raw["sunlit"],
-            y_end=raw["y_end"],
+            **_hinge_columns(raw),
             T_nodes=temps,
             depth=raw["depth"],
             node_labels=tuple(raw["node_labels"]),
-            limit_crossing=LimitCrossing.of(raw["crossing"]),
-            stopped_at_limit=bool(raw["stopped"]),
         )
+        warn_crossing(sol.limit_crossing, theta_limit, on_limit)
+        return sol
     raw = interruptible(
         _core.simulate,
         panel.as_dict(),
@@ -310,23 +294,15 @@ def _simulate(
         y0=start_state(y0, 4),
         **args,
     )
-    return Solution(
-        t=raw["t"],
-        n_steps=raw["n_steps"],
-        n_rejected=raw["n_rejected"],
-        n_rhs=raw["n_rhs"],
-        method=used.method,
+    sol = Solution(
+        **run_record(raw, used),
         settings={**settings, "solver": dict(raw["solver"])},
         T_front=raw["T_front"],
         T_back=raw["T_back"],
-        theta=raw["theta"],
-        theta_dot=raw["theta_dot"],
-        thermal_moment=raw["thermal_moment"],
-        sunlit=raw["sunlit"],
-        y_end=raw["y_end"],
-        limit_crossing=LimitCrossing.of(raw["crossing"]),
-        stopped_at_limit=bool(raw["stopped"]),
+        **_hinge_columns(raw),
     )
+    warn_crossing(sol.limit_crossing, theta_limit, on_limit)
+    return sol
 
 
 def simulate_thermal(
@@ -351,10 +327,10 @@ def simulate_thermal(
     check_inputs(panel, orbit)
     layers = checks.integer("layers", layers, 1, 2)  # type: ignore[assignment]
     t0, t1 = time_span(t_span)
-    used = SolverSettings.of(
-        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
-    )
-    args = solver_args(used, t_eval, dt_out)
+    used, args = run_settings(
+        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
+        max_steps=max_steps,
+    )  # fmt: skip
     raw = interruptible(
         _core.simulate_thermal,
         panel.as_dict(),
@@ -366,11 +342,7 @@ def simulate_thermal(
         **args,
     )
     return ThermalSolution(
-        t=raw["t"],
-        n_steps=raw["n_steps"],
-        n_rejected=raw["n_rejected"],
-        n_rhs=raw["n_rhs"],
-        method=used.method,
+        **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
         layers=int(layers),
         T=raw.get("T"),
@@ -402,10 +374,10 @@ def simulate_hinge(
     ``y0`` = (θ rad, θ̇ rad/s)."""
     check_inputs(panel)
     t0, t1 = time_span(t_span)
-    used = SolverSettings.of(
-        solver, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step, max_steps=max_steps
-    )
-    args = solver_args(used, t_eval, dt_out)
+    used, args = run_settings(
+        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
+        max_steps=max_steps,
+    )  # fmt: skip
     m = checks.real_array("moment", moment)
     mt = None if moment_t is None else checks.real_array("moment_t", moment_t)
     raw = interruptible(
@@ -420,11 +392,7 @@ def simulate_hinge(
         **args,
     )
     return HingeSolution(
-        t=raw["t"],
-        n_steps=raw["n_steps"],
-        n_rejected=raw["n_rejected"],
-        n_rhs=raw["n_rhs"],
-        method=used.method,
+        **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
         theta=raw["theta"],
         theta_dot=raw["theta_dot"],

@@ -265,12 +265,18 @@ def sampled(
     return names, values, matrix
 
 
-def check_vary(vary: Any) -> Mapping[str, Any]:
-    if not isinstance(vary, Mapping) or not vary:
+def check_table(table: Any, what: str, of: str) -> Mapping[str, Any]:
+    """``table`` (the argument ``what``: ``vary``, ``grid``) as a non-empty mapping of panel
+    parameter names to ``of``."""
+    if not isinstance(table, Mapping) or not table:
         raise ParameterError(
-            "vary",
-            vary,
-            message="vary must be a non-empty mapping of panel parameter names to distributions",
+            what,
+            table,
+            message=f"{what} must be a non-empty mapping of panel parameter names to {of}",
         )
-    check_names(list(vary), "vary")
-    return vary
+    check_names(list(table), what)
+    return table
+
+
+def check_vary(vary: Any) -> Mapping[str, Any]:
+    return check_table(vary, "vary", "distributions")

@@ -19,8 +19,8 @@ from thermojitter.montecarlo.design import (
     MAX_SAMPLES,
     Sampler,
     check_n,
-    check_names,
     check_seed,
+    check_table,
     check_vary,
     describe,
     panel_matrix,
@@ -174,13 +174,7 @@ def sweep(
     arguments (``layers`` too) are the same, and so is the handling of failed samples (a
     warning and ``frame.attrs["n_failed"]``; :class:`AllSamplesFailedError` when all failed)."""
     check_inputs(panel, orbit)
-    if not isinstance(grid, Mapping) or not grid:
-        raise ParameterError(
-            "grid",
-            grid,
-            message="grid must be a non-empty mapping of panel parameter names to values",
-        )
-    check_names(list(grid), "grid")
+    check_table(grid, "grid", "values")
     axes: list[list[float]] = []
     for name, vals in grid.items():
         arr = checks.real_array(f"grid.{name}", vals)  # numbers: not bools, not strings
