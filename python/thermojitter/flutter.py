@@ -121,7 +121,7 @@ def _result(
         frequency_hz=float(raw["frequency_hz"]),
         critical_damping=float(raw["critical_damping"]),
         model=model,
-        coupled=bool(coupled),
+        coupled=coupled,
         flux=float(flux),
     )
 
@@ -249,7 +249,7 @@ def stability_map(
         growth_rate=np.concatenate(growth),
         frequency_hz=np.concatenate(frequency),
         model=model,
-        coupled=bool(coupled),
+        coupled=coupled,
         flux=float(flux),
     )
 

@@ -127,7 +127,7 @@ def monte_carlo(
     )  # fmt: skip
     options = with_layers(options, panel, layers, list(vary))
     u = unit_design(sampler, n, len(vary), seed)
-    names, values, matrix = sampled(panel, vary, u, bool(truncate))
+    names, values, matrix = sampled(panel, vary, u, truncate)
     settings = {
         "study": "monte_carlo",
         "panel": panel.as_dict(),
@@ -135,7 +135,7 @@ def monte_carlo(
         "n": n,
         "seed": seed,
         "sampler": sampler,
-        "truncate": bool(truncate),
+        "truncate": truncate,
     }
     frame = run_design(
         names, values, matrix, options, settings, threads=threads, backend=backend,
@@ -294,15 +294,15 @@ def sensitivity(
         u = np.asarray(
             sobol_sample.sample(problem, n, calc_second_order=second_order, seed=seed), dtype=float
         )
-    names, values, matrix = sampled(panel, vary, u, bool(truncate))
+    names, values, matrix = sampled(panel, vary, u, truncate)
     settings = {
         "study": "sensitivity",
         "panel": panel.as_dict(),
         "vary": {name: describe(vary[name]) for name in names},
         "n": n,
         "seed": seed,
-        "second_order": bool(second_order),
-        "truncate": bool(truncate),
+        "second_order": second_order,
+        "truncate": truncate,
     }
     samples = run_design(
         names, values, matrix, options, settings, threads=threads, backend=backend,
