@@ -98,3 +98,17 @@ def test_a_small_study_and_a_figure(tmp_path: Path) -> None:
     ax.plot([0.0, 1.0], [0.0, 1.0])
     assert save(fig, tmp_path / "f.png").stat().st_size > 0
     pyplot().close(fig)
+
+
+def test_the_build_gives_the_recorded_bits() -> None:
+    """What most differs between builds is the compiler's work on the engine (the release
+    profile's optimisation, link-time inlining): one orbit of each recorded case, with the
+    portable kernel, to the bit (the records of tests/test_recorded.py)."""
+    from test_recorded import COLUMNS, RECORDED, run_cases
+
+    got = run_cases("portable")
+    assert got["kernel"] == "portable"
+    for name, want in RECORDED.items():
+        assert (got[name]["n_steps"], got[name]["n_rhs"]) == (want["n_steps"], want["n_rhs"])
+        for column in COLUMNS:
+            assert got[name][column] == want[column], (name, column)
