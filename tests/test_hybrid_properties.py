@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import hypothesis.strategies as st
 import numpy as np
-from hypothesis import HealthCheck, given, note, settings
+from hypothesis import HealthCheck, Phase, given, note, settings
 from test_hybrid import METRICS
 
 import thermojitter as tj
@@ -116,7 +116,10 @@ def cases(draw: st.DrawFn) -> Case:
         panel = tj.Panel.from_laminate(tj.Laminate(layers, **optics(draw)), length=length)
     panel = with_drawn_damping(draw, panel)
 
-    which = draw(st.sampled_from(["geo_equinox", "geo_spring", "geo_no_eclipse", "leo"]))
+    orbits = ["geo_equinox", "geo_spring", "geo_no_eclipse", "leo"]
+    # rk45 on a sandwich through GEO eclipses took up to 260 s for 2 orbits (measured on
+    # 22f48cb): only the slow tier takes sandwiches to GEO.
+    which = draw(st.sampled_from(orbits if SLOW or kind != "sandwich" else ["leo"]))
     if which == "geo_equinox":
         orbit_name, orbit = "geo_equinox()", tj.Orbit.geo_equinox()
     elif which == "leo":
@@ -131,7 +134,7 @@ def cases(draw: st.DrawFn) -> Case:
     if SLOW:
         n = (15 if kind == "metal" else 30) if leo else (2 if kind == "metal" else 4)
     else:
-        n = (5 if kind == "metal" else 10) if leo else (1 if kind == "metal" else 2)
+        n = {"metal": 5, "sandwich": 3}.get(kind, 10) if leo else (1 if kind == "metal" else 2)
     return Case(kind, panel, orbit_name, orbit, n)
 
 
@@ -176,9 +179,12 @@ def compared_orbits(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries, n: int) 
     return min(m, len(full), len(hybrid))
 
 
+# Shrinking re-runs rk45 dozens of times (minutes for thin metal on GEO): the default tier
+# reports the drawn case as it failed (the message names every field), the slow tier shrinks.
 @settings(
     max_examples=60 if SLOW else 8,
     deadline=None,
+    phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
     suppress_health_check=[HealthCheck.too_slow],
 )
 @given(case=cases())
