@@ -19,20 +19,16 @@ import sys
 from collections.abc import Sequence
 
 from thermojitter import __version__
-from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.cli import beam, flutter, mc, paper, run
 from thermojitter.cli.common import (
     EXIT_INTERRUPTED,
     EXIT_SAMPLES_FAILED,
     EXIT_USER_ERROR,
-    STOP,
-    Interrupted,
     Parser,
-    SamplesFailed,
     UserError,
+    run_parsed,
 )
 from thermojitter.cli.run import MAX_ORBITS, MAX_ROWS, simulate_scenario
-from thermojitter.scenario import ScenarioError
 
 __all__ = [
     "EXIT_INTERRUPTED",
@@ -64,44 +60,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _fail(message: str, code: int = EXIT_USER_ERROR) -> int:
-    print(f"thermojitter: error: {message}", file=sys.stderr)
-    return code
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``thermojitter`` command; returns the exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if getattr(args, "handler", None) is None:
-        parser.print_help(sys.stderr)
-        return EXIT_USER_ERROR
-    try:
-        if args.stop_flag:
-            with STOP:
-                return int(args.handler(args))
-        return int(args.handler(args))
-    except Interrupted:
-        return EXIT_INTERRUPTED  # what was kept is already said
-    except KeyboardInterrupt:
-        print(
-            "thermojitter: interrupted; the files already written are kept; run the command "
-            "again to redo the rest",
-            file=sys.stderr,
-        )
-        return EXIT_INTERRUPTED
-    except (ScenarioError, UserError) as exc:
-        return _fail(str(exc))
-    except SamplesFailed as exc:
-        return _fail(" ".join(str(exc).split()), EXIT_SAMPLES_FAILED)
-    except (ValueError, TypeError, IntegrationError, ConvergenceError) as exc:
-        return _fail(" ".join(str(exc).split()))
-    except ImportError as exc:
-        return _fail(f"{exc} (pip install 'thermojitter[cli]')")
-    except OSError as exc:
-        if exc.filename:
-            return _fail(f"{exc.filename}: {exc.strerror or exc}")
-        return _fail(str(exc))
+    return run_parsed(parser, parser.parse_args(argv))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,16 +1,19 @@
-"""What every subcommand of ``thermojitter`` shares: the user-error type, exit codes, the output
-folder, number options and the Ctrl-C flag."""
+"""What every subcommand of ``thermojitter`` shares: the user-error type, exit codes and the one
+error path that gives them, the output folder, number options and the Ctrl-C flag."""
 
 from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Callable
+import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, BinaryIO, NoReturn
 
+from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.checkpoint import write_atomic
 from thermojitter.progress import SigintHandler
+from thermojitter.scenario import ScenarioError
 
 EXIT_USER_ERROR = 2
 EXIT_SAMPLES_FAILED = 3
@@ -114,3 +117,51 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _fail(message: str, code: int = EXIT_USER_ERROR) -> int:
+    print(f"thermojitter: error: {message}", file=sys.stderr)
+    return code
+
+
+def run_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """Runs the subcommand ``parser`` parsed into ``args``, through the command's one error path
+    (the module's docstring of ``thermojitter.cli``); returns the exit code."""
+    if getattr(args, "handler", None) is None:
+        parser.print_help(sys.stderr)
+        return EXIT_USER_ERROR
+    try:
+        if args.stop_flag:
+            with STOP:
+                return int(args.handler(args))
+        return int(args.handler(args))
+    except Interrupted:
+        return EXIT_INTERRUPTED  # what was kept is already said
+    except KeyboardInterrupt:
+        print(
+            "thermojitter: interrupted; the files already written are kept; run the command "
+            "again to redo the rest",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    except (ScenarioError, UserError) as exc:
+        return _fail(str(exc))
+    except SamplesFailed as exc:
+        return _fail(" ".join(str(exc).split()), EXIT_SAMPLES_FAILED)
+    except (ValueError, TypeError, IntegrationError, ConvergenceError) as exc:
+        return _fail(" ".join(str(exc).split()))
+    except ImportError as exc:
+        return _fail(f"{exc} (pip install 'thermojitter[cli]')")
+    except OSError as exc:
+        if exc.filename:
+            return _fail(f"{exc.filename}: {exc.strerror or exc}")
+        return _fail(str(exc))
+
+
+def run_command(add_parser: Callable[[Any], None], argv: Sequence[str]) -> int:
+    """``thermojitter ARGV`` with only the subcommand that ``add_parser`` adds (the scripts that
+    predate the subcommands: ``python -m thermojitter.montecarlo_cli``): the same parser, error
+    path and exit codes as the whole command."""
+    parser = Parser(prog="thermojitter")
+    add_parser(parser.add_subparsers(dest="command", metavar="COMMAND"))
+    return run_parsed(parser, parser.parse_args(argv))

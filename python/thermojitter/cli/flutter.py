@@ -26,7 +26,7 @@ from typing import Any, Literal, cast
 import numpy as np
 
 from thermojitter import _core
-from thermojitter.cli.common import UserError, add_out, out_dir, write_output
+from thermojitter.cli.common import UserError, add_out, out_dir, run_command, write_output
 from thermojitter.flutter import (
     FlutterResult,
     flutter,
@@ -84,9 +84,7 @@ def _analysis_record(r: FlutterResult) -> dict[str, Any]:
 
 def flutter_command(argv: Sequence[str] | None = None) -> int:
     """``thermojitter flutter ARGS``; returns the exit code (0, or 2 for bad input)."""
-    from thermojitter.cli import main
-
-    return main(["flutter", *(sys.argv[1:] if argv is None else argv)])
+    return run_command(add_parser, ["flutter", *(sys.argv[1:] if argv is None else argv)])
 
 
 def add_parser(sub: Any) -> None:

@@ -39,6 +39,7 @@ from thermojitter.cli.common import (
     SamplesFailed,
     add_out,
     out_dir,
+    run_command,
     write_output,
 )
 from thermojitter.errors import SampleFailureWarning
@@ -86,9 +87,7 @@ def read_scenario(path: str | Path) -> dict[str, Any]:
 
 def mc_command(argv: Sequence[str] | None = None) -> int:
     """``thermojitter mc ARGS``; returns the exit status."""
-    from thermojitter.cli import main
-
-    return main(["mc", *(sys.argv[1:] if argv is None else argv)])
+    return run_command(add_parser, ["mc", *(sys.argv[1:] if argv is None else argv)])
 
 
 def add_parser(sub: Any) -> None:
