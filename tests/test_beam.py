@@ -196,3 +196,15 @@ def test_default_damping_matches_the_hinge_decay_rate() -> None:
     expected = PAPER.damping / (2 * math.sqrt(k_freq * PAPER.hinge_inertia))
     assert tj.beam.default_damping_ratio(PAPER) == pytest.approx(expected, rel=1e-9)
     assert tj.beam.default_damping_ratio(PAPER.replace(damping=0.0)) == 0.0
+
+
+def test_report_functions_still_reachable_from_their_old_module() -> None:
+    """The report half of thermojitter.beam moved to thermojitter.reports.beam; scripts that
+    import its functions from the old module get the same functions."""
+    import thermojitter.beam as beam
+    from thermojitter.reports import beam as reports
+
+    for name in ("write_beam_comparison", "beam_report_markdown", "frequency_convergence"):
+        assert getattr(beam, name) is getattr(reports, name)
+    with pytest.raises(AttributeError):
+        beam.no_such_report  # noqa: B018

@@ -15,6 +15,7 @@ model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly 
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -375,9 +376,8 @@ _REPORTS = (
 
 def __getattr__(name: str) -> Any:
     # The report half of this module moved up to thermojitter.reports.beam (a report builds on
-    # this module, never the reverse): say where, rather than a bare AttributeError.
+    # this module, never the reverse). Scripts that import them from here keep working: the
+    # report module is loaded on first use, so importing this module does not load it.
     if name in _REPORTS:
-        raise AttributeError(
-            f"thermojitter.beam.{name} moved to thermojitter.reports.beam.{name}", name=name
-        )
+        return getattr(importlib.import_module("thermojitter.reports.beam"), name)
     raise AttributeError(f"module 'thermojitter.beam' has no attribute {name!r}", name=name)
