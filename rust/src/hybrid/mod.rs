@@ -903,6 +903,17 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
                 continue;
             }
             self.system.enter_segment(a, b);
+            if a == start {
+                // An oscillation already too large for the exponential integrator's reads goes
+                // to the full integration before any step: a step taken first would carry it
+                // (its length set by the slow thermal part) before the check after it.
+                let flux = self.system.flux_at(a);
+                let f = self.system.rhs_at_flux(flux, &self.y);
+                if self.judge.oscillation(flux, &self.y, &f) > self.settings.resolved_amplitude {
+                    large = true;
+                    break;
+                }
+            }
             let system = self.system.clone();
             let settings = self.settings;
             let mut t = self.t;
