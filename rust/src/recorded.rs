@@ -14,16 +14,16 @@
 //! changed how the summary reads each step (see [`SUMMARIES_TWO_READS`]); the four-read values
 //! are kept and checked within 1e-3.
 
-use crate::dynamics::HingeModel;
-use crate::flutter::{analyse, critical_damping};
-use crate::integrate::lockstep::on_portable;
-use crate::integrate::{Method, ScalarKernel, Tolerances};
-use crate::longrun::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
-use crate::orbit::Orbit;
-use crate::params::Panel;
-use crate::simulate::{run, Output};
-use crate::steady::equilibrium;
-use crate::system::{state, Coupled, Coupling};
+use crate::analysis::flutter::{analyse, critical_damping};
+use crate::analysis::steady::equilibrium;
+use crate::inputs::orbit::Orbit;
+use crate::inputs::panel::Panel;
+use crate::models::coupled::{state, Coupled, Coupling};
+use crate::models::hinge::HingeModel;
+use crate::numerics::integrate::{Method, ScalarKernel, Tolerances};
+use crate::runs::lockstep::on_portable;
+use crate::runs::orbits::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
+use crate::runs::simulate::{run, Output};
 
 /// The penumbral year orbit: 1 October, inside the autumn eclipse season.
 fn year_orbit() -> Orbit {

@@ -1,0 +1,7 @@
+//! What the models say without a transient: the steady state, flutter (eigen-analysis and
+//! critical damping), stability maps and the linear thermal response.
+
+pub mod flutter;
+pub mod linear;
+pub mod stability;
+pub mod steady;

@@ -1,0 +1,201 @@
+//! Bindings of the long runs (`crate::runs::orbits`, and the hybrid propagator).
+
+use super::cancel::{token, CancelToken};
+use super::convert::{hinge_model, orbit_from, panel_from, solver_dict, solver_from, state};
+use super::error::shield;
+use super::laminate::conduction_from;
+use crate::models::coupled::Coupling;
+use crate::models::hinge::Hinge;
+use crate::models::layered;
+use crate::runs::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
+use crate::runs::orbits::{run_orbits_cancellable as run, OrbitRunRequest, SummaryOptions};
+use nalgebra::U4;
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Integrates whole orbits and returns one summary per orbit (columns as arrays): the two-layer
+/// model, or the N-node model (`nodes`, `layup`), or with `hybrid` (its settings) the hybrid
+/// propagator, whose fallback is the solver's full integration; a hybrid run adds how the
+/// simulated time was split between linear arcs, the exponential integrator and the fallback.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None, hybrid=None))]
+#[allow(clippy::too_many_arguments)]
+fn run_orbits<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    model: &str,
+    coupled: bool,
+    solver: &Bound<'py, PyDict>,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vec<f64>,
+    window: f64,
+    theta_limit: f64,
+    stop_at_limit: bool,
+    steps_per_period: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
+    layup: Option<&Bound<'py, PyDict>>,
+    nodes: Option<usize>,
+    hybrid: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let hinge = hinge_model(model)?;
+        let coupling = if coupled {
+            Coupling::ProjectedArea
+        } else {
+            Coupling::Frozen
+        };
+        let m = solver_from(solver)?;
+        crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
+        let options = SummaryOptions {
+            window,
+            theta_limit,
+            stop_at_limit,
+            steps_per_period,
+        };
+        let settings = hybrid.map(hybrid_from).transpose()?;
+        if let Some(n) = nodes {
+            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
+            let req = layered::LayeredRunRequest {
+                panel: p,
+                conduction: conduction_from(&p, layup, n)?,
+                orbit: o,
+                model: hinge,
+                coupling,
+                method: m,
+                t_start,
+                first_index,
+                n_orbits,
+                y0,
+                options,
+            };
+            let Some(settings) = settings else {
+                let run = py.detach(|| layered::run_orbits(&req, &cancel))?;
+                return summary_dict(py, &run, &req.method);
+            };
+            let out = py.detach(|| layered::run_orbits_hybrid(&req, &settings, &cancel))?;
+            let d = summary_dict(py, &out.run, &req.method)?;
+            return hybrid_counters(d, &out.split);
+        }
+        let req = OrbitRunRequest {
+            panel: p,
+            orbit: o,
+            model: hinge,
+            coupling,
+            method: m,
+            t_start,
+            first_index,
+            n_orbits,
+            y0: state(&y0, U4)?,
+            options,
+        };
+        crate::models::hinge::check_start_state(
+            req.y0.as_slice(),
+            2,
+            Some(&Hinge::new(&p, hinge)),
+        )?;
+        let Some(settings) = settings else {
+            let run = py.detach(|| run(&req, &cancel))?;
+            return summary_dict(py, &run.into(), &req.method);
+        };
+        let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
+        // The run is copied (one summary per orbit) so that the counters stay with `out`.
+        let d = summary_dict(py, &out.run.clone().into(), &req.method)?;
+        hybrid_counters(d, &out)
+    })
+}
+
+/// A hybrid run's summary columns with how it split the simulated time.
+fn hybrid_counters<'py>(
+    d: Bound<'py, PyDict>,
+    out: &crate::runs::hybrid::HybridRun,
+) -> PyResult<Bound<'py, PyDict>> {
+    d.set_item("t_linear", out.t_linear)?;
+    d.set_item("t_exponential", out.t_exponential)?;
+    d.set_item("t_fallback", out.t_fallback)?;
+    d.set_item("n_arcs", out.n_arcs)?;
+    d.set_item("n_exp_steps", out.n_exp_steps)?;
+    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+    Ok(d)
+}
+
+/// The summaries of a run (of either model: a two-layer `OrbitRun` converts) as columns, with
+/// its counters and the solver settings it ran with (`method`, as [`solver_dict`] reports them
+/// for every run).
+fn summary_dict<'py>(
+    py: Python<'py>,
+    out: &layered::LayeredSummaries,
+    method: &crate::numerics::integrate::Method,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let col = |f: fn(&crate::runs::orbits::OrbitSummary) -> f64| -> Vec<f64> {
+        out.summaries.iter().map(f).collect()
+    };
+    d.set_item(
+        "index",
+        out.summaries.iter().map(|s| s.index).collect::<Vec<u64>>(),
+    )?;
+    for (name, values) in [
+        ("t_start", col(|s| s.t_start)),
+        ("t_end", col(|s| s.t_end)),
+        ("theta_eq", col(|s| s.theta_eq)),
+        ("theta_max", col(|s| s.theta_max)),
+        ("theta_min", col(|s| s.theta_min)),
+        ("amplitude", col(|s| s.amplitude)),
+        ("jitter_rms", col(|s| s.jitter_rms)),
+        ("jitter_peak", col(|s| s.jitter_peak)),
+        ("t_entry", col(|s| s.t_entry)),
+        ("t_exit", col(|s| s.t_exit)),
+        ("entry_theta_min", col(|s| s.entry_theta_min)),
+        ("exit_theta_max", col(|s| s.exit_theta_max)),
+        ("entry_peak", col(|s| s.entry_peak)),
+        ("exit_peak", col(|s| s.exit_peak)),
+    ] {
+        d.set_item(name, PyArray1::from_vec(py, values))?;
+    }
+    d.set_item("n_steps", out.stats.n_steps)?;
+    d.set_item("n_rejected", out.stats.n_rejected)?;
+    d.set_item("n_rhs", out.stats.n_rhs)?;
+    d.set_item("t_reached", out.stats.t_end)?;
+    d.set_item("stopped", out.stats.stopped)?;
+    d.set_item("y_end", out.y_end.clone())?;
+    d.set_item("crossing", out.crossing.map(|c| (c.t, c.orbit, c.theta)))?;
+    d.set_item("solver", solver_dict(py, method)?)?;
+    Ok(d)
+}
+
+/// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
+pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
+    let mut s = HybridSettings::default();
+    for (key, value) in d.iter() {
+        let key: String = key.extract()?;
+        let v: f64 = value.extract()?;
+        match key.as_str() {
+            "rtol" => s.tolerances.rtol = v,
+            "atol_temperature" => s.tolerances.atol_temperature = v,
+            "atol_angle" => s.tolerances.atol_angle = v,
+            "max_step" => s.tolerances.max_step = v,
+            "linear_tolerance" => s.linear_tolerance = v,
+            "linear_amplitude" => s.linear_amplitude = v,
+            "resolved_amplitude" => s.resolved_amplitude = v,
+            other => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "hybrid = {{{other:?}: ...}} is invalid: not a hybrid setting"
+                )))
+            }
+        }
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(run_orbits, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,6 @@
+//! Numerical methods that know no physics: SIMD number types, the processor and the kernel
+//! chosen on it, and the ODE integrators with their output.
+
+pub mod cpu;
+pub mod integrate;
+pub(crate) mod simd;
