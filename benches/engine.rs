@@ -16,9 +16,10 @@ use thermojitter::analysis::steady::equilibrium;
 use thermojitter::cancel::Cancel;
 use thermojitter::models::coupled::{Coupled, Coupling};
 use thermojitter::models::hinge::HingeModel;
+use thermojitter::numerics::cpu::ScalarKernel;
 use thermojitter::numerics::integrate::dopri5;
 use thermojitter::numerics::integrate::{
-    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, ScalarKernel, StepCounter, Tolerances,
+    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, StepCounter, Tolerances,
 };
 use thermojitter::runs::ensemble::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::runs::lockstep::RUNS_PER_CORE;

@@ -6,7 +6,7 @@
 //! its sunlit equilibrium with the adaptive integrator over one orbit, plus the linear/frozen
 //! variants, a fixed-step run, per-orbit summaries and the flutter analysis.
 //!
-//! The records are the portable kernel's bits (`integrate::ScalarKernel::Portable`, the only
+//! The records are the portable kernel's bits (`numerics::cpu::ScalarKernel::Portable`, the only
 //! one there was), so every case runs on it ([`on_portable`]); the fused kernel's results are
 //! checked against them within a tolerance ([`fused_kernel_stays_near_the_records`]).
 //!
@@ -20,8 +20,9 @@ use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{state, Coupled, Coupling};
 use crate::models::hinge::HingeModel;
-use crate::numerics::integrate::{Method, ScalarKernel, Tolerances};
-use crate::runs::lockstep::on_portable;
+use crate::numerics::cpu::on_portable;
+use crate::numerics::cpu::ScalarKernel;
+use crate::numerics::integrate::{Method, Tolerances};
 use crate::runs::orbits::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
 use crate::runs::simulate::{run, Output};
 

@@ -217,11 +217,11 @@ fn cpu_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("build", crate::numerics::cpu::compiled())?;
     d.set_item(
         "scalar_kernel",
-        crate::numerics::integrate::ScalarKernel::detect().name(),
+        crate::numerics::cpu::ScalarKernel::detect().name(),
     )?;
     d.set_item(
         "ensemble_kernel",
-        crate::runs::lockstep::Kernel::detect().name(),
+        crate::numerics::cpu::Kernel::detect().name(),
     )?;
     d.set_item("summary", crate::numerics::cpu::describe())?;
     Ok(d)

@@ -483,10 +483,10 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "ENSEMBLE_RUNS_PER_CORE",
         crate::runs::lockstep::RUNS_PER_CORE,
     )?;
-    m.add("KERNEL_VARIABLE", crate::runs::lockstep::KERNEL_VARIABLE)?;
+    m.add("KERNEL_VARIABLE", crate::numerics::cpu::KERNEL_VARIABLE)?;
     m.add(
         "KERNEL_CHOICES",
-        crate::runs::lockstep::KERNEL_CHOICES.to_vec(),
+        crate::numerics::cpu::KERNEL_CHOICES.to_vec(),
     )?;
     m.add("MAX_THREADS", crate::runs::ensemble::MAX_THREADS)?;
     m.add("VALIDITY_LIMIT", crate::models::hinge::VALIDITY_LIMIT)?;

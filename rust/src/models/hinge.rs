@@ -101,7 +101,7 @@ pub trait StructuralModel {
 
     /// [`StructuralModel::rates`] with its multiply-adds fused where the model has a fused form
     /// (the hinge does), else `rates` itself. Only code compiled for FMA calls it
-    /// (`integrate::ScalarKernel::Fma`).
+    /// (`numerics::cpu::ScalarKernel::Fma`).
     #[inline(always)]
     fn rates_fused(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
         self.rates(load, q, out)

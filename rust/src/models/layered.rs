@@ -1960,7 +1960,7 @@ mod tests {
     fn two_nodes_reproduce_the_two_layer_orbit_to_1e10() {
         // On the portable kernel: the fused one rounds the two-layer plate's multiply-adds once,
         // which the nodal model (no fused form) does not, so their steps part.
-        crate::runs::lockstep::on_portable(two_nodes_reproduce_the_two_layer_orbit);
+        crate::numerics::cpu::on_portable(two_nodes_reproduce_the_two_layer_orbit);
     }
 
     fn two_nodes_reproduce_the_two_layer_orbit() {

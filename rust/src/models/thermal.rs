@@ -68,7 +68,7 @@ pub trait ThermalModel {
 
     /// [`ThermalModel::rates`] with its multiply-adds fused where the model has a fused form
     /// (the two-layer plate does), else `rates` itself. Only code compiled for FMA calls it
-    /// (`integrate::ScalarKernel::Fma`).
+    /// (`numerics::cpu::ScalarKernel::Fma`).
     #[inline(always)]
     fn rates_fused(&self, flux: f64, temps: &[f64], out: &mut [f64]) {
         self.rates(flux, temps, out);

@@ -73,7 +73,7 @@ impl Num for f64 {}
 
 /// One f64 whose [`Num::mul_add`] rounds once (a fused multiply-add): the scalar twin of the
 /// AVX2 and AVX-512 lanes, used by the scalar loop compiled for FMA
-/// (`integrate::ScalarKernel::Fma`). Compiled without FMA, `f64::mul_add` is a library call:
+/// (`numerics::cpu::ScalarKernel::Fma`). Compiled without FMA, `f64::mul_add` is a library call:
 /// the same bits, slowly.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Fused(pub(crate) f64);
@@ -296,7 +296,7 @@ impl Neg for Portable {
 
 /// [`Lanes`] as AVX instructions, two per operation (four lanes each), `mul_add` fused. Values
 /// of this type are made only inside the lockstep kernel compiled for AVX2 and FMA, which runs
-/// only once the processor is known to have both (`integrate::lockstep::Kernel`); its
+/// only once the processor is known to have both (`numerics::cpu::Kernel`); its
 /// operations are inlined there. The lanes
 /// are kept in an array (no vector type crosses a function boundary compiled without AVX).
 #[cfg(target_arch = "x86_64")]

@@ -14,9 +14,10 @@ use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
+use crate::numerics::cpu::Kernel;
 use crate::numerics::integrate::{DenseStep, Method, Observer};
 use crate::runs::hybrid::{run_orbits_hybrid, HybridSettings};
-use crate::runs::lockstep::{solve_lockstep, Job, Kernel, LaneObserver, StepReads, RUNS_PER_CORE};
+use crate::runs::lockstep::{solve_lockstep, Job, LaneObserver, StepReads, RUNS_PER_CORE};
 use crate::runs::orbits::{
     finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, OrbitRunRequest,
     SummaryObserver, SummaryOptions, TwoLayerView,

@@ -26,12 +26,12 @@ use crate::error::{Error, Result};
 use crate::models::coupled::{Coupled, Coupling, LaneForm};
 use crate::models::hinge::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::models::thermal::Balance;
+use crate::numerics::cpu::{Kernel, ScalarKernel};
 use crate::numerics::integrate::dopri5::{
     self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
 };
 use crate::numerics::integrate::{
-    check_span, solve_on, DenseStep, FusedRhs, Method, Observer, OdeSystem, ScalarKernel, Stats,
-    Tolerances,
+    check_span, solve_on, DenseStep, FusedRhs, Method, Observer, OdeSystem, Stats, Tolerances,
 };
 #[cfg(target_arch = "x86_64")]
 use crate::numerics::simd::{Avx, Avx512};
@@ -39,7 +39,6 @@ use crate::numerics::simd::{Lanes, Portable};
 use crate::runs::orbits::quasi_static;
 use nalgebra::Vector4;
 use std::f64::consts::FRAC_PI_4;
-use std::sync::OnceLock;
 
 /// Runs advanced together on one core.
 pub const LANES: usize = crate::numerics::simd::LANES;
@@ -85,111 +84,6 @@ pub struct StepReads {
     pub dynamic: [f64; 2],
     /// θ̇ > 0 at the start, the middle and the end.
     pub rising: [bool; 3],
-}
-
-/// The environment variable that picks the kernels: `portable` runs the portable scalar and
-/// lane kernels on any processor (the engine's own arithmetic without FMA; the C library may
-/// still use its FMA paths); unset, or `auto`, the best the processor has. Read once, at the
-/// first run.
-pub const KERNEL_VARIABLE: &str = "THERMOJITTER_KERNEL";
-
-/// What [`KERNEL_VARIABLE`] may be set to.
-pub const KERNEL_CHOICES: [&str; 2] = ["auto", "portable"];
-
-/// Which compilation of the lane kernel runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Kernel {
-    /// The build's baseline instruction set (SSE2 on x86-64).
-    Portable,
-    /// AVX2 and FMA (x86-64 only, when the processor has both).
-    Avx2,
-    /// AVX-512F and FMA (x86-64 only, when the processor has both).
-    Avx512,
-}
-
-#[cfg(test)]
-thread_local! {
-    /// Set by [`on_portable`]: this thread's runs take the portable kernels.
-    static PORTABLE_HERE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Runs `f` with the portable kernels chosen on this thread (tests that pin portable bits).
-#[cfg(test)]
-pub(crate) fn on_portable<R>(f: impl FnOnce() -> R) -> R {
-    PORTABLE_HERE.with(|p| p.set(true));
-    let out = f();
-    PORTABLE_HERE.with(|p| p.set(false));
-    out
-}
-
-impl Kernel {
-    /// Every kernel, oldest instruction set first.
-    const ALL: [Kernel; 3] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512];
-
-    /// Whether this processor has the kernel's instruction sets.
-    pub fn runs_here(self) -> bool {
-        match self {
-            Kernel::Portable => true,
-            #[cfg(target_arch = "x86_64")]
-            Kernel::Avx2 => {
-                std::arch::is_x86_feature_detected!("avx2")
-                    && std::arch::is_x86_feature_detected!("fma")
-            }
-            #[cfg(target_arch = "x86_64")]
-            Kernel::Avx512 => {
-                std::arch::is_x86_feature_detected!("avx512f")
-                    && std::arch::is_x86_feature_detected!("fma")
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            _ => false,
-        }
-    }
-
-    /// The kernel runs use here: the best this processor runs, or the portable one when
-    /// [`KERNEL_VARIABLE`] says `portable`.
-    pub fn detect() -> Self {
-        #[cfg(test)]
-        if PORTABLE_HERE.with(|p| p.get()) {
-            return Kernel::Portable;
-        }
-        static CHOSEN: OnceLock<Kernel> = OnceLock::new();
-        *CHOSEN.get_or_init(|| {
-            if portable_requested() {
-                return Kernel::Portable;
-            }
-            Kernel::ALL
-                .into_iter()
-                .rev()
-                .find(|k| k.runs_here())
-                .unwrap_or(Kernel::Portable)
-        })
-    }
-
-    /// The scalar kernel whose bits this one's lanes give.
-    pub fn scalar(self) -> ScalarKernel {
-        match self {
-            Kernel::Portable => ScalarKernel::Portable,
-            Kernel::Avx2 | Kernel::Avx512 => ScalarKernel::Fma,
-        }
-    }
-
-    /// Every kernel this processor runs, the portable one first.
-    pub fn available() -> Vec<Self> {
-        Kernel::ALL.into_iter().filter(|k| k.runs_here()).collect()
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Kernel::Portable => "portable",
-            Kernel::Avx2 => "avx2",
-            Kernel::Avx512 => "avx512f",
-        }
-    }
-}
-
-/// Whether [`KERNEL_VARIABLE`] asks for the portable kernels.
-pub fn portable_requested() -> bool {
-    std::env::var(KERNEL_VARIABLE).is_ok_and(|v| v.trim().eq_ignore_ascii_case("portable"))
 }
 
 /// Runs every job `next` hands out, [`LANES`] at a time, and hands each observer back to `done`

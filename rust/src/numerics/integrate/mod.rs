@@ -12,7 +12,7 @@ pub mod output;
 pub mod rk4;
 
 use crate::error::{require_positive, Error, Result};
-use crate::runs::lockstep;
+use crate::numerics::cpu::ScalarKernel;
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OVector};
 use std::cell::OnceCell;
@@ -339,66 +339,6 @@ pub struct Stats {
     pub t_end: f64,
     /// True when the observer asked to stop before t1.
     pub stopped: bool,
-}
-
-/// Which compilation of the scalar integration loop ([`solve`]'s loop over segments and steps,
-/// with the right-hand side inlined into it) runs.
-///
-/// The fused one differs from the portable one in the last bits: the paper model's right-hand
-/// side ([`OdeSystem::rhs_fused`]) rounds each of its multiply-adds once. Every other
-/// operation, and every other model, is the same in both. The lockstep lanes pick theirs to
-/// match ([`lockstep::Kernel::scalar`]), so a run gives the same bits alone or in a lane.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScalarKernel {
-    /// The build's baseline instruction set (SSE2 on x86-64), multiply and add rounded apart:
-    /// the same bits on every processor.
-    Portable,
-    /// Compiled for AVX and FMA (x86-64 only, when the processor has both): the sin/cos
-    /// polynomials, the hinge's and the layers' balances as fused multiply-adds, which shortens
-    /// the right-hand side's chain of dependent operations.
-    Fma,
-}
-
-impl ScalarKernel {
-    /// Whether this processor has the kernel's instruction sets.
-    pub fn runs_here(self) -> bool {
-        match self {
-            ScalarKernel::Portable => true,
-            #[cfg(target_arch = "x86_64")]
-            ScalarKernel::Fma => {
-                std::arch::is_x86_feature_detected!("avx")
-                    && std::arch::is_x86_feature_detected!("fma")
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            ScalarKernel::Fma => false,
-        }
-    }
-
-    /// The kernel runs use here: the one matching the lockstep kernel chosen
-    /// ([`lockstep::Kernel::detect`], which [`lockstep::KERNEL_VARIABLE`] can set to portable).
-    pub fn detect() -> Self {
-        lockstep::Kernel::detect().scalar()
-    }
-
-    /// Every kernel this processor runs, the portable one first.
-    pub fn available() -> Vec<Self> {
-        [ScalarKernel::Portable, ScalarKernel::Fma]
-            .into_iter()
-            .filter(|k| k.runs_here())
-            .collect()
-    }
-
-    /// Whether the kernel's multiply-adds round once.
-    pub fn fused(self) -> bool {
-        self == ScalarKernel::Fma
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ScalarKernel::Portable => "portable",
-            ScalarKernel::Fma => "fma",
-        }
-    }
 }
 
 /// Integrates `system` from (t0, y0) to t1 with `method`, cutting at the system's breakpoints.
