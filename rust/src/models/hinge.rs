@@ -135,6 +135,13 @@ pub fn hinge_point(panel: &Panel, zeta: f64, theta: f64) -> (f64, f64) {
     ((arm - zeta) * theta.sin(), zeta * theta.cos())
 }
 
+/// The quasi-static angle M_T/K_el of the two-layer panel, M_T = (M_T per kelvin)(T_f − T_b)
+/// ([`thermal_moment`]), for one value or for lanes (the lockstep lanes read their steps with it).
+#[inline(always)]
+pub(crate) fn quasi_static<T: Num>(moment_per_kelvin: T, stiffness: T, t_front: T, t_back: T) -> T {
+    moment_per_kelvin * (t_front - t_back) / stiffness
+}
+
 /// M_T = χ a E I (T_f − T_b) / d, N m.
 #[inline]
 pub fn thermal_moment(panel: &Panel, t_front: f64, t_back: f64) -> f64 {

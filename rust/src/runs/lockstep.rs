@@ -24,6 +24,7 @@
 
 use crate::error::{Error, Result};
 use crate::models::coupled::{Coupled, Coupling, LaneForm};
+use crate::models::hinge::quasi_static;
 use crate::models::hinge::{angular_acceleration, generalised_moment, sin_cos_kernel, HingeModel};
 use crate::models::thermal::Balance;
 use crate::numerics::cpu::{Kernel, ScalarKernel};
@@ -36,7 +37,6 @@ use crate::numerics::integrate::{
 #[cfg(target_arch = "x86_64")]
 use crate::numerics::simd::{Avx, Avx512};
 use crate::numerics::simd::{Lanes, Portable};
-use crate::runs::orbits::quasi_static;
 use nalgebra::Vector4;
 use std::f64::consts::FRAC_PI_4;
 
@@ -59,7 +59,7 @@ pub struct Job<O> {
 /// spares the lane building the step's dense output.
 pub trait LaneObserver: Observer<nalgebra::U4> {
     /// (M_T per kelvin, K_el) of the run's panel, for the dynamic part θ − M_T/K_el of
-    /// [`StepReads`] (`longrun::quasi_static`); None: the observer takes dense steps only.
+    /// [`StepReads`] (`models::hinge::quasi_static`); None: the observer takes dense steps only.
     fn dynamic_form(&self) -> Option<(f64, f64)> {
         None
     }

@@ -14,9 +14,8 @@ use crate::error::Result;
 use crate::inputs::orbit::{EclipseTable, Orbit};
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{Coupled, Coupling};
-use crate::models::hinge::HingeModel;
+use crate::models::hinge::{quasi_static, HingeModel};
 use crate::numerics::integrate::{solve, DenseStep, Method, Observer, OdeSystem, State, Stats};
-use crate::numerics::simd::Num;
 use crate::runs::lockstep::{LaneObserver, StepReads};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, Vector4, U4};
@@ -54,13 +53,6 @@ pub trait SummaryView {
         let _ = dy;
         self.angles(t, y)
     }
-}
-
-/// The quasi-static angle M_T/K_el of the two-layer panel, M_T = (M_T per kelvin)(T_f − T_b)
-/// ([`crate::models::hinge::thermal_moment`]), for one value or for lanes (the lockstep lanes read their steps with it).
-#[inline(always)]
-pub(crate) fn quasi_static<T: Num>(moment_per_kelvin: T, stiffness: T, t_front: T, t_back: T) -> T {
-    moment_per_kelvin * (t_front - t_back) / stiffness
 }
 
 /// The two-layer system's view: state (T_f, T_b, θ, θ̇).
