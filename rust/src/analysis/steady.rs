@@ -8,6 +8,7 @@ use crate::models::coupled::Coupling;
 use crate::models::hinge::{Hinge, HingeModel, StructuralModel};
 use crate::models::thermal::{ThermalModel, TwoLayer};
 use crate::numerics::integrate::State;
+use crate::numerics::newton::newton;
 use nalgebra::allocator::Allocator;
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dim};
 
@@ -115,38 +116,6 @@ where
     let x = newton("steady state", x, n, residual_and_jacobian, settled)?;
     structure.check_static(&x.as_slice()[n..])?;
     Ok(x)
-}
-
-/// Newton's method from `x` for a steady state whose first `n_temps` unknowns are temperatures:
-/// each step solves J dx = −f, with (f, J) at x from `system`, shortened by halves where it
-/// would take a temperature to zero or below (wild parameter sets); it stops when
-/// `settled(x, dx)` after a step, and gives up after 100 steps. `what` names the state in errors.
-pub fn newton(
-    what: &str,
-    mut x: DVector<f64>,
-    n_temps: usize,
-    mut system: impl FnMut(&DVector<f64>) -> (DVector<f64>, DMatrix<f64>),
-    settled: impl Fn(&DVector<f64>, &DVector<f64>) -> bool,
-) -> Result<DVector<f64>> {
-    for _ in 0..100 {
-        let (f, jac) = system(&x);
-        let dx = jac.lu().solve(&(-f)).ok_or_else(|| Error::NoConvergence {
-            what: what.into(),
-            reason: "singular Jacobian".into(),
-        })?;
-        let mut lambda = 1.0;
-        while (0..n_temps).any(|i| x[i] + lambda * dx[i] <= 0.0) {
-            lambda *= 0.5;
-        }
-        x += &dx * lambda;
-        if settled(&x, &dx) {
-            return Ok(x);
-        }
-    }
-    Err(Error::NoConvergence {
-        what: what.into(),
-        reason: "Newton did not converge in 100 iterations".into(),
-    })
 }
 
 /// The full state at rest of a system of dimension `dim` from a steady (temperatures,

@@ -305,7 +305,7 @@ impl Conduction {
             (f, jac)
         };
         let settled = |t: &DVector<f64>, dt: &DVector<f64>| dt.amax() < 1e-12 * t.amax();
-        let t = crate::analysis::steady::newton(
+        let t = crate::numerics::newton::newton(
             "steady profile",
             DVector::from_element(n, t0),
             n,

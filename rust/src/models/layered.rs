@@ -1246,7 +1246,7 @@ pub fn equilibrium(
     let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
         (0..n).all(|i| dx[i].abs() < 1e-12 * x[i]) && dx[n].abs() < 1e-14
     };
-    let x = crate::analysis::steady::newton("steady state", x, n, residual_and_jacobian, settled)?;
+    let x = crate::numerics::newton::newton("steady state", x, n, residual_and_jacobian, settled)?;
     if x[n].abs() >= std::f64::consts::FRAC_PI_2 {
         return Err(Error::NoConvergence {
             what: "steady state".into(),
@@ -1541,7 +1541,7 @@ impl<const S: usize> HybridModel<S> for HybridLayered<S> {
             (0..S - 2).all(|i| dx[i].abs() < 1e-12 * x[i].abs().max(1.0)) && dx[S - 2].abs() < 1e-14
         };
         let x0 = DVector::from_column_slice(&start.as_slice()[..S - 1]);
-        Ok(state(&crate::analysis::steady::newton(
+        Ok(state(&crate::numerics::newton::newton(
             "sunlit equilibrium",
             x0,
             0,

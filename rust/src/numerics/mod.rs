@@ -3,4 +3,5 @@
 
 pub mod cpu;
 pub mod integrate;
+pub mod newton;
 pub(crate) mod simd;

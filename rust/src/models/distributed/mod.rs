@@ -24,11 +24,11 @@
 pub mod structure;
 
 use crate::analysis::flutter::{balancing, critical_value, Spectrum};
-use crate::analysis::steady::newton;
 use crate::error::{require_finite, require_non_negative, Error, Result};
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::thermal::{self, ThermalModel};
+use crate::numerics::newton::newton;
 use nalgebra::{Complex, DMatrix, DVector};
 use std::f64::consts::{FRAC_PI_2, PI};
 pub use structure::{Mesh, Reduction, Support, CANTILEVER_BETA1_L, MAX_ELEMENTS};

@@ -5,12 +5,13 @@
 //! laminate implements it in `crate::models::layered`.
 
 use super::jacobian::Linearisation;
-use crate::analysis::steady::{equilibrium, newton};
+use crate::analysis::steady::equilibrium;
 use crate::error::Result;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{Coupled, Coupling};
 use crate::models::hinge::{thermal_moment, HingeModel};
 use crate::numerics::integrate::{OdeSystem, State};
+use crate::numerics::newton::newton;
 use crate::runs::orbits::{SummaryView, TwoLayerView};
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, Vector4, U4};
 
