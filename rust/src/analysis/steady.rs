@@ -4,7 +4,7 @@
 
 use crate::error::{Error, Result};
 use crate::inputs::panel::Panel;
-use crate::models::coupled::Coupling;
+use crate::models::coupled::{Coupled, Coupling};
 use crate::models::hinge::{Hinge, HingeModel, StructuralModel};
 use crate::models::thermal::{ThermalModel, TwoLayer};
 use crate::numerics::integrate::State;
@@ -127,6 +127,18 @@ where
     let mut y = State::<D>::zeros_generic(dim, nalgebra::U1);
     y.as_mut_slice()[..x.len()].copy_from_slice(x.as_slice());
     y
+}
+
+impl<T: ThermalModel, S: StructuralModel, D: Dim> Coupled<T, S, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// The steady state under constant flux factor `flux`, velocities zero: the default start
+    /// of a run.
+    pub fn steady_state(&self, flux: f64) -> Result<State<D>> {
+        let x = steady(self.thermal(), self.structure(), self.coupling(), flux)?;
+        Ok(rest(&x, self.dim()))
+    }
 }
 
 /// The paper model's steady state: two layers and the hinge (whose static balance does not

@@ -275,7 +275,7 @@ fn simulate<'py>(
             let sys = Coupled::new(p, o, hinge, coupling);
             return run_coupled(py, sys, &m, (t0, t1), y0, &out, limit, &cancel);
         }
-        let thermal = crate::models::thermal::model(&p, layers)?;
+        let thermal = crate::models::thermal_model(&p, layers)?;
         let n = thermal.size() + 2;
         let structure = Hinge::new(&p, hinge);
         let sys = Coupled::compose(thermal, structure, o, coupling, Dyn(n))?;
@@ -363,7 +363,7 @@ fn simulate_thermal<'py>(
         let o = orbit_from(orbit)?;
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
-        let thermal = crate::models::thermal::model(&p, layers)?;
+        let thermal = crate::models::thermal_model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o);
         run_coupled(py, sys, &m, (t0, t1), y0, &out, None, &cancel)
     })

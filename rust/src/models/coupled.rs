@@ -1,7 +1,6 @@
 //! The right-hand sides: a thermal model coupled to a structural model (or alone), and the hinge
 //! driven by a prescribed moment. Each implements [`OdeSystem`].
 
-use crate::analysis::steady::{rest, steady};
 use crate::error::{Error, Result};
 use crate::inputs::orbit::{Orbit, Shadow};
 use crate::inputs::panel::Panel;
@@ -188,6 +187,10 @@ where
         &self.sun.orbit
     }
 
+    pub fn coupling(&self) -> Coupling {
+        self.coupling
+    }
+
     /// The state's dimension.
     pub fn dim(&self) -> D {
         self.dim
@@ -204,13 +207,6 @@ where
         let n = self.thermal.size();
         crate::models::hinge::check_start_state(y.as_slice(), n, None)?;
         self.structure.check_start(n, &y.as_slice()[n..])
-    }
-
-    /// The steady state under constant flux factor `flux`, velocities zero: the default start
-    /// of a run.
-    pub fn steady_state(&self, flux: f64) -> Result<State<D>> {
-        let x = steady(&self.thermal, &self.structure, self.coupling, flux)?;
-        Ok(rest(&x, self.dim))
     }
 
     /// Names of the state's components, temperatures first.
@@ -445,7 +441,7 @@ mod tests {
         let o = Orbit::geo_year(273.0);
         let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
         let mut fixed = Coupled::new(p, o, model, coupling);
-        let thermal = crate::models::thermal::model(&p, 2).unwrap();
+        let thermal = crate::models::thermal_model(&p, 2).unwrap();
         let mut dynamic =
             Coupled::compose(thermal, Hinge::new(&p, model), o, coupling, Dyn(4)).unwrap();
         let flux = o.flux_scale(40_000.0);

@@ -2019,7 +2019,7 @@ mod tests {
 
     #[test]
     fn the_seams_coupled_system_runs_the_nodal_model_alike() {
-        // The N-node model registered as a thermal model of the seam (thermal::model) and run by
+        // The N-node model registered as a thermal model of the seam (models::thermal_model) and run by
         // its generic coupled system agrees with this module's nodal system.
         use crate::models::coupled::Coupled as Generic;
         use crate::models::hinge::Hinge;
@@ -2029,7 +2029,7 @@ mod tests {
         let o = Orbit::geo_equinox();
         let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
         let nodes = 7;
-        let thermal = crate::models::thermal::model(&p, nodes as u32).unwrap();
+        let thermal = crate::models::thermal_model(&p, nodes as u32).unwrap();
         let mut generic =
             Generic::compose(thermal, Hinge::new(&p, model), o, coupling, Dyn(nodes + 2)).unwrap();
         let eq = equilibrium(

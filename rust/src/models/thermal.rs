@@ -8,7 +8,6 @@
 //! heat flows, divided by the heat capacity to give rates) or already divided by the capacity
 //! (K/s, the form the integrator's hot path uses, with no division left in it).
 
-use crate::error::{Error, Result};
 use crate::inputs::panel::Panel;
 use crate::numerics::simd::{Fused, Num};
 use crate::STEFAN_BOLTZMANN;
@@ -16,28 +15,6 @@ use crate::STEFAN_BOLTZMANN;
 /// Highest temperature a panel is described at, K: above any structural material's melting point
 /// (and σT⁴ stays a number; at 1e300 K it is inf).
 pub const MAX_TEMPERATURE: f64 = 1e4;
-
-/// The thermal models by their number of layers (the `layers=` of the Python API). This is the
-/// one place a new model is registered: the runs, steady states and bindings that take a
-/// `layers` go through it.
-pub fn model(panel: &Panel, layers: u32) -> Result<Box<dyn ThermalModel + Send + Sync>> {
-    match layers {
-        1 => Ok(Box::new(OneNode::new(panel))),
-        2 => Ok(Box::new(TwoLayer::new(panel))),
-        // N nodes through one homogeneous layer (the N-node conduction model).
-        n if n >= 3 && (n as usize) <= crate::models::conduction::MAX_NODES => Ok(Box::new(
-            crate::models::conduction::Conduction::homogeneous(panel, n as usize)?,
-        )),
-        other => Err(Error::invalid(
-            "layers",
-            other,
-            &format!(
-                "must be between 1 and {}",
-                crate::models::conduction::MAX_NODES
-            ),
-        )),
-    }
-}
 
 /// A through-thickness thermal model of the plate: its temperatures, their rates under an
 /// absorbed flux, and the thermal moment they bend the plate with.

@@ -27,7 +27,7 @@ use crate::analysis::flutter::{balancing, critical_value, Spectrum};
 use crate::error::{require_finite, require_non_negative, Error, Result};
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
-use crate::models::thermal::{self, ThermalModel};
+use crate::models::thermal::ThermalModel;
 use crate::numerics::newton::newton;
 use nalgebra::{Complex, DMatrix, DVector};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -49,7 +49,7 @@ pub struct Settings {
     /// ψ, the Sun's angle to the undeformed front normal, rad, |ψ| < π/2.
     pub sun_angle: f64,
     pub coupling: Coupling,
-    /// Layers of every element's through-thickness model ([`thermal::model`]).
+    /// Layers of every element's through-thickness model ([`crate::models::thermal_model`]).
     pub layers: u32,
 }
 
@@ -88,7 +88,7 @@ pub struct DistributedPanel {
     pub panel: Panel,
     pub settings: Settings,
     pub reduction: Reduction,
-    /// The through-thickness model every element carries (registered in [`thermal::model`]),
+    /// The through-thickness model every element carries (registered in [`crate::models::thermal_model`]),
     /// built with χ = 1: the panel's physical thermal moment.
     thermal: Box<dyn ThermalModel + Send + Sync>,
 }
@@ -142,7 +142,7 @@ impl DistributedPanel {
             panel: *panel,
             settings,
             reduction,
-            thermal: thermal::model(&physical, settings.layers)?,
+            thermal: crate::models::thermal_model(&physical, settings.layers)?,
         })
     }
 
