@@ -2,6 +2,7 @@
 //! critical damping), stability maps and the linear thermal response.
 
 pub mod flutter;
+pub mod layered;
 pub mod linear;
 pub mod stability;
 pub mod steady;

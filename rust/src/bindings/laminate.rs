@@ -10,7 +10,6 @@ use crate::analysis::flutter::check_flux;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
-use crate::models::layered;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -198,7 +197,7 @@ fn layered_steady_state<'py>(
         let p = panel_from(panel)?;
         check_flux(flux)?;
         let c = conduction_from(&p, layup, nodes)?;
-        let eq = layered::equilibrium(&p, &c, coupling(coupled), flux)?;
+        let eq = crate::analysis::layered::equilibrium(&p, &c, coupling(coupled), flux)?;
         let d = PyDict::new(py);
         d.set_item("temperatures", eq.temperatures)?;
         d.set_item("theta", eq.theta)?;
@@ -223,7 +222,13 @@ fn layered_start_state(
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let c = conduction_from(&p, layup, nodes)?;
-        Ok(layered::start_state(&p, &c, coupling(coupled), &o, t0)?)
+        Ok(crate::analysis::layered::start_state(
+            &p,
+            &c,
+            coupling(coupled),
+            &o,
+            t0,
+        )?)
     })
 }
 
@@ -247,7 +252,7 @@ fn layered_flutter<'py>(
         check_flux(flux)?;
         let c = conduction_from(&p, layup, nodes)?;
         let k = coupling(coupled);
-        let a = py.detach(|| layered::analyse(&p, &c, m, k, flux))?;
+        let a = py.detach(|| crate::analysis::layered::analyse(&p, &c, m, k, flux))?;
         let d = PyDict::new(py);
         d.set_item("temperatures", a.equilibrium.temperatures.clone())?;
         d.set_item("theta", a.equilibrium.theta)?;
@@ -262,7 +267,8 @@ fn layered_flutter<'py>(
         let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
         d.set_item("eigenvalues", ev)?;
         if with_critical {
-            let cd = py.detach(|| layered::critical_damping(&p, &c, m, k, flux))?;
+            let cd =
+                py.detach(|| crate::analysis::layered::critical_damping(&p, &c, m, k, flux))?;
             d.set_item("critical_damping", cd)?;
         }
         Ok(d)
@@ -306,7 +312,7 @@ fn simulate_layers<'py>(
         let k = coupling(coupled);
         let span = (t0, t1);
         let run = py.detach(|| {
-            layered::simulate(
+            crate::runs::layered::simulate(
                 &p,
                 c,
                 &o,

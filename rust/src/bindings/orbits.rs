@@ -6,7 +6,6 @@ use super::error::shield;
 use super::laminate::conduction_from;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::Hinge;
-use crate::models::layered;
 use crate::runs::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::runs::orbits::{run_orbits_cancellable as run, OrbitRunRequest, SummaryOptions};
 use nalgebra::U4;
@@ -62,7 +61,7 @@ fn run_orbits<'py>(
         let settings = hybrid.map(hybrid_from).transpose()?;
         if let Some(n) = nodes {
             // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            let req = layered::LayeredRunRequest {
+            let req = crate::runs::layered::LayeredRunRequest {
                 panel: p,
                 conduction: conduction_from(&p, layup, n)?,
                 orbit: o,
@@ -76,10 +75,12 @@ fn run_orbits<'py>(
                 options,
             };
             let Some(settings) = settings else {
-                let run = py.detach(|| layered::run_orbits(&req, &cancel))?;
+                let run = py.detach(|| crate::runs::layered::run_orbits(&req, &cancel))?;
                 return summary_dict(py, &run, &req.method);
             };
-            let out = py.detach(|| layered::run_orbits_hybrid(&req, &settings, &cancel))?;
+            let out = py.detach(|| {
+                crate::runs::hybrid::layered::run_orbits_hybrid(&req, &settings, &cancel)
+            })?;
             let d = summary_dict(py, &out.run, &req.method)?;
             return hybrid_counters(d, &out.split);
         }
@@ -130,7 +131,7 @@ fn hybrid_counters<'py>(
 /// for every run).
 fn summary_dict<'py>(
     py: Python<'py>,
-    out: &layered::LayeredSummaries,
+    out: &crate::runs::layered::LayeredSummaries,
     method: &crate::numerics::integrate::Method,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);

@@ -295,7 +295,6 @@ pub fn run_sample_layered(
     layers: &Layers,
     cancel: &Cancel,
 ) -> Result<SampleMetrics> {
-    use crate::models::layered;
     cancel.check()?;
     panel.validate()?;
     let s = settings;
@@ -303,9 +302,9 @@ pub fn run_sample_layered(
         Some(l) => crate::models::conduction::Conduction::new(panel, l, layers.nodes)?,
         None => crate::models::conduction::Conduction::homogeneous(panel, layers.nodes)?,
     };
-    let flutter = layered::analyse(panel, &c, s.model, s.coupling, 1.0)?;
-    let critical = layered::critical_damping(panel, &c, s.model, s.coupling, 1.0)?;
-    let eq = layered::equilibrium(panel, &c, s.coupling, s.orbit.flux_scale(0.0))?;
+    let flutter = crate::analysis::layered::analyse(panel, &c, s.model, s.coupling, 1.0)?;
+    let critical = crate::analysis::layered::critical_damping(panel, &c, s.model, s.coupling, 1.0)?;
+    let eq = crate::analysis::layered::equilibrium(panel, &c, s.coupling, s.orbit.flux_scale(0.0))?;
     let mut y0 = eq.temperatures;
     y0.extend([eq.theta, 0.0]);
     let head = SampleHead {
@@ -314,7 +313,7 @@ pub fn run_sample_layered(
         frequency_hz: flutter.frequency_hz,
         critical_damping: critical,
     };
-    let req = layered::LayeredRunRequest {
+    let req = crate::runs::layered::LayeredRunRequest {
         panel: *panel,
         conduction: c,
         orbit: s.orbit,
@@ -329,12 +328,12 @@ pub fn run_sample_layered(
     };
     let (out, t_nonlinear) = match &s.hybrid {
         None => {
-            let out = layered::run_orbits(&req, cancel)?;
+            let out = crate::runs::layered::run_orbits(&req, cancel)?;
             let t = out.stats.t_end;
             (out, t)
         }
         Some(h) => {
-            let out = layered::run_orbits_hybrid(&req, h, cancel)?;
+            let out = crate::runs::hybrid::layered::run_orbits_hybrid(&req, h, cancel)?;
             (out.run, out.split.t_exponential + out.split.t_fallback)
         }
     };

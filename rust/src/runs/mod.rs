@@ -4,6 +4,9 @@
 pub mod distributed;
 pub mod ensemble;
 pub mod hybrid;
+pub mod layered;
+#[cfg(test)]
+mod layered_tests;
 pub mod lockstep;
 pub mod orbits;
 pub mod simulate;

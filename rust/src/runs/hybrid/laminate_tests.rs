@@ -3,20 +3,22 @@
 
 use super::tests::{compare, options};
 use super::HybridSettings;
+use crate::analysis::layered::{analyse, critical_damping, start_state};
 use crate::cancel::Cancel;
 use crate::inputs::orbit::{Orbit, Shadow};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
-use crate::models::layered::{self, LayeredHybrid, LayeredRunRequest};
 use crate::numerics::integrate::{Method, Tolerances};
+use crate::runs::hybrid::layered::{run_orbits_hybrid, LayeredHybrid};
+use crate::runs::layered::{run_orbits, LayeredRunRequest, LayeredSummaries};
 
 const MODEL: HingeModel = HingeModel::Nonlinear;
 const COUPLING: Coupling = Coupling::ProjectedArea;
 
 fn start(panel: &Panel, c: &Conduction, orbit: &Orbit, kick: f64) -> Vec<f64> {
-    let mut y = layered::start_state(panel, c, COUPLING, orbit, 0.0).unwrap();
+    let mut y = start_state(panel, c, COUPLING, orbit, 0.0).unwrap();
     let n = y.len();
     y[n - 2] += kick;
     y
@@ -41,17 +43,11 @@ fn request(panel: &Panel, c: &Conduction, orbit: &Orbit, n: u64, y0: &[f64]) -> 
 
 fn hybrid(panel: &Panel, c: &Conduction, orbit: &Orbit, n: u64, y0: &[f64]) -> LayeredHybrid {
     let req = request(panel, c, orbit, n, y0);
-    layered::run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap()
+    run_orbits_hybrid(&req, &HybridSettings::default(), &Cancel::new()).unwrap()
 }
 
-fn full(
-    panel: &Panel,
-    c: &Conduction,
-    orbit: &Orbit,
-    n: u64,
-    y0: &[f64],
-) -> layered::LayeredSummaries {
-    layered::run_orbits(&request(panel, c, orbit, n, y0), &Cancel::new()).unwrap()
+fn full(panel: &Panel, c: &Conduction, orbit: &Orbit, n: u64, y0: &[f64]) -> LayeredSummaries {
+    run_orbits(&request(panel, c, orbit, n, y0), &Cancel::new()).unwrap()
 }
 
 #[test]
@@ -96,7 +92,7 @@ fn weak_flutter_of_three_nodes_grows_at_the_n_node_eigenvalue() {
         ..Panel::paper()
     };
     let c = Conduction::homogeneous(&base, 3).unwrap();
-    let crit = layered::critical_damping(&base, &c, MODEL, COUPLING, 1.0).unwrap();
+    let crit = critical_damping(&base, &c, MODEL, COUPLING, 1.0).unwrap();
     let orbit = Orbit {
         shadow: Shadow::None,
         ..Orbit::geo_equinox()
@@ -104,7 +100,7 @@ fn weak_flutter_of_three_nodes_grows_at_the_n_node_eigenvalue() {
     for damping in [crit - 0.1, crit + 0.1] {
         let panel = Panel { damping, ..base };
         let c = Conduction::homogeneous(&panel, 3).unwrap();
-        let predicted = layered::analyse(&panel, &c, MODEL, COUPLING, 1.0)
+        let predicted = analyse(&panel, &c, MODEL, COUPLING, 1.0)
             .unwrap()
             .growth_rate;
         let run = hybrid(&panel, &c, &orbit, 4, &start(&panel, &c, &orbit, 1e-6));

@@ -24,6 +24,7 @@ pub mod exprb;
 pub mod jacobian;
 #[cfg(test)]
 mod laminate_tests;
+pub mod layered;
 pub mod linear;
 pub(crate) mod model;
 
