@@ -1,6 +1,7 @@
 //! Runs of the models in time: one transient, runs of many orbits with per-orbit summaries, the
 //! hybrid exponential method, the lockstep SIMD lanes, ensembles, the distributed panel's runs.
 
+pub mod beam;
 pub mod distributed;
 pub mod ensemble;
 pub mod hybrid;

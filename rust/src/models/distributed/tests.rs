@@ -69,9 +69,10 @@ fn analytic_jacobian_matches_finite_differences() {
 mod runs {
     use super::*;
     use crate::inputs::orbit::{Orbit, Shadow};
-    use crate::models::beam::{respond, FreeFreeBeam};
+    use crate::models::beam::FreeFreeBeam;
     use crate::models::coupled::MomentHistory;
     use crate::numerics::integrate::{Method, Tolerances};
+    use crate::runs::beam::respond;
     use crate::runs::distributed::simulate;
     use crate::runs::simulate::Output;
 
