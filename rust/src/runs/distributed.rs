@@ -9,7 +9,7 @@ use crate::models::distributed::DistributedPanel;
 use crate::numerics::integrate::Stats;
 use crate::numerics::integrate::{Dyn, Method, OdeSystem, State};
 use crate::runs::orbits::LimitCrossing;
-use crate::runs::simulate::{run_watched, OnLimit, Output};
+use crate::runs::simulate::{run_watched, Limit, OnLimit, Output};
 use nalgebra::DVector;
 
 /// The distributed panel driven by an orbit's sunlight; state (T_f[n], T_b[n], q[k], q̇[k]).
@@ -146,4 +146,37 @@ pub fn simulate(
         out.sunlit.push(orbit.illumination(*t));
     }
     Ok(out)
+}
+
+impl DistributedPanel {
+    /// The validity limit on θ_f as the integrators watch it: |tip rise| <= arm · sin(θ_limit),
+    /// the rise an affine function of the state (the modes' share, and the element moments',
+    /// which are linear in the temperatures: read off unit temperatures).
+    pub fn limit(&self, on: OnLimit) -> Limit {
+        let s = self.layers();
+        let r = &self.reduction;
+        let zero = vec![0.0; s];
+        let m0 = self.thermal.moment(&zero);
+        let mut weights = Vec::with_capacity(self.state_size());
+        let mut unit = zero.clone();
+        for e in 0..self.n() {
+            for i in 0..s {
+                unit[i] = 1.0;
+                weights.push((
+                    e * s + i,
+                    r.rise_residual[e] * (self.thermal.moment(&unit) - m0),
+                ));
+                unit[i] = 0.0;
+            }
+        }
+        for j in 0..self.k() {
+            weights.push((self.temps() + j, r.rise_modal[j]));
+        }
+        Limit {
+            weights,
+            offset: r.rise_residual.sum() * m0,
+            bound: r.mesh.arm() * on.theta_limit.sin(),
+            stop: on.stop,
+        }
+    }
 }
