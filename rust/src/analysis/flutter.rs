@@ -58,11 +58,7 @@ pub fn jacobian(
     let rad_b = 4.0 * STEFAN_BOLTZMANN * panel.emissivity_back * eq.t_back.powi(3);
     // Non-linear inertia factor 1 + 3 sin²θ; its derivative multiplies the static residual,
     // which is zero at the equilibrium, and the θ̇² term vanishes with θ̇.
-    let inertia = panel.hinge_inertia()
-        * match model {
-            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
-            HingeModel::Linear => 1.0,
-        };
+    let inertia = panel.hinge_inertia() * model.inertia_factor(s);
     let mu = panel.moment_per_kelvin();
     Matrix4::new(
         (-k - rad_f) / h,

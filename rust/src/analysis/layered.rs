@@ -139,11 +139,7 @@ pub fn jacobian(
     j[(n, n + 1)] = 1.0;
     // The static residual is zero at the equilibrium, so the derivative of the non-linear
     // inertia factor drops out (as in the two-layer Jacobian).
-    let inertia = panel.hinge_inertia()
-        * match model {
-            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
-            HingeModel::Linear => 1.0,
-        };
+    let inertia = panel.hinge_inertia() * model.inertia_factor(s);
     for col in 0..n {
         j[(n + 1, col)] = c.moment_weight[col] / inertia;
     }

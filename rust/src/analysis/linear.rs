@@ -116,7 +116,7 @@ impl LinearThermal {
         Ok(LinearThermal {
             p: 2.0 * panel.absorptivity * panel.solar_constant * flux / mc,
             q: (4.0 * panel.conductance + 8.0 * STEFAN_BOLTZMANN * eps * t_star.powi(3)) / mc,
-            r: panel.damping / inertia,
+            r: panel.damping_rate(),
             s: panel.moment_per_kelvin() / inertia,
             omega,
             omega_n,

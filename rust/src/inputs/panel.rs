@@ -201,7 +201,6 @@ impl Panel {
                 return Err(Error::invalid(name, v, &range));
             }
         }
-        let inertia = self.hinge_inertia();
         let rates = [
             (
                 "hinge_stiffness",
@@ -212,7 +211,7 @@ impl Panel {
             (
                 "damping",
                 self.damping,
-                self.damping / inertia,
+                self.damping_rate(),
                 "the damping rate c_d/I_B",
             ),
             (
@@ -279,9 +278,19 @@ impl Panel {
         self.hinge_stiffness / self.flexural_stiffness()
     }
 
+    /// c_d / I_B, the hinge's damping rate, 1/s: the one place it is computed.
+    pub fn damping_rate(&self) -> f64 {
+        self.damping / self.hinge_inertia()
+    }
+
+    /// K_el / I_B = ω_n², the hinge's stiffness rate, 1/s².
+    pub fn stiffness_rate(&self) -> f64 {
+        self.hinge_stiffness / self.hinge_inertia()
+    }
+
     /// Natural angular frequency of the linearised hinge, sqrt(K_el / I_B), rad/s.
     pub fn natural_angular_frequency(&self) -> f64 {
-        (self.hinge_stiffness / self.hinge_inertia()).sqrt()
+        self.stiffness_rate().sqrt()
     }
 }
 

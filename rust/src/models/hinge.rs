@@ -13,6 +13,17 @@ pub enum HingeModel {
     Linear,
 }
 
+impl HingeModel {
+    /// The factor on I_B θ̈ at sin θ = `sin`: 1 + 3 sin²θ (eq. 20), 1 for the linear model.
+    #[inline(always)]
+    pub fn inertia_factor(self, sin: f64) -> f64 {
+        match self {
+            HingeModel::Nonlinear => 1.0 + 3.0 * sin * sin,
+            HingeModel::Linear => 1.0,
+        }
+    }
+}
+
 /// |θ| the hinge model describes, rad: its two rigid halves fold by θ each, so beyond π/2 they
 /// would pass through each other (and the paper's use is for a few degrees).
 pub const MAX_HINGE_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
@@ -183,6 +194,28 @@ pub(crate) fn angular_acceleration<T: Num>(
     }
 }
 
+/// The same equation of motion as (1 + 3 sin² θ, load), (1 + 3 sin² θ) θ̈ = M_T/I_B − load with
+/// load = c_d θ̇/I_B + K_el θ/I_B + 3 θ̇² sin θ cos θ (the non-linear model; 1 and no θ̇² term for
+/// the linear one), for models that divide by the factor once and reuse it (the N-node slow-mode
+/// model). `damping`, `stiffness` are per I_B.
+#[inline(always)]
+pub(crate) fn hinge_load(
+    model: HingeModel,
+    damping: f64,
+    stiffness: f64,
+    theta: f64,
+    theta_dot: f64,
+    sin: f64,
+    cos: f64,
+) -> (f64, f64) {
+    let restoring = damping * theta_dot + stiffness * theta;
+    let load = match model {
+        HingeModel::Linear => restoring,
+        HingeModel::Nonlinear => restoring + 3.0 * theta_dot * theta_dot * sin * cos,
+    };
+    (model.inertia_factor(sin), load)
+}
+
 /// θ̈ of the hinge under the thermal moment `moment`, rad/s².
 #[inline]
 pub fn hinge_acceleration(
@@ -223,12 +256,11 @@ pub struct Hinge {
 
 impl Hinge {
     pub fn new(panel: &Panel, model: HingeModel) -> Self {
-        let inertia = panel.hinge_inertia();
         Hinge {
             model,
-            inertia,
-            damping: panel.damping / inertia,
-            stiffness: panel.hinge_stiffness / inertia,
+            inertia: panel.hinge_inertia(),
+            damping: panel.damping_rate(),
+            stiffness: panel.stiffness_rate(),
             hinge_stiffness: panel.hinge_stiffness,
         }
     }
@@ -470,9 +502,7 @@ mod tests {
         let p = Panel::paper();
         let hinge = Hinge::new(&p, HingeModel::Nonlinear);
         let most = hinge.max_start_rate();
-        let w = p
-            .natural_angular_frequency()
-            .max(p.damping / p.hinge_inertia());
+        let w = p.natural_angular_frequency().max(p.damping_rate());
         assert_eq!(most, std::f64::consts::FRAC_PI_2 * w);
         let ok = [360.0, 350.0, 0.1, 0.99 * most];
         check_start_state(&ok, 2, Some(&hinge)).unwrap();

@@ -19,7 +19,9 @@ use crate::error::{Error, Result};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::{Conduction, Modes};
 use crate::models::coupled::Coupling;
-use crate::models::hinge::{sin_cos, HingeModel};
+use crate::models::hinge::{
+    angular_acceleration, generalised_moment, hinge_load, sin_cos, HingeModel,
+};
 
 /// A conduction mode is kept as a state when λ_k ≤ FAST_MODE_FACTOR × ω_n (ω_n = sqrt(K_el/I_B),
 /// the hinge's angular frequency), and quasi-static above. See docs/laminates.md for the
@@ -211,8 +213,8 @@ impl Layered {
             model,
             coupling,
             inverse_inertia: 1.0 / inertia,
-            damping: panel.damping / inertia,
-            stiffness: panel.hinge_stiffness / inertia,
+            damping: panel.damping_rate(),
+            stiffness: panel.stiffness_rate(),
             compliance: inertia / panel.hinge_stiffness,
         })
     }
@@ -253,13 +255,8 @@ impl Layered {
             // In the order of operations of the two-layer system, to the bit.
             Thermal::Nodal(r) => {
                 let moment_rate = r.rates(flux * area, &y[..m], dy);
-                let forced = moment_rate - self.damping * om - self.stiffness * th;
-                dy[m + 1] = match self.model {
-                    HingeModel::Linear => forced,
-                    HingeModel::Nonlinear => {
-                        (forced - 3.0 * om * om * sin * cos) / (1.0 + 3.0 * sin * sin)
-                    }
-                };
+                let forced = generalised_moment(moment_rate, self.damping, self.stiffness, th, om);
+                dy[m + 1] = angular_acceleration(self.model, forced, om, sin, cos);
             }
             // θ̈ = M_T r/I_B − bias: the hinge's terms, and the non-linear model's division, are
             // ready before the faces are solved, so that M_T is two operations from the end.
@@ -274,16 +271,10 @@ impl Layered {
         }
     }
 
-    /// The hinge's equation of motion (1 + 3 sin² θ) θ̈ = M_T/I_B − load, load = c_d θ̇/I_B +
-    /// K_el θ/I_B + 3 θ̇² sin θ cos θ, as (1 + 3 sin² θ, load) (the non-linear model; 1 and no
-    /// θ̇² term for the linear one).
+    /// The hinge's equation of motion as (1 + 3 sin² θ, load) ([`hinge_load`]).
     #[inline(always)]
     fn hinge_equation(&self, th: f64, om: f64, sin: f64, cos: f64) -> (f64, f64) {
-        let restoring = self.damping * om + self.stiffness * th;
-        match self.model {
-            HingeModel::Linear => (1.0, restoring),
-            HingeModel::Nonlinear => (1.0 + 3.0 * sin * sin, restoring + 3.0 * om * om * sin * cos),
-        }
+        hinge_load(self.model, self.damping, self.stiffness, th, om, sin, cos)
     }
 
     /// (r, bias) of [`Layered::hinge_equation`] solved for θ̈: θ̈ = M_T r/I_B − bias, with

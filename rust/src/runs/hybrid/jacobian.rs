@@ -4,7 +4,7 @@
 
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
-use crate::models::hinge::HingeModel;
+use crate::models::hinge::{generalised_moment, HingeModel};
 use crate::STEFAN_BOLTZMANN;
 use nalgebra::{Matrix4, Vector4};
 
@@ -38,8 +38,8 @@ impl Linearisation {
             radiation_front: STEFAN_BOLTZMANN * panel.emissivity_front / half_capacity,
             radiation_back: STEFAN_BOLTZMANN * panel.emissivity_back / half_capacity,
             moment: panel.moment_per_kelvin() / inertia,
-            damping: panel.damping / inertia,
-            stiffness: panel.hinge_stiffness / inertia,
+            damping: panel.damping_rate(),
+            stiffness: panel.stiffness_rate(),
         }
     }
 
@@ -60,8 +60,14 @@ impl Linearisation {
             HingeModel::Linear => (self.moment, -self.moment, -self.stiffness, -self.damping),
             HingeModel::Nonlinear => {
                 // θ̈ = N / D with N = forced − 3 θ̇² s c and D = 1 + 3 s² (eq. 20).
-                let inertia = 1.0 + 3.0 * sin * sin;
-                let forced = self.moment * (tf - tb) - self.damping * om - self.stiffness * th;
+                let inertia = HingeModel::Nonlinear.inertia_factor(sin);
+                let forced = generalised_moment(
+                    self.moment * (tf - tb),
+                    self.damping,
+                    self.stiffness,
+                    th,
+                    om,
+                );
                 let n = forced - 3.0 * om * om * sin * cos;
                 let cos2 = cos * cos - sin * sin;
                 let dn_dth = -self.stiffness - 3.0 * om * om * cos2;
