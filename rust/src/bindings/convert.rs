@@ -4,12 +4,9 @@ use super::error::invalid;
 use crate::inputs::orbit::Shadow;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
-use crate::numerics::integrate::State;
 use crate::numerics::integrate::{Method, Tolerances};
 use crate::runs::simulate::Output;
 use crate::{Orbit, Panel};
-use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, U1};
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -133,6 +130,8 @@ pub fn hinge_model(name: &str) -> PyResult<HingeModel> {
     }
 }
 
+/// The integrator a run is asked for, converted only: its settings are checked once, by the
+/// integrator ([`Method::validate`], at the start of every solve).
 pub fn method(
     name: &str,
     rtol: f64,
@@ -170,7 +169,6 @@ pub fn method(
             ))
         }
     };
-    m.validate()?;
     Ok(m)
 }
 
@@ -246,29 +244,6 @@ pub fn output(
     };
     out.sample_times(t0, t1)?;
     Ok(out)
-}
-
-/// A start state of dimension `dim` (`U4`, or `Dyn(n)` for a size known at run time).
-pub fn state<D: Dim>(v: &[f64], dim: D) -> PyResult<State<D>>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    let n = dim.value();
-    if v.len() != n {
-        return Err(invalid(
-            "y0",
-            format!("{v:?}"),
-            &format!("must have {n} components, not {}", v.len()),
-        ));
-    }
-    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-        return Err(invalid(
-            "y0",
-            format!("{v:?}"),
-            &format!("component {x} is not finite"),
-        ));
-    }
-    Ok(State::from_column_slice_generic(dim, U1, v))
 }
 
 /// The integrator settings as a solver mapping (what [`solver_from`] reads): the engine's

@@ -2,15 +2,15 @@
 
 use super::cancel::{token, CancelToken};
 use super::convert::{
-    coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_dict, solver_from,
-    type_error,
+    coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
 };
 use super::error::{invalid, shield};
 use crate::analysis::flutter::check_flux;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use crate::runs::transient::{RunRequest, Thermal};
+use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -301,52 +301,27 @@ fn simulate_layers<'py>(
     let cancel = token(cancel);
     shield(|| {
         let p = panel_from(panel)?;
-        let o = orbit_from(orbit)?;
-        let hinge = hinge_model(model)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (o, hinge) = (orbit_from(orbit)?, hinge_model(model)?);
+        let (method, out) = (solver_from(solver)?, output(t_eval, dt_out, t0, t1)?);
         let limit = super::convert::on_limit(theta_limit, on_limit)?;
         let c = conduction_from(&p, layup, nodes)?;
-        let depth = c.depth.clone();
-        let labels = c.node_labels();
-        let k = coupling(coupled);
-        let span = (t0, t1);
-        let run = py.detach(|| {
-            crate::runs::layered::simulate(
-                &p,
-                c,
-                &o,
-                hinge,
-                k,
-                &m,
-                span,
-                y0.as_deref(),
-                &out,
-                limit,
-                &cancel,
-            )
-        })?;
-        let n_t = run.t.len();
-        let d = PyDict::new(py);
-        let sunlit: Vec<f64> = run.t.iter().map(|&t| o.illumination(t)).collect();
-        let temps = PyArray1::from_vec(py, run.temperatures).reshape([n_t, nodes])?;
-        d.set_item("t", PyArray1::from_vec(py, run.t))?;
-        d.set_item("T_nodes", temps)?;
+        let (depth, labels) = (c.depth.clone(), c.node_labels());
+        let req = RunRequest {
+            panel: p,
+            orbit: o,
+            thermal: Thermal::Laminate(c),
+            model: hinge,
+            coupling: coupling(coupled),
+            method,
+            span: (t0, t1),
+            output: out,
+            y0,
+            limit,
+        };
+        let run = py.detach(|| crate::runs::transient::simulate(req, &cancel))?;
+        let d = super::transient_dict(py, run)?;
         d.set_item("depth", PyArray1::from_vec(py, depth))?;
         d.set_item("node_labels", labels)?;
-        d.set_item("theta", PyArray1::from_vec(py, run.theta))?;
-        d.set_item("theta_dot", PyArray1::from_vec(py, run.theta_dot))?;
-        d.set_item("thermal_moment", PyArray1::from_vec(py, run.moment))?;
-        d.set_item("sunlit", PyArray1::from_vec(py, sunlit))?;
-        d.set_item("n_steps", run.stats.n_steps)?;
-        d.set_item("n_rejected", run.stats.n_rejected)?;
-        d.set_item("n_rhs", run.stats.n_rhs)?;
-        d.set_item("t_end", run.stats.t_end)?;
-        d.set_item("y_end", PyArray1::from_vec(py, run.y_end))?;
-        d.set_item("solver", solver_dict(py, &run.method)?)?;
-        d.set_item("crossing", super::convert::crossing_tuple(run.crossing))?;
-        let stopped = run.crossing.is_some() && limit.is_some_and(|l| l.stop);
-        d.set_item("stopped", stopped)?;
         Ok(d)
     })
 }

@@ -16,19 +16,17 @@ use crate::analysis::steady::equilibrium;
 use crate::inputs::panel::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
 use crate::models::coupled::{Coupled, DrivenHinge, MomentHistory};
 use crate::models::hinge::checked_hinge_energy;
-use crate::models::hinge::{thermal_moment, Hinge, StructuralModel};
-use crate::models::thermal::ThermalModel;
-use crate::numerics::integrate::State;
-use crate::runs::simulate::{run_watched, OnLimit, Trajectory};
+use crate::models::hinge::{thermal_moment, Hinge};
+use crate::numerics::integrate::{Method, Stats};
+use crate::runs::simulate::{run_watched, state_from};
+use crate::runs::transient::{coupled_run, CoupledRun, RunRequest, Thermal, Transient};
 use cancel::{token, CancelToken};
 use convert::{
     coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_from, solver_from,
-    state,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
-use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, Dyn, U2};
-use numpy::{PyArray1, PyReadonlyArray1};
+use nalgebra::U2;
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -38,33 +36,22 @@ fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_vec(py, v)
 }
 
-/// Column `i` of a sampled trajectory.
-fn column<D: Dim>(traj: &Trajectory<D>, i: usize) -> Vec<f64>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    traj.column(i)
-}
-
-/// The counters and end state common to every run.
-fn run_info<'py, D: Dim>(py: Python<'py>, traj: &Trajectory<D>) -> PyResult<Bound<'py, PyDict>>
-where
-    DefaultAllocator: Allocator<D>,
-{
+/// The counters, the end state and the settings common to every run.
+fn run_info<'py>(
+    py: Python<'py>,
+    t: Vec<f64>,
+    stats: &Stats,
+    y_end: Vec<f64>,
+    method: &Method,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item(intern!(py, "t"), array(py, traj.t.clone()))?;
-    d.set_item(intern!(py, "n_steps"), traj.stats.n_steps)?;
-    d.set_item(intern!(py, "n_rejected"), traj.stats.n_rejected)?;
-    d.set_item(intern!(py, "n_rhs"), traj.stats.n_rhs)?;
-    d.set_item(intern!(py, "t_end"), traj.stats.t_end)?;
-    d.set_item(
-        intern!(py, "y_end"),
-        array(py, traj.y_end.as_slice().to_vec()),
-    )?;
-    d.set_item(
-        intern!(py, "solver"),
-        convert::solver_dict(py, &traj.method)?,
-    )?;
+    d.set_item(intern!(py, "t"), array(py, t))?;
+    d.set_item(intern!(py, "n_steps"), stats.n_steps)?;
+    d.set_item(intern!(py, "n_rejected"), stats.n_rejected)?;
+    d.set_item(intern!(py, "n_rhs"), stats.n_rhs)?;
+    d.set_item(intern!(py, "t_end"), stats.t_end)?;
+    d.set_item(intern!(py, "y_end"), array(py, y_end))?;
+    d.set_item(intern!(py, "solver"), convert::solver_dict(py, method)?)?;
     Ok(d)
 }
 
@@ -82,6 +69,7 @@ fn panel_dict<'py>(py: Python<'py>, p: &crate::Panel) -> PyResult<Bound<'py, PyD
 #[pyfunction]
 fn check_solver<'py>(py: Python<'py>, solver: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
     let m = solver_from(solver)?;
+    m.validate()?;
     convert::solver_dict(py, &m)
 }
 
@@ -263,80 +251,58 @@ fn simulate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let cancel = token(cancel);
     shield(|| {
-        let p = panel_from(panel)?;
-        let o = orbit_from(orbit)?;
-        let hinge = hinge_model(model)?;
-        let coupling = coupling(coupled);
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
-        let limit = self::on_limit(theta_limit, on_limit)?;
-        if layers == 2 {
-            // The paper's model, its state size known at compile time.
-            let sys = Coupled::new(p, o, hinge, coupling);
-            return run_coupled(py, sys, &m, (t0, t1), y0, &out, limit, &cancel);
-        }
-        let thermal = crate::models::thermal_model(&p, layers)?;
-        let n = thermal.size() + 2;
-        let structure = Hinge::new(&p, hinge);
-        let sys = Coupled::compose(thermal, structure, o, coupling, Dyn(n))?;
-        run_coupled(py, sys, &m, (t0, t1), y0, &out, limit, &cancel)
+        let req = RunRequest {
+            panel: panel_from(panel)?,
+            orbit: orbit_from(orbit)?,
+            thermal: Thermal::Layers(layers),
+            model: hinge_model(model)?,
+            coupling: coupling(coupled),
+            method: solver_from(solver)?,
+            span: (t0, t1),
+            output: output(t_eval, dt_out, t0, t1)?,
+            y0,
+            limit: self::on_limit(theta_limit, on_limit)?,
+        };
+        let run = py.detach(|| crate::runs::transient::simulate(req, &cancel))?;
+        transient_dict(py, run)
     })
 }
 
-/// Runs a coupled system (or a thermal model alone) from `y0` (default: its steady state at t0's
-/// flux) and returns every state component under its model's name, the thermal moment and the
-/// illumination; with `limit`, where θ first passed it ("crossing": (t, orbit, θ) or None) and
-/// whether the run stopped there ("stopped").
-#[allow(clippy::too_many_arguments)]
-fn run_coupled<'py, T, S, D>(
-    py: Python<'py>,
-    mut sys: Coupled<T, S, D>,
-    method: &crate::numerics::integrate::Method,
-    span: (f64, f64),
-    y0: Option<Vec<f64>>,
-    out: &crate::runs::simulate::Output,
-    limit: Option<OnLimit>,
-    cancel: &crate::cancel::Cancel,
-) -> PyResult<Bound<'py, PyDict>>
-where
-    T: ThermalModel + Send,
-    S: StructuralModel + Send,
-    D: Dim + Send,
-    DefaultAllocator: Allocator<D>,
-    State<D>: Send,
-{
-    let orbit = *sys.orbit();
-    let y_start = match y0 {
-        Some(v) => {
-            let y = state(&v, sys.dim())?;
-            sys.check_start(&y)?;
-            y
+/// A transient as a mapping: the counters, the end state and the settings used, every state
+/// component by name (the N-node run: its node temperatures as a (time × node) array), θ's
+/// limit crossing, the thermal moment and the illumination.
+pub(crate) fn transient_dict(py: Python<'_>, run: Transient) -> PyResult<Bound<'_, PyDict>> {
+    let (run, nodes) = match run {
+        Transient::Coupled(run) => (run, None),
+        Transient::Layered(run) => {
+            let n_t = run.t.len();
+            let temps = PyArray1::from_vec(py, run.temperatures).reshape([n_t, run.nodes])?;
+            let run = CoupledRun {
+                names: vec!["theta".into(), "theta_dot".into()],
+                columns: vec![run.theta, run.theta_dot],
+                sunlit: run.sunlit,
+                moment: run.moment,
+                t: run.t,
+                stats: run.stats,
+                y_end: run.y_end,
+                method: run.method,
+                crossing: run.crossing,
+                stopped: run.stopped,
+            };
+            (run, Some(temps))
         }
-        None => sys.steady_state(orbit.flux_scale(span.0))?,
     };
-    let names = sys.names();
-    // The limit is on θ, the structure's first state (a thermal model alone has none).
-    let theta = names.iter().position(|n| n == "theta");
-    let watch = limit.zip(theta).map(|(l, i)| l.on_component(i));
-    let traj =
-        py.detach(|| run_watched(&mut sys, method, span, y_start, out, watch.as_ref(), cancel))?;
-    let d = run_info(py, &traj)?;
-    let crossing =
-        traj.crossing.as_ref().zip(theta).map(|((t, y), i)| {
-            crate::runs::orbits::LimitCrossing::in_run(&orbit, span.0, *t, y[i])
-        });
-    d.set_item(intern!(py, "crossing"), crossing_tuple(crossing))?;
-    d.set_item(
-        intern!(py, "stopped"),
-        crossing.is_some() && watch.is_some_and(|l| l.stop),
-    )?;
-    for (i, name) in names.iter().enumerate() {
-        d.set_item(name, array(py, column(&traj, i)))?;
+    let d = run_info(py, run.t, &run.stats, run.y_end, &run.method)?;
+    if let Some(temps) = nodes {
+        d.set_item(intern!(py, "T_nodes"), temps)?;
     }
-    let moment: Vec<f64> = traj.y.iter().map(|y| sys.moment(y)).collect();
-    let sunlit: Vec<f64> = traj.t.iter().map(|&t| orbit.illumination(t)).collect();
-    d.set_item(intern!(py, "thermal_moment"), array(py, moment))?;
-    d.set_item(intern!(py, "sunlit"), array(py, sunlit))?;
+    d.set_item(intern!(py, "crossing"), crossing_tuple(run.crossing))?;
+    d.set_item(intern!(py, "stopped"), run.stopped)?;
+    for (name, column) in run.names.iter().zip(run.columns) {
+        d.set_item(name, array(py, column))?;
+    }
+    d.set_item(intern!(py, "thermal_moment"), array(py, run.moment))?;
+    d.set_item(intern!(py, "sunlit"), array(py, run.sunlit))?;
     Ok(d)
 }
 
@@ -365,7 +331,8 @@ fn simulate_thermal<'py>(
         let out = output(t_eval, dt_out, t0, t1)?;
         let thermal = crate::models::thermal_model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o);
-        run_coupled(py, sys, &m, (t0, t1), y0, &out, None, &cancel)
+        let run = py.detach(|| coupled_run(sys, &m, (t0, t1), y0, &out, None, &cancel))?;
+        transient_dict(py, Transient::Coupled(run))
     })
 }
 
@@ -410,7 +377,7 @@ fn simulate_hinge<'py>(
         };
         history.validate()?;
         history.check_against(&p)?;
-        let y_start = state(&y0, U2)?;
+        let y_start = state_from(&y0, U2)?;
         let start_hinge = Hinge::new(&p, hinge);
         crate::models::hinge::check_start_state(y_start.as_slice(), 0, Some(&start_hinge))?;
         let traj = py.detach(|| {
@@ -421,9 +388,15 @@ fn simulate_hinge<'py>(
             };
             run_watched(&mut sys, &m, (t0, t1), y_start, &out, None, &cancel)
         })?;
-        let d = run_info(py, &traj)?;
-        d.set_item("theta", array(py, column(&traj, 0)))?;
-        d.set_item("theta_dot", array(py, column(&traj, 1)))?;
+        let d = run_info(
+            py,
+            traj.t.clone(),
+            &traj.stats,
+            traj.y_end.as_slice().to_vec(),
+            &traj.method,
+        )?;
+        d.set_item("theta", array(py, traj.column(0)))?;
+        d.set_item("theta_dot", array(py, traj.column(1)))?;
         Ok(d)
     })
 }

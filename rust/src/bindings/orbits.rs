@@ -1,13 +1,14 @@
 //! Bindings of the long runs (`crate::runs::orbits`, and the hybrid propagator).
 
 use super::cancel::{token, CancelToken};
-use super::convert::{hinge_model, orbit_from, panel_from, solver_dict, solver_from, state};
+use super::convert::{hinge_model, orbit_from, panel_from, solver_dict, solver_from};
 use super::error::shield;
 use super::laminate::conduction_from;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::Hinge;
 use crate::runs::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
 use crate::runs::orbits::{run_orbits_cancellable as run, OrbitRunRequest, SummaryOptions};
+use crate::runs::simulate::state_from;
 use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -93,7 +94,7 @@ fn run_orbits<'py>(
             t_start,
             first_index,
             n_orbits,
-            y0: state(&y0, U4)?,
+            y0: state_from(&y0, U4)?,
             options,
         };
         crate::models::hinge::check_start_state(

@@ -105,11 +105,15 @@ macro_rules! on_fastest_state {
 #[derive(Debug, Clone)]
 pub struct LayeredRun {
     pub t: Vec<f64>,
+    /// Number of nodes.
+    pub nodes: usize,
     /// Node temperatures at each sample (sample-major: t.len() × nodes).
     pub temperatures: Vec<f64>,
     pub theta: Vec<f64>,
     pub theta_dot: Vec<f64>,
     pub moment: Vec<f64>,
+    /// The illumination at each sample.
+    pub sunlit: Vec<f64>,
     pub stats: crate::numerics::integrate::Stats,
     /// The end state as node temperatures, θ, θ̇ (a run can resume from it).
     pub y_end: Vec<f64>,
@@ -117,6 +121,8 @@ pub struct LayeredRun {
     pub method: crate::numerics::integrate::Method,
     /// Where |θ| first passed the validity limit, when one was watched.
     pub crossing: Option<crate::runs::orbits::LimitCrossing>,
+    /// Whether the run ended there.
+    pub stopped: bool,
 }
 
 /// Integrates the N-node system over `t_span` from `y0` (node temperatures, θ, θ̇; default the
@@ -157,7 +163,11 @@ pub fn simulate(
         sample_run(method, t_span, &y_start, output, watch.as_ref(), cancel)
     )?;
     let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
+    let stopped = crossing.is_some() && watch.is_some_and(|l| l.stop);
     let mut run = LayeredRun {
+        nodes: n,
+        sunlit: t.iter().map(|&t| orbit.illumination(t)).collect(),
+        stopped,
         theta: y.iter().map(|v| v[m]).collect(),
         theta_dot: y.iter().map(|v| v[m + 1]).collect(),
         temperatures: Vec::with_capacity(t.len() * n),

@@ -11,3 +11,4 @@ mod layered_tests;
 pub mod lockstep;
 pub mod orbits;
 pub mod simulate;
+pub mod transient;

@@ -6,8 +6,31 @@ use crate::numerics::integrate::{
     check_span, output, solve, DenseStep, Method, Observer, OdeSystem, Recorder, State, Stats,
 };
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim};
+use nalgebra::{DefaultAllocator, Dim, U1};
 use std::ops::ControlFlow;
+
+/// A start state of dimension `dim` (`U4`, or `Dyn(n)` for a size known at run time).
+pub fn state_from<D: Dim>(v: &[f64], dim: D) -> Result<State<D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let n = dim.value();
+    if v.len() != n {
+        return Err(Error::invalid(
+            "y0",
+            format!("{v:?}"),
+            &format!("must have {n} components, not {}", v.len()),
+        ));
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(Error::invalid(
+            "y0",
+            format!("{v:?}"),
+            &format!("component {x} is not finite"),
+        ));
+    }
+    Ok(State::from_column_slice_generic(dim, U1, v))
+}
 
 /// Where to report the solution.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,0 +1,170 @@
+//! One transient of the panel on its hinge, as the public `simulate` asks for it: one request,
+//! and the choice of the engine that runs it (the paper's two layers with the state size known at
+//! compile time, any registered thermal model, or a laminate's N-node model) made here, once.
+
+use crate::cancel::Cancel;
+use crate::error::Result;
+use crate::inputs::orbit::Orbit;
+use crate::inputs::panel::Panel;
+use crate::models::conduction::Conduction;
+use crate::models::coupled::{Coupled, Coupling};
+use crate::models::hinge::{Hinge, HingeModel, StructuralModel};
+use crate::models::thermal::ThermalModel;
+use crate::numerics::integrate::{Dyn, Method, Stats};
+use crate::runs::layered::LayeredRun;
+use crate::runs::orbits::LimitCrossing;
+use crate::runs::simulate::{run_watched, state_from, OnLimit, Output};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim};
+
+/// The through-thickness model of a run.
+#[derive(Debug, Clone)]
+pub enum Thermal {
+    /// The thermal model registered for this number of layers ([`crate::models::thermal_model`]).
+    Layers(u32),
+    /// A laminate's N-node conduction model ([`crate::runs::layered`]).
+    Laminate(Conduction),
+}
+
+/// One transient: the panel in its orbit, its thermal model on the hinge, the integrator, where
+/// to report, the start (default: the steady state at the start's flux) and the validity limit
+/// to watch.
+#[derive(Debug, Clone)]
+pub struct RunRequest {
+    pub panel: Panel,
+    pub orbit: Orbit,
+    pub thermal: Thermal,
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    pub method: Method,
+    pub span: (f64, f64),
+    pub output: Output,
+    pub y0: Option<Vec<f64>>,
+    pub limit: Option<OnLimit>,
+}
+
+/// A sampled run of a coupled system (or of a thermal model alone): every state component by
+/// its model's name, the thermal moment and the illumination at each sample.
+#[derive(Debug, Clone)]
+pub struct CoupledRun {
+    pub t: Vec<f64>,
+    pub names: Vec<String>,
+    /// Component `i` of every sample, in the order of `names`.
+    pub columns: Vec<Vec<f64>>,
+    pub moment: Vec<f64>,
+    pub sunlit: Vec<f64>,
+    pub stats: Stats,
+    /// The state at `stats.t_end`.
+    pub y_end: Vec<f64>,
+    /// The integrator and the settings the run used.
+    pub method: Method,
+    /// Where θ first passed the validity limit, when one was watched.
+    pub crossing: Option<LimitCrossing>,
+    /// Whether the run ended there.
+    pub stopped: bool,
+}
+
+/// What a transient gives, by the engine that ran it.
+#[derive(Debug, Clone)]
+pub enum Transient {
+    Coupled(CoupledRun),
+    /// The N-node run, with its node temperatures sample by sample.
+    Layered(LayeredRun),
+}
+
+/// Runs `req` on its engine, stopping within a step of `cancel`.
+pub fn simulate(req: RunRequest, cancel: &Cancel) -> Result<Transient> {
+    let RunRequest {
+        panel,
+        orbit,
+        thermal,
+        model,
+        coupling,
+        method,
+        span,
+        output,
+        y0,
+        limit,
+    } = req;
+    let layers = match thermal {
+        Thermal::Layers(n) => n,
+        Thermal::Laminate(c) => {
+            let run = crate::runs::layered::simulate(
+                &panel,
+                c,
+                &orbit,
+                model,
+                coupling,
+                &method,
+                span,
+                y0.as_deref(),
+                &output,
+                limit,
+                cancel,
+            )?;
+            return Ok(Transient::Layered(run));
+        }
+    };
+    let run = if layers == 2 {
+        // The paper's model, its state size known at compile time.
+        let sys = Coupled::new(panel, orbit, model, coupling);
+        coupled_run(sys, &method, span, y0, &output, limit, cancel)?
+    } else {
+        let thermal = crate::models::thermal_model(&panel, layers)?;
+        let n = thermal.size() + 2;
+        let structure = Hinge::new(&panel, model);
+        let sys = Coupled::compose(thermal, structure, orbit, coupling, Dyn(n))?;
+        coupled_run(sys, &method, span, y0, &output, limit, cancel)?
+    };
+    Ok(Transient::Coupled(run))
+}
+
+/// Runs a coupled system (or a thermal model alone) from `y0` (default: its steady state at the
+/// start's flux), watching θ against `limit` when the system has a θ.
+pub fn coupled_run<T, S, D>(
+    mut sys: Coupled<T, S, D>,
+    method: &Method,
+    span: (f64, f64),
+    y0: Option<Vec<f64>>,
+    out: &Output,
+    limit: Option<OnLimit>,
+    cancel: &Cancel,
+) -> Result<CoupledRun>
+where
+    T: ThermalModel,
+    S: StructuralModel,
+    D: Dim,
+    DefaultAllocator: Allocator<D>,
+{
+    let orbit = *sys.orbit();
+    let y_start = match y0 {
+        Some(v) => {
+            let y = state_from(&v, sys.dim())?;
+            sys.check_start(&y)?;
+            y
+        }
+        None => sys.steady_state(orbit.flux_scale(span.0))?,
+    };
+    let names = sys.names();
+    // The limit is on θ, the structure's first state (a thermal model alone has none).
+    let theta = names.iter().position(|n| n == "theta");
+    let watch = limit.zip(theta).map(|(l, i)| l.on_component(i));
+    let traj = run_watched(&mut sys, method, span, y_start, out, watch.as_ref(), cancel)?;
+    let crossing = traj
+        .crossing
+        .as_ref()
+        .zip(theta)
+        .map(|((t, y), i)| LimitCrossing::in_run(&orbit, span.0, *t, y[i]));
+    Ok(CoupledRun {
+        columns: (0..names.len()).map(|i| traj.column(i)).collect(),
+        moment: traj.y.iter().map(|y| sys.moment(y)).collect(),
+        sunlit: traj.t.iter().map(|&t| orbit.illumination(t)).collect(),
+        stopped: crossing.is_some() && watch.is_some_and(|l| l.stop),
+        crossing,
+        names,
+        stats: traj.stats,
+        y_end: traj.y_end.as_slice().to_vec(),
+        method: traj.method,
+        t: traj.t,
+    })
+}
