@@ -9,7 +9,7 @@ use crate::analysis::flutter::check_flux;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
-use crate::runs::transient::{RunRequest, Thermal};
+use crate::runs::request::{RunRequest, Thermal};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -318,7 +318,7 @@ fn simulate_layers<'py>(
             y0,
             limit,
         };
-        let run = py.detach(|| crate::runs::transient::simulate(req, &cancel))?;
+        let run = py.detach(|| crate::runs::request::simulate(req, &cancel))?;
         let d = super::transient_dict(py, run)?;
         d.set_item("depth", PyArray1::from_vec(py, depth))?;
         d.set_item("node_labels", labels)?;

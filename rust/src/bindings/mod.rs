@@ -18,8 +18,8 @@ use crate::models::coupled::{Coupled, DrivenHinge, MomentHistory};
 use crate::models::hinge::checked_hinge_energy;
 use crate::models::hinge::{thermal_moment, Hinge};
 use crate::numerics::integrate::{Method, Stats};
+use crate::runs::request::{coupled_run, CoupledRun, RunRequest, Thermal, Transient};
 use crate::runs::simulate::{run_watched, state_from};
-use crate::runs::transient::{coupled_run, CoupledRun, RunRequest, Thermal, Transient};
 use cancel::{token, CancelToken};
 use convert::{
     coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_from, solver_from,
@@ -263,7 +263,7 @@ fn simulate<'py>(
             y0,
             limit: self::on_limit(theta_limit, on_limit)?,
         };
-        let run = py.detach(|| crate::runs::transient::simulate(req, &cancel))?;
+        let run = py.detach(|| crate::runs::request::simulate(req, &cancel))?;
         transient_dict(py, run)
     })
 }

@@ -10,5 +10,5 @@ pub mod layered;
 mod layered_tests;
 pub mod lockstep;
 pub mod orbits;
+pub mod request;
 pub mod simulate;
-pub mod transient;
