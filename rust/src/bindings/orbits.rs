@@ -1,15 +1,12 @@
 //! Bindings of the long runs (`crate::runs::orbits`, and the hybrid propagator).
 
 use super::cancel::{token, CancelToken};
-use super::convert::{hinge_model, orbit_from, panel_from, solver_dict, solver_from};
+use super::convert::{coupling, hinge_model, orbit_from, panel_from, solver_dict, solver_from};
 use super::error::shield;
 use super::laminate::conduction_from;
-use crate::models::coupled::Coupling;
-use crate::models::hinge::Hinge;
-use crate::runs::hybrid::{run_orbits_hybrid as run_hybrid, HybridSettings};
-use crate::runs::orbits::{run_orbits_cancellable as run, OrbitRunRequest, SummaryOptions};
-use crate::runs::simulate::state_from;
-use nalgebra::U4;
+use crate::runs::hybrid::HybridSettings;
+use crate::runs::orbits::SummaryOptions;
+use crate::runs::request::{OrbitsRequest, Thermal};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -46,11 +43,7 @@ fn run_orbits<'py>(
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let hinge = hinge_model(model)?;
-        let coupling = if coupled {
-            Coupling::ProjectedArea
-        } else {
-            Coupling::Frozen
-        };
+        let coupling = coupling(coupled);
         let m = solver_from(solver)?;
         crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
         let options = SummaryOptions {
@@ -59,33 +52,12 @@ fn run_orbits<'py>(
             stop_at_limit,
             steps_per_period,
         };
-        let settings = hybrid.map(hybrid_from).transpose()?;
-        if let Some(n) = nodes {
-            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            let req = crate::runs::layered::LayeredRunRequest {
-                panel: p,
-                conduction: conduction_from(&p, layup, n)?,
-                orbit: o,
-                model: hinge,
-                coupling,
-                method: m,
-                t_start,
-                first_index,
-                n_orbits,
-                y0,
-                options,
-            };
-            let Some(settings) = settings else {
-                let run = py.detach(|| crate::runs::layered::run_orbits(&req, &cancel))?;
-                return summary_dict(py, &run, &req.method);
-            };
-            let out = py.detach(|| {
-                crate::runs::hybrid::layered::run_orbits_hybrid(&req, &settings, &cancel)
-            })?;
-            let d = summary_dict(py, &out.run, &req.method)?;
-            return hybrid_counters(d, &out.split);
-        }
-        let req = OrbitRunRequest {
+        let hybrid = hybrid.map(hybrid_from).transpose()?;
+        let req = OrbitsRequest {
+            thermal: match nodes {
+                Some(n) => Thermal::Laminate(conduction_from(&p, layup, n)?),
+                None => Thermal::Layers(2),
+            },
             panel: p,
             orbit: o,
             model: hinge,
@@ -94,22 +66,17 @@ fn run_orbits<'py>(
             t_start,
             first_index,
             n_orbits,
-            y0: state_from(&y0, U4)?,
+            y0,
             options,
+            hybrid,
         };
-        crate::models::hinge::check_start_state(
-            req.y0.as_slice(),
-            2,
-            Some(&Hinge::new(&p, hinge)),
-        )?;
-        let Some(settings) = settings else {
-            let run = py.detach(|| run(&req, &cancel))?;
-            return summary_dict(py, &run.into(), &req.method);
-        };
-        let out = py.detach(|| run_hybrid(&req, &settings, &cancel))?;
-        // The run is copied (one summary per orbit) so that the counters stay with `out`.
-        let d = summary_dict(py, &out.run.clone().into(), &req.method)?;
-        hybrid_counters(d, &out)
+        let method = req.method;
+        let out = py.detach(|| crate::runs::request::run_orbits(req, &cancel))?;
+        let d = summary_dict(py, &out.summaries, &method)?;
+        match out.split {
+            Some(split) => hybrid_counters(d, &split),
+            None => Ok(d),
+        }
     })
 }
 

@@ -1,9 +1,11 @@
-//! One transient of the panel on its hinge, as the public `simulate` asks for it: one request,
-//! and the choice of the engine that runs it (the paper's two layers with the state size known at
-//! compile time, any registered thermal model, or a laminate's N-node model) made here, once.
+//! What a caller asks of the engine, one request type per kind of run, and the choice of the
+//! engine that runs it, made here once: a transient ([`RunRequest`]: the paper's two layers with
+//! the state size known at compile time, any registered thermal model, or a laminate's N-node
+//! model) and runs of whole orbits with per-orbit summaries ([`OrbitsRequest`]: two layers or a
+//! laminate, hinge-resolved or by the hybrid propagator).
 
 use crate::cancel::Cancel;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -11,11 +13,12 @@ use crate::models::coupled::{Coupled, Coupling};
 use crate::models::hinge::{Hinge, HingeModel, StructuralModel};
 use crate::models::thermal::ThermalModel;
 use crate::numerics::integrate::{Dyn, Method, Stats};
-use crate::runs::layered::LayeredRun;
-use crate::runs::orbits::LimitCrossing;
+use crate::runs::hybrid::{HybridRun, HybridSettings};
+use crate::runs::layered::{LayeredRun, LayeredRunRequest, LayeredSummaries};
+use crate::runs::orbits::{LimitCrossing, OrbitRunRequest, SummaryOptions};
 use crate::runs::simulate::{run_watched, state_from, OnLimit, Output};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim};
+use nalgebra::{DefaultAllocator, Dim, U4};
 
 /// The through-thickness model of a run.
 #[derive(Debug, Clone)]
@@ -167,4 +170,118 @@ where
         method: traj.method,
         t: traj.t,
     })
+}
+
+/// Whole orbits from a start state, summarised orbit by orbit.
+#[derive(Debug, Clone)]
+pub struct OrbitsRequest {
+    pub panel: Panel,
+    pub orbit: Orbit,
+    /// Two layers, or a laminate's N-node model.
+    pub thermal: Thermal,
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    /// The integrator (with `hybrid`: its fallback).
+    pub method: Method,
+    pub t_start: f64,
+    pub first_index: u64,
+    pub n_orbits: u64,
+    /// The start state: (T_f, T_b, θ, θ̇), or the node temperatures, θ, θ̇.
+    pub y0: Vec<f64>,
+    pub options: SummaryOptions,
+    /// The hybrid propagator's settings; None: the hinge-resolved integration.
+    pub hybrid: Option<HybridSettings>,
+}
+
+/// The summaries of a run of orbits and, for a hybrid run, how it split the simulated time.
+pub struct OrbitsRun {
+    pub summaries: LayeredSummaries,
+    pub split: Option<HybridRun>,
+}
+
+/// Runs `req` on its engine, stopping within a step of `cancel`.
+pub fn run_orbits(req: OrbitsRequest, cancel: &Cancel) -> Result<OrbitsRun> {
+    let OrbitsRequest {
+        panel,
+        orbit,
+        thermal,
+        model,
+        coupling,
+        method,
+        t_start,
+        first_index,
+        n_orbits,
+        y0,
+        options,
+        hybrid,
+    } = req;
+    match thermal {
+        Thermal::Laminate(conduction) => {
+            let req = LayeredRunRequest {
+                panel,
+                conduction,
+                orbit,
+                model,
+                coupling,
+                method,
+                t_start,
+                first_index,
+                n_orbits,
+                y0,
+                options,
+            };
+            Ok(match hybrid {
+                None => OrbitsRun {
+                    summaries: crate::runs::layered::run_orbits(&req, cancel)?,
+                    split: None,
+                },
+                Some(settings) => {
+                    let out =
+                        crate::runs::hybrid::layered::run_orbits_hybrid(&req, &settings, cancel)?;
+                    OrbitsRun {
+                        summaries: out.run,
+                        split: Some(out.split),
+                    }
+                }
+            })
+        }
+        Thermal::Layers(2) => {
+            let req = OrbitRunRequest {
+                panel,
+                orbit,
+                model,
+                coupling,
+                method,
+                t_start,
+                first_index,
+                n_orbits,
+                y0: state_from(&y0, U4)?,
+                options,
+            };
+            crate::models::hinge::check_start_state(
+                req.y0.as_slice(),
+                2,
+                Some(&Hinge::new(&panel, model)),
+            )?;
+            Ok(match hybrid {
+                None => OrbitsRun {
+                    summaries: crate::runs::orbits::run_orbits_cancellable(&req, cancel)?.into(),
+                    split: None,
+                },
+                Some(settings) => {
+                    let out = crate::runs::hybrid::run_orbits_hybrid(&req, &settings, cancel)?;
+                    // The run is copied (one summary per orbit) so that the counters keep theirs.
+                    OrbitsRun {
+                        summaries: out.run.clone().into(),
+                        split: Some(out),
+                    }
+                }
+            })
+        }
+        Thermal::Layers(other) => Err(Error::invalid(
+            "layers",
+            other,
+            "runs of whole orbits take two layers or a laminate",
+        )),
+    }
 }
