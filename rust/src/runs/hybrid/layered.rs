@@ -7,11 +7,11 @@ use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
 use crate::numerics::integrate::{OdeSystem, State};
-use crate::runs::hybrid::model::HybridModel;
+use crate::runs::hybrid::model::{equilibrium_at_rest, HybridModel};
 use crate::runs::layered::{
     check_start, LayeredOrbit, LayeredRunRequest, LayeredSummaries, LayeredView,
 };
-use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector};
+use nalgebra::{Const, DVector, SMatrix, SVector};
 
 /// The N-node system as the hybrid propagator's model, on a state of S components (the slow
 /// thermal coordinates, θ, θ̇): the same right-hand side as the full run, its derivatives by
@@ -132,32 +132,11 @@ impl<const S: usize> HybridModel<S> for HybridLayered<S> {
             }
         };
         // Refined on this model's own right-hand side (the slow-mode model's steady state in its
-        // coordinates): every component but θ̇, every equation but θ' = θ̇.
-        let rows: Vec<usize> = (0..S).filter(|&i| i != S - 2).collect();
-        let state = |x: &DVector<f64>| {
-            let mut y = SVector::<f64, S>::zeros();
-            y.as_mut_slice()[..S - 1].copy_from_slice(x.as_slice());
-            y
-        };
-        let system = |x: &DVector<f64>| {
-            let y = state(x);
-            let (f, jac) = (self.rhs_at_flux(flux, &y), self.jacobian(flux, &y));
-            (
-                DVector::from_fn(S - 1, |i, _| f[rows[i]]),
-                DMatrix::from_fn(S - 1, S - 1, |i, j| jac[(rows[i], j)]),
-            )
-        };
+        // coordinates).
         let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
             (0..S - 2).all(|i| dx[i].abs() < 1e-12 * x[i].abs().max(1.0)) && dx[S - 2].abs() < 1e-14
         };
-        let x0 = DVector::from_column_slice(&start.as_slice()[..S - 1]);
-        Ok(state(&crate::numerics::newton::newton(
-            "sunlit equilibrium",
-            x0,
-            0,
-            system,
-            settled,
-        )?))
+        equilibrium_at_rest(self, flux, &start, 0, settled)
     }
     fn static_angle(&self, flux: f64, y: &SVector<f64, S>, f: &SVector<f64, S>) -> (f64, f64) {
         // The rate along the flow by a central difference over 10 ms.

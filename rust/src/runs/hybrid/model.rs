@@ -74,35 +74,51 @@ impl TwoLayerModel {
         }
     }
 
-    /// The equilibrium under `flux` by Newton's method from the state `start` at rest, with the
-    /// analytic Jacobian: the unknowns (T_f, T_b, θ), the equations dT_f/dt = dT_b/dt = θ̈ = 0.
+    /// The equilibrium under `flux` by Newton's method from the state `start` at rest
+    /// ([`equilibrium_at_rest`]): the unknowns (T_f, T_b, θ), the equations dT_f/dt = dT_b/dt =
+    /// θ̈ = 0, with the analytic Jacobian.
     fn equilibrium_from(&self, flux: f64, start: &Vector4<f64>) -> Result<Vector4<f64>> {
-        const ROWS: [usize; 3] = [0, 1, 3];
-        let state = |x: &DVector<f64>| Vector4::new(x[0], x[1], x[2], 0.0);
-        let system = |x: &DVector<f64>| {
-            let y = state(x);
-            let (f, jac) = (
-                self.system.rhs_at_flux(flux, &y),
-                self.lin.jacobian(flux, &y),
-            );
-            (
-                DVector::from_fn(3, |i, _| f[ROWS[i]]),
-                DMatrix::from_fn(3, 3, |i, j| jac[(ROWS[i], j)]),
-            )
-        };
         // As steady::steady: temperatures to 1e-12 relative, the angle to 1e-14 rad.
         let settled = |x: &DVector<f64>, dx: &DVector<f64>| {
             dx[0].abs() < 1e-12 * x[0] && dx[1].abs() < 1e-12 * x[1] && dx[2].abs() < 1e-14
         };
-        let x0 = DVector::from_column_slice(&start.as_slice()[..3]);
-        Ok(state(&newton(
-            "sunlit equilibrium",
-            x0,
-            2,
-            system,
-            settled,
-        )?))
+        equilibrium_at_rest(self, flux, start, 2, settled)
     }
+}
+
+/// A model's equilibrium at rest under `flux`, by Newton's method on its own right-hand side and
+/// Jacobian from `start`: the unknowns every component but θ̇ (the last), the equations every
+/// rate but θ' = θ̇ (the one before last). The first `n_temps` unknowns are kept positive;
+/// `settled(x, dx)` ends it.
+pub(crate) fn equilibrium_at_rest<const N: usize, M: HybridModel<N>>(
+    model: &M,
+    flux: f64,
+    start: &SVector<f64, N>,
+    n_temps: usize,
+    settled: impl Fn(&DVector<f64>, &DVector<f64>) -> bool,
+) -> Result<SVector<f64, N>> {
+    let rows: Vec<usize> = (0..N).filter(|&i| i != N - 2).collect();
+    let state = |x: &DVector<f64>| {
+        let mut y = SVector::<f64, N>::zeros();
+        y.as_mut_slice()[..N - 1].copy_from_slice(x.as_slice());
+        y
+    };
+    let system = |x: &DVector<f64>| {
+        let y = state(x);
+        let (f, jac) = (model.rhs_at_flux(flux, &y), model.jacobian(flux, &y));
+        (
+            DVector::from_fn(N - 1, |i, _| f[rows[i]]),
+            DMatrix::from_fn(N - 1, N - 1, |i, j| jac[(rows[i], j)]),
+        )
+    };
+    let x0 = DVector::from_column_slice(&start.as_slice()[..N - 1]);
+    Ok(state(&newton(
+        "sunlit equilibrium",
+        x0,
+        n_temps,
+        system,
+        settled,
+    )?))
 }
 
 impl OdeSystem<U4> for TwoLayerModel {
