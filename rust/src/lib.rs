@@ -22,6 +22,4 @@ mod bindings;
 pub use error::{Error, Result};
 pub use inputs::orbit::Orbit;
 pub use inputs::panel::Panel;
-
-/// Stefan–Boltzmann constant, W/(m² K⁴) (CODATA 2018, exact).
-pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
+pub use models::thermal::STEFAN_BOLTZMANN;

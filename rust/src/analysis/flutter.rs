@@ -11,8 +11,8 @@ use crate::inputs::panel::Panel;
 use crate::models::coupled::{Coupled, Coupling};
 use crate::models::hinge::{HingeModel, StructuralModel};
 use crate::models::thermal::ThermalModel;
+use crate::models::thermal::STEFAN_BOLTZMANN;
 use crate::numerics::integrate::State;
-use crate::STEFAN_BOLTZMANN;
 use nalgebra::allocator::Allocator;
 use nalgebra::{Complex, DMatrix, DVector, DefaultAllocator, Dim, Matrix4, U1};
 

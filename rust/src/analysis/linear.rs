@@ -16,7 +16,7 @@ use crate::error::{require_positive, Error, Result};
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::thermal::MAX_TEMPERATURE;
-use crate::STEFAN_BOLTZMANN;
+use crate::models::thermal::STEFAN_BOLTZMANN;
 
 /// The coefficients of Sec. 4.2 for one panel and forcing frequency, with what follows from them.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -189,7 +189,7 @@ mod tests {
         for flux in [1.0, 0.97] {
             let one = crate::models::thermal::OneNode::new(&p);
             let exact = one.equilibrium(flux);
-            let orbit = crate::Orbit::geo_equinox();
+            let orbit = crate::inputs::orbit::Orbit::geo_equinox();
             let y = crate::models::coupled::Coupled::thermal_only(one, orbit)
                 .steady_state(flux)
                 .unwrap();
@@ -202,7 +202,7 @@ mod tests {
         let p = Panel::paper();
         for flux in [0.0, 5e-324, 0.9e-6, 100.1, 1e12, f64::NAN, f64::INFINITY] {
             match equilibrium(&p, Coupling::ProjectedArea, flux) {
-                Err(crate::Error::InvalidParameter { name, .. }) => assert_eq!(name, "flux"),
+                Err(crate::error::Error::InvalidParameter { name, .. }) => assert_eq!(name, "flux"),
                 other => panic!("flux {flux}: {other:?}"),
             }
         }

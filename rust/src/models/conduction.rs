@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::inputs::laminate::{linear_moment, Laminate};
 use crate::inputs::panel::Panel;
 use crate::models::thermal::ThermalModel;
-use crate::STEFAN_BOLTZMANN;
+use crate::models::thermal::STEFAN_BOLTZMANN;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 /// Most nodes through the thickness a model may have.

@@ -275,7 +275,7 @@ where
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)
     }
-    fn check_span(&self, t0: f64, t1: f64) -> crate::Result<()> {
+    fn check_span(&self, t0: f64, t1: f64) -> crate::error::Result<()> {
         self.sun.orbit.check_span(t0, t1)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
@@ -312,7 +312,7 @@ impl MomentHistory {
 
     /// Checks every value against the hinge model's range for this panel
     /// ([`crate::models::hinge::check_moment`]).
-    pub fn check_against(&self, panel: &crate::Panel) -> Result<()> {
+    pub fn check_against(&self, panel: &crate::inputs::panel::Panel) -> Result<()> {
         match self {
             MomentHistory::Constant(m) => crate::models::hinge::check_moment(panel, *m),
             MomentHistory::Samples { moment, .. } => moment

@@ -35,7 +35,7 @@ pub const VALIDITY_LIMIT: f64 = 20.0 * (std::f64::consts::PI / 180.0);
 
 /// Checks an angle given to the hinge model (a start state, a limit): within ±π/2 rad. The
 /// message says what a value in degrees would have been, the likely slip.
-pub fn check_hinge_angle(name: &str, theta: f64) -> crate::Result<()> {
+pub fn check_hinge_angle(name: &str, theta: f64) -> crate::error::Result<()> {
     if theta.is_finite() && theta.abs() <= MAX_HINGE_ANGLE {
         return Ok(());
     }
@@ -46,7 +46,7 @@ pub fn check_hinge_angle(name: &str, theta: f64) -> crate::Result<()> {
             theta.to_radians()
         );
     }
-    Err(crate::Error::invalid(name, theta, &reason))
+    Err(crate::error::Error::invalid(name, theta, &reason))
 }
 
 /// Checks a start state `y0` of (temperatures…, then, with `hinge`, θ and θ̇): the one check
@@ -72,12 +72,12 @@ pub fn check_start_state(y0: &[f64], temperatures: usize, hinge: Option<&Hinge>)
 
 /// The static angle M/K_el of a moment on the hinge, checked against the hinge model's range:
 /// a larger moment would fold the panel beyond what the model describes.
-pub fn check_moment(panel: &Panel, moment: f64) -> crate::Result<()> {
+pub fn check_moment(panel: &Panel, moment: f64) -> crate::error::Result<()> {
     let angle = moment / panel.hinge_stiffness;
     if angle.is_finite() && angle.abs() <= MAX_HINGE_ANGLE {
         return Ok(());
     }
-    Err(crate::Error::invalid(
+    Err(crate::error::Error::invalid(
         "moment",
         moment,
         &format!(

@@ -10,7 +10,9 @@
 
 use crate::inputs::panel::Panel;
 use crate::numerics::simd::{Fused, Num};
-use crate::STEFAN_BOLTZMANN;
+
+/// Stefan–Boltzmann constant, W/(m² K⁴) (CODATA 2018, exact).
+pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
 
 /// Highest temperature a panel is described at, K: above any structural material's melting point
 /// (and σT⁴ stays a number; at 1e300 K it is inf).

@@ -266,7 +266,7 @@ fn step_guard_stops_runaway_integrations() {
         &mut StepCounter::default(),
     )
     .unwrap_err();
-    assert!(matches!(e, crate::Error::Integration { .. }), "{e}");
+    assert!(matches!(e, crate::error::Error::Integration { .. }), "{e}");
 }
 
 /// y' = y², blowing up at t = 1: the integrator must report an error, not return inf or NaN.
@@ -408,7 +408,10 @@ fn the_interpolants_slope_is_the_derivative_at_fourth_order() {
 fn paper_theta(kernel: ScalarKernel, rtol: f64, atol: f64) -> (Vec<f64>, Stats) {
     use crate::models::coupled::{Coupled, Coupling};
     use crate::models::hinge::HingeModel;
-    let (p, o) = (crate::Panel::paper(), crate::Orbit::geo_equinox());
+    let (p, o) = (
+        crate::inputs::panel::Panel::paper(),
+        crate::inputs::orbit::Orbit::geo_equinox(),
+    );
     let eq = crate::analysis::steady::equilibrium(&p, Coupling::ProjectedArea, 1.0).unwrap();
     let y0 = nalgebra::Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
     let times = (0..=12).map(|k| o.period * k as f64 / 12.0).collect();

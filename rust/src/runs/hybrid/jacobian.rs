@@ -5,7 +5,7 @@
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::{generalised_moment, HingeModel};
-use crate::STEFAN_BOLTZMANN;
+use crate::models::thermal::STEFAN_BOLTZMANN;
 use nalgebra::{Matrix4, Vector4};
 
 /// The coupled system's coefficients, each per unit capacity or inertia (eqs. 2, 20, 28).
