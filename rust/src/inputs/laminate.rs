@@ -405,6 +405,23 @@ pub fn material(key: &str) -> Result<&'static Material> {
     })
 }
 
+/// A CFRP/honeycomb solar-array substrate with Kapton on the Sun side (the tests' wing).
+#[cfg(test)]
+pub(crate) fn wing_layup() -> Laminate {
+    Laminate {
+        layers: vec![
+            MATERIALS[4].layer(50e-6),
+            MATERIALS[2].layer(0.3e-3),
+            MATERIALS[3].layer(20e-3),
+            MATERIALS[2].layer(0.3e-3),
+        ],
+        emissivity_front: 0.8,
+        emissivity_back: 0.8,
+        absorptivity: 0.9,
+        reference_temperature: 293.15,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

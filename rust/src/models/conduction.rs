@@ -439,18 +439,7 @@ mod tests {
 
     #[test]
     fn capacity_and_resistance_add_up() {
-        let lam = Laminate {
-            layers: vec![
-                MATERIALS[4].layer(50e-6),
-                MATERIALS[2].layer(0.3e-3),
-                MATERIALS[3].layer(20e-3),
-                MATERIALS[2].layer(0.3e-3),
-            ],
-            emissivity_front: 0.8,
-            emissivity_back: 0.8,
-            absorptivity: 0.9,
-            reference_temperature: 293.15,
-        };
+        let lam = crate::inputs::laminate::wing_layup();
         let c = Conduction::new(&panel(), &lam, 20).unwrap();
         assert_eq!(c.nodes(), 20);
         assert!((c.total_capacity() / lam.heat_capacity() - 1.0).abs() < 1e-14);

@@ -4,7 +4,7 @@ use crate::analysis::layered::{
     analyse, critical_damping, equilibrium, jacobian, start_state, LayeredEquilibrium,
 };
 use crate::error::Error;
-use crate::inputs::laminate::{Laminate, MATERIALS};
+use crate::inputs::laminate::{wing_layup, Laminate, MATERIALS};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -16,22 +16,6 @@ use crate::runs::layered::{
     run_orbits, run_orbits_reading, simulate, LayeredOrbit, LayeredRun, LayeredRunRequest,
 };
 use nalgebra::{DMatrix, DVector};
-
-/// A CFRP/honeycomb solar-array substrate with Kapton on the Sun side.
-pub(crate) fn wing_layup() -> Laminate {
-    Laminate {
-        layers: vec![
-            MATERIALS[4].layer(50e-6),
-            MATERIALS[2].layer(0.3e-3),
-            MATERIALS[3].layer(20e-3),
-            MATERIALS[2].layer(0.3e-3),
-        ],
-        emissivity_front: 0.8,
-        emissivity_back: 0.8,
-        absorptivity: 0.9,
-        reference_temperature: 293.15,
-    }
-}
 
 #[test]
 fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
