@@ -72,35 +72,33 @@ fn map_times<'py>(
     Ok(PyArray1::from_vec(py, v))
 }
 
-/// Illumination s(t) at each time.
-#[pyfunction]
-fn illumination<'py>(
-    py: Python<'py>,
-    orbit: &Bound<'py, PyDict>,
-    t: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    shield(|| map_times(py, orbit, t, Orbit::illumination))
+/// A function of the orbit at each time of an array, as a pyfunction named `$name`.
+macro_rules! at_times {
+    ($(#[$doc:meta])* $name:ident => $f:path) => {
+        $(#[$doc])*
+        #[pyfunction]
+        fn $name<'py>(
+            py: Python<'py>,
+            orbit: &Bound<'py, PyDict>,
+            t: PyReadonlyArray1<'py, f64>,
+        ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+            shield(|| map_times(py, orbit, t, $f))
+        }
+    };
 }
 
-/// Solar flux relative to 1 au at each time.
-#[pyfunction]
-fn flux_scale<'py>(
-    py: Python<'py>,
-    orbit: &Bound<'py, PyDict>,
-    t: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    shield(|| map_times(py, orbit, t, Orbit::flux_scale))
-}
-
-/// The Sun's declination at each time, rad.
-#[pyfunction]
-fn declination<'py>(
-    py: Python<'py>,
-    orbit: &Bound<'py, PyDict>,
-    t: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    shield(|| map_times(py, orbit, t, Orbit::declination))
-}
+at_times!(
+    /// Illumination s(t) at each time.
+    illumination => Orbit::illumination
+);
+at_times!(
+    /// Solar flux relative to 1 au at each time.
+    flux_scale => Orbit::flux_scale
+);
+at_times!(
+    /// The Sun's declination at each time, rad.
+    declination => Orbit::declination
+);
 
 /// Orbit period relative to the Sun (time between eclipses), s.
 #[pyfunction]
