@@ -5,8 +5,11 @@ use super::convert::{coupling, hinge_model, orbit_from, panel_from, solver_dict,
 use super::error::shield;
 use super::laminate::conduction_from;
 use crate::runs::hybrid::HybridSettings;
-use crate::runs::orbits::SummaryOptions;
-use crate::runs::request::{OrbitsRequest, Thermal};
+use crate::runs::layered::LayeredRunRequest;
+use crate::runs::orbits::{OrbitRunRequest, SummaryOptions};
+use crate::runs::request::{OrbitsModel, OrbitsRequest};
+use crate::runs::simulate::state_from;
+use nalgebra::U4;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -53,26 +56,37 @@ fn run_orbits<'py>(
             steps_per_period,
         };
         let hybrid = hybrid.map(hybrid_from).transpose()?;
-        let req = OrbitsRequest {
-            thermal: match nodes {
-                Some(n) => Thermal::Laminate(conduction_from(&p, layup, n)?),
-                None => Thermal::Layers(2),
-            },
-            panel: p,
-            orbit: o,
-            model: hinge,
-            coupling,
-            method: m,
-            t_start,
-            first_index,
-            n_orbits,
-            y0,
-            options,
-            hybrid,
+        let model = match nodes {
+            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
+            Some(n) => OrbitsModel::Laminate(LayeredRunRequest {
+                panel: p,
+                conduction: conduction_from(&p, layup, n)?,
+                orbit: o,
+                model: hinge,
+                coupling,
+                method: m,
+                t_start,
+                first_index,
+                n_orbits,
+                y0,
+                options,
+            }),
+            None => OrbitsModel::TwoLayer(OrbitRunRequest {
+                panel: p,
+                orbit: o,
+                model: hinge,
+                coupling,
+                method: m,
+                t_start,
+                first_index,
+                n_orbits,
+                y0: state_from(&y0, U4)?,
+                options,
+            }),
         };
-        let method = req.method;
-        let out = py.detach(|| crate::runs::request::run_orbits(req, &cancel))?;
-        let d = summary_dict(py, &out.summaries, &method)?;
+        let req = OrbitsRequest { model, hybrid };
+        let out = py.detach(|| crate::runs::request::run_orbits(&req, &cancel))?;
+        let d = summary_dict(py, &out.summaries, &m)?;
         match out.split {
             Some(split) => hybrid_counters(d, &split),
             None => Ok(d),

@@ -2,10 +2,10 @@
 //! engine that runs it, made here once: a transient ([`RunRequest`]: the paper's two layers with
 //! the state size known at compile time, any registered thermal model, or a laminate's N-node
 //! model) and runs of whole orbits with per-orbit summaries ([`OrbitsRequest`]: two layers or a
-//! laminate, hinge-resolved or by the hybrid propagator).
+//! laminate, each by its own request, hinge-resolved or by the hybrid propagator).
 
 use crate::cancel::Cancel;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -15,10 +15,10 @@ use crate::models::thermal::ThermalModel;
 use crate::numerics::integrate::{Dyn, Method, Stats};
 use crate::runs::hybrid::{HybridRun, HybridSettings};
 use crate::runs::layered::{LayeredRun, LayeredRunRequest, LayeredSummaries};
-use crate::runs::orbits::{LimitCrossing, OrbitRunRequest, SummaryOptions};
+use crate::runs::orbits::{LimitCrossing, OrbitRunRequest};
 use crate::runs::simulate::{run_watched, state_from, OnLimit, Output};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, U4};
+use nalgebra::{DefaultAllocator, Dim};
 
 /// The through-thickness model of a run.
 #[derive(Debug, Clone)]
@@ -172,25 +172,20 @@ where
     })
 }
 
-/// Whole orbits from a start state, summarised orbit by orbit.
-#[derive(Debug, Clone)]
+/// Whole orbits from a start state, summarised orbit by orbit: the model's own request, and
+/// the hybrid propagator's settings (None: the hinge-resolved integration, which is also the
+/// hybrid's fallback).
 pub struct OrbitsRequest {
-    pub panel: Panel,
-    pub orbit: Orbit,
-    /// Two layers, or a laminate's N-node model.
-    pub thermal: Thermal,
-    pub model: HingeModel,
-    pub coupling: Coupling,
-    /// The integrator (with `hybrid`: its fallback).
-    pub method: Method,
-    pub t_start: f64,
-    pub first_index: u64,
-    pub n_orbits: u64,
-    /// The start state: (T_f, T_b, θ, θ̇), or the node temperatures, θ, θ̇.
-    pub y0: Vec<f64>,
-    pub options: SummaryOptions,
-    /// The hybrid propagator's settings; None: the hinge-resolved integration.
+    pub model: OrbitsModel,
     pub hybrid: Option<HybridSettings>,
+}
+
+/// The model a run of orbits integrates.
+pub enum OrbitsModel {
+    /// The paper's two layers on the hinge.
+    TwoLayer(OrbitRunRequest),
+    /// A laminate's N-node model on the hinge.
+    Laminate(LayeredRunRequest),
 }
 
 /// The summaries of a run of orbits and, for a hybrid run, how it split the simulated time.
@@ -200,88 +195,36 @@ pub struct OrbitsRun {
 }
 
 /// Runs `req` on its engine, stopping within a step of `cancel`.
-pub fn run_orbits(req: OrbitsRequest, cancel: &Cancel) -> Result<OrbitsRun> {
-    let OrbitsRequest {
-        panel,
-        orbit,
-        thermal,
-        model,
-        coupling,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
-        y0,
-        options,
-        hybrid,
-    } = req;
-    match thermal {
-        Thermal::Laminate(conduction) => {
-            let req = LayeredRunRequest {
-                panel,
-                conduction,
-                orbit,
-                model,
-                coupling,
-                method,
-                t_start,
-                first_index,
-                n_orbits,
-                y0,
-                options,
-            };
-            Ok(match hybrid {
-                None => OrbitsRun {
-                    summaries: crate::runs::layered::run_orbits(&req, cancel)?,
-                    split: None,
-                },
-                Some(settings) => {
-                    let out =
-                        crate::runs::hybrid::layered::run_orbits_hybrid(&req, &settings, cancel)?;
-                    OrbitsRun {
-                        summaries: out.run,
-                        split: Some(out.split),
-                    }
-                }
-            })
+pub fn run_orbits(req: &OrbitsRequest, cancel: &Cancel) -> Result<OrbitsRun> {
+    Ok(match (&req.model, &req.hybrid) {
+        (OrbitsModel::Laminate(run), None) => OrbitsRun {
+            summaries: crate::runs::layered::run_orbits(run, cancel)?,
+            split: None,
+        },
+        (OrbitsModel::Laminate(run), Some(settings)) => {
+            let out = crate::runs::hybrid::layered::run_orbits_hybrid(run, settings, cancel)?;
+            OrbitsRun {
+                summaries: out.run,
+                split: Some(out.split),
+            }
         }
-        Thermal::Layers(2) => {
-            let req = OrbitRunRequest {
-                panel,
-                orbit,
-                model,
-                coupling,
-                method,
-                t_start,
-                first_index,
-                n_orbits,
-                y0: state_from(&y0, U4)?,
-                options,
-            };
-            crate::models::hinge::check_start_state(
-                req.y0.as_slice(),
-                2,
-                Some(&Hinge::new(&panel, model)),
-            )?;
-            Ok(match hybrid {
+        (OrbitsModel::TwoLayer(run), hybrid) => {
+            let hinge = Hinge::new(&run.panel, run.model);
+            crate::models::hinge::check_start_state(run.y0.as_slice(), 2, Some(&hinge))?;
+            match hybrid {
                 None => OrbitsRun {
-                    summaries: crate::runs::orbits::run_orbits_cancellable(&req, cancel)?.into(),
+                    summaries: crate::runs::orbits::run_orbits_cancellable(run, cancel)?.into(),
                     split: None,
                 },
                 Some(settings) => {
-                    let out = crate::runs::hybrid::run_orbits_hybrid(&req, &settings, cancel)?;
+                    let out = crate::runs::hybrid::run_orbits_hybrid(run, settings, cancel)?;
                     // The run is copied (one summary per orbit) so that the counters keep theirs.
                     OrbitsRun {
                         summaries: out.run.clone().into(),
                         split: Some(out),
                     }
                 }
-            })
+            }
         }
-        Thermal::Layers(other) => Err(Error::invalid(
-            "layers",
-            other,
-            "runs of whole orbits take two layers or a laminate",
-        )),
-    }
+    })
 }
