@@ -81,7 +81,7 @@ pub trait ThermalModel {
     fn initial_guess(&self, flux: f64, out: &mut [f64]);
 }
 
-/// A boxed model is a model (what [`model`] returns).
+/// A boxed model is a model (what [`crate::models::thermal_model`] returns).
 impl<M: ThermalModel + ?Sized> ThermalModel for Box<M> {
     fn size(&self) -> usize {
         (**self).size()

@@ -87,8 +87,8 @@ pub struct StepReads {
 }
 
 /// Runs every job `next` hands out, [`LANES`] at a time, and hands each observer back to `done`
-/// with the run's outcome (as [`solve`] returns it) as soon as its run ends. Jobs whose model or
-/// coupling differs from the first job's run alone, through [`solve`].
+/// with the run's outcome (as [`crate::numerics::integrate::solve`] returns it) as soon as its run ends. Jobs whose model or
+/// coupling differs from the first job's run alone, through [`crate::numerics::integrate::solve`].
 pub fn solve_lockstep<O, N, F>(kernel: Kernel, next: N, done: F)
 where
     O: LaneObserver,
