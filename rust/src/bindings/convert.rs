@@ -130,50 +130,6 @@ pub fn hinge_model(name: &str) -> PyResult<HingeModel> {
     }
 }
 
-/// The integrator a run is asked for, converted only: its settings are checked once, by the
-/// integrator ([`Method::validate`], at the start of every solve).
-pub fn method(
-    name: &str,
-    rtol: f64,
-    atol: f64,
-    dt: Option<f64>,
-    max_step: f64,
-    max_steps: u64,
-) -> PyResult<Method> {
-    // rk45 does not use dt, but a dt no method could use is a mistake all the same.
-    if let Some(dt) = dt {
-        crate::error::require_positive("dt", dt)?;
-    }
-    let m = match name {
-        "rk45" => Method::Dopri5(Tolerances {
-            rtol,
-            atol,
-            max_step,
-            max_steps,
-        }),
-        "rk4" => match dt {
-            Some(dt) => Method::Rk4 { dt },
-            None => {
-                return Err(invalid(
-                    "dt",
-                    "None",
-                    "is required with method='rk4' (the fixed step, s)",
-                ))
-            }
-        },
-        other => {
-            return Err(invalid(
-                "method",
-                format!("{other:?}"),
-                "must be 'rk45' or 'rk4'",
-            ))
-        }
-    };
-    Ok(m)
-}
-
-/// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
-/// run function receives it.
 /// The validity limit a run watches: `theta_limit` (rad, checked whatever `on_limit`) with
 /// `on_limit` "flag" (record the first crossing), "stop" (end the run there) or "ignore" (None).
 pub fn on_limit(
@@ -206,6 +162,9 @@ pub fn crossing_tuple(c: Option<crate::runs::orbits::LimitCrossing>) -> Option<(
     c.map(|c| (c.t, c.orbit, c.theta))
 }
 
+/// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
+/// run function receives it, converted only: its settings are checked once, by the integrator
+/// ([`Method::validate`], at the start of every solve).
 pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
     let name: String = required_item(d, "method", "a string")?;
     let dt = match d.get_item("dt")? {
@@ -213,14 +172,33 @@ pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
         _ => None,
     };
     let max_steps: u64 = required_item(d, "max_steps", "an integer >= 1")?;
-    method(
-        &name,
-        float_item(d, "rtol")?,
-        float_item(d, "atol")?,
-        dt,
-        float_item(d, "max_step")?,
-        max_steps,
-    )
+    let (rtol, atol) = (float_item(d, "rtol")?, float_item(d, "atol")?);
+    let max_step = float_item(d, "max_step")?;
+    // rk45 does not use dt, but a dt no method could use is a mistake all the same.
+    if let Some(dt) = dt {
+        crate::error::require_positive("dt", dt)?;
+    }
+    match name.as_str() {
+        "rk45" => Ok(Method::Dopri5(Tolerances {
+            rtol,
+            atol,
+            max_step,
+            max_steps,
+        })),
+        "rk4" => match dt {
+            Some(dt) => Ok(Method::Rk4 { dt }),
+            None => Err(invalid(
+                "dt",
+                "None",
+                "is required with method='rk4' (the fixed step, s)",
+            )),
+        },
+        other => Err(invalid(
+            "method",
+            format!("{other:?}"),
+            "must be 'rk45' or 'rk4'",
+        )),
+    }
 }
 
 pub fn output(
