@@ -30,19 +30,31 @@ fn flutter<'py>(
         let d = PyDict::new(py);
         let eq = a.equilibrium;
         d.set_item("equilibrium", (eq.t_front, eq.t_back, eq.theta))?;
-        let rows: Vec<Vec<f64>> = (0..4)
-            .map(|i| (0..4).map(|j| a.jacobian[(i, j)]).collect())
-            .collect();
-        d.set_item("jacobian", PyArray2::from_vec2(py, &rows)?)?;
-        let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
-        d.set_item("eigenvalues", ev)?;
-        d.set_item("growth_rate", a.growth_rate)?;
-        d.set_item("frequency_hz", a.frequency_hz)?;
+        let jacobian = a.jacobian;
+        let rows = (0..4).map(|i| (0..4).map(|j| jacobian[(i, j)]).collect());
+        set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
         if with_critical {
             d.set_item("critical_damping", critical_damping(&p, m, c, flux)?)?;
         }
         Ok(d)
     })
+}
+
+/// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as
+/// (re, im) pairs), growth rate and frequency.
+pub(super) fn set_spectrum(
+    d: &Bound<'_, PyDict>,
+    rows: impl Iterator<Item = Vec<f64>>,
+    eigenvalues: &[nalgebra::Complex<f64>],
+    growth_rate: f64,
+    frequency_hz: f64,
+) -> PyResult<()> {
+    let rows: Vec<Vec<f64>> = rows.collect();
+    d.set_item("jacobian", PyArray2::from_vec2(d.py(), &rows)?)?;
+    let ev: Vec<(f64, f64)> = eigenvalues.iter().map(|z| (z.re, z.im)).collect();
+    d.set_item("eigenvalues", ev)?;
+    d.set_item("growth_rate", growth_rate)?;
+    d.set_item("frequency_hz", frequency_hz)
 }
 
 /// Growth rate and frequency over a grid of two panel parameters (rows: y, columns: x); stops

@@ -5,6 +5,7 @@ use super::convert::{
     coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
 };
 use super::error::{invalid, shield};
+use super::flutter::set_spectrum;
 use crate::analysis::flutter::check_flux;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
@@ -257,15 +258,9 @@ fn layered_flutter<'py>(
         d.set_item("temperatures", a.equilibrium.temperatures.clone())?;
         d.set_item("theta", a.equilibrium.theta)?;
         d.set_item("thermal_moment", a.equilibrium.moment)?;
-        d.set_item("growth_rate", a.growth_rate)?;
-        d.set_item("frequency_hz", a.frequency_hz)?;
         let size = a.jacobian.nrows();
-        let rows: Vec<Vec<f64>> = (0..size)
-            .map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect())
-            .collect();
-        d.set_item("jacobian", numpy::PyArray2::from_vec2(py, &rows)?)?;
-        let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
-        d.set_item("eigenvalues", ev)?;
+        let rows = (0..size).map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect());
+        set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
         if with_critical {
             let cd =
                 py.detach(|| crate::analysis::layered::critical_damping(&p, &c, m, k, flux))?;
