@@ -49,6 +49,7 @@ SUMMARY_FIELDS = (
 
 HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
+    "n_reread_steps",
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model and the hinge-resolved fallback."""
@@ -80,7 +81,8 @@ class OrbitSummaries:
     propagation: dict[str, float] = field(default_factory=dict)
     """Hybrid runs: simulated time (s) by linear arcs (``t_linear``), by the non-linear model
     (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
-    full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``)."""
+    full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``, and
+    ``n_reread_steps``: exponential steps whose band of θ failed its check and were read again)."""
     solver: SolverSettings | None = None
     """The integrator settings the engine ran with, as it reports them (with ``method="hybrid"``,
     those of its rk45 fallback); rk45's step is further capped at T_n/``steps_per_period``.

@@ -105,6 +105,7 @@ fn hybrid_counters<'py>(
     d.set_item("n_arcs", out.n_arcs)?;
     d.set_item("n_exp_steps", out.n_exp_steps)?;
     d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+    d.set_item("n_reread_steps", out.n_reread_steps)?;
     Ok(d)
 }
 

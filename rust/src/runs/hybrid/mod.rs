@@ -102,6 +102,9 @@ pub struct HybridRun {
     pub n_arcs: u64,
     pub n_exp_steps: u64,
     pub n_fallback_steps: u64,
+    /// Exponential steps whose band of θ failed its check and that were read again, resolving
+    /// the hinge.
+    pub n_reread_steps: u64,
 }
 
 /// What the state at a sunlit time allows.
@@ -283,6 +286,7 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             n_arcs: 0,
             n_exp_steps: 0,
             n_fallback_steps: 0,
+            n_reread_steps: 0,
         },
         judge: Judge {
             panel,
@@ -373,6 +377,21 @@ const DRIFT_ATOL: f64 = 5e-7;
 /// the summaries read (θ and M_T/K_el), in rad and relative to the deviation from θ_eq.
 const READ_ATOL: f64 = 1e-7;
 const READ_RTOL: f64 = 1e-3;
+
+/// How far the oscillation's amplitude measured at a step's middle may stray from the band's
+/// interpolation between its ends, relative to the largest oscillation the summaries read (with
+/// [`READ_ATOL`]): a tenth of the 2 % gate.
+const BAND_RTOL: f64 = 2e-3;
+
+/// Points read per hinge period off a step's formula where its band cannot be trusted (the peak
+/// of a sine sampled at 32 points is within 0.5 % of the true one), and at most this many per
+/// step.
+const REREADS_PER_PERIOD: f64 = 32.0;
+/// RK4 steps per hinge period where the hinge is resolved without a fast thermal mode: the
+/// amplitude's error is (ωh)⁶/144 ≈ 7e-6 per step, 0.2 % over fifty periods (the summaries read
+/// the extremes off each step's cubic, not at its ends).
+const RK4_STEPS_PER_PERIOD: f64 = 20.0;
+const MAX_FORMULA_READS: usize = 4096;
 
 /// Samples per hinge period of the linearisation's defect along an arc (the defect's harmonics
 /// up to the third stay apart from the first), and how often the points where it is read
@@ -828,9 +847,22 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
         let period = 2.0 * std::f64::consts::PI / self.judge.panel.natural_angular_frequency();
         let mut large = false;
         let mut done = false;
+        let mut resolved_time = 0.0;
         for w in cuts.windows(2) {
             let (a, b) = (w[0], w[1]);
             if b <= a || done {
+                continue;
+            }
+            // Partial shadow moves M_T/K_el fast (the flux follows the overlap of two discs):
+            // the hinge lags it by terms of every order in the rate, which no band of θ holds.
+            // Where no thermal mode is fast, resolving the hinge there costs less than the
+            // exponential steps that the moving flux would ask for.
+            let lit = self.orbit.illumination(0.5 * (a + b));
+            if !self.judge.modal && lit > 0.0 && lit < 1.0 {
+                let before = self.t;
+                self.resolved(b, period)?;
+                resolved_time += self.t - before;
+                done = self.stopped();
                 continue;
             }
             self.system.enter_segment(a, b);
@@ -900,69 +932,175 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             self.stats.n_rhs += 3 * (acc + rej);
             done = stop;
         }
-        self.out.t_exponential += self.t - start;
+        self.out.t_exponential += self.t - start - resolved_time;
         Ok(large)
     }
 
-    /// Feeds one exponential step to the summaries: four points of its Hermite interpolant when
-    /// the step resolves the hinge period, else bands θ_qs ± a (the quasi-static deflection and the
-    /// oscillation's amplitude, interpolated between the step's ends).
+    /// Feeds one exponential step to the summaries: points of its Hermite interpolant when the
+    /// step resolves the hinge period, else bands θ_qs ± a (the quasi-static deflection and the
+    /// oscillation's amplitude, interpolated between the step's ends). Each step is checked
+    /// against its own formula at its middle; where the check fails, the step is read off the
+    /// formula instead, densely enough to resolve the hinge.
     fn read_step(&mut self, st: &ExpStep<N>, period: f64) -> Result<()> {
         let dense = DenseStep::<Const<N>>::hermite(st.t0, st.t1, st.y0, st.y1, st.f0, st.f1);
-        let h = (st.t1 - st.t0) / 4.0;
-        let resolved = st.t1 - st.t0 <= period / 8.0;
+        let length = st.t1 - st.t0;
+        let resolved = length <= period / 8.0;
+        // The cubic through the ends against the step's own formula at its middle: where they
+        // differ in what the summaries read (a fast thermal transient after a flux jump, which
+        // a cubic overshoots), every point is read off the formula instead.
+        let t_mid = st.t0 + 0.5 * length;
+        let flux_mid = 0.5 * (st.flux0 + st.flux1);
+        let reads = |y: &SVector<f64, N>| (y[N - 2], self.judge.model.quasi_static(flux_mid, y));
+        let ((th_c, qs_c), (th_f, qs_f)) = (reads(&dense.eval(t_mid)), reads(&st.y_mid));
+        let eq = self.obs.collector.current.theta_eq;
+        let tol = READ_ATOL + READ_RTOL * (qs_f - eq).abs().max((th_f - eq).abs());
+        let formula = (th_c - th_f).abs().max((qs_c - qs_f).abs()) > tol;
+        if resolved {
+            // Read at the quarters; off the formula, also just after the start, where a fast
+            // transient has settled but the hinge's ringing has not yet decayed.
+            let fractions: &[f64] = if formula {
+                &[1.0 / 64.0, 1.0 / 16.0, 0.25, 0.5, 0.75, 1.0]
+            } else {
+                &[0.25, 0.5, 0.75, 1.0]
+            };
+            let mut before = 0.0;
+            for &frac in fractions {
+                let (t, y) = match frac {
+                    1.0 => (st.t1, st.y1),
+                    0.5 if formula => (t_mid, st.y_mid),
+                    _ => {
+                        let t = st.t0 + frac * length;
+                        (
+                            t,
+                            if formula {
+                                st.state_at(&self.system, t)
+                            } else {
+                                dense.eval(t)
+                            },
+                        )
+                    }
+                };
+                self.obs
+                    .collector
+                    .read(t, y.as_slice(), (frac - before) * length)?;
+                before = frac;
+            }
+            return Ok(());
+        }
         let (a0, a1) = (
             self.judge.oscillation(st.flux0, &st.y0, &st.f0),
             self.judge.oscillation(st.flux1, &st.y1, &st.f1),
         );
-        // The cubic through the ends against the step's own formula at its middle: where they
-        // differ in what the summaries read (a fast thermal transient after a flux jump, which
-        // a cubic overshoots), every point is read off the formula instead.
-        let t_mid = st.t0 + 2.0 * h;
-        let flux_mid = 0.5 * (st.flux0 + st.flux1);
-        let cubic = dense.eval(t_mid);
-        let reads = |y: &SVector<f64, N>| (y[N - 2], self.judge.model.quasi_static(flux_mid, y));
-        let ((th_c, qs_c), (th_f, qs_f)) = (reads(&cubic), reads(&st.y_mid));
-        let eq = self.obs.collector.current.theta_eq;
-        let tol = READ_ATOL + READ_RTOL * (qs_f - eq).abs().max((th_f - eq).abs());
-        let formula = (th_c - th_f).abs().max((qs_c - qs_f).abs()) > tol;
-        // Read at the quarters; off the formula, also just after the start, where a fast
-        // transient has settled but the hinge's ringing has not yet decayed.
-        let fractions: &[f64] = if formula {
-            &[1.0 / 64.0, 1.0 / 16.0, 0.25, 0.5, 0.75, 1.0]
-        } else {
-            &[0.25, 0.5, 0.75, 1.0]
-        };
+        // The band holds where the oscillation's amplitude, measured afresh at the middle, is
+        // what the interpolation between the ends says; it does not (a thermal transient that
+        // is not slow against the hinge, a fast-moving M_T/K_el that the hinge lags) where the
+        // amplitude measured at the middle strays from it, or, on panels with a fast thermal
+        // mode, where the cubic strayed from the formula after a flux jump.
+        let f_mid = self.judge.model.rhs_at_flux(flux_mid, &st.y_mid);
+        let a_mid = self.judge.oscillation(flux_mid, &st.y_mid, &f_mid);
+        // Relative to the largest oscillation the summaries hold (this orbit's peak so far, the
+        // last orbit's): an amplitude far below it reaches no extreme the gate reads.
+        let peak = match self.obs.collector.done.last() {
+            Some(s) if s.jitter_peak.is_finite() => s.jitter_peak,
+            _ => 0.0,
+        }
+        .max(self.obs.collector.current.jitter_peak);
+        let band_tol = READ_ATOL + BAND_RTOL * peak.max(a0).max(a1).max(a_mid);
+        if (formula && self.judge.modal) || (a_mid - 0.5 * (a0 + a1)).abs() > band_tol {
+            return self.reread(st, period);
+        }
         let mut before = 0.0;
-        for &frac in fractions {
-            let dt = (frac - before) * 4.0 * h;
+        for frac in [0.25, 0.5, 0.75, 1.0] {
+            let dt = (frac - before) * length;
             before = frac;
-            let t = if frac == 1.0 {
-                st.t1
+            let (t, y) = if frac == 1.0 {
+                (st.t1, st.y1)
             } else {
-                st.t0 + frac * 4.0 * h
-            };
-            let y = match frac {
-                1.0 => st.y1,
-                0.5 if formula => st.y_mid,
-                _ if formula => st.state_at(&self.system, t),
-                _ => dense.eval(t),
-            };
-            if resolved {
-                self.obs.collector.read(t, y.as_slice(), dt)?;
-            } else {
-                let amp = a0 + (a1 - a0) * frac;
-                let flux = st.flux0 + (st.flux1 - st.flux0) * frac;
-                let quasi_static = self.judge.model.quasi_static(flux, &y);
-                self.obs.collector.record(
+                let t = st.t0 + frac * length;
+                (
                     t,
-                    quasi_static - amp,
-                    quasi_static + amp,
-                    amp,
-                    0.5 * amp * amp * dt,
-                    dt,
-                )?;
+                    if formula {
+                        st.state_at(&self.system, t)
+                    } else {
+                        dense.eval(t)
+                    },
+                )
+            };
+            let amp = a0 + (a1 - a0) * frac;
+            let flux = st.flux0 + (st.flux1 - st.flux0) * frac;
+            let quasi_static = self.judge.model.quasi_static(flux, &y);
+            self.obs.collector.record(
+                t,
+                quasi_static - amp,
+                quasi_static + amp,
+                amp,
+                0.5 * amp * amp * dt,
+                dt,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The model from t to `end` by fixed-step RK4 at [`RK4_STEPS_PER_PERIOD`] steps to the hinge
+    /// period, read as the full integration is: on stretches without a fast thermal mode where
+    /// the hinge must be resolved.
+    fn resolved(&mut self, end: f64, period: f64) -> Result<()> {
+        let method = Method::Rk4 {
+            dt: period / RK4_STEPS_PER_PERIOD,
+        };
+        let (stats, y) = solve(
+            &mut self.system,
+            &method,
+            self.t,
+            self.y,
+            end,
+            &mut self.obs,
+        )?;
+        if let Some(e) = self.obs.error.take() {
+            return Err(e);
+        }
+        self.out.t_fallback += stats.t_end - self.t;
+        self.out.n_fallback_steps += stats.n_steps;
+        self.stats.n_steps += stats.n_steps;
+        self.stats.n_rhs += stats.n_rhs;
+        self.t = if stats.stopped { stats.t_end } else { end };
+        self.y = y;
+        Ok(())
+    }
+
+    /// Reads a step whose band cannot be trusted at points that resolve the hinge: off the step's own formula where a thermal mode is
+    /// fast (an explicit integrator would have to follow it; [`REREADS_PER_PERIOD`]), else by a
+    /// fixed-step RK4 run ([`RK4_STEPS_PER_PERIOD`]) of
+    /// the model over the step from its start (cheaper than evaluating the formula's φ
+    /// functions at each point), whose steps the summaries read as those of the full
+    /// integration. The run goes on from the exponential step's own end.
+    fn reread(&mut self, st: &ExpStep<N>, period: f64) -> Result<()> {
+        self.out.n_reread_steps += 1;
+        let length = st.t1 - st.t0;
+        if !self.judge.modal {
+            let method = Method::Rk4 {
+                dt: period / RK4_STEPS_PER_PERIOD,
+            };
+            let mut system = self.system.clone();
+            let (stats, _) = solve(&mut system, &method, st.t0, st.y0, st.t1, &mut self.obs)?;
+            if let Some(e) = self.obs.error.take() {
+                return Err(e);
             }
+            self.stats.n_rhs += stats.n_rhs;
+            return Ok(());
+        }
+        let n = (length / period * REREADS_PER_PERIOD)
+            .ceil()
+            .clamp(4.0, MAX_FORMULA_READS as f64) as usize;
+        let dt = length / n as f64;
+        for k in 1..=n {
+            let (t, y) = if k == n {
+                (st.t1, st.y1)
+            } else {
+                let t = st.t0 + k as f64 * dt;
+                (t, st.state_at(&self.system, t))
+            };
+            self.obs.collector.read(t, y.as_slice(), dt)?;
         }
         Ok(())
     }
