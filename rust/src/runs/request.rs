@@ -228,3 +228,79 @@ pub fn run_orbits(req: &OrbitsRequest, cancel: &Cancel) -> Result<OrbitsRun> {
         }
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::numerics::integrate::Tolerances;
+    use crate::runs::simulate::run;
+
+    fn request(thermal: Thermal) -> RunRequest {
+        RunRequest {
+            panel: Panel::paper(),
+            orbit: Orbit::geo_equinox(),
+            thermal,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            span: (0.0, 3000.0),
+            output: Output::Every(100.0),
+            y0: None,
+            limit: None,
+        }
+    }
+
+    #[test]
+    fn a_two_layer_request_is_the_paper_model_run_directly() {
+        let req = request(Thermal::Layers(2));
+        let Transient::Coupled(got) = simulate(req.clone(), &Cancel::new()).unwrap() else {
+            panic!("two layers run on the coupled engine");
+        };
+        let mut sys = Coupled::new(req.panel, req.orbit, req.model, req.coupling);
+        let y0 = sys.steady_state(req.orbit.flux_scale(0.0)).unwrap();
+        let want = run(&mut sys, &req.method, req.span, y0, &req.output).unwrap();
+        assert_eq!(got.t, want.t);
+        assert_eq!(got.names, ["T_front", "T_back", "theta", "theta_dot"]);
+        for (i, column) in got.columns.iter().enumerate() {
+            assert_eq!(*column, want.column(i), "{}", got.names[i]);
+        }
+        assert_eq!(got.stats, want.stats);
+    }
+
+    #[test]
+    fn a_laminate_request_runs_the_n_node_engine() {
+        let panel = Panel::paper();
+        let c = Conduction::homogeneous(&panel, 5).unwrap();
+        let req = request(Thermal::Laminate(c.clone()));
+        let Transient::Layered(got) = simulate(req.clone(), &Cancel::new()).unwrap() else {
+            panic!("a laminate runs on the N-node engine");
+        };
+        let want = crate::runs::layered::simulate(
+            &panel,
+            c,
+            &req.orbit,
+            req.model,
+            req.coupling,
+            &req.method,
+            req.span,
+            None,
+            &req.output,
+            None,
+            &Cancel::new(),
+        )
+        .unwrap();
+        assert_eq!((got.nodes, &got.t, &got.theta), (5, &want.t, &want.theta));
+        assert_eq!(got.temperatures, want.temperatures);
+    }
+
+    #[test]
+    fn a_start_of_the_wrong_size_is_refused_by_name() {
+        let mut req = request(Thermal::Layers(3));
+        req.y0 = Some(vec![300.0; 4]);
+        let e = simulate(req, &Cancel::new()).unwrap_err();
+        assert!(
+            matches!(e, crate::error::Error::InvalidParameter { ref name, .. } if name == "y0"),
+            "{e}"
+        );
+    }
+}
