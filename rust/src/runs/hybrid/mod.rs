@@ -384,14 +384,13 @@ const READ_RTOL: f64 = 1e-3;
 const BAND_RTOL: f64 = 2e-3;
 
 /// Points read per hinge period off a step's formula where its band cannot be trusted (the peak
-/// of a sine sampled at 32 points is within 0.5 % of the true one), and at most this many per
-/// step.
+/// of a sine sampled at 32 points is within 0.5 % of the true one). No cap: fewer would miss
+/// the peaks silently.
 const REREADS_PER_PERIOD: f64 = 32.0;
 /// RK4 steps per hinge period where the hinge is resolved without a fast thermal mode: the
 /// amplitude's error is (ωh)⁶/144 ≈ 7e-6 per step, 0.2 % over fifty periods (the summaries read
 /// the extremes off each step's cubic, not at its ends).
 const RK4_STEPS_PER_PERIOD: f64 = 20.0;
-const MAX_FORMULA_READS: usize = 4096;
 
 /// Samples per hinge period of the linearisation's defect along an arc (the defect's harmonics
 /// up to the third stay apart from the first), and how often the points where it is read
@@ -1089,9 +1088,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             self.stats.n_rhs += stats.n_rhs;
             return Ok(());
         }
-        let n = (length / period * REREADS_PER_PERIOD)
-            .ceil()
-            .clamp(4.0, MAX_FORMULA_READS as f64) as usize;
+        let n = (length / period * REREADS_PER_PERIOD).ceil().max(4.0) as usize;
         let dt = length / n as f64;
         for k in 1..=n {
             let (t, y) = if k == n {
