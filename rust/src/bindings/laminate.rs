@@ -10,7 +10,7 @@ use crate::analysis::flutter::check_flux;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
-use crate::runs::request::{RunRequest, Thermal};
+use crate::runs::request::{RunRequest, ThermalChoice};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -304,7 +304,7 @@ fn simulate_layers<'py>(
         let req = RunRequest {
             panel: p,
             orbit: o,
-            thermal: Thermal::Laminate(c),
+            thermal: ThermalChoice::Laminate(c),
             model: hinge,
             coupling: coupling(coupled),
             method,

@@ -18,7 +18,7 @@ use crate::models::coupled::{Coupled, DrivenHinge, MomentHistory};
 use crate::models::hinge::checked_hinge_energy;
 use crate::models::hinge::{thermal_moment, Hinge};
 use crate::numerics::integrate::{Method, Stats};
-use crate::runs::request::{coupled_run, CoupledRun, RunRequest, Thermal, Transient};
+use crate::runs::request::{coupled_run, CoupledRun, RunRequest, ThermalChoice, Transient};
 use crate::runs::simulate::{run_watched, state_from};
 use cancel::{token, CancelToken};
 use convert::{
@@ -254,7 +254,7 @@ fn simulate<'py>(
         let req = RunRequest {
             panel: panel_from(panel)?,
             orbit: orbit_from(orbit)?,
-            thermal: Thermal::Layers(layers),
+            thermal: ThermalChoice::Layers(layers),
             model: hinge_model(model)?,
             coupling: coupling(coupled),
             method: solver_from(solver)?,

@@ -22,7 +22,7 @@ use nalgebra::{DefaultAllocator, Dim};
 
 /// The through-thickness model of a run.
 #[derive(Debug, Clone)]
-pub enum Thermal {
+pub enum ThermalChoice {
     /// The thermal model registered for this number of layers ([`crate::models::thermal_model`]).
     Layers(u32),
     /// A laminate's N-node conduction model ([`crate::runs::layered`]).
@@ -36,7 +36,7 @@ pub enum Thermal {
 pub struct RunRequest {
     pub panel: Panel,
     pub orbit: Orbit,
-    pub thermal: Thermal,
+    pub thermal: ThermalChoice,
     pub model: HingeModel,
     pub coupling: Coupling,
     pub method: Method,
@@ -90,8 +90,8 @@ pub fn simulate(req: RunRequest, cancel: &Cancel) -> Result<Transient> {
         limit,
     } = req;
     let layers = match thermal {
-        Thermal::Layers(n) => n,
-        Thermal::Laminate(c) => {
+        ThermalChoice::Layers(n) => n,
+        ThermalChoice::Laminate(c) => {
             let run = crate::runs::layered::simulate(
                 &panel,
                 c,
@@ -235,7 +235,7 @@ mod tests {
     use crate::numerics::integrate::Tolerances;
     use crate::runs::simulate::run;
 
-    fn request(thermal: Thermal) -> RunRequest {
+    fn request(thermal: ThermalChoice) -> RunRequest {
         RunRequest {
             panel: Panel::paper(),
             orbit: Orbit::geo_equinox(),
@@ -252,7 +252,7 @@ mod tests {
 
     #[test]
     fn a_two_layer_request_is_the_paper_model_run_directly() {
-        let req = request(Thermal::Layers(2));
+        let req = request(ThermalChoice::Layers(2));
         let Transient::Coupled(got) = simulate(req.clone(), &Cancel::new()).unwrap() else {
             panic!("two layers run on the coupled engine");
         };
@@ -271,7 +271,7 @@ mod tests {
     fn a_laminate_request_runs_the_n_node_engine() {
         let panel = Panel::paper();
         let c = Conduction::homogeneous(&panel, 5).unwrap();
-        let req = request(Thermal::Laminate(c.clone()));
+        let req = request(ThermalChoice::Laminate(c.clone()));
         let Transient::Layered(got) = simulate(req.clone(), &Cancel::new()).unwrap() else {
             panic!("a laminate runs on the N-node engine");
         };
@@ -295,7 +295,7 @@ mod tests {
 
     #[test]
     fn a_start_of_the_wrong_size_is_refused_by_name() {
-        let mut req = request(Thermal::Layers(3));
+        let mut req = request(ThermalChoice::Layers(3));
         req.y0 = Some(vec![300.0; 4]);
         let e = simulate(req, &Cancel::new()).unwrap_err();
         assert!(
