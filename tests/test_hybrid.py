@@ -238,3 +238,23 @@ def test_thin_aluminium_found_by_the_property_test(
     on theta_min/amplitude (1.07 x) and on jitter_peak (2.2 x)."""
     full, hybrid = both(tj.Orbit.geo_equinox(), 1, painted_aluminium(thickness, length, damping))
     assert_gate(full, hybrid)
+
+
+def test_table_1_in_the_spring_season_holds_jitter_peak() -> None:
+    """Table 1 on 20 March: the band of θ missed jitter_peak by 1.8-3.4 x the gate in the first
+    orbit (measured on 7d879cf), the hinge lagging the moment that the partial shadow moves fast."""
+    full, hybrid = both(tj.Orbit.geo_year("2026-03-20"), 2)
+    assert_gate(full, hybrid)
+
+
+def test_cfrp_window_edge_found_by_the_property_test() -> None:
+    """A case the slow tier drew on 7d879cf: a 2.3 mm CFRP-like plate at equinox, θ still falling
+    where the window after entry ends; entry_theta_min was read at the exponential step's nearest
+    quarter (1.34 x the gate)."""
+    layer = tj.materials.CFRP_M55J_QI.layer(0.002311025262354906)
+    layer = tj.laminate.Layer(**{**layer.as_dict(), "expansion_coeff": 1.765090568325095e-06})
+    layup = tj.Laminate([layer], emissivity_front=0.20583819318130503, emissivity_back=0.9,
+                        absorptivity=0.4)  # fmt: skip
+    panel = tj.Panel.from_laminate(layup, length=4.461173325460894)
+    full, hybrid = both(tj.Orbit.geo_equinox(), 1, panel.replace(damping=0.9674465460896375))
+    assert_gate(full, hybrid)

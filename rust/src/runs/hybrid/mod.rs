@@ -33,7 +33,7 @@ use crate::error::{require_positive, Error, Result};
 use crate::inputs::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::inputs::panel::Panel;
 use crate::models::hinge::HingeModel;
-use crate::numerics::integrate::{solve, DenseStep, Method, Observer, Stats};
+use crate::numerics::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
 use crate::runs::orbits::{
     resolve_hinge, Collector, OrbitRun, OrbitRunRequest, Summarised, SummaryObserver,
     SummaryOptions, STEPS_PER_HINGE_PERIOD,
@@ -315,6 +315,21 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
         run: obs.collector.finish(stats, y),
         split: out,
     })
+}
+
+/// A model over a span the caller knows to hold none of its breakpoints (a segment between
+/// the exponential integrator's cuts): the integrator then does not search the orbit for them
+/// again.
+struct WithinSegment<'a, M>(&'a mut M);
+
+impl<const N: usize, M: HybridModel<N>> OdeSystem<Const<N>> for WithinSegment<'_, M> {
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &SVector<f64, N>) -> SVector<f64, N> {
+        self.0.rhs(t, y)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.0.enter_segment(a, b)
+    }
 }
 
 /// The tests that decide the regime: everything they need, apart from the driver so that the
@@ -954,31 +969,25 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
         let eq = self.obs.collector.current.theta_eq;
         let tol = READ_ATOL + READ_RTOL * (qs_f - eq).abs().max((th_f - eq).abs());
         let formula = (th_c - th_f).abs().max((qs_c - qs_f).abs()) > tol;
+        let state = |frac: f64, t: f64| -> SVector<f64, N> {
+            match (frac == 1.0, formula, frac == 0.5) {
+                (true, _, _) => st.y1,
+                (false, true, true) => st.y_mid,
+                (false, true, false) => st.state_at(&self.system, t),
+                (false, false, _) => dense.eval(t),
+            }
+        };
         if resolved {
             // Read at the quarters; off the formula, also just after the start, where a fast
             // transient has settled but the hinge's ringing has not yet decayed.
-            let fractions: &[f64] = if formula {
+            let base: &[f64] = if formula {
                 &[1.0 / 64.0, 1.0 / 16.0, 0.25, 0.5, 0.75, 1.0]
             } else {
                 &[0.25, 0.5, 0.75, 1.0]
             };
             let mut before = 0.0;
-            for &frac in fractions {
-                let (t, y) = match frac {
-                    1.0 => (st.t1, st.y1),
-                    0.5 if formula => (t_mid, st.y_mid),
-                    _ => {
-                        let t = st.t0 + frac * length;
-                        (
-                            t,
-                            if formula {
-                                st.state_at(&self.system, t)
-                            } else {
-                                dense.eval(t)
-                            },
-                        )
-                    }
-                };
+            for (frac, t) in self.with_window_edges(base, st.t0, st.t1) {
+                let y = state(frac, t);
                 self.obs
                     .collector
                     .read(t, y.as_slice(), (frac - before) * length)?;
@@ -1009,22 +1018,10 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             return self.reread(st, period);
         }
         let mut before = 0.0;
-        for frac in [0.25, 0.5, 0.75, 1.0] {
+        for (frac, t) in self.with_window_edges(&[0.25, 0.5, 0.75, 1.0], st.t0, st.t1) {
             let dt = (frac - before) * length;
             before = frac;
-            let (t, y) = if frac == 1.0 {
-                (st.t1, st.y1)
-            } else {
-                let t = st.t0 + frac * length;
-                (
-                    t,
-                    if formula {
-                        st.state_at(&self.system, t)
-                    } else {
-                        dense.eval(t)
-                    },
-                )
-            };
+            let y = state(frac, t);
             let amp = a0 + (a1 - a0) * frac;
             let flux = st.flux0 + (st.flux1 - st.flux0) * frac;
             let quasi_static = self.judge.model.quasi_static(flux, &y);
@@ -1040,6 +1037,31 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
         Ok(())
     }
 
+    /// The points (fraction, time) of the step (t0, t1] at the fractions `base`, with the edges
+    /// of the current orbit's windows after entry and exit that fall inside it, at their exact
+    /// times: a window's extreme is read where it ends, not at the nearest quarter (θ still
+    /// falls there as the panel cools).
+    fn with_window_edges(&self, base: &[f64], t0: f64, t1: f64) -> Vec<(f64, f64)> {
+        let s = &self.obs.collector.current;
+        let w = self.obs.collector.options.window;
+        let at = |frac: f64| {
+            if frac == 1.0 {
+                t1
+            } else {
+                t0 + frac * (t1 - t0)
+            }
+        };
+        let mut points: Vec<(f64, f64)> = base.iter().map(|&f| (f, at(f))).collect();
+        for edge in [s.t_entry, s.t_entry + w, s.t_exit, s.t_exit + w] {
+            if edge > t0 && edge < t1 {
+                points.push(((edge - t0) / (t1 - t0), edge));
+            }
+        }
+        points.sort_by(|a, b| a.1.total_cmp(&b.1));
+        points.dedup_by(|a, b| a.1 == b.1);
+        points
+    }
+
     /// The model from t to `end` by fixed-step RK4 at [`RK4_STEPS_PER_PERIOD`] steps to the hinge
     /// period, read as the full integration is: on stretches without a fast thermal mode where
     /// the hinge must be resolved.
@@ -1048,7 +1070,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             dt: period / RK4_STEPS_PER_PERIOD,
         };
         let (stats, y) = solve(
-            &mut self.system,
+            &mut WithinSegment(&mut self.system),
             &method,
             self.t,
             self.y,
@@ -1080,7 +1102,8 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             let method = Method::Rk4 {
                 dt: period / RK4_STEPS_PER_PERIOD,
             };
-            let mut system = self.system.clone();
+            let mut model = self.system.clone();
+            let mut system = WithinSegment(&mut model);
             let (stats, _) = solve(&mut system, &method, st.t0, st.y0, st.t1, &mut self.obs)?;
             if let Some(e) = self.obs.error.take() {
                 return Err(e);
@@ -1089,15 +1112,16 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             return Ok(());
         }
         let n = (length / period * REREADS_PER_PERIOD).ceil().max(4.0) as usize;
-        let dt = length / n as f64;
-        for k in 1..=n {
-            let (t, y) = if k == n {
-                (st.t1, st.y1)
+        let base: Vec<f64> = (1..=n).map(|k| k as f64 / n as f64).collect();
+        let mut before = st.t0;
+        for (frac, t) in self.with_window_edges(&base, st.t0, st.t1) {
+            let y = if frac == 1.0 {
+                st.y1
             } else {
-                let t = st.t0 + k as f64 * dt;
-                (t, st.state_at(&self.system, t))
+                st.state_at(&self.system, t)
             };
-            self.obs.collector.read(t, y.as_slice(), dt)?;
+            self.obs.collector.read(t, y.as_slice(), t - before)?;
+            before = t;
         }
         Ok(())
     }
