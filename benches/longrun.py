@@ -24,7 +24,18 @@ import numpy as np
 
 import thermojitter as tj
 
-METRICS = ("amplitude", "exit_peak", "entry_peak", "jitter_rms", "theta_max", "theta_min")
+METRICS = (
+    "amplitude",
+    "exit_peak",
+    "entry_peak",
+    "jitter_rms",
+    "jitter_peak",
+    "theta_max",
+    "theta_min",
+    "entry_theta_min",
+    "exit_theta_max",
+)
+"""Every summary column: the gate holds on each (tests/test_hybrid.py)."""
 
 
 def peak_rss_mb() -> float:
@@ -45,7 +56,7 @@ def gate(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries) -> None:
         err = np.abs(b[small] - a[small])
         bad = int(np.sum(rel > 0.02) + np.sum(err > 1e-6)) + mismatch
         print(
-            f"  {name:11s} max rel err {rel.max() if rel.size else 0.0:.2e} ({big.sum()} orbits)"
+            f"  {name:15s} max rel err {rel.max() if rel.size else 0.0:.2e} ({big.sum()} orbits)"
             f"  max abs err {err.max() if err.size else 0.0:.2e} rad ({small.sum()} orbits)"
             f"  outside the gate: {bad}"
         )

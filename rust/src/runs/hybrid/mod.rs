@@ -319,16 +319,40 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
 
 /// A model over a span the caller knows to hold none of its breakpoints (a segment between
 /// the exponential integrator's cuts): the integrator then does not search the orbit for them
-/// again.
-struct WithinSegment<'a, M>(&'a mut M);
+/// again. The flux of the last time asked is kept: RK4 asks twice at each time (its two middle
+/// stages, its last stage and the next step's first), and in partial shadow the flux is the
+/// costly part of the right-hand side (the two discs' overlap). Bit for bit the model's own
+/// right-hand side, which is f(flux(t), y).
+struct WithinSegment<'a, M> {
+    model: &'a mut M,
+    last: Cell<(f64, f64)>,
+}
+
+impl<'a, M> WithinSegment<'a, M> {
+    fn new(model: &'a mut M) -> Self {
+        WithinSegment {
+            model,
+            last: Cell::new((f64::NAN, 0.0)),
+        }
+    }
+}
 
 impl<const N: usize, M: HybridModel<N>> OdeSystem<Const<N>> for WithinSegment<'_, M> {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &SVector<f64, N>) -> SVector<f64, N> {
-        self.0.rhs(t, y)
+        let flux = match self.last.get() {
+            (at, flux) if at == t => flux,
+            _ => {
+                let flux = self.model.flux_at(t);
+                self.last.set((t, flux));
+                flux
+            }
+        };
+        self.model.rhs_at_flux(flux, y)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
-        self.0.enter_segment(a, b)
+        self.model.enter_segment(a, b);
+        self.last.set((f64::NAN, 0.0));
     }
 }
 
@@ -1070,7 +1094,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             dt: period / RK4_STEPS_PER_PERIOD,
         };
         let (stats, y) = solve(
-            &mut WithinSegment(&mut self.system),
+            &mut WithinSegment::new(&mut self.system),
             &method,
             self.t,
             self.y,
@@ -1103,7 +1127,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
                 dt: period / RK4_STEPS_PER_PERIOD,
             };
             let mut model = self.system.clone();
-            let mut system = WithinSegment(&mut model);
+            let mut system = WithinSegment::new(&mut model);
             let (stats, _) = solve(&mut system, &method, st.t0, st.y0, st.t1, &mut self.obs)?;
             if let Some(e) = self.obs.error.take() {
                 return Err(e);
