@@ -12,16 +12,17 @@
 use nalgebra::Vector4;
 use std::hint::black_box;
 use std::time::Instant;
+use thermojitter::analysis::steady::equilibrium;
 use thermojitter::cancel::Cancel;
-use thermojitter::dynamics::HingeModel;
-use thermojitter::integrate::dopri5;
-use thermojitter::integrate::lockstep::RUNS_PER_CORE;
-use thermojitter::integrate::{
-    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, ScalarKernel, StepCounter, Tolerances,
+use thermojitter::models::coupled::{Coupled, Coupling};
+use thermojitter::models::hinge::HingeModel;
+use thermojitter::numerics::cpu::ScalarKernel;
+use thermojitter::numerics::integrate::dopri5;
+use thermojitter::numerics::integrate::{
+    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, StepCounter, Tolerances,
 };
-use thermojitter::montecarlo::{pool, run_batch_on, EnsembleSettings, Path};
-use thermojitter::steady::equilibrium;
-use thermojitter::system::{Coupled, Coupling};
+use thermojitter::runs::ensemble::{pool, run_batch_on, EnsembleSettings, Path};
+use thermojitter::runs::lockstep::RUNS_PER_CORE;
 use thermojitter::{Orbit, Panel};
 
 /// Median over `batches` of the time per call of `f`, run `per_batch` times a batch, ns.
@@ -109,7 +110,7 @@ fn main() {
         .filter(|a| !a.starts_with('-'))
         .collect();
     let wanted = |name: &str| filter.is_empty() || filter.iter().any(|f| name.contains(f.as_str()));
-    println!("{}", thermojitter::cpu::describe());
+    println!("{}", thermojitter::numerics::cpu::describe());
     let panel = Panel::paper();
     let orbit = Orbit::geo_equinox();
     let eq = equilibrium(&panel, Coupling::ProjectedArea, 1.0).expect("equilibrium");

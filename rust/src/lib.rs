@@ -3,41 +3,23 @@
 //! coupled to a one-degree-of-freedom hinge model of its first bending mode (Parisse & Angeletti
 //! 2024), integrated through eclipses.
 //!
-//! The engine is plain Rust; the Python bindings live in `py` behind the `python` feature.
+//! The engine is plain Rust; the Python bindings live in `bindings` behind the `python` feature.
 
-pub mod beam;
+pub mod analysis;
 pub mod cancel;
-pub mod conduction;
-pub mod cpu;
-pub mod distributed;
-pub mod dynamics;
 pub mod error;
-pub mod flutter;
-pub mod hybrid;
-pub mod integrate;
-pub mod laminate;
-pub mod layered;
-pub mod linear;
-pub mod longrun;
-pub mod montecarlo;
-mod num;
-pub mod orbit;
-pub mod params;
-pub mod simulate;
-pub mod stability;
-pub mod steady;
-pub mod system;
-pub mod thermal;
+pub mod inputs;
+pub mod models;
+pub mod numerics;
+pub mod runs;
 
 #[cfg(test)]
 mod recorded;
 
 #[cfg(feature = "python")]
-mod py;
+mod bindings;
 
 pub use error::{Error, Result};
-pub use orbit::Orbit;
-pub use params::Panel;
-
-/// Stefan–Boltzmann constant, W/(m² K⁴) (CODATA 2018, exact).
-pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
+pub use inputs::orbit::Orbit;
+pub use inputs::panel::Panel;
+pub use models::thermal::STEFAN_BOLTZMANN;

@@ -6,7 +6,7 @@
 //! its sunlit equilibrium with the adaptive integrator over one orbit, plus the linear/frozen
 //! variants, a fixed-step run, per-orbit summaries and the flutter analysis.
 //!
-//! The records are the portable kernel's bits (`integrate::ScalarKernel::Portable`, the only
+//! The records are the portable kernel's bits (`numerics::cpu::ScalarKernel::Portable`, the only
 //! one there was), so every case runs on it ([`on_portable`]); the fused kernel's results are
 //! checked against them within a tolerance ([`fused_kernel_stays_near_the_records`]).
 //!
@@ -14,16 +14,17 @@
 //! changed how the summary reads each step (see [`SUMMARIES_TWO_READS`]); the four-read values
 //! are kept and checked within 1e-3.
 
-use crate::dynamics::HingeModel;
-use crate::flutter::{analyse, critical_damping};
-use crate::integrate::lockstep::on_portable;
-use crate::integrate::{Method, ScalarKernel, Tolerances};
-use crate::longrun::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
-use crate::orbit::Orbit;
-use crate::params::Panel;
-use crate::simulate::{run, Output};
-use crate::steady::equilibrium;
-use crate::system::{state, Coupled, Coupling};
+use crate::analysis::flutter::{analyse, critical_damping};
+use crate::analysis::steady::equilibrium;
+use crate::inputs::orbit::Orbit;
+use crate::inputs::panel::Panel;
+use crate::models::coupled::{state, Coupled, Coupling};
+use crate::models::hinge::HingeModel;
+use crate::numerics::cpu::on_portable;
+use crate::numerics::cpu::ScalarKernel;
+use crate::numerics::integrate::{Method, Tolerances};
+use crate::runs::orbits::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
+use crate::runs::simulate::{run, Output};
 
 /// The penumbral year orbit: 1 October, inside the autumn eclipse season.
 fn year_orbit() -> Orbit {

@@ -1,0 +1,248 @@
+//! Python values to engine types, with errors that name the parameter.
+
+use super::error::invalid;
+use crate::inputs::orbit::Shadow;
+use crate::models::coupled::Coupling;
+use crate::models::hinge::HingeModel;
+use crate::numerics::integrate::{Method, Tolerances};
+use crate::runs::simulate::Output;
+use crate::{Orbit, Panel};
+use numpy::PyReadonlyArray1;
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyBool, PyDict, PyString};
+
+/// A float entry of a mapping, named in any error. The key may be an interned Python string, so
+/// that the lookup neither builds nor hashes a new string.
+pub(super) fn float_item<'py, K>(d: &Bound<'py, PyDict>, key: K) -> PyResult<f64>
+where
+    K: IntoPyObject<'py> + std::fmt::Display + Copy,
+{
+    let v = d
+        .get_item(key)?
+        .ok_or_else(|| invalid(&key.to_string(), "missing", "is required"))?;
+    // A bool is not a number (Python would read True as 1.0).
+    if v.is_instance_of::<PyBool>() {
+        return Err(type_error(&key.to_string(), "a number", &v));
+    }
+    v.extract::<f64>()
+        .map_err(|_| type_error(&key.to_string(), "a number", &v))
+}
+
+/// A TypeError naming the parameter, the type expected and the type given.
+pub fn type_error(name: &str, expected: &str, given: &Bound<'_, PyAny>) -> PyErr {
+    let kind = given
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_default();
+    PyTypeError::new_err(format!("{name} must be {expected}, not {kind}"))
+}
+
+/// The panel's field names as interned Python strings, built once.
+static PANEL_KEYS: PyOnceLock<Vec<Py<PyString>>> = PyOnceLock::new();
+
+pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
+    let py = d.py();
+    let keys = PANEL_KEYS.get_or_init(py, || {
+        Panel::FIELDS
+            .iter()
+            .map(|name| PyString::intern(py, name).unbind())
+            .collect()
+    });
+    let mut p = Panel::paper();
+    for (name, key) in Panel::FIELDS.iter().zip(keys) {
+        p.set(name, float_item(d, key.bind(py))?)?;
+    }
+    p.validate()?;
+    Ok(p)
+}
+
+/// An optional entry of a mapping of type T, named in any error.
+pub(super) fn optional_item<'py, T: FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    kind: &str,
+) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) => v
+            .extract::<T>()
+            .map(Some)
+            .map_err(|_| type_error(key, kind, &v)),
+    }
+}
+
+/// A required entry of a mapping, of type `T` (`kind` says which in the error).
+pub(super) fn required_item<'py, T: FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    kind: &str,
+) -> PyResult<T> {
+    optional_item(d, key, kind)?.ok_or_else(|| invalid(key, "missing", "is required"))
+}
+
+/// An orbit from a mapping: radius, earth_radius, period and phase0 are required; shadow
+/// ('none' | 'cylindrical' | 'penumbra'), season, eccentric_sun and epoch_day are optional and
+/// default to the paper's equinox.
+pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
+    let base = Orbit::geo_equinox();
+    let shadow = match optional_item::<String>(d, "shadow", "a string")? {
+        Some(name) => Shadow::from_name(&name)?,
+        None => base.shadow,
+    };
+    let o = Orbit {
+        radius: float_item(d, "radius")?,
+        earth_radius: float_item(d, "earth_radius")?,
+        period: float_item(d, "period")?,
+        phase0: float_item(d, "phase0")?,
+        shadow,
+        season: optional_item(d, "season", "a bool")?.unwrap_or(base.season),
+        eccentric_sun: optional_item(d, "eccentric_sun", "a bool")?.unwrap_or(base.eccentric_sun),
+        epoch_day: match d.get_item("epoch_day")? {
+            Some(_) => float_item(d, "epoch_day")?,
+            None => base.epoch_day,
+        },
+    };
+    o.validate()?;
+    Ok(o)
+}
+
+/// The coupling of a `coupled` flag: the projected area follows θ (two-way), or is frozen.
+pub fn coupling(coupled: bool) -> Coupling {
+    if coupled {
+        Coupling::ProjectedArea
+    } else {
+        Coupling::Frozen
+    }
+}
+
+pub fn hinge_model(name: &str) -> PyResult<HingeModel> {
+    match name {
+        "nonlinear" => Ok(HingeModel::Nonlinear),
+        "linear" => Ok(HingeModel::Linear),
+        other => Err(invalid(
+            "model",
+            format!("{other:?}"),
+            "must be 'nonlinear' or 'linear'",
+        )),
+    }
+}
+
+/// The validity limit a run watches: `theta_limit` (rad, checked whatever `on_limit`) with
+/// `on_limit` "flag" (record the first crossing), "stop" (end the run there) or "ignore" (None).
+pub fn on_limit(
+    theta_limit: f64,
+    on_limit: &str,
+) -> PyResult<Option<crate::runs::simulate::OnLimit>> {
+    let stop = match on_limit {
+        "flag" => false,
+        "stop" => true,
+        "ignore" => {
+            crate::runs::simulate::check_theta_limit(theta_limit)?;
+            return Ok(None);
+        }
+        other => {
+            return Err(invalid(
+                "on_limit",
+                format!("{other:?}"),
+                "must be 'flag', 'stop' or 'ignore'",
+            ))
+        }
+    };
+    Ok(Some(crate::runs::simulate::OnLimit::new(
+        theta_limit,
+        stop,
+    )?))
+}
+
+/// A limit crossing as the long runs report theirs: (t s, orbit index, θ rad).
+pub fn crossing_tuple(c: Option<crate::runs::orbits::LimitCrossing>) -> Option<(f64, u64, f64)> {
+    c.map(|c| (c.t, c.orbit, c.theta))
+}
+
+/// The integrator from a solver mapping {method, rtol, atol, dt, max_step, max_steps}, as every
+/// run function receives it, converted only: its settings are checked once, by the integrator
+/// ([`Method::validate`], at the start of every solve).
+pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
+    let name: String = required_item(d, "method", "a string")?;
+    let dt = match d.get_item("dt")? {
+        Some(v) if !v.is_none() => Some(float_item(d, "dt")?),
+        _ => None,
+    };
+    let max_steps: u64 = required_item(d, "max_steps", "an integer >= 1")?;
+    let (rtol, atol) = (float_item(d, "rtol")?, float_item(d, "atol")?);
+    let max_step = float_item(d, "max_step")?;
+    // rk45 does not use dt, but a dt no method could use is a mistake all the same.
+    if let Some(dt) = dt {
+        crate::error::require_positive("dt", dt)?;
+    }
+    match name.as_str() {
+        "rk45" => Ok(Method::Dopri5(Tolerances {
+            rtol,
+            atol,
+            max_step,
+            max_steps,
+        })),
+        "rk4" => match dt {
+            Some(dt) => Ok(Method::Rk4 { dt }),
+            None => Err(invalid(
+                "dt",
+                "None",
+                "is required with method='rk4' (the fixed step, s)",
+            )),
+        },
+        other => Err(invalid(
+            "method",
+            format!("{other:?}"),
+            "must be 'rk45' or 'rk4'",
+        )),
+    }
+}
+
+pub fn output(
+    t_eval: Option<PyReadonlyArray1<'_, f64>>,
+    dt_out: Option<f64>,
+    t0: f64,
+    t1: f64,
+) -> PyResult<Output> {
+    crate::numerics::integrate::check_span(t0, t1)?;
+    let out = match (t_eval, dt_out) {
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "dt_out",
+                "given",
+                "give t_eval or dt_out, not both",
+            ))
+        }
+        (Some(ts), None) => Output::Times(ts.as_array().to_vec()),
+        (None, Some(dt)) => Output::Every(dt),
+        (None, None) => return Err(invalid("dt_out", "None", "t_eval or dt_out is required")),
+    };
+    out.sample_times(t0, t1)?;
+    Ok(out)
+}
+
+/// The integrator settings as a solver mapping (what [`solver_from`] reads): the engine's
+/// defaults, and the settings a run used.
+pub fn solver_dict<'py>(py: Python<'py>, method: &Method) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let tol = match method {
+        Method::Rk4 { dt } => {
+            d.set_item("method", "rk4")?;
+            d.set_item("dt", *dt)?;
+            Tolerances::default()
+        }
+        Method::Dopri5(tol) => {
+            d.set_item("method", "rk45")?;
+            d.set_item("dt", py.None())?;
+            *tol
+        }
+    };
+    d.set_item("rtol", tol.rtol)?;
+    d.set_item("atol", tol.atol)?;
+    d.set_item("max_step", tol.max_step)?;
+    d.set_item("max_steps", tol.max_steps)?;
+    Ok(d)
+}

@@ -1,0 +1,245 @@
+//! Bindings of the distributed panel: its settings, modes, and flutter analysis.
+
+use super::cancel::{token, CancelToken};
+use super::convert::{
+    coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item, solver_from,
+};
+use super::error::{invalid, shield};
+use crate::analysis::flutter::check_flux;
+use crate::models::distributed::{DistributedPanel, Settings, Support};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::f64::consts::PI;
+
+/// A count setting (`elements`, `modes`) as usize, named in any error.
+fn count(name: &str, value: i64) -> PyResult<usize> {
+    usize::try_from(value).map_err(|_| invalid(name, value, "must be a positive integer"))
+}
+
+/// The model from a panel mapping and a settings mapping {support, elements, modes,
+/// damping_ratio (None: hinge-equivalent), sun_angle, coupled}.
+pub(super) fn model_from(
+    panel: &Bound<'_, PyDict>,
+    settings: &Bound<'_, PyDict>,
+) -> PyResult<DistributedPanel> {
+    let p = panel_from(panel)?;
+    let support: String = required_item(settings, "support", "a string")?;
+    let elements: i64 = required_item(settings, "elements", "an integer")?;
+    let modes: i64 = required_item(settings, "modes", "an integer")?;
+    let zeta: Option<f64> = required_item(settings, "damping_ratio", "a number or None")?;
+    let sun_angle: f64 = required_item(settings, "sun_angle", "a number")?;
+    let coupled: bool = required_item(settings, "coupled", "a bool")?;
+    let layers: i64 = required_item(settings, "layers", "an integer")?;
+    let layers = u32::try_from(layers)
+        .map_err(|_| invalid("layers", layers, "must be a positive integer"))?;
+    let defaults = Settings::new(&p);
+    let s = Settings {
+        layers,
+        support: Support::from_name(&support).map_err(PyErr::from)?,
+        elements: count("elements", elements)?,
+        modes: count("modes", modes)?,
+        damping_ratio: zeta.unwrap_or(defaults.damping_ratio),
+        sun_angle,
+        coupling: coupling(coupled),
+    };
+    DistributedPanel::new(&p, s).map_err(PyErr::from)
+}
+
+/// The kept modes' frequencies (Hz) and the damping ratio in use, into `d`.
+fn modal_info<'py>(py: Python<'py>, m: &DistributedPanel, d: &Bound<'py, PyDict>) -> PyResult<()> {
+    let hz: Vec<f64> = m.reduction.omega.iter().map(|w| w / (2.0 * PI)).collect();
+    d.set_item("frequencies_hz", PyArray1::from_vec(py, hz))?;
+    d.set_item("damping_ratio", m.settings.damping_ratio)
+}
+
+/// What the model is: node and element positions, kept frequencies, the damping ratio in use,
+/// the defaults, and the mesh's first elastic frequency.
+#[pyfunction]
+fn distributed_info<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        let mesh = &m.reduction.mesh;
+        let d = PyDict::new(py);
+        d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
+        d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
+        modal_info(py, &m, &d)?;
+        d.set_item("arm", mesh.arm())?;
+        d.set_item("elastic_modes", mesh.elastic_modes())?;
+        Ok(d)
+    })
+}
+
+/// ζ = c_d/(2 I_B ω₁): the modal damping ratio equivalent to the panel's hinge damping (the beam
+/// comparator's and the distributed panel's default).
+#[pyfunction]
+fn hinge_equivalent_damping_ratio(panel: &Bound<'_, PyDict>) -> PyResult<f64> {
+    shield(|| {
+        Ok(crate::models::beam::hinge_equivalent_damping_ratio(
+            &panel_from(panel)?,
+        ))
+    })
+}
+
+/// The defaults of the distributed model's settings.
+#[pyfunction]
+fn distributed_defaults(py: Python<'_>, panel: &Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let s = Settings::new(&p);
+        let d = PyDict::new(py);
+        d.set_item("support", s.support.name())?;
+        d.set_item("elements", s.elements)?;
+        d.set_item("modes", s.modes)?;
+        d.set_item("damping_ratio", s.damping_ratio)?;
+        d.set_item("sun_angle", s.sun_angle)?;
+        Ok(d.unbind())
+    })
+}
+
+/// Eigen-analysis of the distributed panel at its sunlit equilibrium under flux factor `flux`.
+#[pyfunction]
+fn distributed_flutter<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    flux: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        check_flux(flux).map_err(PyErr::from)?;
+        let a = py.detach(|| m.flutter(flux)).map_err(PyErr::from)?;
+        let d = PyDict::new(py);
+        let temps = PyDict::new(py);
+        for (name, row) in m
+            .temperature_names()
+            .iter()
+            .zip(m.temperature_rows(&a.equilibrium))
+        {
+            temps.set_item(name, PyArray1::from_vec(py, row))?;
+        }
+        d.set_item("temperatures", temps)?;
+        let (w, slope) = m.nodal(&a.equilibrium);
+        d.set_item("deflection", PyArray1::from_vec(py, w))?;
+        d.set_item("slope", PyArray1::from_vec(py, slope))?;
+        d.set_item("theta_f", a.theta_f)?;
+        let ev: Vec<(f64, f64)> = a.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
+        d.set_item("eigenvalues", ev)?;
+        d.set_item("growth_rate", a.growth_rate)?;
+        let modes: Vec<(f64, f64, usize)> = a
+            .modes
+            .iter()
+            .map(|o| (o.growth_rate, o.frequency_hz, o.structural_mode))
+            .collect();
+        d.set_item("modes", modes)?;
+        d.set_item("critical_damping_ratio", a.critical_damping_ratio)?;
+        d.set_item("critical_damping", a.critical_damping)?;
+        d.set_item("damping_ratio", m.settings.damping_ratio)?;
+        Ok(d)
+    })
+}
+
+/// Rows of equal length as a 2-D array.
+fn matrix<'py>(
+    py: Python<'py>,
+    rows: &[Vec<f64>],
+    width: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    if rows.is_empty() {
+        return Ok(PyArray2::zeros(py, [0, width], false));
+    }
+    PyArray2::from_vec2(py, rows).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// Integrates the distributed panel on an orbit; fields sampled at the requested times. Watches
+/// |θ_f| against `theta_limit` as `on_limit` says ("flag", "stop", "ignore") and stops with
+/// KeyboardInterrupt within a step of `cancel`.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, settings, t0, t1, *, solver, t_eval, dt_out, y0, theta_limit=crate::models::hinge::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_distributed<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    t0: f64,
+    t1: f64,
+    solver: &Bound<'py, PyDict>,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    dt_out: Option<f64>,
+    y0: Option<PyReadonlyArray1<'py, f64>>,
+    theta_limit: f64,
+    on_limit: &str,
+    cancel: Option<&Bound<'py, CancelToken>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        let o = orbit_from(orbit)?;
+        let method = solver_from(solver)?;
+        let out = output(t_eval, dt_out, t0, t1)?;
+        let limit = self::on_limit(theta_limit, on_limit)?;
+        let start = match y0 {
+            Some(v) => {
+                let v = v.as_array().to_vec();
+                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                    return Err(invalid("y0", x, "every component must be finite"));
+                }
+                Some(v)
+            }
+            None => None,
+        };
+        let r = py
+            .detach(|| {
+                let span = (t0, t1);
+                crate::runs::distributed::simulate(
+                    &m, o, &method, span, start, &out, limit, &cancel,
+                )
+            })
+            .map_err(PyErr::from)?;
+        let mesh = &m.reduction.mesh;
+        let (n, nodes) = (m.n(), m.n() + 1);
+        let d = PyDict::new(py);
+        d.set_item("t", PyArray1::from_vec(py, r.t))?;
+        d.set_item("x", PyArray1::from_vec(py, mesh.element_x()))?;
+        d.set_item("x_node", PyArray1::from_vec(py, mesh.node_x()))?;
+        // One (time × element) array per temperature name.
+        let temps = PyDict::new(py);
+        for (i, name) in r.names.iter().enumerate() {
+            let rows: Vec<Vec<f64>> = r.temperatures.iter().map(|s| s[i].clone()).collect();
+            temps.set_item(name, matrix(py, &rows, n)?)?;
+        }
+        d.set_item("temperatures", temps)?;
+        d.set_item("thermal_moment", matrix(py, &r.moment, n)?)?;
+        d.set_item("deflection", matrix(py, &r.deflection, nodes)?)?;
+        d.set_item("slope", matrix(py, &r.slope, nodes)?)?;
+        d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
+        d.set_item("sunlit", PyArray1::from_vec(py, r.sunlit))?;
+        d.set_item("y_end", PyArray1::from_vec(py, r.y_end))?;
+        d.set_item("n_steps", r.stats.n_steps)?;
+        d.set_item("n_rejected", r.stats.n_rejected)?;
+        d.set_item("n_rhs", r.stats.n_rhs)?;
+        d.set_item("t_end", r.stats.t_end)?;
+        d.set_item("crossing", crossing_tuple(r.crossing))?;
+        d.set_item(
+            "stopped",
+            r.crossing.is_some() && limit.is_some_and(|l| l.stop),
+        )?;
+        modal_info(py, &m, &d)?;
+        Ok(d)
+    })
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
+    m.add_function(wrap_pyfunction!(hinge_equivalent_damping_ratio, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_flutter, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,169 @@
+//! Bindings of the flutter analysis.
+
+use super::cancel::{token, CancelToken};
+use super::convert::{coupling, hinge_model, panel_from};
+use super::error::shield;
+use crate::analysis::flutter::{analyse, check_flux, critical_damping};
+use crate::analysis::linear::LinearThermal;
+use crate::analysis::stability::Axis;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Eigen-analysis at the sunlit equilibrium; with `with_critical`, also the critical damping.
+#[pyfunction]
+#[pyo3(signature = (panel, model, coupled, flux, with_critical=true))]
+fn flutter<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    model: &str,
+    coupled: bool,
+    flux: f64,
+    with_critical: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        let m = hinge_model(model)?;
+        check_flux(flux)?;
+        let c = coupling(coupled);
+        let a = analyse(&p, m, c, flux)?;
+        let d = PyDict::new(py);
+        let eq = a.equilibrium;
+        d.set_item("equilibrium", (eq.t_front, eq.t_back, eq.theta))?;
+        let jacobian = a.jacobian;
+        let rows = (0..4).map(|i| (0..4).map(|j| jacobian[(i, j)]).collect());
+        set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
+        if with_critical {
+            d.set_item("critical_damping", critical_damping(&p, m, c, flux)?)?;
+        }
+        Ok(d)
+    })
+}
+
+/// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as
+/// (re, im) pairs), growth rate and frequency.
+pub(super) fn set_spectrum(
+    d: &Bound<'_, PyDict>,
+    rows: impl Iterator<Item = Vec<f64>>,
+    eigenvalues: &[nalgebra::Complex<f64>],
+    growth_rate: f64,
+    frequency_hz: f64,
+) -> PyResult<()> {
+    let rows: Vec<Vec<f64>> = rows.collect();
+    d.set_item("jacobian", PyArray2::from_vec2(d.py(), &rows)?)?;
+    let ev: Vec<(f64, f64)> = eigenvalues.iter().map(|z| (z.re, z.im)).collect();
+    d.set_item("eigenvalues", ev)?;
+    d.set_item("growth_rate", growth_rate)?;
+    d.set_item("frequency_hz", frequency_hz)
+}
+
+/// Growth rate and frequency over a grid of two panel parameters (rows: y, columns: x); stops
+/// with KeyboardInterrupt within a grid point of `cancel`.
+#[pyfunction]
+#[pyo3(signature = (panel, x_name, x_values, y_name, y_values, model, coupled, flux, *, cancel=None))]
+#[allow(clippy::too_many_arguments)]
+fn stability_map<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    x_name: String,
+    x_values: Vec<f64>,
+    y_name: String,
+    y_values: Vec<f64>,
+    model: &str,
+    coupled: bool,
+    flux: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
+    shield(|| {
+        let p = panel_from(panel)?;
+        let m = hinge_model(model)?;
+        let c = coupling(coupled);
+        let x = Axis {
+            name: x_name,
+            values: x_values,
+        };
+        let y = Axis {
+            name: y_name,
+            values: y_values,
+        };
+        let map = py.detach(|| {
+            crate::analysis::stability::stability_map(&p, m, c, flux, &x, &y, &cancel)
+        })?;
+        let grid = |v: &[f64]| -> Vec<Vec<f64>> { v.chunks(map.nx).map(|r| r.to_vec()).collect() };
+        let d = PyDict::new(py);
+        d.set_item(
+            "growth_rate",
+            PyArray2::from_vec2(py, &grid(&map.growth_rate))?,
+        )?;
+        d.set_item(
+            "frequency_hz",
+            PyArray2::from_vec2(py, &grid(&map.frequency_hz))?,
+        )?;
+        Ok(d)
+    })
+}
+
+/// The closed-form linear analysis of paper Sec. 4.2: its coefficients and what follows.
+#[pyfunction]
+#[pyo3(signature = (panel, flux=1.0, omega=None, t_star=None))]
+fn linear_thermal<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    flux: f64,
+    omega: Option<f64>,
+    t_star: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let lt = LinearThermal::new(&panel_from(panel)?, flux, omega, t_star)?;
+        let d = PyDict::new(py);
+        for (name, v) in LinearThermal::FIELDS.iter().zip(lt.values()) {
+            d.set_item(name, v)?;
+        }
+        d.set_item("amplitude", lt.amplitude())?;
+        d.set_item("phase_lag", lt.phase_lag())?;
+        d.set_item("time_constant", lt.time_constant())?;
+        d.set_item("resonant", lt.resonant())?;
+        d.set_item("thermal_damping", lt.thermal_damping())?;
+        d.set_item("critical_damping_estimate", lt.critical_damping_estimate())?;
+        d.set_item("growth_rate_estimate", lt.growth_rate_estimate())?;
+        Ok(d)
+    })
+}
+
+/// ΔT(t) of the Sec. 4.2 analysis given by its fields (as [`linear_thermal`] returns them).
+#[pyfunction]
+#[pyo3(signature = (fields, t, phi, delta_t0))]
+fn linear_delta_t<'py>(
+    py: Python<'py>,
+    fields: &Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+    phi: f64,
+    delta_t0: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    shield(|| {
+        let mut v = [0.0; 10];
+        for (slot, name) in v.iter_mut().zip(LinearThermal::FIELDS) {
+            *slot = fields
+                .get_item(name)?
+                .ok_or_else(|| crate::Error::invalid("fields", name, "is missing"))?
+                .extract()?;
+        }
+        let lt = LinearThermal::from_values(v);
+        let out: Vec<f64> = t
+            .as_array()
+            .iter()
+            .map(|&x| lt.delta_t(x, phi, delta_t0))
+            .collect();
+        Ok(PyArray1::from_vec(py, out))
+    })
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("LINEAR_FIELDS", LinearThermal::FIELDS.to_vec())?;
+    m.add_function(wrap_pyfunction!(flutter, m)?)?;
+    m.add_function(wrap_pyfunction!(linear_thermal, m)?)?;
+    m.add_function(wrap_pyfunction!(linear_delta_t, m)?)?;
+    m.add_function(wrap_pyfunction!(stability_map, m)?)?;
+    Ok(())
+}

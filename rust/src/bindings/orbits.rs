@@ -1,0 +1,185 @@
+//! Bindings of the long runs (`crate::runs::orbits`, and the hybrid propagator).
+
+use super::cancel::{token, CancelToken};
+use super::convert::{coupling, hinge_model, orbit_from, panel_from, solver_dict, solver_from};
+use super::error::shield;
+use super::laminate::conduction_from;
+use crate::runs::hybrid::HybridSettings;
+use crate::runs::layered::LayeredRunRequest;
+use crate::runs::orbits::{OrbitRunRequest, SummaryOptions};
+use crate::runs::request::{OrbitsModel, OrbitsRequest};
+use crate::runs::simulate::state_from;
+use nalgebra::U4;
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Integrates whole orbits and returns one summary per orbit (columns as arrays): the two-layer
+/// model, or the N-node model (`nodes`, `layup`), or with `hybrid` (its settings) the hybrid
+/// propagator, whose fallback is the solver's full integration; a hybrid run adds how the
+/// simulated time was split between linear arcs, the exponential integrator and the fallback.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None, hybrid=None))]
+#[allow(clippy::too_many_arguments)]
+fn run_orbits<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    model: &str,
+    coupled: bool,
+    solver: &Bound<'py, PyDict>,
+    t_start: f64,
+    first_index: u64,
+    n_orbits: u64,
+    y0: Vec<f64>,
+    window: f64,
+    theta_limit: f64,
+    stop_at_limit: bool,
+    steps_per_period: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
+    layup: Option<&Bound<'py, PyDict>>,
+    nodes: Option<usize>,
+    hybrid: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cancel = token(cancel);
+    shield(|| {
+        let p = panel_from(panel)?;
+        let o = orbit_from(orbit)?;
+        let hinge = hinge_model(model)?;
+        let coupling = coupling(coupled);
+        let m = solver_from(solver)?;
+        crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
+        let options = SummaryOptions {
+            window,
+            theta_limit,
+            stop_at_limit,
+            steps_per_period,
+        };
+        let hybrid = hybrid.map(hybrid_from).transpose()?;
+        let model = match nodes {
+            // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
+            Some(n) => OrbitsModel::Laminate(LayeredRunRequest {
+                panel: p,
+                conduction: conduction_from(&p, layup, n)?,
+                orbit: o,
+                model: hinge,
+                coupling,
+                method: m,
+                t_start,
+                first_index,
+                n_orbits,
+                y0,
+                options,
+            }),
+            None => OrbitsModel::TwoLayer(OrbitRunRequest {
+                panel: p,
+                orbit: o,
+                model: hinge,
+                coupling,
+                method: m,
+                t_start,
+                first_index,
+                n_orbits,
+                y0: state_from(&y0, U4)?,
+                options,
+            }),
+        };
+        let req = OrbitsRequest { model, hybrid };
+        let out = py.detach(|| crate::runs::request::run_orbits(&req, &cancel))?;
+        let d = summary_dict(py, &out.summaries, &m)?;
+        match out.split {
+            Some(split) => hybrid_counters(d, &split),
+            None => Ok(d),
+        }
+    })
+}
+
+/// A hybrid run's summary columns with how it split the simulated time.
+fn hybrid_counters<'py>(
+    d: Bound<'py, PyDict>,
+    out: &crate::runs::hybrid::HybridRun,
+) -> PyResult<Bound<'py, PyDict>> {
+    d.set_item("t_linear", out.t_linear)?;
+    d.set_item("t_exponential", out.t_exponential)?;
+    d.set_item("t_fallback", out.t_fallback)?;
+    d.set_item("n_arcs", out.n_arcs)?;
+    d.set_item("n_exp_steps", out.n_exp_steps)?;
+    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
+    d.set_item("n_reread_steps", out.n_reread_steps)?;
+    Ok(d)
+}
+
+/// The summaries of a run (of either model: a two-layer `OrbitRun` converts) as columns, with
+/// its counters and the solver settings it ran with (`method`, as [`solver_dict`] reports them
+/// for every run).
+fn summary_dict<'py>(
+    py: Python<'py>,
+    out: &crate::runs::layered::LayeredSummaries,
+    method: &crate::numerics::integrate::Method,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let col = |f: fn(&crate::runs::orbits::OrbitSummary) -> f64| -> Vec<f64> {
+        out.summaries.iter().map(f).collect()
+    };
+    d.set_item(
+        "index",
+        out.summaries.iter().map(|s| s.index).collect::<Vec<u64>>(),
+    )?;
+    for (name, values) in [
+        ("t_start", col(|s| s.t_start)),
+        ("t_end", col(|s| s.t_end)),
+        ("theta_eq", col(|s| s.theta_eq)),
+        ("theta_max", col(|s| s.theta_max)),
+        ("theta_min", col(|s| s.theta_min)),
+        ("amplitude", col(|s| s.amplitude)),
+        ("jitter_rms", col(|s| s.jitter_rms)),
+        ("jitter_peak", col(|s| s.jitter_peak)),
+        ("t_entry", col(|s| s.t_entry)),
+        ("t_exit", col(|s| s.t_exit)),
+        ("entry_theta_min", col(|s| s.entry_theta_min)),
+        ("exit_theta_max", col(|s| s.exit_theta_max)),
+        ("entry_peak", col(|s| s.entry_peak)),
+        ("exit_peak", col(|s| s.exit_peak)),
+    ] {
+        d.set_item(name, PyArray1::from_vec(py, values))?;
+    }
+    d.set_item("n_steps", out.stats.n_steps)?;
+    d.set_item("n_rejected", out.stats.n_rejected)?;
+    d.set_item("n_rhs", out.stats.n_rhs)?;
+    d.set_item("t_reached", out.stats.t_end)?;
+    d.set_item("stopped", out.stats.stopped)?;
+    d.set_item("y_end", out.y_end.clone())?;
+    d.set_item("crossing", out.crossing.map(|c| (c.t, c.orbit, c.theta)))?;
+    d.set_item("solver", solver_dict(py, method)?)?;
+    Ok(d)
+}
+
+/// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
+pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
+    let mut s = HybridSettings::default();
+    for (key, value) in d.iter() {
+        let key: String = key.extract()?;
+        let v: f64 = value.extract()?;
+        match key.as_str() {
+            "rtol" => s.tolerances.rtol = v,
+            "atol_temperature" => s.tolerances.atol_temperature = v,
+            "atol_angle" => s.tolerances.atol_angle = v,
+            "max_step" => s.tolerances.max_step = v,
+            "linear_tolerance" => s.linear_tolerance = v,
+            "linear_amplitude" => s.linear_amplitude = v,
+            "resolved_amplitude" => s.resolved_amplitude = v,
+            other => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "hybrid = {{{other:?}: ...}} is invalid: not a hybrid setting"
+                )))
+            }
+        }
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(run_orbits, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,5 @@
+//! The validated inputs of every run: the panel, its laminate, the orbit.
+
+pub mod laminate;
+pub mod orbit;
+pub mod panel;

@@ -1,0 +1,844 @@
+//! Orbit geometry: orbit phase, the Earth's shadow, the illumination s(t), the exact shadow
+//! boundary times and the solar flux over the year.
+//!
+//! The plate is Sun-pointing, so only the illuminated fraction of the Sun and the Sun's distance
+//! change along the orbit. The orbit is circular and lies in the Earth's equatorial plane. Its
+//! phase β is measured from the Sun's meridian: β = ω t + β₀ with β = 0 at the subsolar point and
+//! the shadow centred on β = π.
+//!
+//! Three shadow models ([`Shadow`]): none (permanent sunlight), a cylindrical shadow of radius R_E
+//! (s jumps between 1 and 0; the paper's model), and a penumbra: the Sun is a disk of angular
+//! radius ρ_S = asin(R_☉ / |Sun − satellite|), the Earth a disk of angular radius
+//! ρ_E = asin(R_E / r), and s is the visible fraction of the solar disk, from the overlap area of
+//! the two disks (planar geometry in angles, exact for small disks; the atmosphere is ignored).
+//! s is continuous; it has kinks at first/last contact (separation ρ_E + ρ_S) and at umbra
+//! entry/exit (ρ_E − ρ_S), which are breakpoints for the integrator.
+//!
+//! The year ([`Orbit::season`]): the Sun's declination δ = asin(sin ε sin(2π (d − d_eq) / Y)), with
+//! ε = 23.44°, d the day of the year (days since 1 January 00:00 UTC, fractional),
+//! d_eq = [`EQUINOX_DAY`] and Y the tropical year; the Sun also moves eastwards by 2π/Y per day, so
+//! the orbit phase relative to the Sun advances at ω = 2π/T − 2π/Y (the equation of time is
+//! ignored). At GEO this gives eclipse seasons of about ±23 days around the equinoxes.
+//! With [`Orbit::eccentric_sun`] the Sun–Earth distance is r = 1 − e cos(2π (d − d_p)/Y) au,
+//! d_p = [`PERIHELION_DAY`], e = 0.0167, and the flux scales as 1/r² (±3.3 %). Equinox and
+//! perihelion dates are mean values, good to about a day.
+
+use crate::error::{require_finite, require_positive, Error, Result};
+use std::f64::consts::PI;
+
+/// Shortest orbit period accepted, s: a grazing orbit of a dense body takes tens of minutes; a
+/// shorter one is a unit slip (minutes or hours given for seconds) and would cost an eclipse
+/// every few steps.
+pub const MIN_PERIOD: f64 = 60.0;
+/// Largest |phase0|, rad: beyond it the phase loses its precision (1e3 rad: ~1e-13 rad).
+pub const MAX_PHASE0: f64 = 1e3;
+/// Largest |epoch_day|, days.
+pub const MAX_EPOCH_DAY: f64 = 1e5;
+/// Most eclipses one call may compute (intervals, breakpoints of one integration).
+pub const MAX_ECLIPSES: f64 = 1e6;
+
+/// GEO radius, m.
+pub const GEO_RADIUS: f64 = 42_164_170.0;
+/// Equatorial Earth radius, m.
+pub const EARTH_RADIUS: f64 = 6_378_137.0;
+/// One sidereal day, s.
+pub const SIDEREAL_DAY: f64 = 86_164.090_5;
+/// Earth's gravitational parameter, m³/s².
+pub const MU_EARTH: f64 = 3.986_004_418e14;
+/// Nominal solar radius, m (IAU 2015).
+pub const SUN_RADIUS: f64 = 6.957e8;
+/// Astronomical unit, m.
+pub const AU: f64 = 1.495_978_707e11;
+/// Mean solar day, s.
+pub const DAY: f64 = 86_400.0;
+/// Tropical year, days.
+pub const YEAR_DAYS: f64 = 365.242_2;
+/// Obliquity of the ecliptic, rad (23.44°).
+pub const OBLIQUITY: f64 = 23.44 * PI / 180.0;
+/// Eccentricity of the Earth's orbit.
+pub const EARTH_ECCENTRICITY: f64 = 0.0167;
+/// Mean day of the March equinox, days since 1 January 00:00 UTC (about 20 March, 12:00).
+pub const EQUINOX_DAY: f64 = 78.5;
+/// Altitude of a Hubble-like low orbit, m: the default of `tj.Orbit.leo` and of a scenario's
+/// `leo` preset (about 95 min a revolution).
+pub const LEO_ALTITUDE: f64 = 540e3;
+/// Lowest altitude of a low orbit, m (the Kármán line; lower, the atmosphere ends an orbit within
+/// hours).
+pub const MIN_LEO_ALTITUDE: f64 = 100e3;
+/// Highest altitude of a low orbit, m (beyond the Moon).
+pub const MAX_LEO_ALTITUDE: f64 = 1e9;
+/// Mean day of perihelion, days since 1 January 00:00 UTC (about 4 January, 00:00).
+pub const PERIHELION_DAY: f64 = 3.0;
+
+/// How the Earth hides the Sun.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shadow {
+    /// Permanent sunlight: s = 1.
+    None,
+    /// A cylinder of radius R_E behind the Earth: s = 0 inside, 1 outside (the paper's model).
+    Cylindrical,
+    /// The Sun as a disk partly hidden by the Earth's disk: s in [0, 1], continuous.
+    Penumbra,
+}
+
+impl Shadow {
+    pub fn from_name(name: &str) -> Result<Shadow> {
+        match name {
+            "none" => Ok(Shadow::None),
+            "cylindrical" => Ok(Shadow::Cylindrical),
+            "penumbra" => Ok(Shadow::Penumbra),
+            other => Err(Error::invalid(
+                "shadow",
+                format!("{other:?}"),
+                "must be 'none', 'cylindrical' or 'penumbra'",
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Shadow::None => "none",
+            Shadow::Cylindrical => "cylindrical",
+            Shadow::Penumbra => "penumbra",
+        }
+    }
+}
+
+/// One passage behind the Earth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eclipse {
+    /// Time of the deepest point (smallest Sun–Earth separation), s.
+    pub centre: f64,
+    /// Where s < 1: first and last contact (penumbra), or shadow entry and exit (cylinder), s.
+    pub outer: (f64, f64),
+    /// Where s = 0: umbra entry and exit (equal to `outer` for the cylinder), if any, s.
+    pub umbra: Option<(f64, f64)>,
+}
+
+/// A circular equatorial orbit around the Earth, its shadow and the Sun over the year.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orbit {
+    /// Orbit radius, m.
+    pub radius: f64,
+    /// Radius of the shadowing Earth, m.
+    pub earth_radius: f64,
+    /// Orbit period, s.
+    pub period: f64,
+    /// Orbit phase from the Sun's meridian at t = 0, rad (0: at the subsolar point).
+    pub phase0: f64,
+    /// Shadow model.
+    pub shadow: Shadow,
+    /// The Sun moves over the year (declination and right ascension); false: Sun fixed in the
+    /// orbit plane (equinox).
+    pub season: bool,
+    /// The flux and the Sun's angular size follow the Sun–Earth distance; false: 1 au.
+    pub eccentric_sun: bool,
+    /// Day of the year at t = 0 (days since 1 January 00:00 UTC, fractional).
+    pub epoch_day: f64,
+}
+
+impl Orbit {
+    /// The paper's scenario: GEO at equinox, cylindrical shadow, t = 0 at the subsolar point.
+    pub fn geo_equinox() -> Self {
+        Orbit {
+            radius: GEO_RADIUS,
+            earth_radius: EARTH_RADIUS,
+            period: SIDEREAL_DAY,
+            phase0: 0.0,
+            shadow: Shadow::Cylindrical,
+            season: false,
+            eccentric_sun: false,
+            epoch_day: EQUINOX_DAY,
+        }
+    }
+
+    /// GEO over a realistic year: the Sun's declination and distance follow the date, with a
+    /// penumbra. `epoch_day`: day of the year at t = 0; t = 0 at the subsolar point.
+    pub fn geo_year(epoch_day: f64) -> Self {
+        Orbit {
+            shadow: Shadow::Penumbra,
+            season: true,
+            eccentric_sun: true,
+            epoch_day,
+            ..Orbit::geo_equinox()
+        }
+    }
+
+    /// A circular low orbit at `altitude` (m) with its Keplerian period, the Sun in the orbit
+    /// plane (the longest eclipses), cylindrical shadow.
+    pub fn leo(altitude: f64) -> Self {
+        let radius = EARTH_RADIUS + altitude;
+        Orbit {
+            radius,
+            period: 2.0 * PI * (radius.powi(3) / MU_EARTH).sqrt(),
+            ..Orbit::geo_equinox()
+        }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        require_positive("radius", self.radius)?;
+        require_positive("earth_radius", self.earth_radius)?;
+        require_positive("period", self.period)?;
+        require_finite("phase0", self.phase0)?;
+        require_finite("epoch_day", self.epoch_day)?;
+        if self.period < MIN_PERIOD {
+            return Err(Error::invalid(
+                "period",
+                self.period,
+                &format!("must be >= {MIN_PERIOD} s (no orbit is faster)"),
+            ));
+        }
+        if self.phase0.abs() > MAX_PHASE0 {
+            return Err(Error::invalid(
+                "phase0",
+                self.phase0,
+                &format!("must be in [-{MAX_PHASE0}, {MAX_PHASE0}] rad (reduce it modulo 2π)"),
+            ));
+        }
+        if self.epoch_day.abs() > MAX_EPOCH_DAY {
+            return Err(Error::invalid(
+                "epoch_day",
+                self.epoch_day,
+                &format!("must be in [-{MAX_EPOCH_DAY}, {MAX_EPOCH_DAY}] days"),
+            ));
+        }
+        if self.earth_radius >= self.radius {
+            return Err(Error::invalid(
+                "earth_radius",
+                self.earth_radius,
+                "must be smaller than the orbit radius",
+            ));
+        }
+        if self.rate().is_nan() || self.rate() <= 0.0 {
+            return Err(Error::invalid(
+                "period",
+                self.period,
+                "must be shorter than a year when the Sun moves over the year (season)",
+            ));
+        }
+        if self.shadow == Shadow::Penumbra {
+            let widest = self.earth_angular_radius() + (SUN_RADIUS / (AU * 0.98)).asin();
+            if widest >= 0.5 * PI {
+                return Err(Error::invalid(
+                    "radius",
+                    self.radius,
+                    "is too close to earth_radius for the penumbra model",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks a span of time for the shadow computations: finite, increasing, and holding at
+    /// most [`MAX_ECLIPSES`] eclipses, counted up front, so that no list grows without bound.
+    pub fn check_span(&self, t0: f64, t1: f64) -> Result<()> {
+        crate::numerics::integrate::check_span(t0, t1)?;
+        if self.shadow == Shadow::None {
+            return Ok(());
+        }
+        let n = (t1 - t0) / self.synodic_period() + 2.0;
+        if n > MAX_ECLIPSES {
+            return Err(Error::invalid(
+                "t_span",
+                format!("({t0}, {t1})"),
+                &format!(
+                    "covers about {n:.3e} eclipses; at most {MAX_ECLIPSES:e} per call \
+                     (long runs go orbit by orbit: simulate_orbits)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks one time at which s(t), the flux or the declination is asked: finite and within
+    /// ±[`crate::numerics::integrate::MAX_TIME`].
+    pub fn check_time(t: f64) -> Result<()> {
+        let limit = crate::numerics::integrate::MAX_TIME;
+        if t.abs() <= limit {
+            Ok(())
+        } else {
+            Err(Error::invalid(
+                "t",
+                t,
+                &format!("must be finite and in [-{limit:e}, {limit:e}] s"),
+            ))
+        }
+    }
+
+    /// Half the orbit arc spent in the cylindrical shadow at equinox, asin(R_E / r), rad.
+    pub fn shadow_half_angle(&self) -> f64 {
+        (self.earth_radius / self.radius).asin()
+    }
+
+    /// Angular radius of the Earth seen from the orbit, rad (equal to `shadow_half_angle`).
+    pub fn earth_angular_radius(&self) -> f64 {
+        self.shadow_half_angle()
+    }
+
+    /// Eclipse duration per orbit with the cylindrical shadow at equinox, s.
+    pub fn eclipse_duration(&self) -> f64 {
+        self.period * self.shadow_half_angle() / PI
+    }
+
+    /// Day of the year at time t (days since 1 January 00:00 UTC).
+    pub fn day_of_year(&self, t: f64) -> f64 {
+        self.epoch_day + t / DAY
+    }
+
+    /// The Sun's declination at time t, rad (0 without `season`).
+    pub fn declination(&self, t: f64) -> f64 {
+        if !self.season {
+            return 0.0;
+        }
+        let lon = 2.0 * PI * (self.day_of_year(t) - EQUINOX_DAY) / YEAR_DAYS;
+        (OBLIQUITY.sin() * lon.sin()).asin()
+    }
+
+    /// Sun–Earth distance at time t, au (1 without `eccentric_sun`).
+    pub fn sun_distance_au(&self, t: f64) -> f64 {
+        if !self.eccentric_sun {
+            return 1.0;
+        }
+        1.0 - EARTH_ECCENTRICITY
+            * (2.0 * PI * (self.day_of_year(t) - PERIHELION_DAY) / YEAR_DAYS).cos()
+    }
+
+    /// Rate of the orbit phase relative to the Sun, rad/s.
+    pub fn rate(&self) -> f64 {
+        let sun = if self.season {
+            2.0 * PI / (YEAR_DAYS * DAY)
+        } else {
+            0.0
+        };
+        2.0 * PI / self.period - sun
+    }
+
+    /// Orbit period relative to the Sun (time between two eclipses), s.
+    pub fn synodic_period(&self) -> f64 {
+        2.0 * PI / self.rate()
+    }
+
+    /// Angle between the satellite's direction and the anti-Sun direction, both from the
+    /// Earth's centre, rad in [0, π].
+    fn anti_sun_angle(&self, t: f64) -> f64 {
+        if !self.season {
+            let beta = 2.0 * PI * t / self.period + self.phase0;
+            let from_anti_sun = (beta - PI).rem_euclid(2.0 * PI);
+            return from_anti_sun.min(2.0 * PI - from_anti_sun);
+        }
+        let beta = self.rate() * t + self.phase0;
+        let (sd, cd) = self.declination(t).sin_cos();
+        let (sb, cb) = beta.sin_cos();
+        (sd * sd + cd * cd * sb * sb).sqrt().atan2(-cd * cb)
+    }
+
+    /// Seen from the satellite: the angle between the Earth's and the Sun's centres and the Sun's
+    /// angular radius, rad. For the cylinder the Sun is a point at infinity.
+    fn sky(&self, t: f64) -> (f64, f64) {
+        let psi = self.anti_sun_angle(t);
+        if self.shadow != Shadow::Penumbra {
+            return (psi, 0.0);
+        }
+        let d = AU * self.sun_distance_au(t);
+        let (sp, cp) = psi.sin_cos();
+        let r = self.radius;
+        let separation = (d * sp).atan2(r + d * cp);
+        let to_sun = (d * d + r * r + 2.0 * d * r * cp).sqrt();
+        (separation, (SUN_RADIUS / to_sun).asin())
+    }
+
+    /// Illuminated fraction of the Sun seen from the plate at time t: 1 in sunlight, 0 in umbra,
+    /// in between in the penumbra.
+    pub fn illumination(&self, t: f64) -> f64 {
+        match self.shadow {
+            Shadow::None => 1.0,
+            Shadow::Cylindrical => {
+                if self.anti_sun_angle(t) < self.shadow_half_angle() {
+                    0.0
+                } else {
+                    1.0
+                }
+            }
+            Shadow::Penumbra => {
+                let (sep, rho_s) = self.sky(t);
+                visible_fraction(rho_s, self.earth_angular_radius(), sep)
+            }
+        }
+    }
+
+    /// Illumination to use inside the segment [a, b] between two breakpoints. With the cylinder
+    /// s(t) is constant there, so it is taken at the midpoint: this gives the right one-sided
+    /// value at the ends, where the integrator evaluates the right-hand side exactly on a
+    /// discontinuity. With the penumbra s(t) is continuous and is evaluated at t.
+    pub fn illumination_on(&self, t: f64, a: f64, b: f64) -> f64 {
+        match self.shadow {
+            Shadow::None => 1.0,
+            Shadow::Cylindrical => self.illumination(0.5 * (a + b)),
+            Shadow::Penumbra => self.illumination(t),
+        }
+    }
+
+    /// Solar flux relative to the nominal solar constant (1 au) at time t: 1/r², r in au.
+    #[inline]
+    pub fn flux_scale(&self, t: f64) -> f64 {
+        // Exactly 1 at 1 au, returned before the division: right-hand sides call this at every
+        // evaluation.
+        if !self.eccentric_sun {
+            return 1.0;
+        }
+        let r = self.sun_distance_au(t);
+        1.0 / (r * r)
+    }
+
+    /// Time of the k-th shadow centre (β = π + 2πk) of the fixed-Sun orbit, s.
+    fn shadow_centre(&self, k: f64) -> f64 {
+        if self.season {
+            (PI + 2.0 * PI * k - self.phase0) / self.rate()
+        } else {
+            (PI + 2.0 * PI * k - self.phase0) * self.period / (2.0 * PI)
+        }
+    }
+
+    /// Every eclipse overlapping [t0, t1], unclipped, in time order.
+    pub fn eclipses(&self, t0: f64, t1: f64) -> Vec<Eclipse> {
+        match self.shadow {
+            Shadow::None => Vec::new(),
+            Shadow::Cylindrical if !self.season => self.equinox_cylinder_eclipses(t0, t1),
+            _ => self.searched_eclipses(t0, t1, true),
+        }
+    }
+
+    /// Whether the passage behind the Earth within `quarter` of c can hold an eclipse. The
+    /// satellite, in the equatorial plane, is at least |δ| from the anti-Sun direction, and the
+    /// separation of the Sun's and the Earth's centres seen from it grows with that angle and with
+    /// the Sun's distance; the Sun's angular radius is largest at the least distance. Out of the
+    /// eclipse seasons this rules a passage out without a search.
+    fn may_eclipse(&self, c: f64, quarter: f64) -> bool {
+        // |δ| is monotonic over half a day except at a solstice, far from any eclipse; the
+        // margin covers its curvature (1e-6 rad) many times over.
+        let least = [c - quarter, c, c + quarter]
+            .iter()
+            .map(|&t| self.declination(t).abs())
+            .fold(f64::INFINITY, f64::min)
+            - 1e-4;
+        if least <= 0.0 {
+            return true;
+        }
+        let (sep, rho_s) = match self.shadow {
+            Shadow::Penumbra => {
+                let nearest = if self.eccentric_sun {
+                    1.0 - EARTH_ECCENTRICITY
+                } else {
+                    1.0
+                };
+                let (d, r) = (AU * nearest, self.radius);
+                let (sp, cp) = least.sin_cos();
+                ((d * sp).atan2(r + d * cp), (SUN_RADIUS / (d - r)).asin())
+            }
+            _ => (least, 0.0),
+        };
+        sep - self.earth_angular_radius() - rho_s < 0.0
+    }
+
+    /// Closed form for the cylinder with the Sun fixed in the orbit plane.
+    fn equinox_cylinder_eclipses(&self, t0: f64, t1: f64) -> Vec<Eclipse> {
+        let half = 0.5 * self.eclipse_duration();
+        let k_first = ((t0 + half) * 2.0 * PI / self.period + self.phase0 - PI) / (2.0 * PI);
+        let mut k = k_first.floor() - 1.0;
+        let mut out = Vec::new();
+        loop {
+            let c = self.shadow_centre(k);
+            let (enter, exit) = (c - half, c + half);
+            if enter >= t1 {
+                break;
+            }
+            if exit > t0 {
+                out.push(Eclipse {
+                    centre: c,
+                    outer: (enter, exit),
+                    umbra: Some((enter, exit)),
+                });
+            }
+            k += 1.0;
+        }
+        out
+    }
+
+    /// Eclipses found numerically around each passage behind the Earth: the deepest point by
+    /// golden-section search, the contacts by bisection (each side is monotonic).
+    /// `prefilter`: skip the passages [`Orbit::may_eclipse`] rules out (off only to test it).
+    fn searched_eclipses(&self, t0: f64, t1: f64, prefilter: bool) -> Vec<Eclipse> {
+        let quarter = 0.25 * self.synodic_period();
+        let rho_e = self.earth_angular_radius();
+        let outer = |t: f64| {
+            let (sep, rho_s) = self.sky(t);
+            sep - rho_e - rho_s
+        };
+        let inner = |t: f64| {
+            let (sep, rho_s) = self.sky(t);
+            sep - rho_e + rho_s
+        };
+        let mut k = ((t0 * self.rate() + self.phase0 - PI) / (2.0 * PI)).floor() - 1.0;
+        let mut out = Vec::new();
+        loop {
+            let c = self.shadow_centre(k);
+            k += 1.0;
+            if c - quarter >= t1 {
+                break;
+            }
+            if c + quarter <= t0 || (prefilter && !self.may_eclipse(c, quarter)) {
+                continue;
+            }
+            let deepest = golden_min(outer, c - 0.5 * quarter, c + 0.5 * quarter);
+            if outer(deepest) >= 0.0 {
+                continue;
+            }
+            let contacts = (
+                bisect(outer, deepest, c - quarter),
+                bisect(outer, deepest, c + quarter),
+            );
+            if contacts.1 <= t0 || contacts.0 >= t1 {
+                continue;
+            }
+            let umbra = (inner(deepest) < 0.0).then(|| {
+                (
+                    bisect(inner, deepest, c - quarter),
+                    bisect(inner, deepest, c + quarter),
+                )
+            });
+            out.push(Eclipse {
+                centre: deepest,
+                outer: contacts,
+                umbra,
+            });
+        }
+        out
+    }
+
+    /// Every eclipse (t_enter, t_exit) overlapping [t0, t1], clipped to it, in time order. With
+    /// the penumbra these are the first and last contacts (where s starts to fall below 1 and is
+    /// back to 1).
+    pub fn shadow_intervals(&self, t0: f64, t1: f64) -> Vec<(f64, f64)> {
+        self.eclipses(t0, t1)
+            .iter()
+            .map(|e| (e.outer.0.max(t0), e.outer.1.min(t1)))
+            .collect()
+    }
+
+    /// The umbra (s = 0) intervals overlapping [t0, t1], clipped to it, in time order.
+    pub fn umbra_intervals(&self, t0: f64, t1: f64) -> Vec<(f64, f64)> {
+        self.eclipses(t0, t1)
+            .iter()
+            .filter_map(|e| e.umbra)
+            .filter(|(a, b)| *b > t0 && *a < t1)
+            .map(|(a, b)| (a.max(t0), b.min(t1)))
+            .collect()
+    }
+
+    /// Times in (t0, t1) where s(t) jumps (cylinder) or has a kink (penumbra: first and last
+    /// contact, umbra entry and exit), sorted.
+    pub fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        breakpoints_of(&self.eclipses(t0, t1), t0, t1)
+    }
+}
+
+/// The breakpoints in (t0, t1) of the eclipses `eclipses` (in time order), as
+/// [`Orbit::breakpoints`].
+pub fn breakpoints_of(eclipses: &[Eclipse], t0: f64, t1: f64) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for e in eclipses {
+        let (a, b) = e.outer;
+        let contacts = match e.umbra {
+            Some((c, d)) => [a, c, d, b],
+            None => [a, a, b, b],
+        };
+        for t in contacts {
+            if t > t0 && t < t1 && out.last().is_none_or(|&last| t > last) {
+                out.push(t);
+            }
+        }
+    }
+    out
+}
+
+/// The eclipses of an orbit searched once over a stretch of several orbits and then looked up:
+/// a long run asks for the eclipses of the same orbit many times. Each eclipse depends only on
+/// its passage behind the Earth, not on the window asked for, so a look-up returns exactly what
+/// [`Orbit::eclipses`] returns for the same window.
+#[derive(Debug, Clone)]
+pub struct EclipseTable {
+    orbit: Orbit,
+    /// The span searched, and every eclipse overlapping it, in time order.
+    span: (f64, f64),
+    list: Vec<Eclipse>,
+    /// No search goes past this time unless asked to: a run of one orbit searches one orbit.
+    limit: f64,
+}
+
+/// Orbits searched at a time by [`EclipseTable`].
+const TABLE_ORBITS: f64 = 16.0;
+
+impl EclipseTable {
+    pub fn new(orbit: &Orbit) -> Self {
+        Self::until(orbit, f64::INFINITY)
+    }
+
+    /// A table for a run that ends at `limit`: its searches stop there (a long run is called a
+    /// few orbits at a time, and each call would otherwise search [`TABLE_ORBITS`] orbits).
+    pub fn until(orbit: &Orbit, limit: f64) -> Self {
+        EclipseTable {
+            orbit: *orbit,
+            span: (0.0, 0.0),
+            list: Vec::new(),
+            limit,
+        }
+    }
+
+    /// Every eclipse overlapping [t0, t1], unclipped, in time order (as [`Orbit::eclipses`]).
+    pub fn overlapping(&mut self, t0: f64, t1: f64) -> &[Eclipse] {
+        if !(self.span.0 <= t0 && t1 <= self.span.1) {
+            let end = t1.max((t0 + TABLE_ORBITS * self.orbit.period).min(self.limit));
+            self.span = (t0, end);
+            self.list = self.orbit.eclipses(t0, end);
+        }
+        let first = self.list.partition_point(|e| e.outer.1 <= t0);
+        let last = self.list.partition_point(|e| e.outer.0 < t1);
+        &self.list[first..last.max(first)]
+    }
+}
+
+/// Visible fraction of a disk of angular radius `rho_s` whose centre is `sep` away from the
+/// centre of an occulting disk of angular radius `rho_e` (planar geometry): 1 − overlap / area.
+pub fn visible_fraction(rho_s: f64, rho_e: f64, sep: f64) -> f64 {
+    if sep >= rho_s + rho_e {
+        return 1.0;
+    }
+    if sep <= rho_e - rho_s {
+        return 0.0;
+    }
+    if sep <= rho_s - rho_e {
+        return 1.0 - (rho_e / rho_s).powi(2);
+    }
+    // Lens between the two circles: a circular segment of each, cut by their common chord.
+    let x_s = (sep * sep + rho_s * rho_s - rho_e * rho_e) / (2.0 * sep);
+    let x_e = sep - x_s;
+    let h = (rho_s * rho_s - x_s * x_s).max(0.0).sqrt();
+    let segment = |r: f64, x: f64| {
+        let a = h.atan2(x);
+        r * r * (a - a.sin() * a.cos())
+    };
+    let overlap = segment(rho_s, x_s) + segment(rho_e, x_e);
+    (1.0 - overlap / (PI * rho_s * rho_s)).clamp(0.0, 1.0)
+}
+
+/// The time where the increasing-away-from-`neg` function f changes sign, between `neg`
+/// (f < 0) and `pos` (f ≥ 0), by bisection to 1e-7 s.
+fn bisect(f: impl Fn(f64) -> f64, mut neg: f64, mut pos: f64) -> f64 {
+    for _ in 0..200 {
+        let mid = 0.5 * (neg + pos);
+        if (pos - neg).abs() < 1e-7 || mid == neg || mid == pos {
+            break;
+        }
+        if f(mid) < 0.0 {
+            neg = mid;
+        } else {
+            pos = mid;
+        }
+    }
+    0.5 * (neg + pos)
+}
+
+/// The minimum of a unimodal f on [a, b] by golden-section search, to 1e-3 s.
+fn golden_min(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    let (a, b) = crate::numerics::simd::golden_section(f, a, b, 1e-3, usize::MAX);
+    0.5 * (a + b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn geo_eclipse_is_about_seventy_minutes() {
+        let o = Orbit::geo_equinox();
+        let minutes = o.eclipse_duration() / 60.0;
+        assert!((minutes - 69.4).abs() < 0.1, "{minutes}");
+    }
+
+    #[test]
+    fn shadow_intervals_are_centred_on_half_orbits_with_analytic_length() {
+        let o = Orbit::geo_equinox();
+        let iv = o.shadow_intervals(0.0, 3.0 * o.period);
+        assert_eq!(iv.len(), 3);
+        for (k, (a, b)) in iv.iter().enumerate() {
+            let centre = (k as f64 + 0.5) * o.period;
+            assert!(((a + b) / 2.0 - centre).abs() < 1e-6);
+            assert!((b - a - o.eclipse_duration()).abs() < 1e-6);
+            assert_eq!(o.illumination(centre), 0.0);
+            assert_eq!(o.illumination(a - 1e-3), 1.0);
+            assert_eq!(o.illumination(b + 1e-3), 1.0);
+            assert_eq!(o.illumination(a + 1e-3), 0.0);
+        }
+    }
+
+    #[test]
+    fn intervals_are_clipped_to_the_span() {
+        let o = Orbit::geo_equinox();
+        let mid = 0.5 * o.period;
+        let iv = o.shadow_intervals(mid, mid + 10.0);
+        assert_eq!(iv, vec![(mid, mid + 10.0)]);
+        assert!(o.breakpoints(mid, mid + 10.0).is_empty());
+        assert!(o.shadow_intervals(0.0, 1000.0).is_empty());
+        // negative times and a phase offset
+        let shifted = Orbit { phase0: PI, ..o };
+        let iv = shifted.shadow_intervals(-10.0, 10.0);
+        assert_eq!(iv.len(), 1);
+        assert!(iv[0].0 == -10.0 && iv[0].1 == 10.0);
+    }
+
+    #[test]
+    fn visible_fraction_is_continuous_and_bounded() {
+        let (rs, re) = (0.004_65, 0.152);
+        let n = 20_000;
+        let mut prev = visible_fraction(rs, re, re - 2.0 * rs);
+        assert_eq!(prev, 0.0);
+        for i in 1..=n {
+            let sep = re - 2.0 * rs + 4.0 * rs * i as f64 / n as f64;
+            let s = visible_fraction(rs, re, sep);
+            assert!((0.0..=1.0).contains(&s));
+            assert!(s >= prev, "not monotonic at {sep}");
+            assert!(s - prev < 1e-3, "jump at {sep}: {prev} -> {s}");
+            prev = s;
+        }
+        assert_eq!(prev, 1.0);
+        // half the Sun hidden by a straight edge when the centres are ρ_E apart (to O(ρ_S/ρ_E))
+        assert!((visible_fraction(rs, re, re) - 0.5).abs() < 0.02);
+        // two equal disks at half a radius: known lens area
+        let r: f64 = 1.0;
+        let d: f64 = 0.5;
+        let lens = 2.0 * r * r * (d / (2.0 * r)).acos() - 0.5 * d * (4.0 * r * r - d * d).sqrt();
+        assert!((visible_fraction(r, r, d) - (1.0 - lens / PI)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn penumbra_brackets_the_umbra_and_s_is_continuous() {
+        let o = Orbit {
+            shadow: Shadow::Penumbra,
+            ..Orbit::geo_equinox()
+        };
+        let e = o.eclipses(0.0, o.period);
+        assert_eq!(e.len(), 1);
+        let (a, b) = e[0].outer;
+        let (c, d) = e[0].umbra.unwrap();
+        assert!(a < c && c < d && d < b);
+        assert!((o.illumination(a - 1e-3) - 1.0).abs() < 1e-9);
+        assert!(o.illumination(c + 1e-3) < 1e-9);
+        let bp = o.breakpoints(0.0, o.period);
+        assert_eq!(bp, vec![a, c, d, b]);
+        // sunrise about two minutes
+        assert!((b - d) > 100.0 && (b - d) < 160.0, "{}", b - d);
+        let mut prev = o.illumination(a - 10.0);
+        let mut t = a - 10.0;
+        while t < b + 10.0 {
+            t += 0.5;
+            let s = o.illumination(t);
+            assert!((s - prev).abs() < 0.01);
+            prev = s;
+        }
+    }
+
+    #[test]
+    fn no_geo_eclipse_at_the_solstice_and_flux_follows_the_distance() {
+        let june = Orbit::geo_year(171.0);
+        assert!(june.eclipses(0.0, 5.0 * DAY).is_empty());
+        assert!(june.breakpoints(0.0, 5.0 * DAY).is_empty());
+        let march = Orbit::geo_year(EQUINOX_DAY);
+        assert_eq!(march.eclipses(0.0, 3.0 * DAY).len(), 3);
+        let jan = Orbit::geo_year(PERIHELION_DAY);
+        assert!((jan.flux_scale(0.0) - 1.0 / (1.0 - EARTH_ECCENTRICITY).powi(2)).abs() < 1e-12);
+        assert_eq!(Orbit::geo_equinox().flux_scale(1e7), 1.0);
+    }
+
+    #[test]
+    fn passages_ruled_out_without_a_search_hold_no_eclipse() {
+        // A year of each kind of searched shadow, with and without the test before the search;
+        // and the test does rule out most passages (out of the seasons).
+        for orbit in [
+            Orbit::geo_year(0.0),
+            Orbit {
+                shadow: Shadow::Cylindrical,
+                ..Orbit::geo_year(0.0)
+            },
+            Orbit {
+                eccentric_sun: false,
+                ..Orbit::geo_year(200.0)
+            },
+        ] {
+            let year = YEAR_DAYS * DAY;
+            let searched = orbit.searched_eclipses(0.0, year, false);
+            assert_eq!(orbit.searched_eclipses(0.0, year, true), searched);
+            assert!(
+                searched.len() > 60 && searched.len() < 200,
+                "{}",
+                searched.len()
+            );
+            let quarter = 0.25 * orbit.synodic_period();
+            let ruled_out = (0..366)
+                .filter(|&k| !orbit.may_eclipse(orbit.shadow_centre(k as f64), quarter))
+                .count();
+            assert!(ruled_out > 150, "{ruled_out}");
+        }
+    }
+
+    #[test]
+    fn the_eclipse_table_returns_what_a_search_of_the_window_returns() {
+        // Windows of odd lengths and starts, forward and back, across the eclipse season's edge
+        // and inside it, for the searched penumbra and the closed-form cylinder.
+        for orbit in [
+            Orbit::geo_year(EQUINOX_DAY - 30.0),
+            Orbit::geo_equinox(),
+            Orbit::leo(LEO_ALTITUDE),
+        ] {
+            let p = orbit.period;
+            let mut table = EclipseTable::new(&orbit);
+            // A table whose run ends early still answers windows past its end.
+            let mut short = EclipseTable::until(&orbit, 2.5 * p);
+            let mut t0 = 0.3 * p;
+            let mut seen = 0;
+            for k in 0..120 {
+                let t1 = t0 + p * (0.2 + 0.7 * ((k * 7) % 5) as f64);
+                let want = orbit.eclipses(t0, t1);
+                seen += want.len();
+                assert_eq!(table.overlapping(t0, t1), want.as_slice(), "[{t0}, {t1}]");
+                assert_eq!(short.overlapping(t0, t1), want.as_slice(), "[{t0}, {t1}]");
+                assert_eq!(
+                    breakpoints_of(&want, t0, t1),
+                    orbit.breakpoints(t0, t1),
+                    "[{t0}, {t1}]"
+                );
+                t0 += if k % 9 == 8 { -1.3 * p } else { 0.45 * p };
+            }
+            assert!(seen > 20, "{seen}");
+        }
+    }
+
+    #[test]
+    fn leo_period_is_keplerian() {
+        let o = Orbit::leo(LEO_ALTITUDE);
+        assert!((o.period / 60.0 - 95.4).abs() < 0.3, "{}", o.period / 60.0);
+        assert_eq!(o.shadow_intervals(0.0, o.period).len(), 1);
+    }
+
+    #[test]
+    fn validation_names_the_parameter() {
+        let mut o = Orbit::geo_equinox();
+        o.radius = 1.0;
+        assert!(o
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("earth_radius"));
+        o.period = f64::NAN;
+        assert!(o.validate().unwrap_err().to_string().starts_with("period"));
+    }
+}

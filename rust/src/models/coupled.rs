@@ -1,0 +1,469 @@
+//! The right-hand sides: a thermal model coupled to a structural model (or alone), and the hinge
+//! driven by a prescribed moment. Each implements [`OdeSystem`].
+
+use crate::error::{Error, Result};
+use crate::inputs::orbit::{Orbit, Shadow};
+use crate::inputs::panel::Panel;
+use crate::models::hinge::{hinge_acceleration, Hinge, HingeModel, Rigid, StructuralModel};
+use crate::models::thermal::{AsWritten, Balance, ThermalModel, TwoLayer};
+use crate::numerics::integrate::{OdeSystem, State};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, DimName, Dyn, SVector, Vector2, Vector4, U1, U2, U4};
+
+/// How the hinge angle feeds back on the heating (paper Sec. 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Coupling {
+    /// Absorbed flux ∝ cos θ: the projected area follows the hinge angle (two-way coupling).
+    ProjectedArea,
+    /// Projected area frozen (cos θ → 1): one-way coupling, paper Fig. 18.
+    Frozen,
+}
+
+/// Illumination bookkeeping shared by every orbit-driven system: the segment being integrated
+/// decides s, so a step that ends on a shadow boundary sees the segment's own side.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sunlight {
+    pub(crate) orbit: Orbit,
+    segment: (f64, f64),
+    /// s over the current segment when it cannot change there: every segment of a cylindrical
+    /// shadow, and the full-Sun and umbra segments of a penumbral one (the breakpoints include
+    /// every contact). None inside a penumbra, where s(t) is evaluated at each call.
+    constant_s: Option<f64>,
+}
+
+impl Sunlight {
+    pub(crate) fn new(orbit: Orbit) -> Self {
+        Sunlight {
+            orbit,
+            segment: (0.0, 0.0),
+            constant_s: None,
+        }
+    }
+
+    pub(crate) fn enter(&mut self, a: f64, b: f64) {
+        self.segment = (a, b);
+        let mid = self.orbit.illumination_on(0.5 * (a + b), a, b);
+        let varies = matches!(self.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
+        self.constant_s = if varies { None } else { Some(mid) };
+    }
+
+    /// The flux over the current segment when it is the same at every time of it (s constant
+    /// there and the Sun at 1 au): what [`Sunlight::flux`] returns at any t of the segment.
+    pub(crate) fn constant_flux(&self) -> Option<f64> {
+        match self.constant_s {
+            Some(s) if !self.orbit.eccentric_sun => Some(s * self.orbit.flux_scale(self.segment.0)),
+            _ => None,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn flux(&self, t: f64) -> f64 {
+        let s = match self.constant_s {
+            Some(s) => s,
+            None => {
+                let (a, b) = self.segment;
+                self.orbit.illumination_on(t, a, b)
+            }
+        };
+        // At 1 au the scale is exactly 1: no multiplication, no division on the right-hand
+        // side's path (with the multiplication the compiler merged both paths into a division).
+        if self.orbit.eccentric_sun {
+            s * self.orbit.flux_scale(t)
+        } else {
+            s
+        }
+    }
+}
+
+/// A thermal model and a structural model coupled through the thermal moment (thermal →
+/// structure) and the projected-area factor (structure → thermal), driven by the orbit's Sun.
+///
+/// State: the thermal model's temperatures, then the structural model's states; `D` is its
+/// dimension, `Const<N>` when N is known at compile time (the paper's model, [`Coupled::new`]:
+/// (T_f, T_b, θ, θ̇)) or `Dyn`. Each model keeps its coefficients folded into per-second rates;
+/// the moment's division by the structure's inertia is folded here, once.
+#[derive(Debug, Clone, Copy)]
+pub struct Coupled<T = TwoLayer, S = Hinge, D = U4> {
+    thermal: T,
+    structure: S,
+    coupling: Coupling,
+    sun: Sunlight,
+    /// M_T per kelvin of the thermal gradient over the structure's inertia.
+    load_per_kelvin: f64,
+    dim: D,
+}
+
+impl Coupled<TwoLayer, Hinge, U4> {
+    /// The paper's model: two layers (eq. 2) and the hinge (eq. 20 or 28).
+    pub fn new(panel: Panel, orbit: Orbit, model: HingeModel, coupling: Coupling) -> Self {
+        let (thermal, structure) = (TwoLayer::new(&panel), Hinge::new(&panel, model));
+        Self::compose(thermal, structure, orbit, coupling, U4::name())
+            .expect("two temperatures and two hinge states make four")
+    }
+}
+
+/// What a kernel that evaluates [`Coupled::rhs_at_flux`] of the panel model for several panels at
+/// once needs, so that it can do the same arithmetic lane by lane (the ensemble's lockstep lanes).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LaneForm {
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    /// The two-layer balance per half capacity.
+    pub balance: Balance,
+    /// Thermal moment per kelvin over I_B.
+    pub load_per_kelvin: f64,
+    /// c_d / I_B and K_el / I_B.
+    pub damping: f64,
+    pub stiffness: f64,
+}
+
+impl Coupled<TwoLayer, Hinge, U4> {
+    /// [`Sunlight::constant_flux`] of the current segment.
+    pub(crate) fn constant_flux(&self) -> Option<f64> {
+        self.sun.constant_flux()
+    }
+
+    pub(crate) fn lane_form(&self) -> LaneForm {
+        let (model, damping, stiffness) = self.structure.rate_form();
+        LaneForm {
+            model,
+            coupling: self.coupling,
+            balance: self.thermal.rate_balance(),
+            load_per_kelvin: self.load_per_kelvin,
+            damping,
+            stiffness,
+        }
+    }
+}
+
+impl<T: ThermalModel> Coupled<AsWritten<T>, Rigid, Dyn> {
+    /// A thermal model alone, the plate held flat (θ = 0), its rates as written.
+    pub fn thermal_only(thermal: T, orbit: Orbit) -> Self {
+        let n = thermal.size();
+        Self::compose(AsWritten(thermal), Rigid, orbit, Coupling::Frozen, Dyn(n))
+            .expect("the state is the temperatures")
+    }
+}
+
+impl<T: ThermalModel, S: StructuralModel, D: Dim> Coupled<T, S, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// Couples `thermal` and `structure`; `dim` must hold both models' states.
+    pub fn compose(
+        thermal: T,
+        structure: S,
+        orbit: Orbit,
+        coupling: Coupling,
+        dim: D,
+    ) -> Result<Self> {
+        let n = thermal.size() + structure.size();
+        if dim.value() != n {
+            return Err(Error::invalid(
+                "state size",
+                dim.value(),
+                &format!("the models have {n} states"),
+            ));
+        }
+        Ok(Coupled {
+            load_per_kelvin: thermal.moment_per_kelvin() / structure.inertia(),
+            thermal,
+            structure,
+            coupling,
+            sun: Sunlight::new(orbit),
+            dim,
+        })
+    }
+
+    pub fn thermal(&self) -> &T {
+        &self.thermal
+    }
+
+    pub fn structure(&self) -> &S {
+        &self.structure
+    }
+
+    pub fn orbit(&self) -> &Orbit {
+        &self.sun.orbit
+    }
+
+    pub fn coupling(&self) -> Coupling {
+        self.coupling
+    }
+
+    /// The state's dimension.
+    pub fn dim(&self) -> D {
+        self.dim
+    }
+
+    /// The thermal moment in state `y`, N m.
+    pub fn moment(&self, y: &State<D>) -> f64 {
+        self.thermal.moment(&y.as_slice()[..self.thermal.size()])
+    }
+
+    /// Refuses a start state the models do not describe: a temperature not above 0 K, the hinge
+    /// beyond ±π/2 or faster than it can move ([`crate::models::hinge::check_start_state`]).
+    pub fn check_start(&self, y: &State<D>) -> Result<()> {
+        let n = self.thermal.size();
+        crate::models::hinge::check_start_state(y.as_slice(), n, None)?;
+        self.structure.check_start(n, &y.as_slice()[n..])
+    }
+
+    /// Names of the state's components, temperatures first.
+    pub fn names(&self) -> Vec<String> {
+        let mut names = self.thermal.names();
+        names.extend(self.structure.names());
+        names
+    }
+
+    /// The right-hand side at a given illumination factor (used by the equilibrium solver too).
+    #[inline(always)]
+    pub fn rhs_at_flux(&self, flux: f64, y: &State<D>) -> State<D> {
+        self.rhs_at_flux_as::<false>(flux, y)
+    }
+
+    /// [`Coupled::rhs_at_flux`], with the models' fused rates when `FUSED`.
+    #[inline(always)]
+    fn rhs_at_flux_as<const FUSED: bool>(&self, flux: f64, y: &State<D>) -> State<D> {
+        let mut out = State::<D>::zeros_generic(self.dim, U1);
+        let n = self.thermal.size();
+        let (temps, q) = y.as_slice().split_at(n);
+        let (temp_rates, q_rates) = out.as_mut_slice().split_at_mut(n);
+        let load = self.load_per_kelvin * self.thermal.gradient(temps);
+        let area = match self.coupling {
+            Coupling::ProjectedArea => self.structure_rates::<FUSED>(load, q, q_rates),
+            Coupling::Frozen => {
+                self.structure_rates::<FUSED>(load, q, q_rates);
+                1.0
+            }
+        };
+        if FUSED {
+            self.thermal.rates_fused(flux * area, temps, temp_rates);
+        } else {
+            self.thermal.rates(flux * area, temps, temp_rates);
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn structure_rates<const FUSED: bool>(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        if FUSED {
+            self.structure.rates_fused(load, q, out)
+        } else {
+            self.structure.rates(load, q, out)
+        }
+    }
+
+    /// Illumination factor (s × flux scale) inside the current segment at time t.
+    pub fn flux_at(&self, t: f64) -> f64 {
+        self.sun.flux(t)
+    }
+}
+
+impl<T: ThermalModel, S: StructuralModel, D: Dim> OdeSystem<D> for Coupled<T, S, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &State<D>) -> State<D> {
+        self.rhs_at_flux(self.sun.flux(t), y)
+    }
+    #[inline(always)]
+    fn rhs_fused(&self, t: f64, y: &State<D>) -> State<D> {
+        self.rhs_at_flux_as::<true>(self.sun.flux(t), y)
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.sun.orbit.breakpoints(t0, t1)
+    }
+    fn check_span(&self, t0: f64, t1: f64) -> crate::error::Result<()> {
+        self.sun.orbit.check_span(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.sun.enter(a, b);
+    }
+}
+
+/// A thermal-moment history M(t), N m: constant, or linear between samples (held at the ends).
+#[derive(Debug, Clone, PartialEq)]
+pub enum MomentHistory {
+    Constant(f64),
+    Samples { t: Vec<f64>, moment: Vec<f64> },
+}
+
+impl MomentHistory {
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        match self {
+            MomentHistory::Constant(m) => *m,
+            MomentHistory::Samples { t: ts, moment } => {
+                let n = ts.len();
+                if t <= ts[0] {
+                    return moment[0];
+                }
+                if t >= ts[n - 1] {
+                    return moment[n - 1];
+                }
+                let i = ts.partition_point(|&x| x <= t) - 1;
+                let w = (t - ts[i]) / (ts[i + 1] - ts[i]);
+                moment[i] + w * (moment[i + 1] - moment[i])
+            }
+        }
+    }
+
+    /// Checks every value against the hinge model's range for this panel
+    /// ([`crate::models::hinge::check_moment`]).
+    pub fn check_against(&self, panel: &crate::inputs::panel::Panel) -> Result<()> {
+        match self {
+            MomentHistory::Constant(m) => crate::models::hinge::check_moment(panel, *m),
+            MomentHistory::Samples { moment, .. } => moment
+                .iter()
+                .try_for_each(|&m| crate::models::hinge::check_moment(panel, m)),
+        }
+    }
+
+    /// Checks sample times increasing and values finite.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            MomentHistory::Constant(m) => crate::error::require_finite("moment", *m),
+            MomentHistory::Samples { t, moment } => {
+                if t.len() < 2 || t.len() != moment.len() {
+                    return Err(Error::invalid(
+                        "moment",
+                        format!("{} times, {} values", t.len(), moment.len()),
+                        "needs at least two (time, moment) samples of equal length",
+                    ));
+                }
+                if let Some(i) = t
+                    .windows(2)
+                    .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+                {
+                    return Err(Error::invalid(
+                        "moment_t",
+                        t[i + 1],
+                        "times must be finite and increasing",
+                    ));
+                }
+                if let Some(v) = t.iter().chain(moment).find(|v| !v.is_finite()) {
+                    return Err(Error::invalid("moment", v, "samples must be finite"));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// The hinge alone, driven by a prescribed thermal moment; state (θ, θ̇).
+#[derive(Debug, Clone)]
+pub struct DrivenHinge {
+    pub panel: Panel,
+    pub model: HingeModel,
+    pub moment: MomentHistory,
+}
+
+impl OdeSystem<U2> for DrivenHinge {
+    #[inline]
+    fn rhs(&self, t: f64, y: &Vector2<f64>) -> Vector2<f64> {
+        let m = self.moment.at(t);
+        Vector2::new(
+            y[1],
+            hinge_acceleration(&self.panel, self.model, m, y[0], y[1]),
+        )
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        // Kinks of the piecewise-linear history would cost accuracy if straddled.
+        match &self.moment {
+            MomentHistory::Constant(_) => Vec::new(),
+            MomentHistory::Samples { t, .. } => {
+                t.iter().copied().filter(|&x| x > t0 && x < t1).collect()
+            }
+        }
+    }
+}
+
+/// Convenience: a state vector from its four components.
+pub fn state(t_front: f64, t_back: f64, theta: f64, theta_dot: f64) -> SVector<f64, 4> {
+    Vector4::new(t_front, t_back, theta, theta_dot)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::hinge::thermal_moment;
+    use crate::models::thermal::two_layer_rates;
+
+    /// The folded coefficients give the rates of the textbook form of the equations.
+    #[test]
+    fn coupled_rhs_matches_the_equations_term_by_term() {
+        let panel = Panel {
+            damping: 2.0,
+            ..Panel::paper()
+        };
+        let states = [
+            Vector4::new(380.0, 368.0, 0.085, 0.0),
+            Vector4::new(250.0, 262.0, -0.3, 0.02),
+            Vector4::new(120.0, 119.0, 1.2, -0.7),
+        ];
+        for model in [HingeModel::Nonlinear, HingeModel::Linear] {
+            for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+                let sys = Coupled::new(panel, Orbit::geo_equinox(), model, coupling);
+                for y in &states {
+                    for flux in [0.0, 1.0, 0.97] {
+                        let got = sys.rhs_at_flux(flux, y);
+                        let area = match coupling {
+                            Coupling::ProjectedArea => y[2].cos(),
+                            Coupling::Frozen => 1.0,
+                        };
+                        let (dtf, dtb) = two_layer_rates(&panel, flux * area, y[0], y[1]);
+                        let m = thermal_moment(&panel, y[0], y[1]);
+                        let acc = hinge_acceleration(&panel, model, m, y[2], y[3]);
+                        let want = Vector4::new(dtf, dtb, y[3], acc);
+                        for i in 0..4 {
+                            let tol = 1e-13 * want[i].abs().max(1e-3);
+                            assert!(
+                                (got[i] - want[i]).abs() <= tol,
+                                "{model:?} {coupling:?} {y} flux {flux}: component {i} {} vs {}",
+                                got[i],
+                                want[i]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The same models behind a run-time size and dynamic dispatch give the same bits.
+    #[test]
+    fn a_run_time_sized_system_reproduces_the_paper_model() {
+        use crate::numerics::integrate::{Method, Tolerances};
+        use crate::runs::simulate::{run, Output};
+        let p = Panel::paper();
+        let o = Orbit::geo_year(273.0);
+        let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+        let mut fixed = Coupled::new(p, o, model, coupling);
+        let thermal = crate::models::thermal_model(&p, 2).unwrap();
+        let mut dynamic =
+            Coupled::compose(thermal, Hinge::new(&p, model), o, coupling, Dyn(4)).unwrap();
+        let flux = o.flux_scale(40_000.0);
+        let y0 = fixed.steady_state(flux).unwrap();
+        let y0_dyn = dynamic.steady_state(flux).unwrap();
+        assert_eq!(y0.as_slice(), y0_dyn.as_slice());
+        let method = Method::Dopri5(Tolerances::default());
+        let out = Output::Every(60.0);
+        let span = (40_000.0, 50_000.0);
+        let a = run(&mut fixed, &method, span, y0, &out).unwrap();
+        let b = run(&mut dynamic, &method, span, y0_dyn, &out).unwrap();
+        assert_eq!(a.stats, b.stats);
+        for (x, y) in a.y.iter().zip(&b.y) {
+            assert_eq!(x.as_slice(), y.as_slice());
+        }
+        assert!(Coupled::compose(
+            TwoLayer::new(&p),
+            Hinge::new(&p, model),
+            o,
+            coupling,
+            Dyn(5)
+        )
+        .is_err());
+    }
+}

@@ -1,0 +1,7 @@
+//! Numerical methods that know no physics: SIMD number types, the processor and the kernel
+//! chosen on it, and the ODE integrators with their output.
+
+pub mod cpu;
+pub mod integrate;
+pub mod newton;
+pub(crate) mod simd;

@@ -1,0 +1,182 @@
+//! The distributed panel on an orbit: the coupled system on a run-time-sized state, integrated by
+//! the generic integrators through eclipses and penumbrae, and its sampled fields.
+
+use crate::cancel::Cancel;
+use crate::error::{Error, Result};
+use crate::inputs::orbit::Orbit;
+use crate::models::coupled::Sunlight;
+use crate::models::distributed::DistributedPanel;
+use crate::numerics::integrate::Stats;
+use crate::numerics::integrate::{Dyn, Method, OdeSystem, State};
+use crate::runs::orbits::LimitCrossing;
+use crate::runs::simulate::{run_watched, Limit, OnLimit, Output};
+use nalgebra::DVector;
+
+/// The distributed panel driven by an orbit's sunlight; state (T_f[n], T_b[n], q[k], q̇[k]).
+#[derive(Debug, Clone)]
+pub struct DistributedSystem {
+    pub model: DistributedPanel,
+    sun: Sunlight,
+}
+
+impl DistributedSystem {
+    pub fn new(model: DistributedPanel, orbit: Orbit) -> Self {
+        DistributedSystem {
+            model,
+            sun: Sunlight::new(orbit),
+        }
+    }
+}
+
+impl OdeSystem<Dyn> for DistributedSystem {
+    fn rhs(&self, t: f64, y: &State<Dyn>) -> State<Dyn> {
+        let mut dy = DVector::zeros(y.len());
+        self.model
+            .rhs_at_flux(self.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        dy
+    }
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.sun.orbit.breakpoints(t0, t1)
+    }
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.sun.enter(a, b);
+    }
+}
+
+/// The sampled fields of a distributed run; per-sample rows.
+#[derive(Debug, Clone)]
+pub struct DistributedRun {
+    pub t: Vec<f64>,
+    /// Names of an element's temperatures ("T_front", "T_back" for two layers).
+    pub names: Vec<String>,
+    /// Per sample, per name, the temperature of every element, K.
+    pub temperatures: Vec<Vec<Vec<f64>>>,
+    /// Thermal moment per element, N m.
+    pub moment: Vec<Vec<f64>>,
+    /// Deflection (m) and slope per node.
+    pub deflection: Vec<Vec<f64>>,
+    pub slope: Vec<Vec<f64>>,
+    /// θ_f, rad.
+    pub theta_f: Vec<f64>,
+    /// s(t), the illuminated fraction.
+    pub sunlit: Vec<f64>,
+    pub stats: Stats,
+    pub y_end: Vec<f64>,
+    /// Where |θ_f| first passed the validity limit, when one was watched.
+    pub crossing: Option<LimitCrossing>,
+}
+
+/// Integrates `model` on `orbit` over `t_span` from `y0` (default: the sunlit equilibrium at the
+/// start's flux scale) and samples it as `output` asks, watching θ_f against `limit` (see
+/// [`crate::runs::simulate::run_watched`]) and stopping within a step of `cancel`.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate(
+    model: &DistributedPanel,
+    orbit: Orbit,
+    method: &Method,
+    t_span: (f64, f64),
+    y0: Option<Vec<f64>>,
+    output: &Output,
+    limit: Option<OnLimit>,
+    cancel: &Cancel,
+) -> Result<DistributedRun> {
+    orbit.validate()?;
+    let (t0, _) = t_span;
+    crate::numerics::integrate::check_span(t_span.0, t_span.1)?;
+    let start = match y0 {
+        Some(v) => {
+            if v.len() != model.state_size() {
+                return Err(Error::invalid(
+                    "y0",
+                    format!("{} components", v.len()),
+                    &format!(
+                        "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
+                        model.state_size(),
+                        model.layers(),
+                        model.n(),
+                        model.k()
+                    ),
+                ));
+            }
+            // Its temperatures as every start state's; the modal amplitudes have no such range.
+            crate::models::hinge::check_start_state(&v, model.layers() * model.n(), None)?;
+            v
+        }
+        None => model.equilibrium(orbit.flux_scale(t0))?,
+    };
+    let mut system = DistributedSystem::new(model.clone(), orbit);
+    let watch = limit.map(|on| model.limit(on));
+    let traj = run_watched(
+        &mut system,
+        method,
+        t_span,
+        DVector::from_vec(start),
+        output,
+        watch.as_ref(),
+        cancel,
+    )?;
+    let crossing = match &traj.crossing {
+        Some((t, y)) => {
+            let theta = model.theta_f(y.as_slice(), *t)?;
+            Some(LimitCrossing::in_run(&orbit, t0, *t, theta))
+        }
+        None => None,
+    };
+    let mut out = DistributedRun {
+        t: traj.t.clone(),
+        names: model.temperature_names(),
+        temperatures: Vec::with_capacity(traj.t.len()),
+        moment: Vec::with_capacity(traj.t.len()),
+        deflection: Vec::with_capacity(traj.t.len()),
+        slope: Vec::with_capacity(traj.t.len()),
+        theta_f: Vec::with_capacity(traj.t.len()),
+        sunlit: Vec::with_capacity(traj.t.len()),
+        stats: traj.stats,
+        y_end: traj.y_end.as_slice().to_vec(),
+        crossing,
+    };
+    for (t, y) in traj.t.iter().zip(&traj.y) {
+        let y = y.as_slice();
+        out.temperatures.push(model.temperature_rows(y));
+        out.moment.push(model.moments(y));
+        let (w, s) = model.nodal(y);
+        out.deflection.push(w);
+        out.slope.push(s);
+        out.theta_f.push(model.theta_f(y, *t)?);
+        out.sunlit.push(orbit.illumination(*t));
+    }
+    Ok(out)
+}
+
+impl DistributedPanel {
+    /// The validity limit on θ_f as the integrators watch it: |tip rise| <= arm · sin(θ_limit),
+    /// the rise an affine function of the state (the modes' share, and the element moments',
+    /// which are linear in the temperatures: read off unit temperatures).
+    pub fn limit(&self, on: OnLimit) -> Limit {
+        let s = self.layers();
+        let r = &self.reduction;
+        let zero = vec![0.0; s];
+        let m0 = self.thermal.moment(&zero);
+        let mut weights = Vec::with_capacity(self.state_size());
+        let mut unit = zero.clone();
+        for e in 0..self.n() {
+            for i in 0..s {
+                unit[i] = 1.0;
+                weights.push((
+                    e * s + i,
+                    r.rise_residual[e] * (self.thermal.moment(&unit) - m0),
+                ));
+                unit[i] = 0.0;
+            }
+        }
+        for j in 0..self.k() {
+            weights.push((self.temps() + j, r.rise_modal[j]));
+        }
+        Limit {
+            weights,
+            offset: r.rise_residual.sum() * m0,
+            bound: r.mesh.arm() * on.theta_limit.sin(),
+            stop: on.stop,
+        }
+    }
+}
