@@ -32,7 +32,6 @@ use crate::cancel::Cancel;
 use crate::error::{require_positive, Error, Result};
 use crate::inputs::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::inputs::panel::Panel;
-use crate::models::hinge::HingeModel;
 use crate::numerics::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
 use crate::runs::orbits::{
     resolve_hinge, Collector, OrbitRun, OrbitRunRequest, Summarised, SummaryObserver,
@@ -484,11 +483,7 @@ impl<const N: usize, M: HybridModel<N>> Judge<N, M> {
         let (quasi_static, rate) = self.model.static_angle(flux, y, f);
         let d = y[N - 2] - quasi_static;
         let d_rate = y[N - 1] - rate;
-        let s = y[N - 2].sin();
-        let inertia = match self.model.hinge() {
-            HingeModel::Nonlinear => 1.0 + 3.0 * s * s,
-            HingeModel::Linear => 1.0,
-        };
+        let inertia = self.model.hinge().inertia_factor(y[N - 2].sin());
         let w2 = self.panel.hinge_stiffness / (self.panel.hinge_inertia() * inertia);
         (d * d + d_rate * d_rate / w2).sqrt()
     }
@@ -1169,6 +1164,7 @@ mod tests {
     use crate::analysis::steady::equilibrium;
     use crate::inputs::orbit::Shadow;
     use crate::models::coupled::Coupling;
+    use crate::models::hinge::HingeModel;
     use crate::numerics::integrate::Tolerances;
     use crate::runs::orbits::{run_orbits, OrbitSummary, SummaryOptions};
 
