@@ -66,7 +66,8 @@ def both(orbit: tj.Orbit, n: int, panel: tj.Panel = PAPER) -> tuple[tj.OrbitSumm
 def test_spring_eclipses_in_the_penumbra() -> None:
     """Eight orbits in mid-March (penumbra, eccentric Sun): the CI-sized part of case (a). The
     hinge is resolved through the partial shadow (no band of θ holds the lag behind a fast-moving
-    flux) and nowhere else."""
+    flux) and for two hinge periods after each of its last contacts (where the lag is released),
+    and nowhere else."""
     orbit = tj.Orbit.geo_year("2026-03-08")
     full, hybrid = both(orbit, 8)
     assert_gate(full, hybrid)
@@ -75,7 +76,10 @@ def test_spring_eclipses_in_the_penumbra() -> None:
     penumbra = sum(b - a for a, b in orbit.shadow_intervals(*span)) - sum(
         b - a for a, b in orbit.umbra_intervals(*span)
     )
-    assert penumbra > 0.0 and p["t_fallback"] == pytest.approx(penumbra, rel=1e-9)
+    # Two contacts per orbit end a partial shadow (the way in and the way out of the umbra).
+    after = 8 * 2 * 2.0 / tj.natural_frequency(PAPER)
+    assert penumbra > 0.0
+    assert penumbra < p["t_fallback"] <= penumbra + after * (1.0 + 1e-9)
     assert p["t_linear"] > 0.9 * 8 * orbit.period
     assert 0.0 < hybrid.nonlinear_fraction < 0.1
     assert hybrid.n_steps * 50 < full.n_steps

@@ -421,6 +421,11 @@ const READ_RTOL: f64 = 1e-3;
 /// [`READ_ATOL`]): a tenth of the 2 % gate.
 const BAND_RTOL: f64 = 2e-3;
 
+/// Hinge periods resolved after partial shadow, where the flux stops moving and the hinge's lag
+/// behind M_T/K_el is released (on Table 1 at equinox the orbit's jitter peak comes 1.7 s after
+/// the last contact).
+const RESOLVED_AFTER_PARTIAL_SHADOW: f64 = 2.0;
+
 /// Points read per hinge period off a step's formula where its band cannot be trusted (the peak
 /// of a sine sampled at 32 points is within 0.5 % of the true one). No cap: fewer would miss
 /// the peaks silently.
@@ -881,6 +886,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
         let mut large = false;
         let mut done = false;
         let mut resolved_time = 0.0;
+        let mut resolve_until = f64::NEG_INFINITY;
         for w in cuts.windows(2) {
             let (a, b) = (w[0], w[1]);
             if b <= a || done {
@@ -895,8 +901,21 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
                 let before = self.t;
                 self.resolved(b, period)?;
                 resolved_time += self.t - before;
+                resolve_until = b + RESOLVED_AFTER_PARTIAL_SHADOW * period;
                 done = self.stopped();
                 continue;
+            }
+            if !self.judge.modal && self.t < resolve_until {
+                // Where the flux stops moving (the partial shadow's last contact) the hinge's
+                // lag behind it is released: its first swings are resolved too.
+                let until = resolve_until.min(b);
+                let before = self.t;
+                self.resolved(until, period)?;
+                resolved_time += self.t - before;
+                if self.stopped() || until >= b {
+                    done = self.stopped();
+                    continue;
+                }
             }
             self.system.enter_segment(a, b);
             if a == start {
