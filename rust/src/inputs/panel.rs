@@ -3,70 +3,103 @@
 
 use crate::error::{short, Error, Result};
 
-/// A long, thin, Sun-pointing plate of unit width (all quantities SI).
-///
-/// The thermal equations are per unit area; the hinge model uses `mass_per_length`,
-/// `bending_inertia` and `hinge_stiffness` of the whole panel, as in the paper (width 1 m).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Panel {
+/// The panel's parameters, one row each: its doc, name, Table 1 value and valid range
+/// `(low, high, low end open)` (the high end is closed). The struct, [`Panel::paper`],
+/// [`Panel::FIELDS`], [`Panel::get`], [`Panel::set`] and [`Panel::RANGES`] are all made from this
+/// one table, so a new parameter is one row here (and one line in the Python `Panel`).
+macro_rules! panel_parameters {
+    ($( $(#[$doc:meta])* $name:ident = $paper:expr, in ($low:expr, $high:expr, $open:expr); )*) => {
+        /// How many parameters a panel has.
+        const PANEL_PARAMETERS: usize = [$( stringify!($name), )*].len();
+
+        /// A long, thin, Sun-pointing plate of unit width (all quantities SI).
+        ///
+        /// The thermal equations are per unit area; the hinge model uses `mass_per_length`,
+        /// `bending_inertia` and `hinge_stiffness` of the whole panel, as in the paper (width 1 m).
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub struct Panel {
+            $( $(#[$doc])* pub $name: f64, )*
+        }
+
+        impl Panel {
+            /// The paper's Table 1 panel (Case B: ε_f = 0.8 > ε_b = 0.3), C = 1361 W/m².
+            pub fn paper() -> Self {
+                Panel { $( $name: $paper, )* }
+            }
+
+            /// The field names, in declaration order (the Python layer and scenario files use
+            /// them).
+            pub const FIELDS: [&'static str; PANEL_PARAMETERS] = [$( stringify!($name), )*];
+
+            /// Sets a field by name (used by bindings and parameter sweeps).
+            pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
+                match name {
+                    $( stringify!($name) => self.$name = value, )*
+                    _ => return Err(not_a_parameter(name)),
+                }
+                Ok(())
+            }
+
+            /// Reads a field by name.
+            pub fn get(&self, name: &str) -> Result<f64> {
+                match name {
+                    $( stringify!($name) => Ok(self.$name), )*
+                    _ => Err(not_a_parameter(name)),
+                }
+            }
+
+            /// The physical range of each parameter: (name, low, high, low end open); the high
+            /// end is closed. The ranges are wide (a thin film to a truss boom, polymers to
+            /// steel) but finite: values outside them are unit slips or typing errors, and would
+            /// make the model meaningless or the integration endless.
+            pub const RANGES: [(&'static str, f64, f64, bool); PANEL_PARAMETERS] =
+                [$( (stringify!($name), $low, $high, $open), )*];
+        }
+    };
+}
+
+fn not_a_parameter(name: &str) -> Error {
+    Error::invalid("parameter", name, "is not a panel parameter")
+}
+
+panel_parameters! {
     /// ε_f, emissivity of the Sun-facing side, in (0, 1].
-    pub emissivity_front: f64,
+    emissivity_front = 0.8, in (0.0, 1.0, true);
     /// ε_b, emissivity of the back side, in (0, 1].
-    pub emissivity_back: f64,
+    emissivity_back = 0.3, in (0.0, 1.0, true);
     /// α, solar absorptivity of the front side, in (0, 1].
-    pub absorptivity: f64,
+    absorptivity = 0.8, in (0.0, 1.0, true);
     /// c, specific heat, J/(kg K).
-    pub specific_heat: f64,
+    specific_heat = 900.0, in (10.0, 1e5, false);
     /// m, mass per unit length (unit width, so also per unit area), kg/m.
-    pub mass_per_length: f64,
+    mass_per_length = 5.51, in (1e-3, 1e4, false);
     /// a, coefficient of thermal expansion, 1/K: any sign within ±[`MAX_EXPANSION`] (carbon
-    /// fibre shrinks when heated; 0 bends by nothing).
-    pub expansion_coeff: f64,
+    /// fibre shrinks when heated, and CFRP booms are designed around a ≈ −1e-6 1/K; 0 bends by
+    /// nothing).
+    expansion_coeff = 2.5e-5, in (-MAX_EXPANSION, MAX_EXPANSION, false);
     /// L, panel length, m (hinge half-arm l = L/4).
-    pub length: f64,
+    length = 50.0, in (0.1, 1e4, false);
     /// E, Young's modulus, Pa.
-    pub youngs_modulus: f64,
+    youngs_modulus = 70e9, in (1e6, 1e13, false);
     /// d, thickness, m.
-    pub thickness: f64,
+    thickness = 0.04, in (1e-5, 10.0, false);
     /// w, width, m.
-    pub width: f64,
+    width = 1.0, in (1e-3, 1e3, false);
     /// K, conductance through the thickness per unit area, W/(m² K).
-    pub conductance: f64,
+    conductance = 25.0, in (0.0, 1e6, true);
     /// K_el, rotational stiffness of the hinge, N m/rad.
-    pub hinge_stiffness: f64,
+    hinge_stiffness = 4438.0, in (0.0, 1e12, true);
     /// I, second moment of area of the cross-section, m⁴.
-    pub bending_inertia: f64,
+    bending_inertia = 8e-7, in (0.0, 1e3, true);
     /// c_d, rotational damping of the hinge, N m s/rad (>= 0).
-    pub damping: f64,
+    damping = 3.0, in (0.0, 1e9, false);
     /// C, solar flux at 1 au, W/m².
-    pub solar_constant: f64,
+    solar_constant = 1361.0, in (0.0, 1e5, true);
     /// χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3); 1 by default.
-    pub moment_scale: f64,
+    moment_scale = 1.0, in (0.0, 100.0, true);
 }
 
 impl Panel {
-    /// The paper's Table 1 panel (Case B: ε_f = 0.8 > ε_b = 0.3), C = 1361 W/m².
-    pub fn paper() -> Self {
-        Panel {
-            emissivity_front: 0.8,
-            emissivity_back: 0.3,
-            absorptivity: 0.8,
-            specific_heat: 900.0,
-            mass_per_length: 5.51,
-            expansion_coeff: 2.5e-5,
-            length: 50.0,
-            youngs_modulus: 70e9,
-            thickness: 0.04,
-            width: 1.0,
-            conductance: 25.0,
-            hinge_stiffness: 4438.0,
-            bending_inertia: 8e-7,
-            damping: 3.0,
-            solar_constant: 1361.0,
-            moment_scale: 1.0,
-        }
-    }
-
     /// The paper's Case A: Table 1 with the emissivities swapped (ε_f = 0.3, ε_b = 0.8).
     pub fn case_a() -> Self {
         let b = Panel::paper();
@@ -76,109 +109,6 @@ impl Panel {
             ..b
         }
     }
-
-    /// The field names, in declaration order (the Python layer and scenario files use them).
-    pub const FIELDS: [&'static str; 16] = [
-        "emissivity_front",
-        "emissivity_back",
-        "absorptivity",
-        "specific_heat",
-        "mass_per_length",
-        "expansion_coeff",
-        "length",
-        "youngs_modulus",
-        "thickness",
-        "width",
-        "conductance",
-        "hinge_stiffness",
-        "bending_inertia",
-        "damping",
-        "solar_constant",
-        "moment_scale",
-    ];
-
-    /// Sets a field by name (used by bindings and parameter sweeps).
-    pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
-        match name {
-            "emissivity_front" => self.emissivity_front = value,
-            "emissivity_back" => self.emissivity_back = value,
-            "absorptivity" => self.absorptivity = value,
-            "specific_heat" => self.specific_heat = value,
-            "mass_per_length" => self.mass_per_length = value,
-            "expansion_coeff" => self.expansion_coeff = value,
-            "length" => self.length = value,
-            "youngs_modulus" => self.youngs_modulus = value,
-            "thickness" => self.thickness = value,
-            "width" => self.width = value,
-            "conductance" => self.conductance = value,
-            "hinge_stiffness" => self.hinge_stiffness = value,
-            "bending_inertia" => self.bending_inertia = value,
-            "damping" => self.damping = value,
-            "solar_constant" => self.solar_constant = value,
-            "moment_scale" => self.moment_scale = value,
-            _ => {
-                return Err(Error::invalid(
-                    "parameter",
-                    name,
-                    "is not a panel parameter",
-                ))
-            }
-        }
-        Ok(())
-    }
-
-    /// Reads a field by name.
-    pub fn get(&self, name: &str) -> Result<f64> {
-        Ok(match name {
-            "emissivity_front" => self.emissivity_front,
-            "emissivity_back" => self.emissivity_back,
-            "absorptivity" => self.absorptivity,
-            "specific_heat" => self.specific_heat,
-            "mass_per_length" => self.mass_per_length,
-            "expansion_coeff" => self.expansion_coeff,
-            "length" => self.length,
-            "youngs_modulus" => self.youngs_modulus,
-            "thickness" => self.thickness,
-            "width" => self.width,
-            "conductance" => self.conductance,
-            "hinge_stiffness" => self.hinge_stiffness,
-            "bending_inertia" => self.bending_inertia,
-            "damping" => self.damping,
-            "solar_constant" => self.solar_constant,
-            "moment_scale" => self.moment_scale,
-            _ => {
-                return Err(Error::invalid(
-                    "parameter",
-                    name,
-                    "is not a panel parameter",
-                ))
-            }
-        })
-    }
-
-    /// The physical range of each parameter: (name, low, high, low end open); the high end is
-    /// closed. The ranges are wide (a thin film to a truss boom, polymers to steel) but finite:
-    /// values outside them are unit slips or typing errors, and would make the model meaningless
-    /// or the integration endless.
-    pub const RANGES: [(&'static str, f64, f64, bool); 16] = [
-        ("emissivity_front", 0.0, 1.0, true),
-        ("emissivity_back", 0.0, 1.0, true),
-        ("absorptivity", 0.0, 1.0, true),
-        ("specific_heat", 10.0, 1e5, false),
-        ("mass_per_length", 1e-3, 1e4, false),
-        // Negative and zero are physical: CFRP booms are designed around a ≈ −1e-6 1/K.
-        ("expansion_coeff", -MAX_EXPANSION, MAX_EXPANSION, false),
-        ("length", 0.1, 1e4, false),
-        ("youngs_modulus", 1e6, 1e13, false),
-        ("thickness", 1e-5, 10.0, false),
-        ("width", 1e-3, 1e3, false),
-        ("conductance", 0.0, 1e6, true),
-        ("hinge_stiffness", 0.0, 1e12, true),
-        ("bending_inertia", 0.0, 1e3, true),
-        ("damping", 0.0, 1e9, false),
-        ("solar_constant", 0.0, 1e5, true),
-        ("moment_scale", 0.0, 100.0, true),
-    ];
 
     /// The fastest rate the model may have, 1/s: the hinge's natural angular frequency, its
     /// damping rate c_d/I_B and the thermal rate 2K/(m c) are each at most this. Beyond it an
