@@ -1,6 +1,6 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{output, panel_from, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
@@ -120,8 +120,7 @@ fn beam_response<'py>(
     dt_out: Option<f64>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let beam = beam_from(panel, n_elements)?;
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
@@ -140,7 +139,7 @@ fn beam_response<'py>(
                 &m,
                 span,
                 &out,
-                &cancel,
+                cancel,
             )
         })?;
         let d = PyDict::new(py);

@@ -1,6 +1,6 @@
 //! Bindings of the distributed panel: its settings, modes, and flutter analysis.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{
     coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item, solver_from,
 };
@@ -177,8 +177,7 @@ fn simulate_distributed<'py>(
     on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let m = model_from(panel, settings)?;
         let o = orbit_from(orbit)?;
         let method = solver_from(solver)?;
@@ -197,9 +196,7 @@ fn simulate_distributed<'py>(
         let r = py
             .detach(|| {
                 let span = (t0, t1);
-                crate::runs::distributed::simulate(
-                    &m, o, &method, span, start, &out, limit, &cancel,
-                )
+                crate::runs::distributed::simulate(&m, o, &method, span, start, &out, limit, cancel)
             })
             .map_err(PyErr::from)?;
         let mesh = &m.reduction.mesh;

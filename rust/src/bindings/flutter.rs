@@ -1,6 +1,6 @@
 //! Bindings of the flutter analysis.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{coupling, hinge_model, panel_from};
 use super::error::shield;
 use crate::analysis::flutter::{analyse, check_flux, critical_damping};
@@ -74,8 +74,7 @@ fn stability_map<'py>(
     flux: f64,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let m = hinge_model(model)?;
         let c = coupling(coupled);
@@ -87,9 +86,8 @@ fn stability_map<'py>(
             name: y_name,
             values: y_values,
         };
-        let map = py.detach(|| {
-            crate::analysis::stability::stability_map(&p, m, c, flux, &x, &y, &cancel)
-        })?;
+        let map = py
+            .detach(|| crate::analysis::stability::stability_map(&p, m, c, flux, &x, &y, cancel))?;
         let grid = |v: &[f64]| -> Vec<Vec<f64>> { v.chunks(map.nx).map(|r| r.to_vec()).collect() };
         let d = PyDict::new(py);
         d.set_item(

@@ -1,6 +1,6 @@
 //! Bindings of the laminate layups and the N-node through-thickness model.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{
     coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
 };
@@ -293,8 +293,7 @@ fn simulate_layers<'py>(
     on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let (o, hinge) = (orbit_from(orbit)?, hinge_model(model)?);
         let (method, out) = (solver_from(solver)?, output(t_eval, dt_out, t0, t1)?);
@@ -313,7 +312,7 @@ fn simulate_layers<'py>(
             y0,
             limit,
         };
-        let run = py.detach(|| crate::runs::request::simulate(req, &cancel))?;
+        let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
         let d = super::transient_dict(py, run)?;
         d.set_item("depth", PyArray1::from_vec(py, depth))?;
         d.set_item("node_labels", labels)?;

@@ -1,8 +1,7 @@
 //! Bindings of the long runs (`crate::runs::orbits`, and the hybrid propagator).
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{coupling, hinge_model, orbit_from, panel_from, solver_dict, solver_from};
-use super::error::shield;
 use super::laminate::conduction_from;
 use crate::runs::hybrid::HybridSettings;
 use crate::runs::layered::LayeredRunRequest;
@@ -41,8 +40,7 @@ fn run_orbits<'py>(
     nodes: Option<usize>,
     hybrid: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let hinge = hinge_model(model)?;
@@ -85,7 +83,7 @@ fn run_orbits<'py>(
             }),
         };
         let req = OrbitsRequest { model, hybrid };
-        let out = py.detach(|| crate::runs::request::run_orbits(&req, &cancel))?;
+        let out = py.detach(|| crate::runs::request::run_orbits(&req, cancel))?;
         let d = summary_dict(py, &out.summaries, &m)?;
         match out.split {
             Some(split) => hybrid_counters(d, &split),
