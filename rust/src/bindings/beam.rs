@@ -1,7 +1,7 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{output, panel_from, solver_dict, solver_from};
+use super::convert::{output, panel_from, set_counters, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use crate::models::beam::{FreeFreeBeam, BEAM_MODES};
@@ -146,9 +146,7 @@ fn beam_response<'py>(
         d.set_item("t", PyArray1::from_vec(py, r.t))?;
         d.set_item("eta", PyArray1::from_vec(py, r.eta))?;
         d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
-        d.set_item("n_steps", r.stats.n_steps)?;
-        d.set_item("n_rejected", r.stats.n_rejected)?;
-        d.set_item("n_rhs", r.stats.n_rhs)?;
+        set_counters(&d, &r.stats)?;
         d.set_item("solver", solver_dict(py, &m)?)?;
         Ok(d)
     })

@@ -22,7 +22,8 @@ use crate::runs::request::{coupled_run, CoupledRun, RunRequest, ThermalChoice, T
 use crate::runs::simulate::{run_watched, state_from};
 use cancel::{cancellable, CancelToken};
 use convert::{
-    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_from, solver_from,
+    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_dict, panel_from,
+    set_counters, solver_from,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -46,21 +47,10 @@ fn run_info<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item(intern!(py, "t"), array(py, t))?;
-    d.set_item(intern!(py, "n_steps"), stats.n_steps)?;
-    d.set_item(intern!(py, "n_rejected"), stats.n_rejected)?;
-    d.set_item(intern!(py, "n_rhs"), stats.n_rhs)?;
+    set_counters(&d, stats)?;
     d.set_item(intern!(py, "t_end"), stats.t_end)?;
     d.set_item(intern!(py, "y_end"), array(py, y_end))?;
     d.set_item(intern!(py, "solver"), convert::solver_dict(py, method)?)?;
-    Ok(d)
-}
-
-/// A panel as a mapping of its parameters.
-fn panel_dict<'py>(py: Python<'py>, p: &crate::Panel) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    for name in crate::Panel::FIELDS {
-        d.set_item(name, p.get(name)?)?;
-    }
     Ok(d)
 }
 
