@@ -6,7 +6,7 @@ use super::convert::{
     type_error,
 };
 use super::error::{invalid, shield};
-use super::flutter::set_spectrum;
+use super::flutter::{flutter_inputs, set_spectrum};
 use crate::analysis::flutter::check_flux;
 use crate::analysis::layered::LayeredEquilibrium;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
@@ -251,9 +251,7 @@ fn layered_flutter<'py>(
     with_critical: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let p = panel_from(panel)?;
-        let m = hinge_model(model)?;
-        check_flux(flux)?;
+        let (p, m) = flutter_inputs(panel, model, flux)?;
         let c = conduction_from(&p, layup, nodes)?;
         let k = coupling(coupled);
         let a = py.detach(|| crate::analysis::layered::analyse(&p, &c, m, k, flux))?;
