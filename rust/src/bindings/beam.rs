@@ -1,7 +1,7 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
-use super::cancel::{token, CancelToken};
-use super::convert::{output, panel_from, solver_dict, solver_from};
+use super::cancel::{cancellable, CancelToken};
+use super::convert::{output, panel_from, set_counters, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
 use crate::models::beam::{FreeFreeBeam, BEAM_MODES};
@@ -120,8 +120,7 @@ fn beam_response<'py>(
     dt_out: Option<f64>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let beam = beam_from(panel, n_elements)?;
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
@@ -140,16 +139,14 @@ fn beam_response<'py>(
                 &m,
                 span,
                 &out,
-                &cancel,
+                cancel,
             )
         })?;
         let d = PyDict::new(py);
         d.set_item("t", PyArray1::from_vec(py, r.t))?;
         d.set_item("eta", PyArray1::from_vec(py, r.eta))?;
         d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
-        d.set_item("n_steps", r.stats.n_steps)?;
-        d.set_item("n_rejected", r.stats.n_rejected)?;
-        d.set_item("n_rhs", r.stats.n_rhs)?;
+        set_counters(&d, &r.stats)?;
         d.set_item("solver", solver_dict(py, &m)?)?;
         Ok(d)
     })

@@ -1,6 +1,7 @@
 //! The engine's cancellation token as a Python object: Python keeps it, hands it to long calls
 //! and cancels it on Ctrl-C from the thread that waits for them.
 
+use super::error::shield;
 use crate::cancel::Cancel;
 use pyo3::prelude::*;
 
@@ -30,9 +31,14 @@ impl CancelToken {
     }
 }
 
-/// The engine token of an optional Python token (a fresh one when None).
-pub(crate) fn token(cancel: Option<&Bound<'_, CancelToken>>) -> Cancel {
-    cancel.map_or_else(Cancel::new, |c| c.get().inner.clone())
+/// Runs `f` under [`shield`] with the engine token of an optional Python token (a fresh one when
+/// None): how every call that Ctrl-C can stop begins.
+pub(crate) fn cancellable<T>(
+    cancel: Option<&Bound<'_, CancelToken>>,
+    f: impl FnOnce(&Cancel) -> PyResult<T>,
+) -> PyResult<T> {
+    let cancel = cancel.map_or_else(Cancel::new, |c| c.get().inner.clone());
+    shield(|| f(&cancel))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -4,11 +4,12 @@ use super::error::invalid;
 use crate::inputs::orbit::Shadow;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
-use crate::numerics::integrate::{Method, Tolerances};
+use crate::numerics::integrate::{Method, Stats, Tolerances};
 use crate::runs::simulate::Output;
 use crate::{Orbit, Panel};
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyTypeError;
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyBool, PyDict, PyString};
@@ -57,6 +58,15 @@ pub fn panel_from(d: &Bound<'_, PyDict>) -> PyResult<Panel> {
     }
     p.validate()?;
     Ok(p)
+}
+
+/// A panel as the mapping [`panel_from`] reads.
+pub fn panel_dict<'py>(py: Python<'py>, p: &Panel) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for name in Panel::FIELDS {
+        d.set_item(name, p.get(name)?)?;
+    }
+    Ok(d)
 }
 
 /// An optional entry of a mapping of type T, named in any error.
@@ -222,6 +232,13 @@ pub fn output(
     };
     out.sample_times(t0, t1)?;
     Ok(out)
+}
+
+/// A run's step counters into `d`, under the names every run's result uses.
+pub fn set_counters(d: &Bound<'_, PyDict>, stats: &Stats) -> PyResult<()> {
+    d.set_item(intern!(d.py(), "n_steps"), stats.n_steps)?;
+    d.set_item(intern!(d.py(), "n_rejected"), stats.n_rejected)?;
+    d.set_item(intern!(d.py(), "n_rhs"), stats.n_rhs)
 }
 
 /// The integrator settings as a solver mapping (what [`solver_from`] reads): the engine's

@@ -1,8 +1,9 @@
 //! Bindings of the distributed panel: its settings, modes, and flutter analysis.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item, solver_from,
+    coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item,
+    set_counters, solver_from,
 };
 use super::error::{invalid, shield};
 use crate::analysis::flutter::check_flux;
@@ -177,8 +178,7 @@ fn simulate_distributed<'py>(
     on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let m = model_from(panel, settings)?;
         let o = orbit_from(orbit)?;
         let method = solver_from(solver)?;
@@ -197,9 +197,7 @@ fn simulate_distributed<'py>(
         let r = py
             .detach(|| {
                 let span = (t0, t1);
-                crate::runs::distributed::simulate(
-                    &m, o, &method, span, start, &out, limit, &cancel,
-                )
+                crate::runs::distributed::simulate(&m, o, &method, span, start, &out, limit, cancel)
             })
             .map_err(PyErr::from)?;
         let mesh = &m.reduction.mesh;
@@ -221,9 +219,7 @@ fn simulate_distributed<'py>(
         d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
         d.set_item("sunlit", PyArray1::from_vec(py, r.sunlit))?;
         d.set_item("y_end", PyArray1::from_vec(py, r.y_end))?;
-        d.set_item("n_steps", r.stats.n_steps)?;
-        d.set_item("n_rejected", r.stats.n_rejected)?;
-        d.set_item("n_rhs", r.stats.n_rhs)?;
+        set_counters(&d, &r.stats)?;
         d.set_item("t_end", r.stats.t_end)?;
         d.set_item("crossing", crossing_tuple(r.crossing))?;
         d.set_item(

@@ -3,7 +3,7 @@
 //! is the same class under the name the Python side used before), and the check of a design up
 //! front.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{coupling, hinge_model, orbit_from, solver_dict, solver_from};
 use super::error::invalid;
 use super::error::shield;
@@ -138,13 +138,12 @@ impl MonteCarloPool {
         layup: Option<&Bound<'py, PyDict>>,
         nodes: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let cancel = token(cancel);
         let path = if lockstep {
             Path::Lockstep
         } else {
             Path::Scalar
         };
-        shield(|| {
+        cancellable(cancel, |cancel| {
             let ps = panels_from(&panels)?;
             let settings = EnsembleSettings {
                 orbit: orbit_from(orbit)?,
@@ -168,8 +167,8 @@ impl MonteCarloPool {
                 None => None,
             };
             let out = py.detach(|| match &layers {
-                Some(l) => run_batch_layered(pool, &ps, &settings, l, &cancel),
-                None => run_batch_on(pool, &ps, &settings, &cancel, path),
+                Some(l) => run_batch_layered(pool, &ps, &settings, l, cancel),
+                None => run_batch_on(pool, &ps, &settings, cancel, path),
             })?;
             let d = PyDict::new(py);
             let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };

@@ -1,11 +1,13 @@
 //! Bindings of the flutter analysis.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{coupling, hinge_model, panel_from};
 use super::error::shield;
 use crate::analysis::flutter::{analyse, check_flux, critical_damping};
 use crate::analysis::linear::LinearThermal;
 use crate::analysis::stability::Axis;
+use crate::inputs::panel::Panel;
+use crate::models::hinge::HingeModel;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -22,9 +24,7 @@ fn flutter<'py>(
     with_critical: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let p = panel_from(panel)?;
-        let m = hinge_model(model)?;
-        check_flux(flux)?;
+        let (p, m) = flutter_inputs(panel, model, flux)?;
         let c = coupling(coupled);
         let a = analyse(&p, m, c, flux)?;
         let d = PyDict::new(py);
@@ -38,6 +38,19 @@ fn flutter<'py>(
         }
         Ok(d)
     })
+}
+
+/// The panel and the hinge model of a flutter analysis, its flux factor checked: the inputs of
+/// the two-layer and the N-node analyses, checked in the same order.
+pub(super) fn flutter_inputs(
+    panel: &Bound<'_, PyDict>,
+    model: &str,
+    flux: f64,
+) -> PyResult<(Panel, HingeModel)> {
+    let p = panel_from(panel)?;
+    let m = hinge_model(model)?;
+    check_flux(flux)?;
+    Ok((p, m))
 }
 
 /// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as
@@ -74,8 +87,7 @@ fn stability_map<'py>(
     flux: f64,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let m = hinge_model(model)?;
         let c = coupling(coupled);
@@ -87,9 +99,8 @@ fn stability_map<'py>(
             name: y_name,
             values: y_values,
         };
-        let map = py.detach(|| {
-            crate::analysis::stability::stability_map(&p, m, c, flux, &x, &y, &cancel)
-        })?;
+        let map = py
+            .detach(|| crate::analysis::stability::stability_map(&p, m, c, flux, &x, &y, cancel))?;
         let grid = |v: &[f64]| -> Vec<Vec<f64>> { v.chunks(map.nx).map(|r| r.to_vec()).collect() };
         let d = PyDict::new(py);
         d.set_item(

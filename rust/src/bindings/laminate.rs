@@ -1,12 +1,14 @@
 //! Bindings of the laminate layups and the N-node through-thickness model.
 
-use super::cancel::{token, CancelToken};
+use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, float_item, hinge_model, orbit_from, output, panel_from, solver_from, type_error,
+    coupling, float_item, hinge_model, orbit_from, output, panel_dict, panel_from, solver_from,
+    type_error,
 };
 use super::error::{invalid, shield};
-use super::flutter::set_spectrum;
+use super::flutter::{flutter_inputs, set_spectrum};
 use crate::analysis::flutter::check_flux;
+use crate::analysis::layered::LayeredEquilibrium;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -131,12 +133,7 @@ fn equivalent_panel<'py>(
     shield(|| {
         let lam = laminate_from(laminate)?;
         let base = panel_from(panel)?;
-        let p = lam.equivalent_panel(&base)?;
-        let d = PyDict::new(py);
-        for name in Panel::FIELDS {
-            d.set_item(name, p.get(name)?)?;
-        }
-        Ok(d)
+        panel_dict(py, &lam.equivalent_panel(&base)?)
     })
 }
 
@@ -183,6 +180,15 @@ fn conduction_grid<'py>(
     })
 }
 
+/// An N-node equilibrium as a mapping: node temperatures, θ and M_T.
+fn equilibrium_dict<'py>(py: Python<'py>, eq: &LayeredEquilibrium) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("temperatures", eq.temperatures.clone())?;
+    d.set_item("theta", eq.theta)?;
+    d.set_item("thermal_moment", eq.moment)?;
+    Ok(d)
+}
+
 /// Sunlit equilibrium of the N-node system: node temperatures, θ and M_T.
 #[pyfunction]
 #[pyo3(signature = (panel, layup, nodes, coupled=true, flux=1.0))]
@@ -199,10 +205,7 @@ fn layered_steady_state<'py>(
         check_flux(flux)?;
         let c = conduction_from(&p, layup, nodes)?;
         let eq = crate::analysis::layered::equilibrium(&p, &c, coupling(coupled), flux)?;
-        let d = PyDict::new(py);
-        d.set_item("temperatures", eq.temperatures)?;
-        d.set_item("theta", eq.theta)?;
-        d.set_item("thermal_moment", eq.moment)?;
+        let d = equilibrium_dict(py, &eq)?;
         d.set_item("depth", c.depth)?;
         Ok(d)
     })
@@ -248,16 +251,11 @@ fn layered_flutter<'py>(
     with_critical: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let p = panel_from(panel)?;
-        let m = hinge_model(model)?;
-        check_flux(flux)?;
+        let (p, m) = flutter_inputs(panel, model, flux)?;
         let c = conduction_from(&p, layup, nodes)?;
         let k = coupling(coupled);
         let a = py.detach(|| crate::analysis::layered::analyse(&p, &c, m, k, flux))?;
-        let d = PyDict::new(py);
-        d.set_item("temperatures", a.equilibrium.temperatures.clone())?;
-        d.set_item("theta", a.equilibrium.theta)?;
-        d.set_item("thermal_moment", a.equilibrium.moment)?;
+        let d = equilibrium_dict(py, &a.equilibrium)?;
         let size = a.jacobian.nrows();
         let rows = (0..size).map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect());
         set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
@@ -293,8 +291,7 @@ fn simulate_layers<'py>(
     on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let (o, hinge) = (orbit_from(orbit)?, hinge_model(model)?);
         let (method, out) = (solver_from(solver)?, output(t_eval, dt_out, t0, t1)?);
@@ -313,7 +310,7 @@ fn simulate_layers<'py>(
             y0,
             limit,
         };
-        let run = py.detach(|| crate::runs::request::simulate(req, &cancel))?;
+        let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
         let d = super::transient_dict(py, run)?;
         d.set_item("depth", PyArray1::from_vec(py, depth))?;
         d.set_item("node_labels", labels)?;

@@ -20,9 +20,10 @@ use crate::models::hinge::{thermal_moment, Hinge};
 use crate::numerics::integrate::{Method, Stats};
 use crate::runs::request::{coupled_run, CoupledRun, RunRequest, ThermalChoice, Transient};
 use crate::runs::simulate::{run_watched, state_from};
-use cancel::{token, CancelToken};
+use cancel::{cancellable, CancelToken};
 use convert::{
-    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_from, solver_from,
+    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_dict, panel_from,
+    set_counters, solver_from,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -46,21 +47,10 @@ fn run_info<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item(intern!(py, "t"), array(py, t))?;
-    d.set_item(intern!(py, "n_steps"), stats.n_steps)?;
-    d.set_item(intern!(py, "n_rejected"), stats.n_rejected)?;
-    d.set_item(intern!(py, "n_rhs"), stats.n_rhs)?;
+    set_counters(&d, stats)?;
     d.set_item(intern!(py, "t_end"), stats.t_end)?;
     d.set_item(intern!(py, "y_end"), array(py, y_end))?;
     d.set_item(intern!(py, "solver"), convert::solver_dict(py, method)?)?;
-    Ok(d)
-}
-
-/// A panel as a mapping of its parameters.
-fn panel_dict<'py>(py: Python<'py>, p: &crate::Panel) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    for name in crate::Panel::FIELDS {
-        d.set_item(name, p.get(name)?)?;
-    }
     Ok(d)
 }
 
@@ -249,8 +239,7 @@ fn simulate<'py>(
     on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let req = RunRequest {
             panel: panel_from(panel)?,
             orbit: orbit_from(orbit)?,
@@ -263,7 +252,7 @@ fn simulate<'py>(
             y0,
             limit: self::on_limit(theta_limit, on_limit)?,
         };
-        let run = py.detach(|| crate::runs::request::simulate(req, &cancel))?;
+        let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
         transient_dict(py, run)
     })
 }
@@ -323,15 +312,14 @@ fn simulate_thermal<'py>(
     y0: Option<Vec<f64>>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let m = solver_from(solver)?;
         let out = output(t_eval, dt_out, t0, t1)?;
         let thermal = crate::models::thermal_model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o);
-        let run = py.detach(|| coupled_run(sys, &m, (t0, t1), y0, &out, None, &cancel))?;
+        let run = py.detach(|| coupled_run(sys, &m, (t0, t1), y0, &out, None, cancel))?;
         transient_dict(py, Transient::Coupled(run))
     })
 }
@@ -354,8 +342,7 @@ fn simulate_hinge<'py>(
     y0: Vec<f64>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let hinge = hinge_model(model)?;
         let m = solver_from(solver)?;
@@ -386,7 +373,7 @@ fn simulate_hinge<'py>(
                 model: hinge,
                 moment: history,
             };
-            run_watched(&mut sys, &m, (t0, t1), y_start, &out, None, &cancel)
+            run_watched(&mut sys, &m, (t0, t1), y_start, &out, None, cancel)
         })?;
         let d = run_info(
             py,

@@ -1,8 +1,10 @@
 //! Bindings of the long runs (`crate::runs::orbits`, and the hybrid propagator).
 
-use super::cancel::{token, CancelToken};
-use super::convert::{coupling, hinge_model, orbit_from, panel_from, solver_dict, solver_from};
-use super::error::shield;
+use super::cancel::{cancellable, CancelToken};
+use super::convert::{
+    coupling, crossing_tuple, hinge_model, orbit_from, panel_from, set_counters, solver_dict,
+    solver_from,
+};
 use super::laminate::conduction_from;
 use crate::runs::hybrid::HybridSettings;
 use crate::runs::layered::LayeredRunRequest;
@@ -41,8 +43,7 @@ fn run_orbits<'py>(
     nodes: Option<usize>,
     hybrid: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cancel = token(cancel);
-    shield(|| {
+    cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
         let hinge = hinge_model(model)?;
@@ -85,7 +86,7 @@ fn run_orbits<'py>(
             }),
         };
         let req = OrbitsRequest { model, hybrid };
-        let out = py.detach(|| crate::runs::request::run_orbits(&req, &cancel))?;
+        let out = py.detach(|| crate::runs::request::run_orbits(&req, cancel))?;
         let d = summary_dict(py, &out.summaries, &m)?;
         match out.split {
             Some(split) => hybrid_counters(d, &split),
@@ -143,13 +144,11 @@ fn summary_dict<'py>(
     ] {
         d.set_item(name, PyArray1::from_vec(py, values))?;
     }
-    d.set_item("n_steps", out.stats.n_steps)?;
-    d.set_item("n_rejected", out.stats.n_rejected)?;
-    d.set_item("n_rhs", out.stats.n_rhs)?;
+    set_counters(&d, &out.stats)?;
     d.set_item("t_reached", out.stats.t_end)?;
     d.set_item("stopped", out.stats.stopped)?;
     d.set_item("y_end", out.y_end.clone())?;
-    d.set_item("crossing", out.crossing.map(|c| (c.t, c.orbit, c.theta)))?;
+    d.set_item("crossing", crossing_tuple(out.crossing))?;
     d.set_item("solver", solver_dict(py, method)?)?;
     Ok(d)
 }
