@@ -8,7 +8,7 @@
 use crate::analysis::steady::{equilibrium, Equilibrium};
 use crate::error::{require_non_negative, Error, Result};
 use crate::inputs::panel::Panel;
-use crate::models::coupled::{Coupled, Coupling};
+use crate::models::coupled::{jacobian_from_rows, Coupled, Coupling};
 use crate::models::hinge::{HingeModel, StructuralModel};
 use crate::models::thermal::ThermalModel;
 use crate::models::thermal::STEFAN_BOLTZMANN;
@@ -60,23 +60,15 @@ pub fn jacobian(
     // which is zero at the equilibrium, and the θ̇² term vanishes with θ̇.
     let inertia = panel.hinge_inertia() * model.inertia_factor(s);
     let mu = panel.moment_per_kelvin();
-    Matrix4::new(
-        (-k - rad_f) / h,
-        k / h,
-        d_heating / h,
-        0.0,
-        k / h,
-        (-k - rad_b) / h,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        1.0,
-        mu / inertia,
-        -mu / inertia,
-        -panel.hinge_stiffness / inertia,
-        -panel.damping / inertia,
+    jacobian_from_rows(
+        [(-k - rad_f) / h, k / h, d_heating / h],
+        [k / h, (-k - rad_b) / h],
+        [
+            mu / inertia,
+            -mu / inertia,
+            -panel.hinge_stiffness / inertia,
+            -panel.damping / inertia,
+        ],
     )
 }
 

@@ -3,7 +3,7 @@
 //! ([`crate::analysis::flutter::jacobian`] is this matrix's value there).
 
 use crate::inputs::panel::Panel;
-use crate::models::coupled::Coupling;
+use crate::models::coupled::{jacobian_from_rows, Coupling};
 use crate::models::hinge::{generalised_moment, HingeModel};
 use crate::models::thermal::STEFAN_BOLTZMANN;
 use nalgebra::{Matrix4, Vector4};
@@ -81,23 +81,10 @@ impl Linearisation {
             }
         };
         let c = self.conduction;
-        Matrix4::new(
-            -c - rad_f,
-            c,
-            d_heating,
-            0.0,
-            c,
-            -c - rad_b,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            1.0,
-            a_tf,
-            a_tb,
-            a_th,
-            a_om,
+        jacobian_from_rows(
+            [-c - rad_f, c, d_heating],
+            [c, -c - rad_b],
+            [a_tf, a_tb, a_th, a_om],
         )
     }
 
