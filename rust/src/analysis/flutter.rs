@@ -331,6 +331,8 @@ mod tests {
     use super::*;
     use crate::inputs::orbit::Orbit;
     use crate::models::coupled::Coupled;
+    use crate::numerics::testing::assert_jacobian;
+    use nalgebra::Vector4;
 
     #[test]
     fn analytic_jacobian_matches_finite_differences() {
@@ -340,24 +342,9 @@ mod tests {
                 let eq = equilibrium(&p, coupling, 1.0).unwrap();
                 let jac = jacobian(&p, model, coupling, 1.0, &eq);
                 let sys = Coupled::new(p, Orbit::geo_equinox(), model, coupling);
-                let y = eq.state();
-                for j in 0..4 {
-                    let h = 1e-6 * y[j].abs().max(1e-3);
-                    let mut yp = y;
-                    let mut ym = y;
-                    yp[j] += h;
-                    ym[j] -= h;
-                    let col = (sys.rhs_at_flux(1.0, &yp) - sys.rhs_at_flux(1.0, &ym)) / (2.0 * h);
-                    for i in 0..4 {
-                        let tol = 1e-6 * jac.column(j).amax().max(1e-12);
-                        assert!(
-                            (col[i] - jac[(i, j)]).abs() < tol,
-                            "{model:?} {coupling:?} ({i},{j}): {} vs {}",
-                            col[i],
-                            jac[(i, j)]
-                        );
-                    }
-                }
+                let f = |y: &Vector4<f64>| sys.rhs_at_flux(1.0, y);
+                let case = format!("{model:?} {coupling:?}");
+                assert_jacobian(&jac, f, &eq.state(), 1e-12, &case);
             }
         }
     }
