@@ -275,44 +275,22 @@ fn two_nodes_reproduce_the_two_layer_orbit_to_1e10() {
 }
 
 fn two_nodes_reproduce_the_two_layer_orbit() {
-    use crate::numerics::integrate::{Method, Tolerances};
     use crate::runs::simulate::{run, Output};
     // The nodal right-hand side on two nodes does eq. 2's arithmetic in eq. 2's order, so
     // the runs take the same steps; anything but rounding-level agreement would show here
     // (a near-undamped hinge amplifies any difference in the step sequence to ~1e-6).
-    let p = Panel::paper();
-    let o = Orbit::geo_equinox();
-    let method = Method::Dopri5(Tolerances::default());
-    let out = Output::Every(30.0);
+    let case = Case::paper(Output::Every(30.0));
+    let (p, o) = (case.p, case.o);
     let span = (0.0, o.period);
     let c = Conduction::homogeneous(&p, 2).unwrap();
-    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+    let (model, coupling) = (case.model, case.coupling);
     // Both from the same start (the equilibria agree to 1e-10 on their own, tested above).
     let eq = crate::analysis::steady::equilibrium(&p, coupling, 1.0).unwrap();
     let y0 = nalgebra::Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
     let start = [eq.t_front, eq.t_back, eq.theta, 0.0];
-    let lay = simulate(
-        &p,
-        c,
-        &o,
-        model,
-        coupling,
-        &method,
-        span,
-        Some(&start),
-        &out,
-        None,
-        &crate::cancel::Cancel::new(),
-    )
-    .unwrap();
-    let two = run(
-        &mut Coupled::new(p, o, model, coupling),
-        &method,
-        span,
-        y0,
-        &out,
-    )
-    .unwrap();
+    let lay = case.simulate_from(c, span, Some(&start));
+    let sys = &mut Coupled::new(p, o, model, coupling);
+    let two = run(sys, &case.method, span, y0, &case.out).unwrap();
     assert_eq!(lay.t.len(), two.t.len());
     assert_eq!(lay.method, two.method, "the settings the run reports");
     let theta_scale = two.column(2).iter().fold(0.0_f64, |a, b| a.max(b.abs()));
@@ -334,11 +312,11 @@ fn the_seams_coupled_system_runs_the_nodal_model_alike() {
     // its generic coupled system agrees with this module's nodal system.
     use crate::models::coupled::Coupled as Generic;
     use crate::models::hinge::Hinge;
-    use crate::numerics::integrate::{Dyn, Method, Tolerances};
+    use crate::numerics::integrate::Dyn;
     use crate::runs::simulate::{run, Output};
-    let p = Panel::paper();
-    let o = Orbit::geo_equinox();
-    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+    let case = Case::paper(Output::Every(50.0));
+    let (p, o) = (case.p, case.o);
+    let (model, coupling) = (case.model, case.coupling);
     let nodes = 7;
     let thermal = crate::models::thermal_model(&p, nodes as u32).unwrap();
     let mut generic =
@@ -352,26 +330,12 @@ fn the_seams_coupled_system_runs_the_nodal_model_alike() {
     .unwrap();
     let mut start = eq.temperatures.clone();
     start.extend([eq.theta, 0.0]);
-    let method = Method::Dopri5(Tolerances::default());
     let (entry, _) = o.shadow_intervals(0.0, o.period)[0];
     let span = (entry - 100.0, entry + 900.0);
-    let out = Output::Every(50.0);
     let c = Conduction::homogeneous(&p, nodes).unwrap();
-    let ours = simulate(
-        &p,
-        c,
-        &o,
-        model,
-        coupling,
-        &method,
-        span,
-        Some(&start),
-        &out,
-        None,
-        &crate::cancel::Cancel::new(),
-    )
-    .unwrap();
-    let theirs = run(&mut generic, &method, span, DVector::from_vec(start), &out).unwrap();
+    let ours = case.simulate_from(c, span, Some(&start));
+    let start = DVector::from_vec(start);
+    let theirs = run(&mut generic, &case.method, span, start, &case.out).unwrap();
     for (k, y) in theirs.y.iter().enumerate() {
         assert!(
             (ours.theta[k] - y[nodes]).abs() < 1e-7 * eq.theta.abs(),
@@ -604,8 +568,8 @@ fn orbit_cost() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(20);
     let (_, p, lam) = examples().into_iter().find(|e| e.0 == want).unwrap();
-    let case = CostCase::of(p);
-    let CostCase {
+    let case = Case::of(p);
+    let Case {
         p,
         o,
         ref method,
@@ -672,9 +636,8 @@ fn orbit_cost() {
     println!("{want}, {nodes} nodes: {steps:?}");
 }
 
-/// The setting of the cost measurements: one GEO orbit of an example panel at 1 % of its
-/// critical damping, rk45 at the default tolerances, sampled at the orbit's end.
-struct CostCase {
+/// A run of these tests: the non-linear, two-way coupled hinge, rk45 at the default tolerances.
+struct Case {
     p: Panel,
     o: Orbit,
     method: crate::numerics::integrate::Method,
@@ -683,40 +646,57 @@ struct CostCase {
     coupling: Coupling,
 }
 
-impl CostCase {
-    fn of(p: Panel) -> Self {
-        let o = Orbit::geo_equinox();
-        CostCase {
-            p: Panel {
-                damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
-                ..p
-            },
-            o,
+impl Case {
+    /// The paper's panel on the GEO equinox orbit, sampled as `out` asks.
+    fn paper(out: crate::runs::simulate::Output) -> Self {
+        Case {
+            p: Panel::paper(),
+            o: Orbit::geo_equinox(),
             method: crate::numerics::integrate::Method::Dopri5(
                 crate::numerics::integrate::Tolerances::default(),
             ),
-            out: crate::runs::simulate::Output::Times(vec![o.period]),
+            out,
             model: HingeModel::Nonlinear,
             coupling: Coupling::ProjectedArea,
         }
     }
 
+    /// The setting of the cost measurements: one GEO orbit of an example panel at 1 % of its
+    /// critical damping, sampled at the orbit's end.
+    fn of(p: Panel) -> Self {
+        let o = Orbit::geo_equinox();
+        Case {
+            p: Panel {
+                damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
+                ..p
+            },
+            o,
+            ..Case::paper(crate::runs::simulate::Output::Times(vec![o.period]))
+        }
+    }
+
     /// The N-node `simulate` of the orbit from its sunlit equilibrium.
     fn simulate(&self, c: Conduction) -> LayeredRun {
-        let span = (0.0, self.o.period);
+        self.simulate_from(c, (0.0, self.o.period), None)
+    }
+
+    /// The N-node `simulate` over `span` from `start` (default: the sunlit equilibrium).
+    fn simulate_from(&self, c: Conduction, span: (f64, f64), start: Option<&[f64]>) -> LayeredRun {
         let (p, o) = (&self.p, &self.o);
+        let cancel = crate::cancel::Cancel::new();
+        let (model, coupling, out) = (self.model, self.coupling, &self.out);
         simulate(
             p,
             c,
             o,
-            self.model,
-            self.coupling,
+            model,
+            coupling,
             &self.method,
             span,
+            start,
+            out,
             None,
-            &self.out,
-            None,
-            &crate::cancel::Cancel::new(),
+            &cancel,
         )
         .unwrap()
     }
@@ -730,8 +710,8 @@ impl CostCase {
 fn orbit_time() {
     use crate::runs::simulate::run;
     for (name, p, lam) in examples() {
-        let case = CostCase::of(p);
-        let CostCase {
+        let case = Case::of(p);
+        let Case {
             p,
             o,
             ref method,
