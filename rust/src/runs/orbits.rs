@@ -1054,6 +1054,18 @@ mod tests {
     /// Reads every step at 64 evenly spaced points: the fine-sampled reference of the peaks.
     struct Fine<'c>(SummaryObserver<'c, TwoLayerView>);
 
+    /// Integrates `run` into its observer as `wrap` wraps it, and summarises the orbits.
+    fn summarise<'c, O: Observer<nalgebra::U4>>(
+        mut run: PreparedOrbits<'c>,
+        wrap: impl FnOnce(SummaryObserver<'c, TwoLayerView>) -> O,
+        unwrap: impl FnOnce(O) -> SummaryObserver<'c, TwoLayerView>,
+    ) -> OrbitRun {
+        let mut observer = wrap(run.observer);
+        let (system, method) = (&mut run.system, &run.method);
+        let outcome = solve(system, method, run.t0, run.y0, run.t1, &mut observer);
+        finish_orbits(unwrap(observer), outcome).unwrap()
+    }
+
     impl Observer<nalgebra::U4> for Fine<'_> {
         fn on_step(&mut self, step: &DenseStep<nalgebra::U4>) -> ControlFlow<()> {
             let h = (step.t1 - step.t0) / 64.0;
@@ -1108,27 +1120,8 @@ mod tests {
                     options: opts,
                 };
                 let prepare = || prepare_orbits(&req, &cancel).unwrap();
-                let mut run = prepare();
-                let outcome = solve(
-                    &mut run.system,
-                    &run.method,
-                    run.t0,
-                    run.y0,
-                    run.t1,
-                    &mut run.observer,
-                );
-                let got = finish_orbits(run.observer, outcome).unwrap();
-                let mut run = prepare();
-                let mut fine = Fine(run.observer);
-                let outcome = solve(
-                    &mut run.system,
-                    &run.method,
-                    run.t0,
-                    run.y0,
-                    run.t1,
-                    &mut fine,
-                );
-                let want = finish_orbits(fine.0, outcome).unwrap();
+                let got = summarise(prepare(), |o| o, |o| o);
+                let want = summarise(prepare(), Fine, |fine| fine.0);
                 assert_eq!(got.stats, want.stats);
                 for (g, w) in got.summaries.iter().zip(&want.summaries) {
                     let case = format!("c_d {damping}, steps_per_period {steps_per_period}");
