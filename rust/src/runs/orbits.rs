@@ -807,15 +807,14 @@ pub fn run_orbits_cancellable(req: &OrbitRunRequest, cancel: &Cancel) -> Result<
         panel: req.panel,
         coupling: req.coupling,
     };
+    let span = (req.t_start, req.first_index, req.n_orbits);
     run_summarised(
         &mut system,
         view,
         &req.panel,
         &req.orbit,
         &req.method,
-        req.t_start,
-        req.first_index,
-        req.n_orbits,
+        span,
         req.y0,
         2,
         req.options,
@@ -951,9 +950,10 @@ where
     pub crossing: Option<LimitCrossing>,
 }
 
-/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` (whose
-/// component `theta_index` is θ) and summarises each orbit through `view`; the step is capped
-/// by `panel`'s hinge period as [`SummaryOptions::steps_per_period`] asks.
+/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` at
+/// `t_start` (`span`; `y0`'s component `theta_index` is θ) and summarises each orbit through
+/// `view`; the step is capped by `panel`'s hinge period as
+/// [`SummaryOptions::steps_per_period`] asks.
 #[allow(clippy::too_many_arguments)]
 pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
     system: &mut S,
@@ -961,9 +961,7 @@ pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
     panel: &Panel,
     orbit: &Orbit,
     method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
+    span: (f64, u64, u64),
     y0: State<D>,
     theta_index: usize,
     options: SummaryOptions,
@@ -977,12 +975,12 @@ where
         panel,
         orbit,
         method,
-        (t_start, first_index, n_orbits),
+        span,
         (theta_index, [y0[theta_index], y0[theta_index + 1]]),
         options,
         cancel,
     )?;
-    let outcome = solve(system, &method, t_start, y0, t_end, &mut observer);
+    let outcome = solve(system, &method, span.0, y0, t_end, &mut observer);
     finish_orbits(observer, outcome)
 }
 
