@@ -17,6 +17,13 @@ use crate::runs::layered::{
 };
 use nalgebra::{DMatrix, DVector};
 
+/// The non-linear, two-way coupled system of `p` and `c`, its conduction modes faster than
+/// `fast_mode_factor` (see [`FAST_MODE_FACTOR`]) slaved; infinity slaves none.
+fn nonlinear_system(p: &Panel, c: &Conduction, fast_mode_factor: f64) -> Layered {
+    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+    Layered::new(p, c.clone(), model, coupling, fast_mode_factor).unwrap()
+}
+
 #[test]
 fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
     let p = Panel {
@@ -56,14 +63,7 @@ fn start_state_is_at_rest_in_the_equilibrium_at_the_start_dates_flux() {
     let orbit = Orbit::geo_year(0.0);
     let (january, july) = (3.0 * 86400.0, 185.0 * 86400.0);
     let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
-    let sys = Layered::new(
-        &p,
-        c.clone(),
-        HingeModel::Nonlinear,
-        Coupling::ProjectedArea,
-        f64::INFINITY,
-    )
-    .unwrap();
+    let sys = nonlinear_system(&p, &c, f64::INFINITY);
     let mut fronts = Vec::new();
     for t0 in [january, july] {
         let y = start_state(&p, &c, Coupling::ProjectedArea, &orbit, t0).unwrap();
@@ -94,14 +94,7 @@ fn jacobian_matches_finite_differences() {
         ..Panel::paper()
     };
     let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
-    let sys = Layered::new(
-        &p,
-        c.clone(),
-        HingeModel::Nonlinear,
-        Coupling::ProjectedArea,
-        f64::INFINITY,
-    )
-    .unwrap();
+    let sys = nonlinear_system(&p, &c, f64::INFINITY);
     let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
     let jac = jacobian(
         &p,
@@ -146,14 +139,7 @@ fn quasi_static_fast_modes_are_exact_in_steady_state() {
     let p = lam.equivalent_panel(&Panel::paper()).unwrap();
     for layup in [lam, wing_layup()] {
         let c = Conduction::new(&p, &layup, 20).unwrap();
-        let sys = Layered::new(
-            &p,
-            c.clone(),
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            FAST_MODE_FACTOR,
-        )
-        .unwrap();
+        let sys = nonlinear_system(&p, &c, FAST_MODE_FACTOR);
         assert!(matches!(sys.thermal, Thermal::Modal(_)));
         let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
         let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
@@ -234,14 +220,7 @@ fn fast_mode_factor_measurement() {
         let t1 = exit + 1200.0;
         let tn = 2.0 * std::f64::consts::PI / wn;
         for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 200.0, 1000.0] {
-            let sys = Layered::new(
-                &p,
-                c.clone(),
-                HingeModel::Nonlinear,
-                Coupling::ProjectedArea,
-                factor,
-            )
-            .unwrap();
+            let sys = nonlinear_system(&p, &c, factor);
             let kept = sys.thermal_size();
             let y0 = DVector::from_vec(sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0));
             let mut orb = LayeredOrbit::new(sys, orbit);
@@ -448,14 +427,7 @@ fn reduced_growth_measurement() {
         let eq = full.equilibrium.clone();
         println!("{name}: full growth {:.6e}", full.growth_rate);
         for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 1e9] {
-            let sys = Layered::new(
-                &p,
-                c.clone(),
-                HingeModel::Nonlinear,
-                Coupling::ProjectedArea,
-                factor,
-            )
-            .unwrap();
+            let sys = nonlinear_system(&p, &c, factor);
             let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
             let n = y.len();
             let mut jac = DMatrix::zeros(n, n);
@@ -561,7 +533,6 @@ fn critical_damping_converges_with_the_nodes_and_two_nodes_are_the_two_layer_mod
 #[test]
 #[ignore]
 fn orbit_cost() {
-    use crate::runs::simulate::run;
     let want = std::env::var("LAMINATE_PANEL").unwrap_or_else(|_| "wing".into());
     let nodes: usize = std::env::var("LAMINATE_NODES")
         .ok()
@@ -573,9 +544,9 @@ fn orbit_cost() {
         p,
         o,
         ref method,
-        ref out,
         model,
         coupling,
+        ..
     } = case;
     let orbits = std::env::var("LAMINATE_RUN").is_ok_and(|v| v == "orbits");
     let options = crate::runs::orbits::SummaryOptions {
@@ -586,9 +557,10 @@ fn orbit_cost() {
     };
     let cancel = crate::cancel::Cancel::new();
     let steps = if nodes == 2 {
-        let mut sys = Coupled::new(p, o, model, coupling);
-        let y0 = sys.steady_state(1.0).unwrap();
         if orbits {
+            let y0 = Coupled::new(p, o, model, coupling)
+                .steady_state(1.0)
+                .unwrap();
             let req = crate::runs::orbits::OrbitRunRequest {
                 panel: p,
                 orbit: o,
@@ -605,9 +577,7 @@ fn orbit_cost() {
                 .unwrap()
                 .stats
         } else {
-            run(&mut sys, method, (0.0, o.period), y0, out)
-                .unwrap()
-                .stats
+            case.run_two_layer()
         }
     } else {
         let c = Conduction::new(&p, &lam, nodes).unwrap();
@@ -682,23 +652,29 @@ impl Case {
 
     /// The N-node `simulate` over `span` from `start` (default: the sunlit equilibrium).
     fn simulate_from(&self, c: Conduction, span: (f64, f64), start: Option<&[f64]>) -> LayeredRun {
-        let (p, o) = (&self.p, &self.o);
-        let cancel = crate::cancel::Cancel::new();
-        let (model, coupling, out) = (self.model, self.coupling, &self.out);
         simulate(
-            p,
+            &self.p,
             c,
-            o,
-            model,
-            coupling,
+            &self.o,
+            self.model,
+            self.coupling,
             &self.method,
             span,
             start,
-            out,
+            &self.out,
             None,
-            &cancel,
+            &crate::cancel::Cancel::new(),
         )
         .unwrap()
+    }
+
+    /// The two-layer run of the orbit from its sunlit steady state.
+    fn run_two_layer(&self) -> crate::numerics::integrate::Stats {
+        let mut sys = Coupled::new(self.p, self.o, self.model, self.coupling);
+        let y0 = sys.steady_state(1.0).unwrap();
+        let span = (0.0, self.o.period);
+        let run = crate::runs::simulate::run(&mut sys, &self.method, span, y0, &self.out);
+        run.unwrap().stats
     }
 }
 
@@ -708,26 +684,15 @@ impl Case {
 #[test]
 #[ignore]
 fn orbit_time() {
-    use crate::runs::simulate::run;
     for (name, p, lam) in examples() {
         let case = Case::of(p);
-        let Case {
-            p,
-            o,
-            ref method,
-            ref out,
-            model,
-            coupling,
-        } = case;
         let mut best = [f64::INFINITY; 2];
         for _ in 0..7 {
             let start = std::time::Instant::now();
-            let mut sys = Coupled::new(p, o, model, coupling);
-            let y0 = sys.steady_state(1.0).unwrap();
-            run(&mut sys, method, (0.0, o.period), y0, out).unwrap();
+            case.run_two_layer();
             best[0] = best[0].min(start.elapsed().as_secs_f64());
             let start = std::time::Instant::now();
-            case.simulate(Conduction::new(&p, &lam, 20).unwrap());
+            case.simulate(Conduction::new(&case.p, &lam, 20).unwrap());
             best[1] = best[1].min(start.elapsed().as_secs_f64());
         }
         println!(
@@ -755,14 +720,7 @@ fn rhs_cost() {
     };
     for (name, p, lam) in examples() {
         let c = Conduction::new(&p, &lam, 20).unwrap();
-        let sys = Layered::new(
-            &p,
-            c.clone(),
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            FAST_MODE_FACTOR,
-        )
-        .unwrap();
+        let sys = nonlinear_system(&p, &c, FAST_MODE_FACTOR);
         let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
         let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 1e-3);
         let mut dy = vec![0.0; y.len()];
