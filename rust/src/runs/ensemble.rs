@@ -245,26 +245,8 @@ fn sample_head(
     let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
     let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
     let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
-    let req = sample_request(*panel, s, eq.state(), summary_options(s));
-    let head = SampleHead {
-        theta_eq: flutter.equilibrium.theta,
-        growth_rate: flutter.growth_rate,
-        frequency_hz: flutter.frequency_hz,
-        critical_damping: critical,
-    };
-    Ok((head, req))
-}
-
-/// The run of `panel` with the settings `s`: its orbits from `y0` at t = 0, summarised as
-/// `options` ask.
-fn sample_request(
-    panel: Panel,
-    s: &EnsembleSettings,
-    y0: Vector4<f64>,
-    options: SummaryOptions,
-) -> OrbitRunRequest {
-    OrbitRunRequest {
-        panel,
+    let req = OrbitRunRequest {
+        panel: *panel,
         orbit: s.orbit,
         model: s.model,
         coupling: s.coupling,
@@ -272,9 +254,16 @@ fn sample_request(
         t_start: 0.0,
         first_index: 0,
         n_orbits: s.n_orbits,
-        y0,
-        options,
-    }
+        y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+        options: summary_options(s),
+    };
+    let head = SampleHead {
+        theta_eq: flutter.equilibrium.theta,
+        growth_rate: flutter.growth_rate,
+        frequency_hz: flutter.frequency_hz,
+        critical_damping: critical,
+    };
+    Ok((head, req))
 }
 
 /// The per-orbit summaries every sample of a batch takes.
@@ -712,18 +701,27 @@ mod tests {
         }
     }
 
-    /// The one long run a sample of `s` should equal, its start and summary options chosen here
-    /// (the sunlit equilibrium, the θ limit `theta_limit`) rather than by the ensemble.
+    /// The one long run a sample of `s` should equal, built here from the settings' parts (from
+    /// the sunlit equilibrium, the summary's θ limit `theta_limit`) rather than by the ensemble.
     fn single_run(panel: Panel, s: &EnsembleSettings, theta_limit: f64) -> OrbitRunRequest {
         let eq = equilibrium(&panel, s.coupling, s.orbit.flux_scale(0.0)).unwrap();
-        let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
-        let options = SummaryOptions {
-            window: s.window,
-            theta_limit,
-            stop_at_limit: false,
-            steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
-        };
-        sample_request(panel, s, y0, options)
+        OrbitRunRequest {
+            panel,
+            orbit: s.orbit,
+            model: s.model,
+            coupling: s.coupling,
+            method: s.method,
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: s.n_orbits,
+            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
+            options: SummaryOptions {
+                window: s.window,
+                theta_limit,
+                stop_at_limit: false,
+                steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+            },
+        }
     }
 
     #[test]
