@@ -8,7 +8,7 @@
 use crate::analysis::steady::{equilibrium, Equilibrium};
 use crate::error::{require_non_negative, Error, Result};
 use crate::inputs::panel::Panel;
-use crate::models::coupled::{Coupled, Coupling};
+use crate::models::coupled::{jacobian_from_rows, Coupled, Coupling};
 use crate::models::hinge::{HingeModel, StructuralModel};
 use crate::models::thermal::ThermalModel;
 use crate::models::thermal::STEFAN_BOLTZMANN;
@@ -60,23 +60,15 @@ pub fn jacobian(
     // which is zero at the equilibrium, and the θ̇² term vanishes with θ̇.
     let inertia = panel.hinge_inertia() * model.inertia_factor(s);
     let mu = panel.moment_per_kelvin();
-    Matrix4::new(
-        (-k - rad_f) / h,
-        k / h,
-        d_heating / h,
-        0.0,
-        k / h,
-        (-k - rad_b) / h,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        1.0,
-        mu / inertia,
-        -mu / inertia,
-        -panel.hinge_stiffness / inertia,
-        -panel.damping / inertia,
+    jacobian_from_rows(
+        [(-k - rad_f) / h, k / h, d_heating / h],
+        [k / h, (-k - rad_b) / h],
+        [
+            mu / inertia,
+            -mu / inertia,
+            -panel.hinge_stiffness / inertia,
+            -panel.damping / inertia,
+        ],
     )
 }
 
@@ -339,6 +331,8 @@ mod tests {
     use super::*;
     use crate::inputs::orbit::Orbit;
     use crate::models::coupled::Coupled;
+    use crate::numerics::testing::assert_jacobian;
+    use nalgebra::Vector4;
 
     #[test]
     fn analytic_jacobian_matches_finite_differences() {
@@ -348,24 +342,9 @@ mod tests {
                 let eq = equilibrium(&p, coupling, 1.0).unwrap();
                 let jac = jacobian(&p, model, coupling, 1.0, &eq);
                 let sys = Coupled::new(p, Orbit::geo_equinox(), model, coupling);
-                let y = eq.state();
-                for j in 0..4 {
-                    let h = 1e-6 * y[j].abs().max(1e-3);
-                    let mut yp = y;
-                    let mut ym = y;
-                    yp[j] += h;
-                    ym[j] -= h;
-                    let col = (sys.rhs_at_flux(1.0, &yp) - sys.rhs_at_flux(1.0, &ym)) / (2.0 * h);
-                    for i in 0..4 {
-                        let tol = 1e-6 * jac.column(j).amax().max(1e-12);
-                        assert!(
-                            (col[i] - jac[(i, j)]).abs() < tol,
-                            "{model:?} {coupling:?} ({i},{j}): {} vs {}",
-                            col[i],
-                            jac[(i, j)]
-                        );
-                    }
-                }
+                let f = |y: &Vector4<f64>| sys.rhs_at_flux(1.0, y);
+                let case = format!("{model:?} {coupling:?}");
+                assert_jacobian(&jac, f, &eq.state(), 1e-12, &case);
             }
         }
     }

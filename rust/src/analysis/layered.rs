@@ -171,9 +171,10 @@ pub fn analyse(
     flux: f64,
 ) -> Result<LayeredFlutter> {
     let eq = equilibrium(panel, c, coupling, flux)?;
-    let (growth_rate, frequency_hz, eigenvalues) = growth(panel, c, model, coupling, flux, &eq)?;
+    let jac = jacobian(panel, c, model, coupling, flux, &eq);
+    let (growth_rate, frequency_hz, eigenvalues) = growth(panel, &jac, &eq)?;
     Ok(LayeredFlutter {
-        jacobian: jacobian(panel, c, model, coupling, flux, &eq),
+        jacobian: jac,
         equilibrium: eq,
         eigenvalues,
         growth_rate,
@@ -181,23 +182,21 @@ pub fn analyse(
     })
 }
 
-/// (growth rate, frequency, eigenvalues by decreasing real part) of the Jacobian at `eq`.
+/// (growth rate, frequency, eigenvalues by decreasing real part) of `jac`, the Jacobian of
+/// `panel`'s system at `eq`.
 fn growth(
     panel: &Panel,
-    c: &Conduction,
-    model: HingeModel,
-    coupling: Coupling,
-    flux: f64,
+    jac: &DMatrix<f64>,
     eq: &LayeredEquilibrium,
 ) -> Result<(f64, f64, Vec<nalgebra::Complex<f64>>)> {
-    let n = c.nodes();
-    let jac = jacobian(panel, c, model, coupling, flux, eq);
+    // The state: n node temperatures, θ and θ̇.
+    let n = jac.nrows() - 2;
     // Balance kelvin rows against radian rows.
     let tmax = eq.temperatures.iter().fold(1.0_f64, |a, &b| a.max(b));
     let mut scale = vec![1.0; n + 2];
     scale[n] = 1.0 / tmax;
     scale[n + 1] = panel.natural_angular_frequency() / tmax;
-    let spectrum = crate::analysis::flutter::Spectrum::of(&jac, &scale)?;
+    let spectrum = crate::analysis::flutter::Spectrum::of(jac, &scale)?;
     Ok((
         spectrum.growth_rate,
         spectrum.frequency_hz,
@@ -221,7 +220,8 @@ pub fn critical_damping(
             damping: cd,
             ..*panel
         };
-        Ok(growth(&p, c, model, coupling, flux, &eq)?.0)
+        let jac = jacobian(&p, c, model, coupling, flux, &eq);
+        Ok(growth(&p, &jac, &eq)?.0)
     };
     let start = panel
         .damping

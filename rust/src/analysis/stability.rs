@@ -111,21 +111,18 @@ mod tests {
         }
     }
 
+    /// The map of `p` over `x` and `y` at the full flux, projected area.
+    fn map(p: &Panel, model: HingeModel, x: &Axis, y: &Axis) -> Result<StabilityMap> {
+        let coupling = Coupling::ProjectedArea;
+        stability_map(p, model, coupling, 1.0, x, y, &Cancel::new())
+    }
+
     #[test]
     fn map_matches_point_by_point_analysis() {
         let p = Panel::paper();
         let x = axis("damping", &[0.0, 1.0, 3.0]);
         let y = axis("conductance", &[10.0, 25.0]);
-        let m = stability_map(
-            &p,
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            1.0,
-            &x,
-            &y,
-            &Cancel::new(),
-        )
-        .unwrap();
+        let m = map(&p, HingeModel::Nonlinear, &x, &y).unwrap();
         assert_eq!((m.nx, m.ny), (3, 2));
         for (iy, &k) in y.values.iter().enumerate() {
             for (ix, &cd) in x.values.iter().enumerate() {
@@ -151,18 +148,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| {
-                    stability_map(
-                        &p,
-                        HingeModel::Nonlinear,
-                        Coupling::ProjectedArea,
-                        1.0,
-                        &x,
-                        &y,
-                        &Cancel::new(),
-                    )
-                    .unwrap()
-                })
+                .install(|| map(&p, HingeModel::Nonlinear, &x, &y).unwrap())
         };
         assert_eq!(run(1), run(3));
     }
@@ -170,20 +156,7 @@ mod tests {
     #[test]
     fn bad_axes_are_refused_by_name() {
         let p = Panel::paper();
-        let run = |x: &Axis, y: &Axis| {
-            let c = Cancel::new();
-            stability_map(
-                &p,
-                HingeModel::Linear,
-                Coupling::ProjectedArea,
-                1.0,
-                x,
-                y,
-                &c,
-            )
-            .unwrap_err()
-            .to_string()
-        };
+        let run = |x: &Axis, y: &Axis| map(&p, HingeModel::Linear, x, y).unwrap_err().to_string();
         let good = axis("damping", &[1.0]);
         assert!(run(&axis("dampng", &[1.0]), &good).contains("dampng"));
         assert!(run(&good, &axis("damping", &[2.0])).starts_with("y"));

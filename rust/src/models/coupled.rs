@@ -8,7 +8,9 @@ use crate::models::hinge::{hinge_acceleration, Hinge, HingeModel, Rigid, Structu
 use crate::models::thermal::{AsWritten, Balance, ThermalModel, TwoLayer};
 use crate::numerics::integrate::{OdeSystem, State};
 use nalgebra::allocator::Allocator;
-use nalgebra::{DefaultAllocator, Dim, DimName, Dyn, SVector, Vector2, Vector4, U1, U2, U4};
+use nalgebra::{
+    DefaultAllocator, Dim, DimName, Dyn, Matrix4, SVector, Vector2, Vector4, U1, U2, U4,
+};
 
 /// How the hinge angle feeds back on the heating (paper Sec. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -383,6 +385,20 @@ impl OdeSystem<U2> for DrivenHinge {
 /// Convenience: a state vector from its four components.
 pub fn state(t_front: f64, t_back: f64, theta: f64, theta_dot: f64) -> SVector<f64, 4> {
     Vector4::new(t_front, t_back, theta, theta_dot)
+}
+
+/// The Jacobian of the two-layer plate on the hinge, state (T_front, T_back, θ, θ̇), from its
+/// rows: the front layer's ∂/∂(T_front, T_back, θ), the back layer's ∂/∂(T_front, T_back) (its
+/// balance does not see θ) and θ̈'s; θ̇'s own row is (0, 0, 0, 1).
+#[inline]
+#[rustfmt::skip] // a row a line
+pub fn jacobian_from_rows(front: [f64; 3], back: [f64; 2], hinge: [f64; 4]) -> Matrix4<f64> {
+    Matrix4::new(
+        front[0], front[1], front[2], 0.0,
+        back[0], back[1], 0.0, 0.0,
+        0.0, 0.0, 0.0, 1.0,
+        hinge[0], hinge[1], hinge[2], hinge[3],
+    )
 }
 
 #[cfg(test)]

@@ -171,6 +171,20 @@ struct ModeRow {
     moment: f64,
 }
 
+/// The first M mode rows, the M amplitudes and the first M rates, as arrays of that length
+/// (see [`Layered::evaluate`]).
+#[inline(always)]
+fn kept<'a, 'b, 'c, const M: usize>(
+    rows: &'a [ModeRow],
+    amp: &'b [f64],
+    dy: &'c mut [f64],
+) -> (&'a [ModeRow; M], &'b [f64; M], &'c mut [f64; M]) {
+    let rows = rows[..M].try_into().expect("one row per kept mode");
+    let amp = amp.try_into().expect("one amplitude per kept mode");
+    let dy = (&mut dy[..M]).try_into().expect("one rate per kept mode");
+    (rows, amp, dy)
+}
+
 /// The coupled N-node system's coefficients (no orbit: the flux factor is an argument).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layered {
@@ -515,27 +529,15 @@ impl Reduced {
         macro_rules! sized {
             ($($m:literal)*) => {
                 match amp.len() {
-                    $($m => self.evaluate_sized::<$m>(c, flux, flux_rate, amp, dy),)*
+                    $($m => {
+                        let (rows, amp, dy) = kept::<$m>(&self.rows, amp, dy);
+                        self.evaluate_rows(c, flux, flux_rate, rows, amp, dy)
+                    })*
                     _ => self.evaluate_rows(c, flux, flux_rate, &self.rows, amp, dy),
                 }
             };
         }
         sized!(1 2 3 4 5 6 7 8)
-    }
-
-    #[inline(always)]
-    fn evaluate_sized<const M: usize>(
-        &self,
-        c: &Conduction,
-        flux: f64,
-        flux_rate: f64,
-        amp: &[f64],
-        dy: &mut [f64],
-    ) -> (f64, [f64; 2], [f64; 2]) {
-        let rows: &[ModeRow; M] = self.rows[..M].try_into().expect("one row per kept mode");
-        let amp: &[f64; M] = amp.try_into().expect("one amplitude per kept mode");
-        let dy: &mut [f64; M] = (&mut dy[..M]).try_into().expect("one rate per kept mode");
-        self.evaluate_rows(c, flux, flux_rate, rows, amp, dy)
     }
 
     /// The evaluation itself, on the kept modes' `rows`.

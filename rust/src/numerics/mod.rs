@@ -5,3 +5,5 @@ pub mod cpu;
 pub mod integrate;
 pub mod newton;
 pub(crate) mod simd;
+#[cfg(test)]
+pub(crate) mod testing;

@@ -362,21 +362,11 @@ pub(crate) fn run_orbits_reading(
     view.slope_reads = slope_reads;
     let orb = LayeredOrbit::new(system.clone(), req.orbit);
     let size = start.len();
-    let args = (
-        view,
-        &req.panel,
-        &req.orbit,
-        &req.method,
-        req.t_start,
-        req.first_index,
-        req.n_orbits,
-        req.options,
-        cancel,
-    );
+    let theta_index = system.thermal_size();
     let mut run = on_fastest_state!(
         orb,
         size,
-        summarised_run(&start, system.thermal_size(), args)
+        summarised_run(&start, theta_index, req, view, cancel)
     )?;
     run.y_end = req.nodal(&system, run.stats.t_end, &run.y_end);
     Ok(run)
@@ -424,19 +414,6 @@ impl LayeredRunRequest {
     }
 }
 
-/// The summarised run's settings, passed through the size dispatch.
-type SummaryArgs<'a> = (
-    LayeredView,
-    &'a Panel,
-    &'a Orbit,
-    &'a crate::numerics::integrate::Method,
-    f64,
-    u64,
-    u64,
-    crate::runs::orbits::SummaryOptions,
-    &'a crate::cancel::Cancel,
-);
-
 /// Per-orbit summaries of the N-node system, the end state as a plain vector.
 pub struct LayeredSummaries {
     pub summaries: Vec<crate::runs::orbits::OrbitSummary>,
@@ -462,28 +439,29 @@ where
     }
 }
 
+/// The summarised run of `req` on `system` (one of [`on_fastest_state`]'s) from `y0`.
 fn summarised_run<D: Dim, S: OdeSystem<D>>(
     system: &mut S,
     y0: &[f64],
     theta_index: usize,
-    args: SummaryArgs<'_>,
+    req: &LayeredRunRequest,
+    view: LayeredView,
+    cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredSummaries>
 where
     DefaultAllocator: Allocator<D>,
 {
-    let (view, panel, orbit, method, t_start, first_index, n_orbits, options, cancel) = args;
+    let span = (req.t_start, req.first_index, req.n_orbits);
     let run = crate::runs::orbits::run_summarised(
         system,
         view,
-        panel,
-        orbit,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
+        &req.panel,
+        &req.orbit,
+        &req.method,
+        span,
         state_of::<D>(y0),
         theta_index,
-        options,
+        req.options,
         cancel,
     )?;
     Ok(run.into())

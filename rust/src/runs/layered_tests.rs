@@ -17,6 +17,13 @@ use crate::runs::layered::{
 };
 use nalgebra::{DMatrix, DVector};
 
+/// The non-linear, two-way coupled system of `p` and `c`, its conduction modes faster than
+/// `fast_mode_factor` (see [`FAST_MODE_FACTOR`]) slaved; infinity slaves none.
+fn nonlinear_system(p: &Panel, c: &Conduction, fast_mode_factor: f64) -> Layered {
+    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+    Layered::new(p, c.clone(), model, coupling, fast_mode_factor).unwrap()
+}
+
 #[test]
 fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
     let p = Panel {
@@ -56,14 +63,7 @@ fn start_state_is_at_rest_in_the_equilibrium_at_the_start_dates_flux() {
     let orbit = Orbit::geo_year(0.0);
     let (january, july) = (3.0 * 86400.0, 185.0 * 86400.0);
     let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
-    let sys = Layered::new(
-        &p,
-        c.clone(),
-        HingeModel::Nonlinear,
-        Coupling::ProjectedArea,
-        f64::INFINITY,
-    )
-    .unwrap();
+    let sys = nonlinear_system(&p, &c, f64::INFINITY);
     let mut fronts = Vec::new();
     for t0 in [january, july] {
         let y = start_state(&p, &c, Coupling::ProjectedArea, &orbit, t0).unwrap();
@@ -94,14 +94,7 @@ fn jacobian_matches_finite_differences() {
         ..Panel::paper()
     };
     let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
-    let sys = Layered::new(
-        &p,
-        c.clone(),
-        HingeModel::Nonlinear,
-        Coupling::ProjectedArea,
-        f64::INFINITY,
-    )
-    .unwrap();
+    let sys = nonlinear_system(&p, &c, f64::INFINITY);
     let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
     let jac = jacobian(
         &p,
@@ -146,14 +139,7 @@ fn quasi_static_fast_modes_are_exact_in_steady_state() {
     let p = lam.equivalent_panel(&Panel::paper()).unwrap();
     for layup in [lam, wing_layup()] {
         let c = Conduction::new(&p, &layup, 20).unwrap();
-        let sys = Layered::new(
-            &p,
-            c.clone(),
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            FAST_MODE_FACTOR,
-        )
-        .unwrap();
+        let sys = nonlinear_system(&p, &c, FAST_MODE_FACTOR);
         assert!(matches!(sys.thermal, Thermal::Modal(_)));
         let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
         let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
@@ -234,14 +220,7 @@ fn fast_mode_factor_measurement() {
         let t1 = exit + 1200.0;
         let tn = 2.0 * std::f64::consts::PI / wn;
         for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 200.0, 1000.0] {
-            let sys = Layered::new(
-                &p,
-                c.clone(),
-                HingeModel::Nonlinear,
-                Coupling::ProjectedArea,
-                factor,
-            )
-            .unwrap();
+            let sys = nonlinear_system(&p, &c, factor);
             let kept = sys.thermal_size();
             let y0 = DVector::from_vec(sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0));
             let mut orb = LayeredOrbit::new(sys, orbit);
@@ -275,44 +254,22 @@ fn two_nodes_reproduce_the_two_layer_orbit_to_1e10() {
 }
 
 fn two_nodes_reproduce_the_two_layer_orbit() {
-    use crate::numerics::integrate::{Method, Tolerances};
     use crate::runs::simulate::{run, Output};
     // The nodal right-hand side on two nodes does eq. 2's arithmetic in eq. 2's order, so
     // the runs take the same steps; anything but rounding-level agreement would show here
     // (a near-undamped hinge amplifies any difference in the step sequence to ~1e-6).
-    let p = Panel::paper();
-    let o = Orbit::geo_equinox();
-    let method = Method::Dopri5(Tolerances::default());
-    let out = Output::Every(30.0);
+    let case = Case::paper(Output::Every(30.0));
+    let (p, o) = (case.p, case.o);
     let span = (0.0, o.period);
     let c = Conduction::homogeneous(&p, 2).unwrap();
-    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+    let (model, coupling) = (case.model, case.coupling);
     // Both from the same start (the equilibria agree to 1e-10 on their own, tested above).
     let eq = crate::analysis::steady::equilibrium(&p, coupling, 1.0).unwrap();
     let y0 = nalgebra::Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
     let start = [eq.t_front, eq.t_back, eq.theta, 0.0];
-    let lay = simulate(
-        &p,
-        c,
-        &o,
-        model,
-        coupling,
-        &method,
-        span,
-        Some(&start),
-        &out,
-        None,
-        &crate::cancel::Cancel::new(),
-    )
-    .unwrap();
-    let two = run(
-        &mut Coupled::new(p, o, model, coupling),
-        &method,
-        span,
-        y0,
-        &out,
-    )
-    .unwrap();
+    let lay = case.simulate_from(c, span, Some(&start));
+    let sys = &mut Coupled::new(p, o, model, coupling);
+    let two = run(sys, &case.method, span, y0, &case.out).unwrap();
     assert_eq!(lay.t.len(), two.t.len());
     assert_eq!(lay.method, two.method, "the settings the run reports");
     let theta_scale = two.column(2).iter().fold(0.0_f64, |a, b| a.max(b.abs()));
@@ -334,11 +291,11 @@ fn the_seams_coupled_system_runs_the_nodal_model_alike() {
     // its generic coupled system agrees with this module's nodal system.
     use crate::models::coupled::Coupled as Generic;
     use crate::models::hinge::Hinge;
-    use crate::numerics::integrate::{Dyn, Method, Tolerances};
+    use crate::numerics::integrate::Dyn;
     use crate::runs::simulate::{run, Output};
-    let p = Panel::paper();
-    let o = Orbit::geo_equinox();
-    let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
+    let case = Case::paper(Output::Every(50.0));
+    let (p, o) = (case.p, case.o);
+    let (model, coupling) = (case.model, case.coupling);
     let nodes = 7;
     let thermal = crate::models::thermal_model(&p, nodes as u32).unwrap();
     let mut generic =
@@ -352,26 +309,12 @@ fn the_seams_coupled_system_runs_the_nodal_model_alike() {
     .unwrap();
     let mut start = eq.temperatures.clone();
     start.extend([eq.theta, 0.0]);
-    let method = Method::Dopri5(Tolerances::default());
     let (entry, _) = o.shadow_intervals(0.0, o.period)[0];
     let span = (entry - 100.0, entry + 900.0);
-    let out = Output::Every(50.0);
     let c = Conduction::homogeneous(&p, nodes).unwrap();
-    let ours = simulate(
-        &p,
-        c,
-        &o,
-        model,
-        coupling,
-        &method,
-        span,
-        Some(&start),
-        &out,
-        None,
-        &crate::cancel::Cancel::new(),
-    )
-    .unwrap();
-    let theirs = run(&mut generic, &method, span, DVector::from_vec(start), &out).unwrap();
+    let ours = case.simulate_from(c, span, Some(&start));
+    let start = DVector::from_vec(start);
+    let theirs = run(&mut generic, &case.method, span, start, &case.out).unwrap();
     for (k, y) in theirs.y.iter().enumerate() {
         assert!(
             (ours.theta[k] - y[nodes]).abs() < 1e-7 * eq.theta.abs(),
@@ -484,14 +427,7 @@ fn reduced_growth_measurement() {
         let eq = full.equilibrium.clone();
         println!("{name}: full growth {:.6e}", full.growth_rate);
         for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 1e9] {
-            let sys = Layered::new(
-                &p,
-                c.clone(),
-                HingeModel::Nonlinear,
-                Coupling::ProjectedArea,
-                factor,
-            )
-            .unwrap();
+            let sys = nonlinear_system(&p, &c, factor);
             let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
             let n = y.len();
             let mut jac = DMatrix::zeros(n, n);
@@ -597,21 +533,20 @@ fn critical_damping_converges_with_the_nodes_and_two_nodes_are_the_two_layer_mod
 #[test]
 #[ignore]
 fn orbit_cost() {
-    use crate::runs::simulate::run;
     let want = std::env::var("LAMINATE_PANEL").unwrap_or_else(|_| "wing".into());
     let nodes: usize = std::env::var("LAMINATE_NODES")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(20);
     let (_, p, lam) = examples().into_iter().find(|e| e.0 == want).unwrap();
-    let case = CostCase::of(p);
-    let CostCase {
+    let case = Case::of(p);
+    let Case {
         p,
         o,
         ref method,
-        ref out,
         model,
         coupling,
+        ..
     } = case;
     let orbits = std::env::var("LAMINATE_RUN").is_ok_and(|v| v == "orbits");
     let options = crate::runs::orbits::SummaryOptions {
@@ -622,9 +557,10 @@ fn orbit_cost() {
     };
     let cancel = crate::cancel::Cancel::new();
     let steps = if nodes == 2 {
-        let mut sys = Coupled::new(p, o, model, coupling);
-        let y0 = sys.steady_state(1.0).unwrap();
         if orbits {
+            let y0 = Coupled::new(p, o, model, coupling)
+                .steady_state(1.0)
+                .unwrap();
             let req = crate::runs::orbits::OrbitRunRequest {
                 panel: p,
                 orbit: o,
@@ -641,9 +577,7 @@ fn orbit_cost() {
                 .unwrap()
                 .stats
         } else {
-            run(&mut sys, method, (0.0, o.period), y0, out)
-                .unwrap()
-                .stats
+            case.run_two_layer()
         }
     } else {
         let c = Conduction::new(&p, &lam, nodes).unwrap();
@@ -672,9 +606,8 @@ fn orbit_cost() {
     println!("{want}, {nodes} nodes: {steps:?}");
 }
 
-/// The setting of the cost measurements: one GEO orbit of an example panel at 1 % of its
-/// critical damping, rk45 at the default tolerances, sampled at the orbit's end.
-struct CostCase {
+/// A run of these tests: the non-linear, two-way coupled hinge, rk45 at the default tolerances.
+struct Case {
     p: Panel,
     o: Orbit,
     method: crate::numerics::integrate::Method,
@@ -683,42 +616,65 @@ struct CostCase {
     coupling: Coupling,
 }
 
-impl CostCase {
-    fn of(p: Panel) -> Self {
-        let o = Orbit::geo_equinox();
-        CostCase {
-            p: Panel {
-                damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
-                ..p
-            },
-            o,
+impl Case {
+    /// The paper's panel on the GEO equinox orbit, sampled as `out` asks.
+    fn paper(out: crate::runs::simulate::Output) -> Self {
+        Case {
+            p: Panel::paper(),
+            o: Orbit::geo_equinox(),
             method: crate::numerics::integrate::Method::Dopri5(
                 crate::numerics::integrate::Tolerances::default(),
             ),
-            out: crate::runs::simulate::Output::Times(vec![o.period]),
+            out,
             model: HingeModel::Nonlinear,
             coupling: Coupling::ProjectedArea,
         }
     }
 
+    /// The setting of the cost measurements: one GEO orbit of an example panel at 1 % of its
+    /// critical damping, sampled at the orbit's end.
+    fn of(p: Panel) -> Self {
+        let o = Orbit::geo_equinox();
+        Case {
+            p: Panel {
+                damping: 0.01 * (p.hinge_stiffness * p.hinge_inertia()).sqrt(),
+                ..p
+            },
+            o,
+            ..Case::paper(crate::runs::simulate::Output::Times(vec![o.period]))
+        }
+    }
+
     /// The N-node `simulate` of the orbit from its sunlit equilibrium.
     fn simulate(&self, c: Conduction) -> LayeredRun {
-        let span = (0.0, self.o.period);
-        let (p, o) = (&self.p, &self.o);
+        self.simulate_from(c, (0.0, self.o.period), None)
+    }
+
+    /// The N-node `simulate` over `span` from `start` (default: the sunlit equilibrium).
+    fn simulate_from(&self, c: Conduction, span: (f64, f64), start: Option<&[f64]>) -> LayeredRun {
         simulate(
-            p,
+            &self.p,
             c,
-            o,
+            &self.o,
             self.model,
             self.coupling,
             &self.method,
             span,
-            None,
+            start,
             &self.out,
             None,
             &crate::cancel::Cancel::new(),
         )
         .unwrap()
+    }
+
+    /// The two-layer run of the orbit from its sunlit steady state.
+    fn run_two_layer(&self) -> crate::numerics::integrate::Stats {
+        let mut sys = Coupled::new(self.p, self.o, self.model, self.coupling);
+        let y0 = sys.steady_state(1.0).unwrap();
+        let span = (0.0, self.o.period);
+        let run = crate::runs::simulate::run(&mut sys, &self.method, span, y0, &self.out);
+        run.unwrap().stats
     }
 }
 
@@ -728,26 +684,15 @@ impl CostCase {
 #[test]
 #[ignore]
 fn orbit_time() {
-    use crate::runs::simulate::run;
     for (name, p, lam) in examples() {
-        let case = CostCase::of(p);
-        let CostCase {
-            p,
-            o,
-            ref method,
-            ref out,
-            model,
-            coupling,
-        } = case;
+        let case = Case::of(p);
         let mut best = [f64::INFINITY; 2];
         for _ in 0..7 {
             let start = std::time::Instant::now();
-            let mut sys = Coupled::new(p, o, model, coupling);
-            let y0 = sys.steady_state(1.0).unwrap();
-            run(&mut sys, method, (0.0, o.period), y0, out).unwrap();
+            case.run_two_layer();
             best[0] = best[0].min(start.elapsed().as_secs_f64());
             let start = std::time::Instant::now();
-            case.simulate(Conduction::new(&p, &lam, 20).unwrap());
+            case.simulate(Conduction::new(&case.p, &lam, 20).unwrap());
             best[1] = best[1].min(start.elapsed().as_secs_f64());
         }
         println!(
@@ -775,14 +720,7 @@ fn rhs_cost() {
     };
     for (name, p, lam) in examples() {
         let c = Conduction::new(&p, &lam, 20).unwrap();
-        let sys = Layered::new(
-            &p,
-            c.clone(),
-            HingeModel::Nonlinear,
-            Coupling::ProjectedArea,
-            FAST_MODE_FACTOR,
-        )
-        .unwrap();
+        let sys = nonlinear_system(&p, &c, FAST_MODE_FACTOR);
         let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
         let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 1e-3);
         let mut dy = vec![0.0; y.len()];

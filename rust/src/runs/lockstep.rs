@@ -268,21 +268,31 @@ fn rhs_lanes<V: Lanes>(
     // branch.
     use {Coupling::*, HingeModel::*};
     match (model, coupling) {
-        (Nonlinear, ProjectedArea) => rhs_lanes_of(Nonlinear, ProjectedArea, p, flux, y),
-        (Nonlinear, Frozen) => rhs_lanes_of(Nonlinear, Frozen, p, flux, y),
-        (Linear, ProjectedArea) => rhs_lanes_of(Linear, ProjectedArea, p, flux, y),
-        (Linear, Frozen) => rhs_lanes_of(Linear, Frozen, p, flux, y),
+        (Nonlinear, ProjectedArea) => rhs_lanes_of::<V, true, true>(p, flux, y),
+        (Nonlinear, Frozen) => rhs_lanes_of::<V, true, false>(p, flux, y),
+        (Linear, ProjectedArea) => rhs_lanes_of::<V, false, true>(p, flux, y),
+        (Linear, Frozen) => rhs_lanes_of::<V, false, false>(p, flux, y),
     }
 }
 
+/// [`rhs_lanes`] of the model and coupling fixed by the type: the non-linear hinge when
+/// `NONLINEAR`, the projected area when `PROJECTED`.
 #[inline(always)]
-fn rhs_lanes_of<V: Lanes>(
-    model: HingeModel,
-    coupling: Coupling,
+fn rhs_lanes_of<V: Lanes, const NONLINEAR: bool, const PROJECTED: bool>(
     p: &Pack<V>,
     flux: V,
     y: &[V; 4],
 ) -> [V; 4] {
+    let model = if NONLINEAR {
+        HingeModel::Nonlinear
+    } else {
+        HingeModel::Linear
+    };
+    let coupling = if PROJECTED {
+        Coupling::ProjectedArea
+    } else {
+        Coupling::Frozen
+    };
     let [tf, tb, th, om] = *y;
     let (mut sin, mut cos) = (V::from(0.0), V::from(1.0));
     if !matches!((coupling, model), (Coupling::Frozen, HingeModel::Linear)) {

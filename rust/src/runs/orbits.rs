@@ -807,15 +807,14 @@ pub fn run_orbits_cancellable(req: &OrbitRunRequest, cancel: &Cancel) -> Result<
         panel: req.panel,
         coupling: req.coupling,
     };
+    let span = (req.t_start, req.first_index, req.n_orbits);
     run_summarised(
         &mut system,
         view,
         &req.panel,
         &req.orbit,
         &req.method,
-        req.t_start,
-        req.first_index,
-        req.n_orbits,
+        span,
         req.y0,
         2,
         req.options,
@@ -951,9 +950,10 @@ where
     pub crossing: Option<LimitCrossing>,
 }
 
-/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` (whose
-/// component `theta_index` is θ) and summarises each orbit through `view`; the step is capped
-/// by `panel`'s hinge period as [`SummaryOptions::steps_per_period`] asks.
+/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` at
+/// `t_start` (`span`; `y0`'s component `theta_index` is θ) and summarises each orbit through
+/// `view`; the step is capped by `panel`'s hinge period as
+/// [`SummaryOptions::steps_per_period`] asks.
 #[allow(clippy::too_many_arguments)]
 pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
     system: &mut S,
@@ -961,9 +961,7 @@ pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
     panel: &Panel,
     orbit: &Orbit,
     method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
+    span: (f64, u64, u64),
     y0: State<D>,
     theta_index: usize,
     options: SummaryOptions,
@@ -977,12 +975,12 @@ where
         panel,
         orbit,
         method,
-        (t_start, first_index, n_orbits),
+        span,
         (theta_index, [y0[theta_index], y0[theta_index + 1]]),
         options,
         cancel,
     )?;
-    let outcome = solve(system, &method, t_start, y0, t_end, &mut observer);
+    let outcome = solve(system, &method, span.0, y0, t_end, &mut observer);
     finish_orbits(observer, outcome)
 }
 
@@ -1054,6 +1052,18 @@ mod tests {
     /// Reads every step at 64 evenly spaced points: the fine-sampled reference of the peaks.
     struct Fine<'c>(SummaryObserver<'c, TwoLayerView>);
 
+    /// Integrates `run` into its observer as `wrap` wraps it, and summarises the orbits.
+    fn summarise<'c, O: Observer<nalgebra::U4>>(
+        mut run: PreparedOrbits<'c>,
+        wrap: impl FnOnce(SummaryObserver<'c, TwoLayerView>) -> O,
+        unwrap: impl FnOnce(O) -> SummaryObserver<'c, TwoLayerView>,
+    ) -> OrbitRun {
+        let mut observer = wrap(run.observer);
+        let (system, method) = (&mut run.system, &run.method);
+        let outcome = solve(system, method, run.t0, run.y0, run.t1, &mut observer);
+        finish_orbits(unwrap(observer), outcome).unwrap()
+    }
+
     impl Observer<nalgebra::U4> for Fine<'_> {
         fn on_step(&mut self, step: &DenseStep<nalgebra::U4>) -> ControlFlow<()> {
             let h = (step.t1 - step.t0) / 64.0;
@@ -1108,27 +1118,8 @@ mod tests {
                     options: opts,
                 };
                 let prepare = || prepare_orbits(&req, &cancel).unwrap();
-                let mut run = prepare();
-                let outcome = solve(
-                    &mut run.system,
-                    &run.method,
-                    run.t0,
-                    run.y0,
-                    run.t1,
-                    &mut run.observer,
-                );
-                let got = finish_orbits(run.observer, outcome).unwrap();
-                let mut run = prepare();
-                let mut fine = Fine(run.observer);
-                let outcome = solve(
-                    &mut run.system,
-                    &run.method,
-                    run.t0,
-                    run.y0,
-                    run.t1,
-                    &mut fine,
-                );
-                let want = finish_orbits(fine.0, outcome).unwrap();
+                let got = summarise(prepare(), |o| o, |o| o);
+                let want = summarise(prepare(), Fine, |fine| fine.0);
                 assert_eq!(got.stats, want.stats);
                 for (g, w) in got.summaries.iter().zip(&want.summaries) {
                     let case = format!("c_d {damping}, steps_per_period {steps_per_period}");

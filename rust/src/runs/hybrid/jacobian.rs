@@ -3,7 +3,7 @@
 //! ([`crate::analysis::flutter::jacobian`] is this matrix's value there).
 
 use crate::inputs::panel::Panel;
-use crate::models::coupled::Coupling;
+use crate::models::coupled::{jacobian_from_rows, Coupling};
 use crate::models::hinge::{generalised_moment, HingeModel};
 use crate::models::thermal::STEFAN_BOLTZMANN;
 use nalgebra::{Matrix4, Vector4};
@@ -81,23 +81,10 @@ impl Linearisation {
             }
         };
         let c = self.conduction;
-        Matrix4::new(
-            -c - rad_f,
-            c,
-            d_heating,
-            0.0,
-            c,
-            -c - rad_b,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            1.0,
-            a_tf,
-            a_tb,
-            a_th,
-            a_om,
+        jacobian_from_rows(
+            [-c - rad_f, c, d_heating],
+            [c, -c - rad_b],
+            [a_tf, a_tb, a_th, a_om],
         )
     }
 
@@ -116,6 +103,7 @@ mod tests {
     use super::*;
     use crate::inputs::orbit::Orbit;
     use crate::models::coupled::Coupled;
+    use crate::numerics::testing::assert_jacobian;
 
     /// Away from any equilibrium (swinging, hot, cold) against central differences of the
     /// system's own right-hand side.
@@ -132,24 +120,9 @@ mod tests {
                 let sys = Coupled::new(panel, Orbit::geo_equinox(), model, coupling);
                 let lin = Linearisation::new(&panel, model, coupling);
                 for y in &states {
-                    let jac = lin.jacobian(0.9, y);
-                    for j in 0..4 {
-                        let h = 1e-6 * y[j].abs().max(1e-3);
-                        let (mut yp, mut ym) = (*y, *y);
-                        yp[j] += h;
-                        ym[j] -= h;
-                        let col =
-                            (sys.rhs_at_flux(0.9, &yp) - sys.rhs_at_flux(0.9, &ym)) / (2.0 * h);
-                        for i in 0..4 {
-                            let tol = 1e-6 * jac.column(j).amax().max(1e-9);
-                            assert!(
-                                (col[i] - jac[(i, j)]).abs() < tol,
-                                "{model:?} {coupling:?} {y} ({i},{j}): {} vs {}",
-                                col[i],
-                                jac[(i, j)]
-                            );
-                        }
-                    }
+                    let f = |y: &Vector4<f64>| sys.rhs_at_flux(0.9, y);
+                    let case = format!("{model:?} {coupling:?} {y}");
+                    assert_jacobian(&lin.jacobian(0.9, y), f, y, 1e-9, &case);
                     let dflux =
                         (sys.rhs_at_flux(0.9 + 1e-6, y) - sys.rhs_at_flux(0.9 - 1e-6, y)) / 2e-6;
                     assert!((dflux - lin.flux_sensitivity(y)).amax() < 1e-6 * dflux.amax());

@@ -1,0 +1,31 @@
+//! Checks shared by the tests of several layers.
+
+use nalgebra::{Matrix4, Vector4};
+
+/// Asserts that `jac` is the Jacobian of `f` at `y`: column j against central differences with
+/// the step 1e-6 max(|y_j|, 1e-3), each entry to 1e-6 of the column's largest (at least `floor`).
+/// `case` names the case in a failure.
+pub(crate) fn assert_jacobian(
+    jac: &Matrix4<f64>,
+    f: impl Fn(&Vector4<f64>) -> Vector4<f64>,
+    y: &Vector4<f64>,
+    floor: f64,
+    case: &str,
+) {
+    for j in 0..4 {
+        let h = 1e-6 * y[j].abs().max(1e-3);
+        let (mut yp, mut ym) = (*y, *y);
+        yp[j] += h;
+        ym[j] -= h;
+        let col = (f(&yp) - f(&ym)) / (2.0 * h);
+        let tol = 1e-6 * jac.column(j).amax().max(floor);
+        for i in 0..4 {
+            assert!(
+                (col[i] - jac[(i, j)]).abs() < tol,
+                "{case} ({i},{j}): {} vs {}",
+                col[i],
+                jac[(i, j)]
+            );
+        }
+    }
+}
