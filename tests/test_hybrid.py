@@ -284,3 +284,18 @@ def test_large_oscillation_in_low_orbit_found_by_the_property_test() -> None:
     full = tj.simulate_orbits(panel, orbit, 30, method="rk45", **kw)
     hybrid = tj.simulate_orbits(panel, orbit, 30, method="hybrid", **kw)
     assert_gate(full, hybrid)
+
+
+def test_fast_conducting_cfrp_through_the_penumbra_found_by_the_property_test() -> None:
+    """A case the slow tier drew on eb216eb: a 0.67 mm CFRP plate whose conduction is faster than
+    its soft hinge (2.3 1/s against 1.43 rad/s), on 12 March. The partial shadow was left to the
+    exponential integrator wherever a thermal mode is fast; jitter_peak came out 3.1-3.3 x the
+    gate (3.8e-6 rad against 6.7e-7) on every orbit."""
+    layer = tj.materials.CFRP_M55J_QI.layer(0.000671901218902616)
+    layer = tj.laminate.Layer(**{**layer.as_dict(), "expansion_coeff": 8.004735605342194e-07})
+    layup = tj.Laminate([layer], emissivity_front=0.753204018906269,
+                        emissivity_back=0.8887718022125843,
+                        absorptivity=0.6541413968151348)  # fmt: skip
+    panel = tj.Panel.from_laminate(layup, length=4.720470996730888)
+    full, hybrid = both(tj.Orbit.geo_year("2026-03-12"), 2, panel.replace(damping=0.0993412054))
+    assert_gate(full, hybrid)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import hypothesis.strategies as st
 import numpy as np
-from hypothesis import HealthCheck, Phase, given, note, settings
+from hypothesis import HealthCheck, Phase, given, note, reject, settings
 from test_hybrid import METRICS
 
 import thermojitter as tj
@@ -192,7 +192,13 @@ def compared_orbits(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries, n: int) 
 def test_hybrid_holds_the_gate_of_the_full_run(case: Case) -> None:
     note(case.describe())
     kw = {"orbits_per_call": case.n, "progress": False}
-    full = tj.simulate_orbits(case.panel, case.orbit, case.n, method="rk45", **kw)  # type: ignore[arg-type]
+    try:
+        full = tj.simulate_orbits(case.panel, case.orbit, case.n, method="rk45", **kw)  # type: ignore[arg-type]
+    except tj.ParameterError as e:
+        # A drawn case whose full integration is beyond the run's step budget (a stiff sandwich
+        # on GEO) has nothing to compare with: the refusal names the span.
+        assert e.parameter == "n_orbits" and "max_steps" in str(e), e
+        reject()
     hybrid = tj.simulate_orbits(case.panel, case.orbit, case.n, method="hybrid", **kw)  # type: ignore[arg-type]
     m = compared_orbits(full, hybrid, case.n)
     failures = gate_failures(full, hybrid, m)

@@ -253,6 +253,9 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
         _ => 1.0,
     });
     let modal = y_eq.is_some_and(|y| has_fast_thermal_mode(&model.jacobian(flux0, &y), &scale, wn));
+    let fastest_rate = y_eq.map_or(f64::INFINITY, |y| {
+        fastest_rate(&model.jacobian(flux0, &y), &scale)
+    });
     let mut d = Driver {
         orbit: *orbit,
         settings,
@@ -295,6 +298,7 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             last: Cell::new(None),
             scale,
             modal,
+            fastest_rate,
             drift_spent: Cell::new(Drift::default()),
         },
         eclipses: EclipseTable::until(orbit, t_end),
@@ -372,6 +376,9 @@ struct Judge<const N: usize, M> {
     /// oscillation is then measured on the hinge's own mode, not about M_T/K_el (whose rate
     /// follows the fast thermal transient, which the hinge does not).
     modal: bool,
+    /// |λ| of the Jacobian's fastest mode at the start, 1/s (infinite where unknown): whether a
+    /// fixed-step RK4 run of the model is stable.
+    fastest_rate: f64,
     /// The drift in θ that linear arcs have left in the state.
     drift_spent: Cell<Drift>,
 }
@@ -435,6 +442,10 @@ const REREADS_PER_PERIOD: f64 = 32.0;
 /// the extremes off each step's cubic, not at its ends).
 const RK4_STEPS_PER_PERIOD: f64 = 20.0;
 
+/// Largest |λ| dt of a fixed-step RK4 run of the hinge: well inside RK4's stability bound on the
+/// real axis (2.78), so that a fast thermal mode decays in it as it does in the model.
+const RK4_STABLE_STEP: f64 = 1.0;
+
 /// Samples per hinge period of the linearisation's defect along an arc (the defect's harmonics
 /// up to the third stay apart from the first), and how often the points where it is read
 /// double in distance from the arc's start at most.
@@ -461,6 +472,15 @@ fn has_fast_thermal_mode<const N: usize>(
         .1
         .iter()
         .any(|l| l.im.abs() <= 1e-9 * l.norm() && l.norm() > QUASI_STATIC_RATIO * wn)
+}
+
+/// |λ| of the fastest mode of the Jacobian `a`, 1/s.
+fn fastest_rate<const N: usize>(a: &SMatrix<f64, N, N>, scale: &SVector<f64, N>) -> f64 {
+    linear::balanced_eigenvalues(a, scale)
+        .1
+        .iter()
+        .map(|l| l.norm())
+        .fold(0.0, f64::max)
 }
 
 impl<const N: usize, M: HybridModel<N>> Judge<N, M> {
@@ -897,7 +917,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             // Where no thermal mode is fast, resolving the hinge there costs less than the
             // exponential steps that the moving flux would ask for.
             let lit = self.orbit.illumination(0.5 * (a + b));
-            if !self.judge.modal && lit > 0.0 && lit < 1.0 {
+            if lit > 0.0 && lit < 1.0 {
                 let before = self.t;
                 self.resolved(b, period)?;
                 resolved_time += self.t - before;
@@ -905,7 +925,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
                 done = self.stopped();
                 continue;
             }
-            if !self.judge.modal && self.t < resolve_until {
+            if self.t < resolve_until {
                 // Where the flux stops moving (the partial shadow's last contact) the hinge's
                 // lag behind it is released: its first swings are resolved too.
                 let until = resolve_until.min(b);
@@ -1112,11 +1132,15 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
     }
 
     /// The model from t to `end` by fixed-step RK4 at [`RK4_STEPS_PER_PERIOD`] steps to the hinge
-    /// period, read as the full integration is: on stretches without a fast thermal mode where
-    /// the hinge must be resolved.
+    /// period, read as the full integration is, where the hinge must be resolved; by the full
+    /// integration's adaptive method where a thermal mode is too fast for that step (RK4 is
+    /// stable for |λ| dt below 2.78).
     fn resolved(&mut self, end: f64, period: f64) -> Result<()> {
-        let method = Method::Rk4 {
-            dt: period / RK4_STEPS_PER_PERIOD,
+        let dt = period / RK4_STEPS_PER_PERIOD;
+        let method = if self.judge.fastest_rate * dt <= RK4_STABLE_STEP {
+            Method::Rk4 { dt }
+        } else {
+            self.fallback
         };
         let (stats, y) = solve(
             &mut WithinSegment::new(&mut self.system),
