@@ -53,6 +53,12 @@ __all__ = [
     "conduction_grid",
     "cpu_info",
     "declination",
+    "beta",
+    "nodal_rate",
+    "J2",
+    "OBLIQUITY",
+    "YEAR_DAYS",
+    "DAY",
     "derived",
     "distributed_defaults",
     "distributed_flutter",
@@ -114,6 +120,10 @@ SIDEREAL_DAY: float
 MU_EARTH: float
 EQUINOX_DAY: float
 PERIHELION_DAY: float
+J2: float
+OBLIQUITY: float
+YEAR_DAYS: float
+DAY: float
 GEO_EQUINOX_ORBIT: dict[str, Any]
 CASE_A_PANEL: dict[str, float]
 STEFAN_BOLTZMANN: float
@@ -272,6 +282,8 @@ def umbra_intervals(orbit: dict[str, Any], t0: float, t1: float) -> list[tuple[f
 def orbit_breakpoints(orbit: dict[str, Any], t0: float, t1: float) -> list[float]: ...
 def flux_scale(orbit: dict[str, Any], t: _F) -> _F: ...
 def declination(orbit: dict[str, Any], t: _F) -> _F: ...
+def beta(orbit: dict[str, Any], t: _F) -> _F: ...
+def nodal_rate(orbit: dict[str, Any]) -> float: ...
 def eclipse_duration(orbit: dict[str, Any]) -> float: ...
 def leo_orbit(altitude: float) -> dict[str, Any]: ...
 def synodic_period(orbit: dict[str, Any]) -> float: ...

@@ -1,18 +1,30 @@
 """Orbits: phase, Earth shadow (none, cylindrical, penumbra), illumination, the Sun over the year.
 
-The orbit is circular, in the Earth's equatorial plane, and the plate points at the Sun. The
-phase β is measured from the Sun's meridian: β = 0 at the subsolar point (t = 0 by default) and
-the shadow is centred on β = π.
+The orbit is circular and the plate points at the Sun. At inclination 0 (the presets) the orbit
+is in the Earth's equatorial plane and its phase is measured from the Sun's meridian: 0 at the
+subsolar point (t = 0 by default), the shadow centred on π.
+
+Inclined orbits (:meth:`Orbit.circular`): inclination i, right ascension of the ascending node
+Ω(t) = raan + Ω̇ t with the J2 nodal drift Ω̇ = −(3/2) J2 (R_E/a)² n cos i (``j2=True``; the
+along-track J2 terms are left out, the period stays Keplerian), the satellite at argument of
+latitude u(t) = u₀ + n t, ``phase0`` past the orbit's noon (its point nearest the Sun) at t = 0.
+The Sun is the unit vector of ecliptic longitude λ = 2π (d − 78.5)/365.2422 (declination
+asin(sin ε sin λ), right ascension atan2(cos ε sin λ, cos λ)); β(t), the Sun's angle to the orbit
+plane, is :meth:`Orbit.beta`. Eclipses exist only while |β| < asin(R_E/r) (plus the penumbra's
+width) and shorten as |β| grows. At inclination 0 the presets' path is kept bit for bit: the
+equator has no node (``raan`` and ``j2`` do nothing) and the Sun's right ascension is the mean
+one, λ itself (at most 2.5° off the true one, building up over months from t = 0).
 
 Shadow models (``shadow``):
 
 - ``"none"``: permanent sunlight, s = 1 (for flutter growth measurements).
 - ``"cylindrical"``: the paper's model, a cylinder of radius R_E behind the Earth; s jumps
   between 1 and 0.
-- ``"penumbra"``: the Sun is a disk (angular radius asin(R_sun / distance), about 0.267° at 1 au)
-  partly hidden by the Earth's disk (angular radius asin(R_E / r)); s is the visible fraction of
-  the solar disk, continuous in [0, 1], from the overlap area of the two disks (planar geometry
-  in angles; the atmosphere is ignored). At GEO sunrise and sunset take about two minutes.
+- ``"penumbra"`` (also ``"conical"``, stored as ``"penumbra"``): the Sun is a disk (angular
+  radius asin(R_sun / distance), about 0.267° at 1 au) partly hidden by the Earth's disk
+  (angular radius asin(R_E / r)); s is the visible fraction of the solar disk, continuous in
+  [0, 1], from the overlap area of the two disks (planar geometry in angles; the atmosphere is
+  ignored). At GEO sunrise and sunset take about two minutes.
 
 The year (``season=True``): the Sun's declination is δ = asin(sin 23.44° · sin(2π (d − 78.5) /
 365.2422)), d the day of the year (days since 1 January 00:00 UTC; 78.5 is a mean March
@@ -58,10 +70,18 @@ MIN_LEO_ALTITUDE: float = _core.MIN_LEO_ALTITUDE
 within hours)."""
 MAX_LEO_ALTITUDE: float = _core.MAX_LEO_ALTITUDE
 """Highest altitude of :meth:`Orbit.leo`, m (beyond the Moon)."""
+J2: float = _core.J2
+"""The Earth's second zonal harmonic, for the nodal drift."""
+OBLIQUITY: float = _core.OBLIQUITY
+"""Obliquity of the ecliptic, rad."""
+YEAR_DAYS: float = _core.YEAR_DAYS
+"""Tropical year, days."""
+DAY: float = _core.DAY
+"""Mean solar day, s."""
 
-ShadowModel = Literal["none", "cylindrical", "penumbra"]
-_SHADOWS = ("none", "cylindrical", "penumbra")
-_BOOLS = ("season", "eccentric_sun")
+ShadowModel = Literal["none", "cylindrical", "conical", "penumbra"]
+_SHADOWS = ("none", "cylindrical", "conical", "penumbra")
+_BOOLS = ("season", "eccentric_sun", "j2")
 
 DateLike = str | _dt.date | float | int
 
@@ -72,7 +92,7 @@ def _time(name: str, value: Any) -> float:
     return checks.in_range(name, value, -_core.MAX_TIME, _core.MAX_TIME, "s")
 
 
-def day_of_year(date: DateLike) -> float:
+def day_of_year(date: DateLike, name: str = "start_date") -> float:
     """Days since 1 January 00:00 UTC of the date's year, fractional.
 
     ``date``: an ISO date or date-time string ("2026-03-20", "2026-03-20T14:46"), a
@@ -81,19 +101,19 @@ def day_of_year(date: DateLike) -> float:
     """
     if isinstance(date, bool):
         raise checks.wrong_type(
-            "start_date",
+            name,
             date,
             "a date, an ISO date string or a day of the year",
-            "start_date must be a date, an ISO date string or a day of the year",
+            f"{name} must be a date, an ISO date string or a day of the year",
         )
     if isinstance(date, (int, float, np.integer, np.floating)):
-        return checks.finite("start_date", date)
+        return checks.finite(name, date)
     if isinstance(date, str):
         try:
             parsed: _dt.date = _dt.datetime.fromisoformat(date)
         except ValueError:
             raise checks.ParameterError(
-                "start_date", date, "not an ISO date (YYYY-MM-DD[THH:MM[:SS]])"
+                name, date, "not an ISO date (YYYY-MM-DD[THH:MM[:SS]])"
             ) from None
         date = parsed
     if isinstance(date, _dt.datetime):
@@ -103,17 +123,38 @@ def day_of_year(date: DateLike) -> float:
         return (date - start).total_seconds() / 86400.0
     if isinstance(date, _dt.date):
         return float((date - _dt.date(date.year, 1, 1)).days)
-    raise checks.wrong_type("start_date", date, "a date, an ISO date string or a day of the year")
+    raise checks.wrong_type(name, date, "a date, an ISO date string or a day of the year")
+
+
+def _altitude(altitude: Any) -> float:
+    """An orbit's altitude, m, in [MIN_LEO_ALTITUDE, MAX_LEO_ALTITUDE], saying so when km were
+    probably meant."""
+    height = checks.real("altitude", altitude)
+    if 0.0 < height < MIN_LEO_ALTITUDE:
+        # Below 100 km nothing stays in orbit: the number was almost surely given in km.
+        raise checks.ParameterError(
+            "altitude",
+            altitude,
+            f"must be in [{MIN_LEO_ALTITUDE:g}, {MAX_LEO_ALTITUDE:g}] m; below 100 km nothing "
+            f"orbits: if km were meant, {height:g} km = {height * 1e3:g} m",
+        )
+    if not (MIN_LEO_ALTITUDE <= height <= MAX_LEO_ALTITUDE):
+        raise checks.ParameterError(
+            "altitude", altitude, f"must be in [{MIN_LEO_ALTITUDE:g}, {MAX_LEO_ALTITUDE:g}] m"
+        )
+    return height
 
 
 @dataclass(frozen=True)
 class Orbit:
-    """A circular equatorial orbit, its Earth shadow and the Sun over the year.
+    """A circular orbit, its Earth shadow and the Sun over the year.
 
-    Phase β = 2π t/period + phase0 relative to a fixed Sun (``season=False``), or advancing at
-    2π/period − 2π/year when the Sun moves over the year; β = 0 at the subsolar point, the shadow
-    centred on β = π. Immutable and validated on construction. The defaults are the paper's
-    scenario (GEO at equinox, cylindrical shadow, Sun at 1 au).
+    Equatorial (the presets, inclination 0): phase 2π t/period + phase0 relative to a fixed Sun
+    (``season=False``), or advancing at 2π/period − 2π/year when the Sun moves over the year; 0 at
+    the subsolar point, the shadow centred on π. Inclined: see the module's notes and
+    :meth:`circular`; ``phase0`` is then measured from the orbit's noon. Immutable and
+    validated on construction. The defaults are the paper's scenario (GEO at equinox, cylindrical
+    shadow, Sun at 1 au).
     """
 
     radius: float = _GEO_EQUINOX["radius"]
@@ -125,16 +166,25 @@ class Orbit:
     phase0: float = _GEO_EQUINOX["phase0"]
     """Phase at t = 0, rad."""
     shadow: ShadowModel = _GEO_EQUINOX["shadow"]
-    """Shadow model: "none", "cylindrical" or "penumbra"."""
+    """Shadow model: "none", "cylindrical" or "penumbra" ("conical" is taken as "penumbra")."""
     season: bool = _GEO_EQUINOX["season"]
     """The Sun's declination and right ascension follow the year from ``epoch_day``."""
     eccentric_sun: bool = _GEO_EQUINOX["eccentric_sun"]
     """The flux (∝ 1/r²) and the Sun's size follow the Sun–Earth distance r."""
     epoch_day: float = _GEO_EQUINOX["epoch_day"]
     """Day of the year at t = 0 (days since 1 January 00:00 UTC)."""
+    inclination: float = _GEO_EQUINOX["inclination"]
+    """Inclination of the orbit plane to the equator, rad in [0, π] (0: equatorial)."""
+    raan: float = _GEO_EQUINOX["raan"]
+    """Right ascension of the ascending node at t = 0, rad (no effect at inclination 0)."""
+    j2: bool = _GEO_EQUINOX["j2"]
+    """The node drifts under the Earth's oblateness (no effect at inclination 0)."""
 
     def __post_init__(self) -> None:
         checks.check_fields(self, flags=_BOOLS, choices={"shadow": _SHADOWS})
+        if self.shadow == "conical":
+            # One stored name per model, so that equal orbits compare equal.
+            object.__setattr__(self, "shadow", "penumbra")
         _core.validate_orbit(self.as_dict())
 
     @classmethod
@@ -164,21 +214,38 @@ class Orbit:
     def leo(cls, altitude: float = LEO_ALTITUDE, *, shadow: ShadowModel = "cylindrical") -> Orbit:
         """A Hubble-like circular low orbit at ``altitude`` (m): Keplerian period (about 95 min at
         540 km), the Sun in the orbit plane (the longest eclipses, about 36 min)."""
-        height = checks.real("altitude", altitude)
-        if 0.0 < height < MIN_LEO_ALTITUDE:
-            # Below 100 km nothing stays in orbit: the number was almost surely given in km.
-            raise checks.ParameterError(
-                "altitude",
-                altitude,
-                f"must be in [{MIN_LEO_ALTITUDE:g}, {MAX_LEO_ALTITUDE:g}] m; below 100 km nothing "
-                f"orbits: if km were meant, {height:g} km = {height * 1e3:g} m",
-            )
-        if not (MIN_LEO_ALTITUDE <= height <= MAX_LEO_ALTITUDE):
-            raise checks.ParameterError(
-                "altitude", altitude, f"must be in [{MIN_LEO_ALTITUDE:g}, {MAX_LEO_ALTITUDE:g}] m"
-            )
-        leo = _core.leo_orbit(height)
+        leo = _core.leo_orbit(_altitude(altitude))
         return cls(radius=leo["radius"], period=leo["period"], shadow=shadow)
+
+    @classmethod
+    def circular(
+        cls,
+        altitude: float,
+        inclination: float = 0.0,
+        raan: float = 0.0,
+        epoch: DateLike = EQUINOX_DAY,
+        *,
+        j2: bool = True,
+        shadow: ShadowModel = "conical",
+    ) -> Orbit:
+        """Any circular Earth orbit: ``altitude`` (m), ``inclination`` and ``raan`` (rad; the node
+        at ``epoch``), the Sun by date from ``epoch`` (as ``geo_year``'s ``start_date``; default
+        the March equinox) with its distance, the node's J2 drift (``j2``), and ``shadow``
+        ("conical" with penumbra, "cylindrical" or "none"). t = 0 at the orbit's noon (its
+        point nearest the Sun). Keplerian period. At inclination 0 this is the presets'
+        equatorial orbit, where ``raan`` and ``j2`` do nothing."""
+        leo = _core.leo_orbit(_altitude(altitude))
+        return cls(
+            radius=leo["radius"],
+            period=leo["period"],
+            shadow=shadow,
+            season=True,
+            eccentric_sun=True,
+            epoch_day=day_of_year(epoch, "epoch"),
+            inclination=inclination,
+            raan=raan,
+            j2=j2,
+        )
 
     @classmethod
     def sunlit(cls) -> Orbit:
@@ -246,6 +313,16 @@ class Orbit:
         """Solar flux at time t relative to the solar constant at 1 au: 1/r², r in au (1 unless
         ``eccentric_sun``). Pass it to :func:`thermojitter.flutter` as ``flux``."""
         return np.asarray(_core.flux_scale(self.as_dict(), checks.real_array("t", t)))
+
+    def beta(self, t: ArrayLike) -> NDArray[np.float64]:
+        """The Sun's angle to the orbit plane at time t, rad in [−π/2, π/2], positive on the
+        side of the orbit normal (for an equatorial orbit, the declination)."""
+        return np.asarray(_core.beta(self.as_dict(), checks.real_array("t", t)))
+
+    @property
+    def nodal_rate(self) -> float:
+        """Rate of the ascending node, rad/s: −(3/2) J2 (R_E/a)² n cos i with ``j2``, else 0."""
+        return float(_core.nodal_rate(self.as_dict()))
 
     def declination(self, t: ArrayLike) -> NDArray[np.float64]:
         """The Sun's declination at time t, rad (0 unless ``season``)."""

@@ -67,6 +67,86 @@ def illumination(orbit: Any, t: float) -> float:
     return 0.0 if abs(beta - math.pi) < _shadow_half_angle(orbit) else 1.0
 
 
+# --------------------------------------------------------------------------- inclined orbits
+#
+# The geometry of a circular orbit of any inclination, written as rotations of vectors (the engine
+# works with the orbit's basis vectors and angles). Constants come from the engine, once.
+
+
+def _rot_x(angle: float) -> FloatArray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _rot_z(angle: float) -> FloatArray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def sun_vector(orbit: Any, t: ArrayLike) -> FloatArray:
+    """Unit vectors to the Sun in the equatorial frame, shape (len(t), 3): the ecliptic direction
+    of longitude λ (from the March equinox, uniform over the year) turned by the obliquity."""
+    from thermojitter.orbit import DAY, EQUINOX_DAY, OBLIQUITY, YEAR_DAYS
+
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    if getattr(orbit, "season", False):
+        lon = 2.0 * np.pi * (orbit.epoch_day + t / DAY - EQUINOX_DAY) / YEAR_DAYS
+    else:
+        lon = np.zeros_like(t)
+    ecliptic = np.stack([np.cos(lon), np.sin(lon), np.zeros_like(lon)], axis=1)
+    return np.asarray(ecliptic @ _rot_x(OBLIQUITY).T)
+
+
+def node_rate(orbit: Any) -> float:
+    """J2 drift of the ascending node, rad/s (0 without ``j2``)."""
+    from thermojitter.orbit import EARTH_RADIUS, J2
+
+    if not getattr(orbit, "j2", False):
+        return 0.0
+    n = 2.0 * math.pi / orbit.period
+    return -1.5 * J2 * (EARTH_RADIUS / orbit.radius) ** 2 * n * math.cos(orbit.inclination)
+
+
+def _plane(orbit: Any, t: float) -> FloatArray:
+    """Rotation from the orbit frame (x: ascending node, z: orbit normal) to the equatorial."""
+    node = orbit.raan + node_rate(orbit) * t
+    return np.asarray(_rot_z(node) @ _rot_x(orbit.inclination))
+
+
+def orbit_normals(orbit: Any, t: ArrayLike) -> FloatArray:
+    """Unit normals of the orbit plane, shape (len(t), 3)."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    return np.array([_plane(orbit, x)[:, 2] for x in t])
+
+
+def beta(orbit: Any, t: ArrayLike) -> FloatArray:
+    """The Sun's angle to the orbit plane, rad (positive on the side of the normal)."""
+    dots = np.einsum("ij,ij->i", sun_vector(orbit, t), orbit_normals(orbit, t))
+    return np.asarray(np.arcsin(np.clip(dots, -1.0, 1.0)))
+
+
+def satellite_vector(orbit: Any, t: ArrayLike) -> FloatArray:
+    """Unit vectors to the satellite, shape (len(t), 3): argument of latitude u0 + n t, u0 putting
+    it ``phase0`` past the orbit's point nearest the Sun (the Sun seen in the orbit frame) at 0."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    in_orbit = _plane(orbit, 0.0).T @ sun_vector(orbit, 0.0)[0]
+    u0 = math.atan2(in_orbit[1], in_orbit[0]) + orbit.phase0
+    u = u0 + 2.0 * np.pi * t / orbit.period
+    return np.array(
+        [_plane(orbit, x) @ [math.cos(a), math.sin(a), 0.0] for x, a in zip(t, u, strict=True)]
+    )
+
+
+def cylinder_sunlit(orbit: Any, t: ArrayLike) -> NDArray[np.bool_]:
+    """Outside the cylindrical shadow: on the Sun's side of the Earth, or farther from the shadow's
+    axis than the Earth's radius."""
+    sat = orbit.radius * satellite_vector(orbit, t)
+    sun = sun_vector(orbit, t)
+    along = np.einsum("ij,ij->i", sat, sun)
+    off_axis = np.linalg.norm(sat - along[:, None] * sun, axis=1)
+    return np.asarray((along > 0.0) | (off_axis >= orbit.earth_radius))
+
+
 # --------------------------------------------------------------------------- model equations
 
 

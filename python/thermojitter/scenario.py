@@ -381,7 +381,7 @@ def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
             continue
         if key == "shadow":
             values[key] = _choice(path, "orbit.shadow", value, SHADOWS)
-        elif key in ("season", "eccentric_sun"):
+        elif key in ("season", "eccentric_sun", "j2"):
             values[key] = _boolean(path, f"orbit.{key}", value)
         else:
             values[key] = _real(path, f"orbit.{key}", value)

@@ -94,8 +94,8 @@ pub(super) fn required_item<'py, T: FromPyObjectOwned<'py>>(
 }
 
 /// An orbit from a mapping: radius, earth_radius, period and phase0 are required; shadow
-/// ('none' | 'cylindrical' | 'penumbra'), season, eccentric_sun and epoch_day are optional and
-/// default to the paper's equinox.
+/// ('none' | 'cylindrical' | 'conical' | 'penumbra'), season, eccentric_sun, epoch_day,
+/// inclination, raan and j2 are optional and default to the paper's equinox.
 pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
     let base = Orbit::geo_equinox();
     let shadow = match optional_item::<String>(d, "shadow", "a string")? {
@@ -114,6 +114,15 @@ pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
             Some(_) => float_item(d, "epoch_day")?,
             None => base.epoch_day,
         },
+        inclination: match d.get_item("inclination")? {
+            Some(_) => float_item(d, "inclination")?,
+            None => base.inclination,
+        },
+        raan: match d.get_item("raan")? {
+            Some(_) => float_item(d, "raan")?,
+            None => base.raan,
+        },
+        j2: optional_item(d, "j2", "a bool")?.unwrap_or(base.j2),
     };
     o.validate()?;
     Ok(o)

@@ -99,6 +99,16 @@ at_times!(
     /// The Sun's declination at each time, rad.
     declination => Orbit::declination
 );
+at_times!(
+    /// The Sun's angle to the orbit plane at each time, rad.
+    beta => Orbit::beta
+);
+
+/// Rate of the ascending node, rad/s (0 without j2).
+#[pyfunction]
+fn nodal_rate(orbit: &Bound<'_, PyDict>) -> PyResult<f64> {
+    shield(|| Ok(orbit_from(orbit)?.nodal_rate()))
+}
 
 /// Orbit period relative to the Sun (time between eclipses), s.
 #[pyfunction]
@@ -123,6 +133,9 @@ fn orbit_dict<'py>(py: Python<'py>, o: &Orbit) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("season", o.season)?;
     d.set_item("eccentric_sun", o.eccentric_sun)?;
     d.set_item("epoch_day", o.epoch_day)?;
+    d.set_item("inclination", o.inclination)?;
+    d.set_item("raan", o.raan)?;
+    d.set_item("j2", o.j2)?;
     Ok(d)
 }
 
@@ -137,8 +150,8 @@ fn leo_orbit(py: Python<'_>, altitude: f64) -> PyResult<Bound<'_, PyDict>> {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     use crate::inputs::orbit::{
-        EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, LEO_ALTITUDE, MAX_LEO_ALTITUDE, MIN_LEO_ALTITUDE,
-        MU_EARTH, PERIHELION_DAY, SIDEREAL_DAY,
+        DAY, EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, J2, LEO_ALTITUDE, MAX_LEO_ALTITUDE,
+        MIN_LEO_ALTITUDE, MU_EARTH, OBLIQUITY, PERIHELION_DAY, SIDEREAL_DAY, YEAR_DAYS,
     };
     m.add("GEO_RADIUS", GEO_RADIUS)?;
     m.add("LEO_ALTITUDE", LEO_ALTITUDE)?;
@@ -149,6 +162,10 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MU_EARTH", MU_EARTH)?;
     m.add("EQUINOX_DAY", EQUINOX_DAY)?;
     m.add("PERIHELION_DAY", PERIHELION_DAY)?;
+    m.add("J2", J2)?;
+    m.add("OBLIQUITY", OBLIQUITY)?;
+    m.add("YEAR_DAYS", YEAR_DAYS)?;
+    m.add("DAY", DAY)?;
     m.add(
         "GEO_EQUINOX_ORBIT",
         orbit_dict(m.py(), &Orbit::geo_equinox())?,
@@ -162,6 +179,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(orbit_breakpoints, m)?)?;
     m.add_function(wrap_pyfunction!(flux_scale, m)?)?;
     m.add_function(wrap_pyfunction!(declination, m)?)?;
+    m.add_function(wrap_pyfunction!(beta, m)?)?;
+    m.add_function(wrap_pyfunction!(nodal_rate, m)?)?;
     m.add_function(wrap_pyfunction!(synodic_period, m)?)?;
     Ok(())
 }

@@ -2,9 +2,20 @@
 //! boundary times and the solar flux over the year.
 //!
 //! The plate is Sun-pointing, so only the illuminated fraction of the Sun and the Sun's distance
-//! change along the orbit. The orbit is circular and lies in the Earth's equatorial plane. Its
-//! phase β is measured from the Sun's meridian: β = ω t + β₀ with β = 0 at the subsolar point and
-//! the shadow centred on β = π.
+//! change along the orbit. The orbit is circular. At inclination 0 (the presets) it lies in the
+//! Earth's equatorial plane and its phase is measured from the Sun's meridian: ω t + φ₀, 0 at the
+//! subsolar point and the shadow centred on π.
+//!
+//! Inclined orbits ([`Orbit::inclination`] > 0): the plane has inclination i and right ascension
+//! of the ascending node Ω(t) = Ω₀ + Ω̇ t, with the nodal drift of the Earth's oblateness
+//! Ω̇ = −(3/2) J2 (R_E/a)² n cos i when [`Orbit::j2`] is on (the along-track J2 terms, of the same
+//! order, are left out: the period stays Keplerian). The satellite is at argument of latitude
+//! u(t) = u₀ + n t, u₀ putting it `phase0` past the orbit's noon (its point nearest the Sun) at
+//! t = 0. The Sun is the unit vector of ecliptic longitude λ = 2π (d − d_eq)/Y, i.e. declination
+//! asin(sin ε sin λ) and right ascension atan2(cos ε sin λ, cos λ). The equatorial path keeps the
+//! presets' mean right ascension (λ itself), bit for bit; the two differ by at most ε²/4 ≈ 2.5°
+//! (the obliquity term of the equation of time), which builds up over months from t = 0.
+//! At inclination 0 the equator has no node and J2 does not turn it: `raan` and `j2` do nothing.
 //!
 //! Three shadow models ([`Shadow`]): none (permanent sunlight), a cylindrical shadow of radius R_E
 //! (s jumps between 1 and 0; the paper's model), and a penumbra: the Sun is a disk of angular
@@ -69,6 +80,8 @@ pub const MIN_LEO_ALTITUDE: f64 = 100e3;
 pub const MAX_LEO_ALTITUDE: f64 = 1e9;
 /// Mean day of perihelion, days since 1 January 00:00 UTC (about 4 January, 00:00).
 pub const PERIHELION_DAY: f64 = 3.0;
+/// The Earth's second zonal harmonic (oblateness), for the nodal drift.
+pub const J2: f64 = 1.082_63e-3;
 
 /// How the Earth hides the Sun.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,11 +99,12 @@ impl Shadow {
         match name {
             "none" => Ok(Shadow::None),
             "cylindrical" => Ok(Shadow::Cylindrical),
-            "penumbra" => Ok(Shadow::Penumbra),
+            // "conical": the usual name of a shadow cone with its penumbra.
+            "penumbra" | "conical" => Ok(Shadow::Penumbra),
             other => Err(Error::invalid(
                 "shadow",
                 format!("{other:?}"),
-                "must be 'none', 'cylindrical' or 'penumbra'",
+                "must be 'none', 'cylindrical', 'conical' or 'penumbra'",
             )),
         }
     }
@@ -115,7 +129,7 @@ pub struct Eclipse {
     pub umbra: Option<(f64, f64)>,
 }
 
-/// A circular equatorial orbit around the Earth, its shadow and the Sun over the year.
+/// A circular orbit around the Earth, its shadow and the Sun over the year.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Orbit {
     /// Orbit radius, m.
@@ -135,6 +149,12 @@ pub struct Orbit {
     pub eccentric_sun: bool,
     /// Day of the year at t = 0 (days since 1 January 00:00 UTC, fractional).
     pub epoch_day: f64,
+    /// Inclination of the orbit plane to the equator, rad in [0, π] (0: equatorial).
+    pub inclination: f64,
+    /// Right ascension of the ascending node at t = 0, rad (no effect at inclination 0).
+    pub raan: f64,
+    /// The node drifts under J2 (no effect at inclination 0).
+    pub j2: bool,
 }
 
 impl Orbit {
@@ -149,6 +169,9 @@ impl Orbit {
             season: false,
             eccentric_sun: false,
             epoch_day: EQUINOX_DAY,
+            inclination: 0.0,
+            raan: 0.0,
+            j2: false,
         }
     }
 
@@ -181,6 +204,32 @@ impl Orbit {
         require_positive("period", self.period)?;
         require_finite("phase0", self.phase0)?;
         require_finite("epoch_day", self.epoch_day)?;
+        require_finite("inclination", self.inclination)?;
+        require_finite("raan", self.raan)?;
+        if !(0.0..=PI).contains(&self.inclination) {
+            let hint = if self.inclination > PI && self.inclination <= 180.0 {
+                // 28.5 or 98 rad make no sense as an inclination, as degrees they do.
+                format!(
+                    "; if degrees were meant, {}° = {} rad",
+                    self.inclination,
+                    self.inclination.to_radians()
+                )
+            } else {
+                String::new()
+            };
+            return Err(Error::invalid(
+                "inclination",
+                self.inclination,
+                &format!("must be in [0, π] rad{hint}"),
+            ));
+        }
+        if self.raan.abs() > MAX_PHASE0 {
+            return Err(Error::invalid(
+                "raan",
+                self.raan,
+                &format!("must be in [-{MAX_PHASE0}, {MAX_PHASE0}] rad (reduce it modulo 2π)"),
+            ));
+        }
         if self.period < MIN_PERIOD {
             return Err(Error::invalid(
                 "period",
@@ -318,9 +367,78 @@ impl Orbit {
         2.0 * PI / self.rate()
     }
 
+    /// Whether the orbit is the presets' equatorial one (their code path, kept to the bit).
+    fn equatorial(&self) -> bool {
+        self.inclination == 0.0
+    }
+
+    /// Rate of the ascending node, rad/s: −(3/2) J2 (R_E/a)² n cos i with `j2`, else 0.
+    pub fn nodal_rate(&self) -> f64 {
+        if !self.j2 {
+            return 0.0;
+        }
+        let n = 2.0 * PI / self.period;
+        -1.5 * J2 * (EARTH_RADIUS / self.radius).powi(2) * n * self.inclination.cos()
+    }
+
+    /// Unit vector to the Sun in the equatorial frame (x: March equinox, z: north pole) at time t;
+    /// without `season` the Sun stays at the March equinox.
+    pub fn sun_direction(&self, t: f64) -> [f64; 3] {
+        if !self.season {
+            return [1.0, 0.0, 0.0];
+        }
+        let lon = 2.0 * PI * (self.day_of_year(t) - EQUINOX_DAY) / YEAR_DAYS;
+        let (sl, cl) = lon.sin_cos();
+        let (se, ce) = OBLIQUITY.sin_cos();
+        [cl, ce * sl, se * sl]
+    }
+
+    /// The orbit plane at time t: the node direction P, the direction Q a quarter orbit on, and
+    /// the normal h (u = 0 at P, u = π/2 at Q).
+    fn plane(&self, t: f64) -> [[f64; 3]; 3] {
+        let node = self.raan + self.nodal_rate() * t;
+        let (so, co) = node.sin_cos();
+        let (si, ci) = self.inclination.sin_cos();
+        [
+            [co, so, 0.0],
+            [-ci * so, ci * co, si],
+            [si * so, -si * co, ci],
+        ]
+    }
+
+    /// Argument of latitude of the orbit's noon (its point nearest the Sun) at time t, rad.
+    fn noon(&self, t: f64) -> f64 {
+        let s = self.sun_direction(t);
+        let [p, q, _] = self.plane(t);
+        dot(s, q).atan2(dot(s, p))
+    }
+
+    /// Argument of latitude of the satellite, u(t) = u₀ + n t, rad.
+    fn latitude_argument(&self, t: f64) -> f64 {
+        self.noon(0.0) + self.phase0 + 2.0 * PI / self.period * t
+    }
+
+    /// The Sun's angle to the orbit plane at time t, rad in [−π/2, π/2], positive on the side of
+    /// the orbit normal (north of the equator for an equatorial orbit: the declination).
+    pub fn beta(&self, t: f64) -> f64 {
+        if self.equatorial() {
+            return self.declination(t);
+        }
+        let h = self.plane(t)[2];
+        dot(self.sun_direction(t), h).clamp(-1.0, 1.0).asin()
+    }
+
     /// Angle between the satellite's direction and the anti-Sun direction, both from the
     /// Earth's centre, rad in [0, π].
     fn anti_sun_angle(&self, t: f64) -> f64 {
+        if !self.equatorial() {
+            let [p, q, _] = self.plane(t);
+            let (su, cu) = self.latitude_argument(t).sin_cos();
+            let sat = [0, 1, 2].map(|k| cu * p[k] + su * q[k]);
+            let s = self.sun_direction(t);
+            // atan2 of |sat × S| and −sat·S: accurate at both ends, unlike acos.
+            return norm(cross(sat, s)).atan2(-dot(sat, s));
+        }
         if !self.season {
             let beta = 2.0 * PI * t / self.period + self.phase0;
             let from_anti_sun = (beta - PI).rem_euclid(2.0 * PI);
@@ -399,28 +517,68 @@ impl Orbit {
         }
     }
 
+    /// Time of the inclined orbit's midnight (u − noon = π, where the eclipse is deepest)
+    /// nearest `guess`, s. The noon moves slowly against the satellite, so each correction by
+    /// the phase left to go gains about two digits.
+    fn midnight_near(&self, guess: f64) -> f64 {
+        let mut t = guess;
+        for _ in 0..4 {
+            let phase = self.latitude_argument(t) - self.noon(t) - PI;
+            let off = phase - 2.0 * PI * (phase / (2.0 * PI)).round();
+            t -= off / self.rate();
+        }
+        t
+    }
+
+    /// The inclined orbit's midnight after the one at c, s. Where the noon swings fast (|β| near
+    /// 90°, no eclipse possible) the search may land on the same midnight or skip one: then
+    /// one synodic period on is used.
+    fn next_midnight(&self, c: f64) -> f64 {
+        let synodic = self.synodic_period();
+        let m = self.midnight_near(c + synodic);
+        if m > c + 0.5 * synodic && m < c + 1.5 * synodic {
+            m
+        } else {
+            c + synodic
+        }
+    }
+
     /// Every eclipse overlapping [t0, t1], unclipped, in time order.
     pub fn eclipses(&self, t0: f64, t1: f64) -> Vec<Eclipse> {
         match self.shadow {
             Shadow::None => Vec::new(),
-            Shadow::Cylindrical if !self.season => self.equinox_cylinder_eclipses(t0, t1),
+            Shadow::Cylindrical if !self.season && self.equatorial() => {
+                self.equinox_cylinder_eclipses(t0, t1)
+            }
             _ => self.searched_eclipses(t0, t1, true),
         }
     }
 
     /// Whether the passage behind the Earth within `quarter` of c can hold an eclipse. The
-    /// satellite, in the equatorial plane, is at least |δ| from the anti-Sun direction, and the
+    /// satellite, in the orbit plane, is at least |β| from the anti-Sun direction, and the
     /// separation of the Sun's and the Earth's centres seen from it grows with that angle and with
     /// the Sun's distance; the Sun's angular radius is largest at the least distance. Out of the
     /// eclipse seasons this rules a passage out without a search.
     fn may_eclipse(&self, c: f64, quarter: f64) -> bool {
-        // |δ| is monotonic over half a day except at a solstice, far from any eclipse; the
-        // margin covers its curvature (1e-6 rad) many times over.
-        let least = [c - quarter, c, c + quarter]
-            .iter()
-            .map(|&t| self.declination(t).abs())
-            .fold(f64::INFINITY, f64::min)
-            - 1e-4;
+        let least = if self.equatorial() {
+            // β = δ. |δ| is monotonic over half a day except at a solstice, far from any
+            // eclipse; the margin covers its curvature (1e-6 rad) many times over.
+            [c - quarter, c, c + quarter]
+                .iter()
+                .map(|&t| self.declination(t).abs())
+                .fold(f64::INFINITY, f64::min)
+                - 1e-4
+        } else {
+            // β changes no faster than the Sun moves (2π/Y) plus the normal turns (|Ω̇| sin i):
+            // the bound over the whole window, with room for rounding.
+            let sun = if self.season {
+                2.0 * PI / (YEAR_DAYS * DAY)
+            } else {
+                0.0
+            };
+            let turn = self.nodal_rate().abs() * self.inclination.sin();
+            self.beta(c).abs() - (sun + turn) * quarter - 1e-6
+        };
         if least <= 0.0 {
             return true;
         }
@@ -478,11 +636,22 @@ impl Orbit {
             let (sep, rho_s) = self.sky(t);
             sep - rho_e + rho_s
         };
+        // Passage centres: closed form on the equator, found one from the last when inclined.
         let mut k = ((t0 * self.rate() + self.phase0 - PI) / (2.0 * PI)).floor() - 1.0;
+        let mut next = if self.equatorial() {
+            self.shadow_centre(k)
+        } else {
+            self.midnight_near(t0 - 4.0 * quarter)
+        };
         let mut out = Vec::new();
         loop {
-            let c = self.shadow_centre(k);
-            k += 1.0;
+            let c = next;
+            if self.equatorial() {
+                k += 1.0;
+                next = self.shadow_centre(k);
+            } else {
+                next = self.next_midnight(c);
+            }
             if c - quarter >= t1 {
                 break;
             }
@@ -605,6 +774,22 @@ impl EclipseTable {
         let last = self.list.partition_point(|e| e.outer.0 < t1);
         &self.list[first..last.max(first)]
     }
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
 }
 
 /// Visible fraction of a disk of angular radius `rho_s` whose centre is `sep` away from the
@@ -827,6 +1012,117 @@ mod tests {
         let o = Orbit::leo(LEO_ALTITUDE);
         assert!((o.period / 60.0 - 95.4).abs() < 0.3, "{}", o.period / 60.0);
         assert_eq!(o.shadow_intervals(0.0, o.period).len(), 1);
+    }
+
+    /// A 540 km orbit at inclination i, node Ω₀, from the March equinox with the Sun moving.
+    fn inclined(inclination: f64, raan: f64, shadow: Shadow, j2: bool) -> Orbit {
+        Orbit {
+            inclination,
+            raan,
+            j2,
+            shadow,
+            season: true,
+            eccentric_sun: true,
+            ..Orbit::leo(LEO_ALTITUDE)
+        }
+    }
+
+    #[test]
+    fn hubble_node_drifts_six_and_a_half_degrees_a_day() {
+        let o = inclined(28.5_f64.to_radians(), 0.0, Shadow::Cylindrical, true);
+        let per_day = o.nodal_rate() * DAY;
+        assert!((per_day.to_degrees() + 6.59).abs() < 0.005, "{per_day}");
+        assert_eq!(Orbit { j2: false, ..o }.nodal_rate(), 0.0);
+    }
+
+    #[test]
+    fn inclined_cylinder_eclipse_follows_beta() {
+        // Sun and plane fixed: the Sun at the equinox direction and Ω = π/2 put β = i; the
+        // shadow's half arc then has cos = sqrt(1 − (R/r)²)/cos β.
+        for deg in [0.5, 20.0, 50.0, 65.0] {
+            let i = f64::to_radians(deg);
+            let o = Orbit {
+                season: false,
+                eccentric_sun: false,
+                ..inclined(i, 0.5 * PI, Shadow::Cylindrical, false)
+            };
+            assert!((o.beta(1e4) - i).abs() < 1e-12);
+            let k = o.earth_radius / o.radius;
+            let half = ((1.0 - k * k).sqrt() / i.cos()).acos();
+            let want = 2.0 * half * o.period / (2.0 * PI);
+            let e = o.eclipses(0.0, 3.0 * o.period);
+            assert_eq!(e.len(), 3, "{deg}");
+            for x in e {
+                assert!((x.outer.1 - x.outer.0 - want).abs() < 1e-5, "{deg}: {x:?}");
+            }
+        }
+        let beyond = Orbit {
+            season: false,
+            ..inclined(1.2, 0.5 * PI, Shadow::Penumbra, false)
+        };
+        assert!(beyond.eclipses(0.0, 10.0 * beyond.period).is_empty());
+    }
+
+    #[test]
+    fn inclined_passages_ruled_out_hold_no_eclipse() {
+        // Through eclipse seasons that open and close with β (the node turns 6.6° a day), and a
+        // year of an inclined GEO, with and without the test before the search.
+        // At 80° from Ω = 90° β starts at 80° (no eclipse beyond 67° at 540 km) and falls.
+        let leo = inclined(80_f64.to_radians(), 0.5 * PI, Shadow::Penumbra, true);
+        let geo = Orbit {
+            inclination: 0.3,
+            raan: 2.0,
+            j2: true,
+            ..Orbit::geo_year(0.0)
+        };
+        for (o, span, least_out) in [(leo, 40.0 * DAY, 20), (geo, YEAR_DAYS * DAY, 40)] {
+            let searched = o.searched_eclipses(0.0, span, false);
+            assert_eq!(o.searched_eclipses(0.0, span, true), searched);
+            let passages = (span / o.synodic_period()) as usize;
+            assert!(searched.len() + least_out < passages, "{}", searched.len());
+            assert!(searched.len() > least_out, "{}", searched.len());
+        }
+    }
+
+    #[test]
+    fn an_inclined_orbit_near_the_equator_is_near_the_equatorial_one() {
+        // Same start at noon; only the Sun's right ascension tells them apart: at the equinox
+        // the true one moves cos ε times the mean rate, 0.08° a day less, 20 s a day at GEO.
+        let flat = Orbit::geo_year(EQUINOX_DAY - 2.0);
+        let tilted = Orbit {
+            inclination: 1e-9,
+            ..flat
+        };
+        let (a, b) = (
+            flat.eclipses(0.0, 3.0 * DAY),
+            tilted.eclipses(0.0, 3.0 * DAY),
+        );
+        assert_eq!(a.len(), 3);
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x.outer.0 - y.outer.0).abs() < 70.0, "{x:?} {y:?}");
+            assert!(((x.outer.1 - x.outer.0) - (y.outer.1 - y.outer.0)).abs() < 1.0);
+        }
+        assert!((flat.beta(5e4) - tilted.beta(5e4)).abs() < 1e-8);
+    }
+
+    #[test]
+    fn an_inclination_in_degrees_is_named() {
+        let o = Orbit {
+            inclination: 28.5,
+            ..Orbit::leo(LEO_ALTITUDE)
+        };
+        let msg = o.validate().unwrap_err().to_string();
+        assert!(
+            msg.starts_with("inclination") && msg.contains("degrees"),
+            "{msg}"
+        );
+        let o = Orbit {
+            raan: f64::NAN,
+            ..Orbit::leo(LEO_ALTITUDE)
+        };
+        assert!(o.validate().unwrap_err().to_string().starts_with("raan"));
+        assert_eq!(Shadow::from_name("conical").unwrap(), Shadow::Penumbra);
     }
 
     #[test]
