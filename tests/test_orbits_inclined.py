@@ -4,6 +4,8 @@ against closed forms and the pure-Python reference; inclination 0 keeps the pres
 from __future__ import annotations
 
 import math
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ from hypothesis import strategies as st
 
 import thermojitter as tj
 from thermojitter import reference as ref
+from thermojitter.checkpoint import CheckpointError
 from thermojitter.errors import ParameterError
 from thermojitter.orbit import (
     DAY,
@@ -60,8 +63,10 @@ def test_geo_equinox_longest_eclipse_is_69_4_minutes() -> None:
         longest = orbit.eclipse_durations(0.0, 7.0 * DAY).max()
         # With the Sun moving the shadow is crossed at n − 2π/year, 0.27 % slower (11 s); the
         # eclipse nearest the equinox has |β| < 0.3°: ~1 s shorter than at β = 0.
-        moving = 2.0 * math.asin(EARTH_RADIUS / GEO_RADIUS) / (
-            mean_motion(GEO_RADIUS) - 2.0 * math.pi / YEAR
+        moving = (
+            2.0
+            * math.asin(EARTH_RADIUS / GEO_RADIUS)
+            / (mean_motion(GEO_RADIUS) - 2.0 * math.pi / YEAR)
         )
         assert abs(longest - moving) < 3.0, (inclination, longest, moving)
         fixed = frozen(orbit).eclipse_durations(0.0, 3.0 * DAY)
@@ -208,3 +213,28 @@ def test_bad_orbits_are_named() -> None:
         tj.Orbit.circular(540e3, epoch="March")
     assert tj.Orbit.circular(540e3).shadow == "penumbra"
     assert tj.Orbit(shadow="conical") == tj.Orbit(shadow="penumbra")
+
+
+PRE_INCLINATION_ORBIT_KEYS = {
+    "radius", "earth_radius", "period", "phase0", "shadow", "season", "eccentric_sun", "epoch_day"
+}  # fmt: skip
+"""The orbit fields a checkpoint recorded before inclined orbits existed."""
+
+
+def test_checkpoints_of_equatorial_orbits_keep_their_identity(tmp_path: Path) -> None:
+    """A checkpoint's request records the orbit plane only where it is set: a long run of an
+    equatorial orbit written before inclined orbits existed still resumes (its request is the
+    same), and an inclined orbit's checkpoint names its plane."""
+    import json
+
+    kw: dict[str, Any] = {"progress": False, "orbits_per_call": 1}
+    flat = tmp_path / "flat.json"
+    tj.simulate_orbits(tj.Panel.paper(), tj.Orbit.leo(), 1, checkpoint=flat, **kw)
+    assert set(json.loads(flat.read_text())["request"]["orbit"]) == PRE_INCLINATION_ORBIT_KEYS
+    tilted = tmp_path / "tilted.json"
+    orbit = tj.Orbit.circular(540e3, math.radians(28.5), shadow="cylindrical")
+    tj.simulate_orbits(tj.Panel.paper(), orbit, 1, checkpoint=tilted, **kw)
+    recorded = json.loads(tilted.read_text())["request"]["orbit"]
+    assert recorded["inclination"] == orbit.inclination and recorded["j2"] is True
+    with pytest.raises(CheckpointError):
+        tj.simulate_orbits(tj.Panel.paper(), orbit.replace(raan=0.5), 1, checkpoint=tilted, **kw)

@@ -352,7 +352,7 @@ def simulate_orbits(
         )
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
-        "orbit": orbit.as_dict(),
+        "orbit": orbit.as_record(),
         "t_start": t_start,
         "model": model,
         "coupled": coupled,

@@ -82,6 +82,9 @@ DAY: float = _core.DAY
 ShadowModel = Literal["none", "cylindrical", "conical", "penumbra"]
 _SHADOWS = ("none", "cylindrical", "conical", "penumbra")
 _BOOLS = ("season", "eccentric_sun", "j2")
+_EQUATORIAL: dict[str, Any] = {k: _GEO_EQUINOX[k] for k in ("inclination", "raan", "j2")}
+"""The orbit plane's fields at their defaults: an equatorial orbit's, as before they existed."""
+_UNSET = object()
 
 DateLike = str | _dt.date | float | int
 
@@ -258,6 +261,12 @@ class Orbit:
 
     def as_dict(self) -> dict[str, Any]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def as_record(self) -> dict[str, Any]:
+        """The orbit as run settings and checkpoints record it: :meth:`as_dict` without the
+        orbit plane's fields where they hold their equatorial defaults, so that a checkpoint
+        written before inclined orbits existed still answers the same run."""
+        return {k: v for k, v in self.as_dict().items() if _EQUATORIAL.get(k, _UNSET) != v}
 
     @property
     def eclipse_duration(self) -> float:

@@ -75,7 +75,7 @@ ORBIT_PRESETS = {
     "leo": Orbit.leo,
     "sunlit": Orbit.sunlit,
 }
-SHADOWS = ("none", "cylindrical", "penumbra")
+SHADOWS = ("none", "cylindrical", "penumbra", "conical")
 MODELS = ("nonlinear", "linear")
 METHODS = ("rk45", "rk4", "hybrid")
 FORMATS = ("csv", "parquet")

@@ -64,7 +64,7 @@ def run_options(
     window = checks.positive("window", window)
     hybrid = chosen == "hybrid"
     return {
-        "orbit": orbit.as_dict(),
+        "orbit": orbit.as_record(),
         "model": checks.choice("model", model, ("nonlinear", "linear")),
         "coupled": checks.flag("coupled", coupled),
         # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
