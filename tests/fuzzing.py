@@ -135,6 +135,18 @@ def _base_calls() -> dict[str, tuple[Callable[..., Any], dict[str, Any]]]:
         "Orbit": (tj.Orbit, {"radius": 42_164e3, "period": 86_164.0, "phase0": 0.0}),
         "Orbit.leo": (tj.Orbit.leo, {"altitude": 540e3}),
         "Orbit.geo_year": (tj.Orbit.geo_year, {"start_date": "2026-03-01"}),
+        "Orbit.circular": (
+            tj.Orbit.circular,
+            {
+                "altitude": 540e3,
+                "inclination": 0.5,
+                "raan": 1.0,
+                "epoch": "2026-06-01",
+                "j2": True,
+                "shadow": "conical",
+            },
+        ),  # fmt: skip
+        "beta": (orbit_call("beta"), {"_self": tj.Orbit.circular(700e3, 1.7), "t": [0.0, 1e6]}),
         "shadow_intervals": (orbit_call("shadow_intervals"), {"t0": 0.0, "t1": 1e5}),
         "eclipses": (orbit_call("eclipses"), {"_self": tj.Orbit.geo_year(), "t0": 0.0, "t1": 1e6}),
         "umbra_intervals": (orbit_call("umbra_intervals"), {"t0": 0.0, "t1": 1e5}),
@@ -459,6 +471,7 @@ INVALID: dict[str, list[Any]] = {
     "expansion": [*_REAL, None, 0.01, -0.01],  # any sign, |a| <= 1e-3 1/K
     "angle": [*_POSITIVE, 2.0, 20.0],  # a limit in (0, π/2] rad
     "sun_angle": [*_REAL, None, 2.0, -1.6],  # |ψ| < π/2
+    "inclination": [*_REAL, None, -0.1, 3.2, 28.5],  # in [0, π] rad (28.5: degrees)
     "cap": [*_CAP, None],
     "count": [*_COUNT, None],
     "count?": _COUNT,
@@ -541,6 +554,15 @@ SPECS: dict[str, dict[str, str]] = {
     },
     "Orbit.leo": {"altitude": "positive"},
     "Orbit.geo_year": {"start_date": "date"},
+    "Orbit.circular": {
+        "altitude": "positive",
+        "inclination": "inclination",
+        "raan": "real",
+        "epoch": "date",
+        "j2": "flag",
+        "shadow": "choice",
+    },
+    "beta": {"t": "reals"},
     "shadow_intervals": _ORBIT_SPAN,
     "umbra_intervals": _ORBIT_SPAN,
     "breakpoints": _ORBIT_SPAN,
