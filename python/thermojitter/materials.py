@@ -31,15 +31,9 @@ class Material:
     def layer(self, thickness: float, name: str | None = None) -> Layer:
         """A layer of this material, ``thickness`` m thick (named after the material by
         default)."""
-        return Layer(
-            thickness=thickness,
-            conductivity=self.conductivity,
-            density=self.density,
-            specific_heat=self.specific_heat,
-            youngs_modulus=self.youngs_modulus,
-            expansion_coeff=self.expansion_coeff,
-            name=self.key if name is None else name,
-        )
+        # The layer's other fields, by the engine's one list of them, are the material's.
+        values = {f: getattr(self, f) for f in _core.LAYER_FIELDS if f != "thickness"}
+        return Layer(thickness=thickness, name=self.key if name is None else name, **values)
 
 
 LIBRARY: dict[str, Material] = {m["key"]: Material(**m) for m in _core.materials()}

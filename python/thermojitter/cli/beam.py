@@ -5,11 +5,12 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from thermojitter.cli.common import add_out, out_dir
+from thermojitter.cli.common import add_writing_command, out_dir
 
 
 def add_parser(sub: Any) -> None:
-    beam = sub.add_parser(
+    beam = add_writing_command(
+        sub,
         "beam",
         help="compare the hinge model with a finite-element beam (paper Sec. 4.3)",
         description=(
@@ -22,7 +23,6 @@ def add_parser(sub: Any) -> None:
         ),
         epilog="Example: thermojitter beam --out out/beam",
     )
-    add_out(beam, required=True, help="output folder (created)")
     beam.add_argument(
         "--elements",
         type=int,

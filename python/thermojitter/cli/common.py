@@ -89,6 +89,14 @@ def add_out(parser: argparse.ArgumentParser, **kwargs: Any) -> None:
     )
 
 
+def add_writing_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
+    """The subcommand ``name`` (``kwargs``: help, description, epilog...) with its required
+    --out DIR and --overwrite."""
+    parser: argparse.ArgumentParser = sub.add_parser(name, **kwargs)
+    add_out(parser, required=True, help="output folder (created)")
+    return parser
+
+
 def write_output(path: Path, write: Callable[[BinaryIO], object]) -> Path:
     """Writes one output file atomically (a temporary file renamed over it): a failure, such as
     a full disk, leaves no partial file and is reported in one line naming the file."""

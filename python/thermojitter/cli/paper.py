@@ -6,11 +6,12 @@ import argparse
 import time
 from typing import Any
 
-from thermojitter.cli.common import STOP, add_out, out_dir, positive
+from thermojitter.cli.common import STOP, add_writing_command, out_dir, positive
 
 
 def add_parser(sub: Any) -> None:
-    paper = sub.add_parser(
+    paper = add_writing_command(
+        sub,
         "paper",
         help="reproduce the paper on its Table 1 panel",
         description=(
@@ -20,7 +21,6 @@ def add_parser(sub: Any) -> None:
         ),
         epilog="Example: thermojitter paper --out out/",
     )
-    add_out(paper, required=True, help="output folder (created)")
     paper.add_argument(
         "--flutter-hours",
         type=positive,

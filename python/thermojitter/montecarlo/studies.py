@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
@@ -127,22 +128,42 @@ def monte_carlo(
     )  # fmt: skip
     options = with_layers(options, panel, layers, list(vary))
     u = unit_design(sampler, n, len(vary), seed)
+    frame = _run_drawn(
+        "monte_carlo", panel, vary, u, n, seed, {"sampler": sampler}, truncate, options,
+        threads=threads, backend=backend, checkpoint=checkpoint, chunk_size=chunk_size,
+        progress=progress,
+    )  # fmt: skip
+    frame.attrs["seed"] = seed
+    return frame
+
+
+def _run_drawn(
+    study: str,
+    panel: Panel,
+    vary: Mapping[str, Any],
+    u: NDArray[np.float64],
+    n: int,
+    seed: int,
+    sampler: dict[str, Any],
+    truncate: bool,
+    options: dict[str, Any],
+    **run: Any,
+) -> Any:
+    """Runs the panels of the unit design ``u`` mapped through the distributions of ``vary``
+    (``monte_carlo`` and ``sensitivity``): the study's settings are its name, the panel, the
+    distributions, ``n``, ``seed``, ``sampler`` (how ``u`` was drawn) and ``truncate``; ``run``
+    goes to ``run_design``."""
     names, values, matrix = sampled(panel, vary, u, truncate)
     settings = {
-        "study": "monte_carlo",
+        "study": study,
         "panel": panel.as_dict(),
         "vary": {name: describe(vary[name]) for name in names},
         "n": n,
         "seed": seed,
-        "sampler": sampler,
+        **sampler,
         "truncate": truncate,
     }
-    frame = run_design(
-        names, values, matrix, options, settings, threads=threads, backend=backend,
-        checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
-    )  # fmt: skip
-    frame.attrs["seed"] = seed
-    return frame
+    return run_design(names, values, matrix, options, settings, **run)
 
 
 def sweep(
@@ -294,19 +315,10 @@ def sensitivity(
         u = np.asarray(
             sobol_sample.sample(problem, n, calc_second_order=second_order, seed=seed), dtype=float
         )
-    names, values, matrix = sampled(panel, vary, u, truncate)
-    settings = {
-        "study": "sensitivity",
-        "panel": panel.as_dict(),
-        "vary": {name: describe(vary[name]) for name in names},
-        "n": n,
-        "seed": seed,
-        "second_order": second_order,
-        "truncate": truncate,
-    }
-    samples = run_design(
-        names, values, matrix, options, settings, threads=threads, backend=backend,
-        checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
+    samples = _run_drawn(
+        "sensitivity", panel, vary, u, n, seed, {"second_order": second_order}, truncate,
+        options, threads=threads, backend=backend, checkpoint=checkpoint, chunk_size=chunk_size,
+        progress=progress,
     )  # fmt: skip
     if samples.attrs["interrupted"]:
         nan = np.full(len(names), np.nan)

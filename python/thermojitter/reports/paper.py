@@ -133,35 +133,34 @@ class PaperContext:
             }
         return self._runs[key]
 
-    def orbit_run(self, *, model: str = "nonlinear") -> Solution:
-        """The coupled system over one orbit from the subsolar point, started at equilibrium."""
+    def _one_orbit(
+        self, key: str, run: Callable[..., Any], panel: Panel, dt_out: float, **kwargs: Any
+    ) -> Any:
+        """``run`` (simulate or simulate_thermal) of ``panel`` over one orbit from the subsolar
+        point with the options' tolerances, cached under ``key``."""
         o = self.options
-        return self.cached(  # type: ignore[no-any-return]
-            f"orbit_{model}",
-            lambda: simulate(
-                self.panel,
-                self.orbit,
-                (0.0, self.orbit.period),
-                model=model,  # type: ignore[arg-type]
-                rtol=o.rtol,
-                atol=o.atol,
-                dt_out=o.dt_out,
-            ),
-        )
-
-    def thermal_run(self, panel: Panel, layers: int, key: str) -> ThermalSolution:
-        o = self.options
-        return self.cached(  # type: ignore[no-any-return]
+        return self.cached(
             key,
-            lambda: simulate_thermal(
+            lambda: run(
                 panel,
                 self.orbit,
                 (0.0, self.orbit.period),
-                layers=layers,  # type: ignore[arg-type]
                 rtol=o.rtol,
                 atol=o.atol,
-                dt_out=o.thermal_dt_out,
+                dt_out=dt_out,
+                **kwargs,
             ),
+        )
+
+    def orbit_run(self, *, model: str = "nonlinear") -> Solution:
+        """The coupled system over one orbit from the subsolar point, started at equilibrium."""
+        return self._one_orbit(  # type: ignore[no-any-return]
+            f"orbit_{model}", simulate, self.panel, self.options.dt_out, model=model
+        )
+
+    def thermal_run(self, panel: Panel, layers: int, key: str) -> ThermalSolution:
+        return self._one_orbit(  # type: ignore[no-any-return]
+            key, simulate_thermal, panel, self.options.thermal_dt_out, layers=layers
         )
 
     def flutter_run(self, *, coupled: bool) -> Solution:
