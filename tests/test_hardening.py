@@ -354,3 +354,21 @@ def test_internal_error_is_a_runtime_error_not_a_base_exception() -> None:
     # No reproducer is left that panics; the mapping is checked on the type itself.
     assert issubclass(tj.InternalError, RuntimeError)
     assert not issubclass(tj.ParameterError, RuntimeError)
+
+
+# --- found by benches/fuzz.py on a2f9ee7 (seed 0, 10,000 calls) --------------------------------
+
+
+def test_overdamped_beam_modes_are_refused_not_minutes_of_steps() -> None:
+    # damping_ratio = 2e5 ran for minutes: an overdamped mode's rate 2ζω sets the step.
+    beam = tj.FreeFreeBeam(P, n_elements=20)
+    kw: dict[str, Any] = {"times": [0.0, 10.0, 20.0], "moments": [400.0, 350.0, 300.0]}
+    refused(lambda: beam.response(**kw, damping_ratio=217546.0), "damping_ratio", "10")
+    assert beam.response(**kw, damping_ratio=10.0).t[-1] == 20.0
+
+
+def test_fitted_names_that_are_not_strings_are_refused_naming_fit() -> None:
+    # An array of numbers as fit raised "unhashable type: 'numpy.ndarray'".
+    t = np.linspace(0.0, 600.0, 40)
+    refused(lambda: tj.calibrate(t, 0.01 * np.ones(40), fit=np.zeros((2, 2))), "fit")  # type: ignore[arg-type]
+    refused(lambda: tj.calibrate(t, 0.01 * np.ones(40), fit=[1.0]), "fit")  # type: ignore[list-item]

@@ -160,7 +160,13 @@ def calibrate(
     if initial is not None and not isinstance(initial, Mapping):
         raise checks.wrong_type("initial", initial, "a mapping of names to values")
     names = list(fit)
-    if not names or len(set(names)) != len(names) or any(n not in FITTABLE for n in names):
+    # Names only: an array's rows or other unhashable items are refused before the set is built.
+    if (
+        not names
+        or not all(isinstance(n, str) for n in names)
+        or len(set(names)) != len(names)
+        or any(n not in FITTABLE for n in names)
+    ):
         raise checks.ParameterError("fit", fit, f"a non-empty set of {', '.join(FITTABLE)}")
     if ts.size <= len(names):
         raise checks.ParameterError(
