@@ -7,6 +7,13 @@ use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+/// The orbit of `orbit`, with [t0, t1] checked as a span of it.
+fn spanned(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Orbit> {
+    let o = orbit_from(orbit)?;
+    o.check_span(t0, t1)?;
+    Ok(o)
+}
+
 /// (centre, first contact, last contact, umbra entry, umbra exit), s.
 type EclipseRow = (f64, f64, f64, f64, f64);
 
@@ -15,9 +22,8 @@ type EclipseRow = (f64, f64, f64, f64, f64);
 #[pyfunction]
 fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<EclipseRow>> {
     shield(|| {
-        let o = orbit_from(orbit)?;
-        o.check_span(t0, t1)?;
-        Ok(o.eclipses(t0, t1)
+        Ok(spanned(orbit, t0, t1)?
+            .eclipses(t0, t1)
             .iter()
             .map(|e| {
                 let (c, d) = e.umbra.unwrap_or((f64::NAN, f64::NAN));
@@ -30,31 +36,19 @@ fn eclipses(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<Eclipse
 /// Shadow intervals of an orbit within [t0, t1].
 #[pyfunction]
 fn shadow_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
-    shield(|| {
-        let o = orbit_from(orbit)?;
-        o.check_span(t0, t1)?;
-        Ok(o.shadow_intervals(t0, t1))
-    })
+    shield(|| Ok(spanned(orbit, t0, t1)?.shadow_intervals(t0, t1)))
 }
 
 /// Umbra intervals of an orbit within [t0, t1], clipped.
 #[pyfunction]
 fn umbra_intervals(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<(f64, f64)>> {
-    shield(|| {
-        let o = orbit_from(orbit)?;
-        o.check_span(t0, t1)?;
-        Ok(o.umbra_intervals(t0, t1))
-    })
+    shield(|| Ok(spanned(orbit, t0, t1)?.umbra_intervals(t0, t1)))
 }
 
 /// Times in (t0, t1) where s(t) jumps or has a kink.
 #[pyfunction]
 fn orbit_breakpoints(orbit: &Bound<'_, PyDict>, t0: f64, t1: f64) -> PyResult<Vec<f64>> {
-    shield(|| {
-        let o = orbit_from(orbit)?;
-        o.check_span(t0, t1)?;
-        Ok(o.breakpoints(t0, t1))
-    })
+    shield(|| Ok(spanned(orbit, t0, t1)?.breakpoints(t0, t1)))
 }
 
 fn map_times<'py>(
