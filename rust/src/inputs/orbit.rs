@@ -83,6 +83,18 @@ pub const PERIHELION_DAY: f64 = 3.0;
 /// The Earth's second zonal harmonic (oblateness), for the nodal drift.
 pub const J2: f64 = 1.082_63e-3;
 
+/// An angle (rad) within ±[`MAX_PHASE0`], where it keeps its precision.
+fn require_angle(name: &str, value: f64) -> Result<()> {
+    if value.abs() > MAX_PHASE0 {
+        return Err(Error::invalid(
+            name,
+            value,
+            &format!("must be in [-{MAX_PHASE0}, {MAX_PHASE0}] rad (reduce it modulo 2π)"),
+        ));
+    }
+    Ok(())
+}
+
 /// How the Earth hides the Sun.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shadow {
@@ -223,13 +235,7 @@ impl Orbit {
                 &format!("must be in [0, π] rad{hint}"),
             ));
         }
-        if self.raan.abs() > MAX_PHASE0 {
-            return Err(Error::invalid(
-                "raan",
-                self.raan,
-                &format!("must be in [-{MAX_PHASE0}, {MAX_PHASE0}] rad (reduce it modulo 2π)"),
-            ));
-        }
+        require_angle("raan", self.raan)?;
         if self.period < MIN_PERIOD {
             return Err(Error::invalid(
                 "period",
@@ -237,13 +243,7 @@ impl Orbit {
                 &format!("must be >= {MIN_PERIOD} s (no orbit is faster)"),
             ));
         }
-        if self.phase0.abs() > MAX_PHASE0 {
-            return Err(Error::invalid(
-                "phase0",
-                self.phase0,
-                &format!("must be in [-{MAX_PHASE0}, {MAX_PHASE0}] rad (reduce it modulo 2π)"),
-            ));
-        }
+        require_angle("phase0", self.phase0)?;
         if self.epoch_day.abs() > MAX_EPOCH_DAY {
             return Err(Error::invalid(
                 "epoch_day",
