@@ -56,6 +56,8 @@ __all__ = [
     "beta",
     "nodal_rate",
     "J2",
+    "EARTH_ALBEDO",
+    "EARTH_IR",
     "OBLIQUITY",
     "YEAR_DAYS",
     "DAY",
@@ -121,6 +123,8 @@ MU_EARTH: float
 EQUINOX_DAY: float
 PERIHELION_DAY: float
 J2: float
+EARTH_ALBEDO: float
+EARTH_IR: float
 OBLIQUITY: float
 YEAR_DAYS: float
 DAY: float

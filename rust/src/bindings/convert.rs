@@ -1,6 +1,7 @@
 //! Python values to engine types, with errors that name the parameter.
 
 use super::error::invalid;
+use crate::inputs::heating::Attitude;
 use crate::inputs::orbit::Shadow;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
@@ -123,9 +124,53 @@ pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
             None => base.raan,
         },
         j2: optional_item(d, "j2", "a bool")?.unwrap_or(base.j2),
+        albedo: match d.get_item("albedo")? {
+            Some(_) => float_item(d, "albedo")?,
+            None => base.albedo,
+        },
+        earth_ir: match d.get_item("earth_ir")? {
+            Some(_) => float_item(d, "earth_ir")?,
+            None => base.earth_ir,
+        },
+        attitude: match d.get_item("attitude")? {
+            Some(a) => attitude_from(&a)?,
+            None => base.attitude,
+        },
     };
     o.validate()?;
     Ok(o)
+}
+
+/// An attitude from a mapping: `kind` ('sun_pointing' | 'sun_tracking' | 'nadir' |
+/// 'inertial'), with `offset` (rad) for Sun tracking and `normal` (three numbers) for inertial.
+pub fn attitude_from(value: &Bound<'_, PyAny>) -> PyResult<Attitude> {
+    let d = value
+        .cast::<PyDict>()
+        .map_err(|_| type_error("attitude", "a mapping", value))?;
+    let kind: String = required_item(d, "kind", "a string")?;
+    let attitude = match kind.as_str() {
+        "sun_pointing" => Attitude::SunPointing,
+        "nadir" => Attitude::Nadir,
+        "sun_tracking" => Attitude::SunTracking {
+            offset: float_item(d, "offset")?,
+        },
+        "inertial" => {
+            let normal: Vec<f64> = required_item(d, "normal", "three numbers")?;
+            let normal: [f64; 3] = normal
+                .try_into()
+                .map_err(|v: Vec<f64>| invalid("attitude.normal", format!("{v:?}"), "must hold three numbers"))?;
+            Attitude::inertial(normal)?
+        }
+        other => {
+            return Err(invalid(
+                "attitude",
+                format!("{other:?}"),
+                "must be 'sun_pointing', 'sun_tracking', 'nadir' or 'inertial'",
+            ))
+        }
+    };
+    attitude.validate()?;
+    Ok(attitude)
 }
 
 /// The coupling of a `coupled` flag: the projected area follows θ (two-way), or is frozen.

@@ -130,6 +130,8 @@ fn orbit_dict<'py>(py: Python<'py>, o: &Orbit) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("inclination", o.inclination)?;
     d.set_item("raan", o.raan)?;
     d.set_item("j2", o.j2)?;
+    d.set_item("albedo", o.albedo)?;
+    d.set_item("earth_ir", o.earth_ir)?;
     Ok(d)
 }
 
@@ -157,6 +159,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("EQUINOX_DAY", EQUINOX_DAY)?;
     m.add("PERIHELION_DAY", PERIHELION_DAY)?;
     m.add("J2", J2)?;
+    m.add("EARTH_ALBEDO", crate::inputs::heating::EARTH_ALBEDO)?;
+    m.add("EARTH_IR", crate::inputs::heating::EARTH_IR)?;
     m.add("OBLIQUITY", OBLIQUITY)?;
     m.add("YEAR_DAYS", YEAR_DAYS)?;
     m.add("DAY", DAY)?;

@@ -198,6 +198,12 @@ pub fn run_orbits_hybrid(
         let run = out.run.clone().into();
         return Ok(LayeredHybrid { run, split: out });
     }
+    if req.orbit.has_face_loads() {
+        return Err(crate::models::coupled::unsupported_face_loads(
+            &req.orbit,
+            "the laminate's N-node model",
+        ));
+    }
     let (system, start) = req.system()?;
     let args = HybridArgs {
         orbit: &req.orbit,
