@@ -272,3 +272,26 @@ def test_attitudes_and_heat_loads_are_checked() -> None:
     # The back's absorptivity follows the front's unless given.
     assert tj.Panel(absorptivity=0.4).absorptivity_back == 0.4
     assert tj.Panel(absorptivity=0.4, absorptivity_back=0.9).absorptivity_back == 0.9
+
+
+def test_a_scenario_sets_the_earths_heat_and_the_attitude() -> None:
+    from thermojitter.scenario import ScenarioError, parse_scenario
+
+    data = {
+        "orbit": {"preset": "leo", "albedo": 0.3, "earth_ir": 237.0, "inclination": 0.5},
+        "attitude": {"kind": "sun_tracking", "offset": 0.2},
+    }
+    scenario = parse_scenario(data)
+    assert scenario.attitude == tj.Attitude.sun_tracking(0.2)
+    assert (scenario.orbit.albedo, scenario.orbit.earth_ir) == (0.3, 237.0)
+    assert parse_scenario({}).attitude == tj.Attitude.sun_pointing()
+    inertial = parse_scenario({"attitude": {"kind": "inertial", "normal": [0, 0, 2]}})
+    assert inertial.attitude.normal == (0.0, 0.0, 2.0)
+    for bad, key in [
+        ({"kind": "nadir", "offset": 0.1}, "attitude.offset"),
+        ({"kind": "inertial", "normal": [1, 0]}, "attitude.normal"),
+        ({"kind": "sideways"}, "attitude.kind"),
+        ({"roll": 0.1}, "roll"),
+    ]:
+        with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
+            parse_scenario({"attitude": bad})
