@@ -295,3 +295,42 @@ def test_a_scenario_sets_the_earths_heat_and_the_attitude() -> None:
     ]:
         with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
             parse_scenario({"attitude": bad})
+
+
+@pytest.mark.parametrize(
+    "attitude", [None, tj.Attitude.sun_tracking(0.1), tj.Attitude.nadir()], ids=str
+)
+def test_flutter_at_a_point_of_the_orbit_takes_the_earths_loads(
+    attitude: tj.Attitude | None,
+) -> None:
+    panel = tj.Panel.paper()
+    orbit = tj.Orbit.circular(540e3, math.radians(28.5), 0.0, "2026-06-01")
+    t = 100.0
+    fl = tj.flutter(panel, orbit=orbit, t=t, attitude=attitude)
+    used = attitude or tj.Attitude.sun_pointing()
+    loads = ref.absorbed_loads(panel, orbit, used, t, 1.0)
+    eq = ref.steady_state_loaded(panel, loads)
+    assert fl.equilibrium.T_front == pytest.approx(eq[0], rel=1e-12)
+    assert fl.equilibrium.T_back == pytest.approx(eq[1], rel=1e-12)
+    assert fl.equilibrium.theta == pytest.approx(eq[2], rel=1e-9, abs=1e-14)
+    # The Jacobian of the reference's equations, by central differences, and its spectrum.
+    y = np.array([*eq, 0.0])
+    jac = np.zeros((4, 4))
+    for j in range(4):
+        h = 1e-6 * max(abs(y[j]), 1e-3)
+        up, down = y.copy(), y.copy()
+        up[j] += h
+        down[j] -= h
+        jac[:, j] = (ref.rhs_loaded(up, panel, loads) - ref.rhs_loaded(down, panel, loads)) / (
+            2 * h
+        )
+    eigenvalues = np.linalg.eigvals(jac)
+    growth = float(np.max(eigenvalues.real))
+    # Both Jacobians are finite differences: the real part is compared on the spectrum's scale
+    # (a nadir panel's growth rate is 2e-5 of its eigenvalues' size).
+    scale = float(np.max(np.abs(eigenvalues)))
+    assert fl.growth_rate == pytest.approx(growth, rel=1e-5, abs=1e-8 * scale)
+    # The Earth's heat on the back face lowers the gradient, and with it the critical damping.
+    bare = tj.flutter(panel, orbit=orbit.replace(albedo=0.0, earth_ir=0.0), t=t, attitude=attitude)
+    if used.kind != "nadir":
+        assert fl.critical_damping < bare.critical_damping

@@ -69,6 +69,7 @@ __all__ = [
     "energy",
     "equivalent_panel",
     "flutter",
+    "flutter_at",
     "flux_scale",
     "hinge_points",
     "hinge_equivalent_damping_ratio",
@@ -210,6 +211,14 @@ def simulate_hinge(
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(
     panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
+) -> dict[str, Any]: ...
+def flutter_at(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    t: float,
+    model: str,
+    coupled: bool,
+    with_critical: bool = True,
 ) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------

@@ -270,6 +270,12 @@ where
         self.sun.optics.map(|o| o.solar_constant)
     }
 
+    /// The loads at time t in full sunlight (the front's sunlight alone, at the Sun's distance
+    /// there, when the orbit has no other).
+    pub fn sunlit_loads(&self, t: f64) -> Loads {
+        self.sun.sunlit_loads(t)
+    }
+
     /// The absorbed loads at time t inside the current segment.
     pub fn loads_at(&self, t: f64) -> Loads {
         self.sun.loads(t)
