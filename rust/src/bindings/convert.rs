@@ -156,9 +156,13 @@ pub fn attitude_from(value: &Bound<'_, PyAny>) -> PyResult<Attitude> {
         },
         "inertial" => {
             let normal: Vec<f64> = required_item(d, "normal", "three numbers")?;
-            let normal: [f64; 3] = normal
-                .try_into()
-                .map_err(|v: Vec<f64>| invalid("attitude.normal", format!("{v:?}"), "must hold three numbers"))?;
+            let normal: [f64; 3] = normal.try_into().map_err(|v: Vec<f64>| {
+                invalid(
+                    "attitude.normal",
+                    format!("{v:?}"),
+                    "must hold three numbers",
+                )
+            })?;
             Attitude::inertial(normal)?
         }
         other => {

@@ -129,8 +129,8 @@ pub fn earth_view_factor(cos_lambda: f64, h: f64) -> f64 {
     // s > 0 here: |c| < 1/H < 1.
     let first = 0.5 - (x / (h * s)).min(1.0).asin() / PI;
     let cot = c / s;
-    let second =
-        (c * (-x * cot).clamp(-1.0, 1.0).acos() - x * (1.0 - h2 * c * c).max(0.0).sqrt()) / (PI * h2);
+    let second = (c * (-x * cot).clamp(-1.0, 1.0).acos() - x * (1.0 - h2 * c * c).max(0.0).sqrt())
+        / (PI * h2);
     (first + second).max(0.0)
 }
 
@@ -311,7 +311,8 @@ impl Orbit {
         let f = self.face_fluxes(t, s, optics.solar_constant);
         Loads {
             sun: f.sun_front / optics.solar_constant,
-            front: optics.absorptivity_front * f.albedo_front + optics.emissivity_front * f.ir_front,
+            front: optics.absorptivity_front * f.albedo_front
+                + optics.emissivity_front * f.ir_front,
             back: optics.absorptivity_back * (f.sun_back + f.albedo_back)
                 + optics.emissivity_back * f.ir_back,
         }

@@ -363,7 +363,8 @@ where
             }
         };
         if FUSED {
-            self.thermal.rates_fused(loads.sun * area, temps, temp_rates);
+            self.thermal
+                .rates_fused(loads.sun * area, temps, temp_rates);
         } else {
             self.thermal.rates(loads.sun * area, temps, temp_rates);
         }
