@@ -45,6 +45,7 @@ from thermojitter.montecarlo import (
 )
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.persist import ResultFileError, load, save
 from thermojitter.results import (
     Equilibrium,
     HingeSolution,
@@ -105,6 +106,7 @@ __all__ = [
     "Panel",
     "ParameterError",
     "ParameterTypeError",
+    "ResultFileError",
     "SampleFailureWarning",
     "SensitivityResult",
     "Solution",
@@ -124,9 +126,11 @@ __all__ = [
     "hinge_energy",
     "hinge_stiffness",
     "linear_thermal_response",
+    "load",
     "materials",
     "monte_carlo",
     "natural_frequency",
+    "save",
     "sensitivity",
     "simulate",
     "simulate_distributed",

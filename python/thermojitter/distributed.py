@@ -28,7 +28,7 @@ import math
 import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,6 +37,7 @@ from thermojitter import _core
 from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible
 from thermojitter.results import LimitCrossing, Run
 from thermojitter.simulate import (
@@ -167,7 +168,7 @@ class DistributedSolution(_FaceTemperatures, Run):
             "sunlit": self.sunlit,
         }
 
-    def to_xarray(self) -> Any:
+    def _dataset(self) -> Any:
         """An xarray Dataset: element fields over (time, x), nodal fields over (time, x_node),
         θ_f and s over time; needs xarray."""
         try:
@@ -299,6 +300,8 @@ def simulate_distributed(
         theta_f=raw["theta_f"],
         sunlit=raw["sunlit"],
         y_end=raw["y_end"],
+        panel=panel,
+        orbit=orbit,
         support=support,
         frequencies_hz=raw["frequencies_hz"],
         damping_ratio=float(raw["damping_ratio"]),
@@ -317,7 +320,7 @@ class OscillatoryMode:
 
 
 @dataclass(frozen=True)
-class DistributedFlutterResult(_FaceTemperatures):
+class DistributedFlutterResult(_FaceTemperatures, Persistent):
     """Linear stability of the distributed panel's sunlit equilibrium.
 
     ``growth_rate`` (1/s) is the largest real part of all eigenvalues; ``oscillatory_modes`` lists
@@ -345,6 +348,17 @@ class DistributedFlutterResult(_FaceTemperatures):
     modes: int
     flux: float
     sun_angle: float
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel analysed (saved with the result)."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "x": ("x",),
+        "x_node": ("x_node",),
+        "temperatures": ("x",),
+        "deflection": ("x_node",),
+        "slope": ("x_node",),
+        "eigenvalues": ("eigenvalue",),
+    }
 
     @property
     def stable(self) -> bool:
@@ -409,6 +423,7 @@ def distributed_flutter(
         modes=settings["modes"],
         flux=float(flux),
         sun_angle=float(sun_angle),
+        panel=panel,
     )
 
 

@@ -274,6 +274,8 @@ def simulate(
         sol = Solution(
             **run_record(raw, used),
             settings={**settings, "layers": nodes, "solver": dict(raw["solver"])},
+            panel=panel,
+            orbit=orbit,
             T_front=temps[:, 0],
             T_back=temps[:, -1],
             **_hinge_columns(raw),
@@ -297,6 +299,8 @@ def simulate(
     sol = Solution(
         **run_record(raw, used),
         settings={**settings, "solver": dict(raw["solver"])},
+        panel=panel,
+        orbit=orbit,
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         **_hinge_columns(raw),
@@ -344,6 +348,8 @@ def simulate_thermal(
     return ThermalSolution(
         **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
+        panel=panel,
+        orbit=orbit,
         layers=int(layers),
         T=raw.get("T"),
         T_front=raw.get("T_front"),
@@ -394,6 +400,7 @@ def simulate_hinge(
     return HingeSolution(
         **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
+        panel=panel,
         theta=raw["theta"],
         theta_dot=raw["theta_dot"],
     )
