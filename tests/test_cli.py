@@ -615,3 +615,24 @@ def test_mc_help_names_the_failure_option_and_exit_code(
         cli.main(["mc", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "--allow-failures" in text and "3 samples failed" in text
+
+
+def test_a_scenario_of_orbit_summaries_defaults_to_the_apis_method(tmp_path: Path) -> None:
+    """keep = "orbits" runs what tj.simulate_orbits runs by default (the hybrid), a time series
+    what tj.simulate runs (rk45); the reference and run --help name the hybrid."""
+    import inspect
+
+    from thermojitter.cli.run import scenario_keys_help
+
+    long = _scenario(tmp_path, '[simulation]\norbits = 3\nkeep = "orbits"\n', "long.toml")
+    api = inspect.signature(tj.simulate_orbits).parameters["method"].default
+    assert load_scenario(long).simulation.method == api == "hybrid"
+    series = _scenario(tmp_path, "[simulation]\norbits = 1\n", "series.toml")
+    assert load_scenario(series).simulation.method == "rk45"
+    assert inspect.signature(tj.simulate).parameters["method"].default == "rk45"
+    chosen = _scenario(tmp_path, '[simulation]\nkeep = "orbits"\nmethod = "rk45"\n', "c.toml")
+    assert load_scenario(chosen).simulation.method == "rk45"
+    reference = (Path(__file__).parent.parent / "docs" / "scenarios.md").read_text()
+    row = next(line for line in reference.splitlines() if line.startswith("| `method` |"))
+    assert '"hybrid"' in row
+    assert "hybrid" in scenario_keys_help()

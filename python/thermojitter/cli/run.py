@@ -71,9 +71,10 @@ def scenario_keys_help() -> str:
                 "simulation",
                 [f.name for f in fields(SimulationSettings)],
                 "the span is one of t_end (s), orbits, years; model = nonlinear | linear; "
-                "method = rk45 | rk4 (dt = step, s); dt_out = output interval, s; keep = "
-                '"samples" | "orbits" (one summary row per orbit, resumable, with '
-                'theta_limit_deg and on_limit = "stop" | "flag"); layers = nodes through '
+                "method = rk45 | rk4 (dt = step, s) | hybrid (keep = orbits; its default); "
+                'dt_out = output interval, s; keep = "samples" | "orbits" (one summary row per '
+                'orbit, resumable, with theta_limit_deg and on_limit = "stop" | "flag"); '
+                "layers = nodes through "
                 "the thickness (the N-node model); max_steps = the run's step budget",
             ),
             table("output", ["format", "plots"], 'format = "csv" | "parquet"; plots = true'),
