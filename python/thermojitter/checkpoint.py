@@ -7,8 +7,9 @@ request, is refused with a :class:`CheckpointError` naming the file and what dif
 never merged into a run, nor returned.
 
 Every file is written to a temporary name in the same folder, flushed to disk, given the
-permissions the umask allows (as any new file), then renamed over the old one, so a killed or failed writer leaves either the previous file or the new one, and no
-partial file: the temporary file is removed when the write fails (a full disk, say).
+permissions the umask allows (as any new file), then renamed over the old one, so a killed or
+failed writer leaves either the previous file or the new one, and no partial file: the temporary
+file is removed when the write fails (a full disk, say).
 """
 
 from __future__ import annotations
