@@ -271,7 +271,7 @@ def test_full_disk_in_the_command_names_the_file_and_leaves_nothing_partial(
     # The time series computed before the failure is complete; nothing partial is left.
     assert leftovers(out) == ["timeseries.csv"]
     frame = pd.read_csv(out / "timeseries.csv")
-    assert frame["t"].iloc[-1] == 60.0
+    assert frame["t [s]"].iloc[-1] == 60.0
 
 
 def test_report_writes_name_the_file_and_leave_nothing_partial(

@@ -216,6 +216,16 @@ def test_module_entry_point_and_help(capsys: pytest.CaptureFixture[str]) -> None
 # run
 
 
+def _bare(frame: pd.DataFrame) -> pd.DataFrame:
+    """The time series with its columns' names without their units (``t [s]`` → ``t``)."""
+    return frame.rename(columns=lambda c: c.split(" [")[0])
+
+
+def read_series(path: Path) -> pd.DataFrame:
+    """timeseries.csv, its columns by name alone."""
+    return _bare(pd.read_csv(path))
+
+
 def _scenario(tmp_path: Path, text: str, name: str = "s.toml") -> Path:
     path = tmp_path / name
     path.write_text(text)
@@ -239,15 +249,14 @@ def test_run_writes_series_and_plots(tmp_path: Path, fmt: str) -> None:
     assert cli.main(["run", str(path), "--out", str(out), "--no-progress"]) == 0
     series = out / f"timeseries.{fmt}"
     frame = pd.read_csv(series) if fmt == "csv" else pd.read_parquet(series)
-    assert list(frame.columns) == [
-        "t",
-        "T_front",
-        "T_back",
-        "theta",
-        "theta_dot",
-        "thermal_moment",
-        "sunlit",
-    ]
+    units = ["s", "K", "K", "rad", "rad/s", "N m", "-"]
+    names = ["t", "T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit"]
+    if fmt == "csv":  # the header says the units, in the columns' order
+        assert list(frame.columns) == [f"{n} [{u}]" for n, u in zip(names, units, strict=True)]
+        frame = _bare(frame)
+    else:
+        assert frame.attrs["units"] == dict(zip(names, units, strict=True))
+    assert list(frame.columns) == names
     t0, t1 = 40999.63121743586 - 60.0, 40999.63121743586 + 240.0
     assert frame["t"].iloc[0] == pytest.approx(t0)
     assert frame["t"].iloc[-1] == pytest.approx(t1)
@@ -269,7 +278,7 @@ def test_run_splits_long_runs_per_orbit_without_changing_them(tmp_path: Path) ->
     text = "[simulation]\norbits = 2\ndt_out = 30.0\n[output]\nplots = false\n"
     out = tmp_path / "out"
     assert cli.main(["run", str(_scenario(tmp_path, text)), "--out", str(out)]) == 0
-    frame = pd.read_csv(out / "timeseries.csv")
+    frame = read_series(out / "timeseries.csv")
     period = tj.Orbit.geo_equinox().period
     assert len(frame) == math.floor(2 * period / 30.0) + 2  # the grid and the end point
     assert np.all(np.diff(frame["t"]) > 0)
@@ -373,7 +382,7 @@ def test_ctrl_c_keeps_finished_orbits(
     assert cli.main(["run", str(path), "--out", str(out), "--no-progress"]) == 130
     err = capsys.readouterr().err
     assert "Traceback" not in err and "interrupted" in err
-    frame = pd.read_csv(out / "timeseries.csv")
+    frame = read_series(out / "timeseries.csv")
     period = tj.Orbit.geo_equinox().period
     assert frame["t"].iloc[-1] < period  # the first orbit only, kept on disk
     assert len(frame) == math.ceil(period / 60.0)
