@@ -83,3 +83,13 @@ def test_every_scenario_key_is_documented() -> None:
         assert re.search(rf"\b{key}\b", run_help), key
     for key in (*FLUTTER_KEYS, *SETTING_KEYS, *RUN_KEYS):
         assert f"| `{key}` |" in reference, key
+
+
+def test_the_install_commands_warn_that_a_plain_install_replaces_an_editable_one() -> None:
+    """``pip install ".[cli]"`` in a checkout installed with ``pip install -e`` silently turns it
+    into a copy: every page that shows the plain install says so, and how to keep it editable."""
+    for path in (REPO / "README.md", REPO / "docs" / "getting-started.md"):
+        text = " ".join(path.read_text().split())
+        assert 'pip install ".[cli]"' in text, path.name
+        assert "replaces an editable install" in text, path.name
+        assert 'pip install -e ".[cli]"' in text, path.name
