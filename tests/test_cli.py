@@ -645,3 +645,26 @@ def test_a_scenario_of_orbit_summaries_defaults_to_the_apis_method(tmp_path: Pat
     row = next(line for line in reference.splitlines() if line.startswith("| `method` |"))
     assert '"hybrid"' in row
     assert "hybrid" in scenario_keys_help()
+
+
+def test_warnings_come_in_the_commands_one_line_format(tmp_path: Path) -> None:
+    """A warning during a command (here the hinge angle past its validity limit) is one line
+    in the command's own format, not Python's file:line and source line."""
+    scenario = _scenario(
+        tmp_path,
+        "[panel]\nhinge_stiffness = 1000.0\n[simulation]\nt_end = 50.0\n[output]\nplots = false\n",
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "thermojitter", "run", str(scenario), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("thermojitter: warning: θ passed theta_limit = 20°")
+    assert lines[0].endswith("(ValidityLimitWarning)")
+    # Code that records warnings still gets them as they are.
+    with pytest.warns(tj.ValidityLimitWarning):
+        assert cli.main(["run", str(scenario), "--out", str(tmp_path / "p")]) == 0
