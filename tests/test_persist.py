@@ -160,6 +160,10 @@ def test_an_unknown_kind_a_later_format_and_a_foreign_file_are_refused(tmp_path:
     later.to_netcdf(tmp_path / "later.nc", engine="h5netcdf")
     with pytest.raises(tj.ResultFileError, match="file format 99"):
         tj.load(tmp_path / "later.nc")
+    damaged = ds.assign_attrs(thermojitter_fields='{"T_front": {"__type__": "Spacecraft"}}')
+    damaged.to_netcdf(tmp_path / "damaged.nc", engine="h5netcdf")
+    with pytest.raises(tj.ResultFileError, match="is damaged"):
+        tj.load(tmp_path / "damaged.nc")
     xr.Dataset({"a": ("t", [1.0])}).to_netcdf(tmp_path / "foreign.nc", engine="h5netcdf")
     with pytest.raises(tj.ResultFileError, match="not a saved thermojitter result"):
         tj.load(tmp_path / "foreign.nc")

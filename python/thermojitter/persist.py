@@ -61,6 +61,10 @@ class ResultFileError(ParameterError):
         super().__init__(parameter, value, allowed, message)
 
 
+class _Damaged(Exception):
+    """A file's fields that :func:`decode` cannot read (reported as a ResultFileError)."""
+
+
 _KINDS: dict[str, type[Persistent]] = {}
 
 
@@ -195,13 +199,13 @@ def decode(data: Any) -> Any:
     if "__type__" in data:
         cls = _types().get(data["__type__"])
         if cls is None:
-            raise ValueError(f"an unknown type {data['__type__']!r}")
+            raise _Damaged(f"an unknown type {data['__type__']!r}")
         made = cls(**decode(data["fields"]))
         if "layup" in data:
             # The panel of a laminate carries the layup it was made from (Panel.from_laminate).
             object.__setattr__(made, "_layup", decode(data["layup"]))
         return made
-    raise ValueError("an untagged mapping")
+    raise _Damaged("an untagged mapping")
 
 
 # --------------------------------------------------------------------------- the Dataset
@@ -318,7 +322,7 @@ def from_xarray(ds: Any, kind: type | None = None, where: Any = "dataset") -> An
         record = json.loads(ds.attrs[FIELDS])
         values = {field: _restore(ds, data) for field, data in record.items()}
         return cls(**values)
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, _Damaged) as exc:
         raise ResultFileError("path", where, f"is damaged ({exc})") from None
 
 
