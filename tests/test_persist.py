@@ -15,7 +15,7 @@ import pytest
 import xarray as xr
 
 import thermojitter as tj
-from conftest import GEO, PAPER, wing_layup
+from conftest import ENTRY, GEO, PAPER, wing_layup
 from thermojitter.persist import from_xarray
 
 LOW = tj.Orbit(radius=7.0e6, period=5828.5)
@@ -84,7 +84,18 @@ def _results() -> dict[str, Any]:
         "linear thermal response": lambda: tj.linear_thermal_response(PAPER),
         "distributed flutter": lambda: tj.distributed_flutter(PAPER, elements=10, modes=3),
         "equilibrium": lambda: tj.steady_state(PAPER),
+        "beam comparison": lambda: tj.compare_with_beam(
+            PAPER, GEO, t_span=(ENTRY - 30.0, ENTRY + 60.0), n_elements=10
+        ),
+        "calibration": _calibration,
     }
+
+
+def _calibration() -> Any:
+    t = np.arange(ENTRY - 30.0, ENTRY + 120.0, 1.0)
+    theta = tj.simulate(PAPER, GEO, (t[0], t[-1]), t_eval=t).theta
+    start = PAPER.replace(hinge_stiffness=4000.0)
+    return tj.calibrate(t, theta, panel=start, orbit=GEO, fit=("hinge_stiffness",))
 
 
 @pytest.mark.parametrize("name", list(_results()))

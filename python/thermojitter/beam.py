@@ -18,7 +18,7 @@ from __future__ import annotations
 import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,6 +27,7 @@ from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.orbit import ECLIPSE_MARGIN, Orbit, eclipse_window
 from thermojitter.panel import Panel, hinge_stiffness, natural_frequency
+from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
@@ -205,7 +206,7 @@ CRITERION_LABELS = {
 
 
 @dataclass(frozen=True)
-class BeamComparison:
+class BeamComparison(Persistent):
     """The hinge model and the beam through an eclipse (paper Figs. 22–24).
 
     Angles in rad (``*_deg`` for degrees), frequencies in Hz, the moment in N m (the physical
@@ -230,6 +231,10 @@ class BeamComparison:
     damping_ratio: float
     criterion: str
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        name: ("t",) for name in ("t", "theta", "theta_f", "moment")
+    }
 
     @property
     def frequency_mismatch(self) -> float:

@@ -24,7 +24,7 @@ import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,6 +34,7 @@ from thermojitter import errors as checks
 from thermojitter.errors import ValidityLimitWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.results import LimitCrossing
 from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
@@ -54,7 +55,7 @@ MIN_POINTS = 20
 
 
 @dataclass(frozen=True)
-class CalibrationResult:
+class CalibrationResult(Persistent):
     """Fitted hinge parameters with standard errors (same units as the panel fields), the RMS of
     the residual θ_model − θ_data (rad), and the model's θ at the series' times."""
 
@@ -72,6 +73,12 @@ class CalibrationResult:
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
     limit_crossing: LimitCrossing | None = None
     """Where the fitted model's θ first passed ``theta_limit`` over the series, or None."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "t": ("t",),
+        "theta_model": ("t",),
+        "covariance": ("parameter", "parameter_"),
+    }
 
     @property
     def residual_rms_deg(self) -> float:
