@@ -50,6 +50,7 @@ from thermojitter.simulate import check_inputs
 
 Array = NDArray[np.float64]
 InertiaRelief = Literal["suport", "auto", "none"]
+Support = Literal["free-free", "cantilever"]
 
 PAPER_ELEMENTS = 100
 """Bar elements of the paper's Nastran model (101 nodes, Sec. 4.3)."""
@@ -80,10 +81,11 @@ def _pynastran() -> Any:
         raise ImportError(
             f"Nastran decks need pyNastran, the optional extra: {INSTALL_HINT}"
         ) from exc
-    except Exception as exc:  # pragma: no cover - an installed pyNastran that does not import
+    except Exception as exc:  # an installed pyNastran that does not import
         raise ImportError(
             f"pyNastran is installed but does not import ({type(exc).__name__}: {exc}); "
-            f"pyNastran 1.4 needs numpy < 2: {INSTALL_HINT} installs a matching set"
+            f"pyNastran 1.4 needs numpy < 2 (here numpy {np.__version__}): {INSTALL_HINT} "
+            "installs a matching set"
         ) from exc
     return bdf
 
@@ -215,9 +217,7 @@ def _beam_cards(model: Any, panel: Panel, x: Array) -> None:
         k2=None,
         comment="A = width x thickness; NSM = the panel's mass per length (kg/m)",
     )
-    model.add_mat1(
-        _MAT, values["youngs_modulus"], None, None, rho=0.0, a=values["expansion_coeff"]
-    )
+    model.add_mat1(_MAT, values["youngs_modulus"], None, None, rho=0.0, a=values["expansion_coeff"])
     model.add_param("COUPMASS", [1])
 
 
@@ -239,7 +239,9 @@ def _load_cards(
         model.add_tabled1(k, times, np.asarray(moment, dtype=float), comment=comment)
         model.add_darea(_DAREA0 + k, [first, second], [_BENDING, _BENDING], [1.0, -1.0])
         model.add_tload1(_TLOAD0 + k, _DAREA0 + k, k)
-    model.add_dload(_DLOAD, 1.0, [1.0] * len(couples), [_TLOAD0 + k for k in range(1, len(couples) + 1)])
+    model.add_dload(
+        _DLOAD, 1.0, [1.0] * len(couples), [_TLOAD0 + k for k in range(1, len(couples) + 1)]
+    )
     model.add_tstep(_TSTEP, n_steps, dt, 1)
 
 
@@ -250,6 +252,7 @@ def to_nastran(
     *,
     elements: int | None = None,
     dt: float | None = None,
+    support: Support | None = None,
     inertia_relief: InertiaRelief | None = None,
     modes: int = DEFAULT_MODES,
     damping_ratio: float | None = None,
@@ -265,6 +268,8 @@ def to_nastran(
     - ``elements``: bars of the beam (even; default the paper's 100, 101 nodes); a distributed
       run brings its own.
     - ``dt``: TSTEP's step, s (default the run's mean sample spacing); the steps cover the run.
+    - ``support``: ``"free-free"`` or ``"cantilever"`` for the beam alone; a run brings its own
+      (the hinge model's panel is free).
     - ``inertia_relief``: ``"suport"`` (PARAM,INREL,-1 with a SUPORT at the centre node, as the
       paper did), ``"auto"`` (PARAM,INREL,-2) or ``"none"``; default ``"suport"`` for a free
       panel and ``"none"`` for a cantilever (clamped at node 1 by an SPC1).
@@ -283,11 +288,18 @@ def to_nastran(
             "a thermojitter.Solution or DistributedSolution",
         )
     modes = checks.integer("modes", modes, 1)
-    x, support = _mesh(panel, solution, elements)
-    relief = "none" if support == "cantilever" else "suport"
+    x, held = _mesh(panel, solution, elements)
+    if support is not None:
+        asked = checks.choice("support", support, ("free-free", "cantilever"))
+        if solution is not None and asked != held:
+            raise checks.ParameterError(
+                "support", support, f"the run's panel is {held}: leave support out"
+            )
+        held = asked
+    relief = "none" if held == "cantilever" else "suport"
     if inertia_relief is not None:
         relief = checks.choice("inertia_relief", inertia_relief, ("suport", "auto", "none"))
-        if support == "cantilever" and relief != "none":
+        if held == "cantilever" and relief != "none":
             raise checks.ParameterError(
                 "inertia_relief", inertia_relief, "a clamped panel takes no inertia relief"
             )
@@ -315,12 +327,12 @@ def to_nastran(
     ]
     if transient:
         case += [f"SDAMPING = {_DAMPING}", f"DLOAD = {_DLOAD}", f"TSTEP = {_TSTEP}"]
-    if support == "cantilever":
+    if held == "cantilever":
         case.append(f"SPC = {_SPC}")
     model.case_control_deck = bdf.CaseControlDeck([*case, "BEGIN BULK"])
     _beam_cards(model, panel, x)
     model.add_eigrl(_EIGRL, nd=modes)
-    if support == "cantilever":
+    if held == "cantilever":
         model.add_spc1(_SPC, "123456", [1], comment="clamped at x = 0")
     elif relief == "suport":
         model.add_param("INREL", [-1])
@@ -349,9 +361,10 @@ def _section(model: Any, element: Any, inertia: str) -> tuple[float, float, floa
     prop = model.properties.get(element.pid)
     if prop is None:
         raise _bad(
-            "PBAR", element.pid, f"property {element.pid} of {element.type} {element.eid} is "
-            "missing from the deck",
-        )  # fmt: skip
+            "PBAR",
+            element.pid,
+            f"property {element.pid} of {element.type} {element.eid} is missing from the deck",
+        )
     if prop.type == "PBAR":
         area, i1, i2, nsm = prop.A, prop.i1, prop.i2, prop.nsm
     elif prop.type == "PBEAM":
@@ -360,22 +373,27 @@ def _section(model: Any, element: Any, inertia: str) -> tuple[float, float, floa
         }
         if len(stations) > 1:
             raise _bad(
-                "PBEAM", prop.pid, f"PBEAM {prop.pid} is tapered (its stations differ): a panel "
-                "has one section",
-            )  # fmt: skip
+                "PBEAM",
+                prop.pid,
+                f"PBEAM {prop.pid} is tapered (its stations differ): a panel has one section",
+            )
         area, i1, i2, nsm = stations.pop()
     else:
         raise _bad(
-            prop.type, prop.pid, f"{prop.type} {prop.pid} is not supported: give the section as "
-            "PBAR or PBEAM",
-        )  # fmt: skip
+            prop.type,
+            prop.pid,
+            f"{prop.type} {prop.pid} is not supported: give the section as PBAR or PBEAM",
+        )
     mat = model.materials.get(prop.mid)
     if mat is None or mat.type != "MAT1":
         found = "missing from the deck" if mat is None else f"a {mat.type}"
         raise _bad(
-            "MAT1", prop.mid, f"material {prop.mid} of {prop.type} {prop.pid} is {found}: "
-            "a MAT1 is needed",
-        )  # fmt: skip
+            "MAT1",
+            prop.mid,
+            f"material {prop.mid} of {prop.type} {prop.pid} is {found}: a MAT1 is needed",
+        )
+    if not mat.e:
+        raise _bad("MAT1", prop.mid, f"MAT1 {prop.mid} gives no Young's modulus E")
     inertia_value = i1 if inertia == "I1" else i2
     return (
         float(mat.e),
@@ -396,10 +414,14 @@ def _chain(ends: dict[int, tuple[int, int]]) -> tuple[list[int], list[int]]:
     tips = sorted(n for n, es in touching.items() if len(es) == 1)
     branched = sorted(n for n, es in touching.items() if len(es) > 2)
     if branched or len(tips) != 2:
-        where = f"node {branched[0]} joins {len(touching[branched[0]])} elements" if branched \
-            else "the elements close a loop"
+        where = (
+            f"node {branched[0]} joins {len(touching[branched[0]])} elements"
+            if branched
+            else "the elements close a loop or fall in pieces"
+        )
         raise _bad("CBAR", sorted(ends)[0], f"the elements are not one open chain: {where}")
-    nodes, order = [tips[0]], []
+    nodes: list[int] = [tips[0]]
+    order: list[int] = []
     while len(order) < len(ends):
         here = nodes[-1]
         nxt = [e for e in touching[here] if not order or e != order[-1]]
@@ -421,7 +443,9 @@ def _read_model(path: Path) -> Any:
     try:
         text = path.read_text(errors="replace")
     except OSError as exc:
-        raise checks.ParameterError("path", str(path), message=f"cannot read {path}: {exc}") from exc
+        raise checks.ParameterError(
+            "path", str(path), message=f"cannot read {path}: {exc}"
+        ) from exc
     bulk_only = re.search(r"^\s*BEGIN\s+BULK", text, re.IGNORECASE | re.MULTILINE) is None
     model = bdf.BDF(debug=None)
     try:
@@ -458,8 +482,11 @@ def from_nastran(
     others = sorted({el.type for el in model.elements.values()} - {"CBAR", "CBEAM"})
     others += sorted({el.type for el in model.rigid_elements.values()})
     if others:
-        raise _bad("elements", others, f"the deck holds {', '.join(others)}: only CBAR and CBEAM "
-                   "make a panel")  # fmt: skip
+        raise _bad(
+            "elements",
+            others,
+            f"the deck holds {', '.join(others)}: only CBAR and CBEAM make a panel",
+        )
     if not beams:
         raise _bad("elements", 0, f"{source} holds no CBAR or CBEAM element")
     for eid, el in beams.items():
@@ -471,16 +498,23 @@ def from_nastran(
         raise _bad("GRID", missing[0], f"node {missing[0]} is missing from the deck")
     for n in nodes:
         if model.nodes[n].cp != 0:
-            raise _bad("GRID", n, f"GRID {n} is in coordinate system {model.nodes[n].cp}: "
-                       "give the beam's nodes in the basic system")  # fmt: skip
+            raise _bad(
+                "GRID",
+                n,
+                f"GRID {n} is in coordinate system {model.nodes[n].cp}: "
+                "give the beam's nodes in the basic system",
+            )
     xyz = np.array([model.nodes[n].xyz for n in nodes], dtype=float)
     axis = xyz[-1] - xyz[0]
     length = float(np.linalg.norm(axis))
     x = (xyz - xyz[0]) @ axis / length if length > 0 else np.zeros(len(nodes))
     off = np.linalg.norm((xyz - xyz[0]) - np.outer(x, axis / max(length, 1e-300)), axis=1)
     if length == 0 or np.any(np.diff(x) <= 0) or np.max(off) > _UNIFORM * length:
-        raise _bad("GRID", nodes[int(np.argmax(off))], "the beam's nodes are not in order on a "
-                   "straight line: a panel is straight")  # fmt: skip
+        raise _bad(
+            "GRID",
+            nodes[int(np.argmax(off))],
+            "the beam's nodes are not in order on a straight line: a panel is straight",
+        )
     sections = np.array([_section(model, beams[eid], inertia) for eid in order])
     names = ("youngs_modulus", "bending_inertia", "mass_per_length", "expansion_coeff")
     for j, name in enumerate(names):
@@ -488,9 +522,13 @@ def from_nastran(
         spread = float(np.max(col) - np.min(col))
         if spread > _UNIFORM * float(np.max(np.abs(col))):
             k = int(np.argmax(np.abs(col - col[0]) > 0))
-            raise _bad("section", name, f"non-uniform section: {name} is {col[0]:g} on element "
-                       f"{order[0]} but {col[k]:g} on element {order[k]}; a panel has one "
-                       "section")  # fmt: skip
+            raise _bad(
+                "section",
+                name,
+                f"non-uniform section: {name} is {col[0]:g} on element "
+                f"{order[0]} but {col[k]:g} on element {order[k]}; a panel has one "
+                "section",
+            )
     e_mod, i_bend, mass, alpha = (float(v) for v in sections[0])
     changes = {
         "length": length,
@@ -505,8 +543,9 @@ def from_nastran(
     tips = []
     for eid, mass_el in sorted(model.masses.items()):
         if mass_el.type != "CONM2":
-            raise _bad(mass_el.type, eid, f"{mass_el.type} {eid} is not supported: give masses "
-                       "as CONM2")  # fmt: skip
+            raise _bad(
+                mass_el.type, eid, f"{mass_el.type} {eid} is not supported: give masses as CONM2"
+            )
         if mass_el.nid not in position:
             raise _bad("CONM2", eid, f"CONM2 {eid} sits on node {mass_el.nid}, not on the beam")
         tips.append(TipMass(int(mass_el.nid), float(position[mass_el.nid]), float(mass_el.mass)))
