@@ -14,21 +14,11 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 import thermojitter as tj
-from conftest import ENTRY, GEO, PAPER, panels
+from conftest import ENTRY, GEO, PAPER, panels, pynastran_imports
 from thermojitter import nastran
 
-
-def _pynastran_imports() -> bool:
-    # pyNastran 1.4 pins numpy < 2 and fails to import under a newer numpy: skip, not fail.
-    try:
-        from pyNastran.bdf import bdf  # noqa: F401
-    except Exception:
-        return False
-    return True
-
-
 needs_pynastran = pytest.mark.skipif(
-    not _pynastran_imports(), reason="pyNastran (thermojitter[nastran]) does not import here"
+    not pynastran_imports(), reason="pyNastran (thermojitter[nastran]) does not import here"
 )
 
 
