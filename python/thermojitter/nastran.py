@@ -164,8 +164,8 @@ def _loads(
     if solution is None:
         return np.empty(0), []
     t = np.asarray(solution.t, dtype=float)
-    if t.size < 2:
-        raise checks.ParameterError("solution", solution, "holds fewer than two samples")
+    if t.size < 2 or not t[-1] > t[0]:
+        raise checks.ParameterError("solution", solution, "holds fewer than two times")
     if isinstance(solution, DistributedSolution):
         moments = np.asarray(solution.thermal_moment, dtype=float)
         return t, [(e + 1, e + 2, moments[:, e]) for e in range(moments.shape[1])]
