@@ -26,14 +26,8 @@ fn nonlinear_system(p: &Panel, c: &Conduction, fast_mode_factor: f64) -> Layered
 
 /// Column `j` of ∂f/∂y of `sys` at `y` in full sun, by central differences with step `h`.
 fn central_difference(sys: &Layered, y: &[f64], j: usize, h: f64) -> Vec<f64> {
-    let n = y.len();
-    let (mut yp, mut ym) = (y.to_vec(), y.to_vec());
-    yp[j] += h;
-    ym[j] -= h;
-    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-    sys.rhs_at_flux(1.0, &yp, &mut fp);
-    sys.rhs_at_flux(1.0, &ym, &mut fm);
-    (0..n).map(|i| (fp[i] - fm[i]) / (2.0 * h)).collect()
+    let f = |y: &[f64], dy: &mut [f64]| sys.rhs_at_flux(1.0, y, dy);
+    crate::numerics::testing::central_difference(f, y, j, h)
 }
 
 #[test]
