@@ -13,7 +13,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +25,7 @@ from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
 from thermojitter.errors import HybridFallbackWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.progress import (
     DeferredInterrupt,
     Interruptible,
@@ -65,7 +66,7 @@ integrator of the non-linear model and the hinge-resolved fallback."""
 
 
 @dataclass
-class OrbitSummaries:
+class OrbitSummaries(Persistent):
     """Per-orbit summaries of a long run, with how it ended.
 
     Columns (one value per orbit): ``index``, ``t_start``, ``t_end``, ``theta_eq`` (sunlit
@@ -96,6 +97,15 @@ class OrbitSummaries:
     """The integrator settings the engine ran with, as it reports them (with ``method="hybrid"``,
     those of its rk45 fallback); rk45's step is further capped at T_n/``steps_per_period``.
     ``settings`` holds the request as given (the checkpoint's identity)."""
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel the run was made with (saved with the result)."""
+    orbit: Orbit | None = field(default=None, repr=False, compare=False)
+    """The orbit the run was made on."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "columns": ("orbit",),
+        "y_end": ("state",),
+    }
 
     @property
     def nonlinear_fraction(self) -> float:
@@ -535,4 +545,6 @@ def simulate_orbits(
         # A run all read from its checkpoint made no engine call: the engine's reading of the
         # same settings (the check every run makes of them) stands for it.
         solver=SolverSettings(**(_core.check_solver(full) if ran_with is None else ran_with)),
+        panel=panel,
+        orbit=orbit,
     )

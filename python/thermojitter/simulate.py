@@ -286,6 +286,8 @@ def simulate(
         sol = Solution(
             **run_record(raw, used),
             settings={**settings, "layers": nodes, "solver": dict(raw["solver"])},
+            panel=panel,
+            orbit=orbit,
             T_front=temps[:, 0],
             T_back=temps[:, -1],
             **_hinge_columns(raw),
@@ -309,6 +311,8 @@ def simulate(
     sol = Solution(
         **run_record(raw, used),
         settings={**settings, "solver": dict(raw["solver"])},
+        panel=panel,
+        orbit=orbit,
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         **_hinge_columns(raw),
@@ -361,6 +365,8 @@ def simulate_thermal(
     return ThermalSolution(
         **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
+        panel=panel,
+        orbit=orbit,
         layers=int(layers),
         T=raw.get("T"),
         T_front=raw.get("T_front"),
@@ -411,6 +417,7 @@ def simulate_hinge(
     return HingeSolution(
         **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
+        panel=panel,
         theta=raw["theta"],
         theta_dot=raw["theta_dot"],
     )
