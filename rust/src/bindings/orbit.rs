@@ -152,11 +152,11 @@ macro_rules! add_constants {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    use crate::inputs::heating::{EARTH_ALBEDO, EARTH_IR};
     use crate::inputs::orbit::{
         DAY, EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, J2, LEO_ALTITUDE, MAX_LEO_ALTITUDE,
         MIN_LEO_ALTITUDE, MU_EARTH, OBLIQUITY, PERIHELION_DAY, SIDEREAL_DAY, YEAR_DAYS,
     };
-    use crate::inputs::heating::{EARTH_ALBEDO, EARTH_IR};
     add_constants!(m: GEO_RADIUS, LEO_ALTITUDE, MIN_LEO_ALTITUDE, MAX_LEO_ALTITUDE,
         EARTH_RADIUS, SIDEREAL_DAY, MU_EARTH, EQUINOX_DAY, PERIHELION_DAY, J2, OBLIQUITY,
         YEAR_DAYS, DAY, EARTH_ALBEDO, EARTH_IR);
