@@ -215,6 +215,7 @@ def flutter(
 def flutter_at(
     panel: dict[str, float],
     orbit: dict[str, Any],
+    *,
     t: float,
     model: str,
     coupled: bool,

@@ -115,8 +115,8 @@ def flutter(
     else:
         if loaded:
             assert orbit is not None
-            args = (panel.as_dict(), engine_orbit(orbit, attitude), t, model, coupled)
-            raw = _core.flutter_at(*args)
+            at = engine_orbit(orbit, attitude)
+            raw = _core.flutter_at(panel.as_dict(), at, t=t, model=model, coupled=coupled)
         else:
             raw = _core.flutter(panel.as_dict(), model, coupled, flux)
         tf, tb, th = raw["equilibrium"]

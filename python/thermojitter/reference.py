@@ -297,38 +297,28 @@ def steady_state_loaded(
     return float(sol[0]), float(sol[1]), float(sol[2])
 
 
-def simulate_loaded(
-    panel: Any,
-    orbit: Any,
-    attitude: Any,
-    t_span: tuple[float, float],
-    *,
-    model: str = "nonlinear",
-    coupled: bool = True,
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
-    t_eval: ArrayLike | None = None,
-    y0: ArrayLike | None = None,
-    max_step: float = np.inf,
+def _simulate_loaded(
+    panel: Any, orbit: Any, attitude: Any, t_span: tuple[float, float], options: dict[str, Any]
 ) -> ReferenceSolution:
-    """A coupled run under the attitude's and the Earth's loads, in permanent sunlight (the
-    orbit's shadow is not modelled here: pass an orbit with ``shadow="none"``). Default start: the
+    """:func:`simulate` under the attitude's and the Earth's loads, in permanent sunlight (the
+    orbit's shadow is not modelled here: an orbit with ``shadow="none"``). Default start: the
     equilibrium under the loads at t_span[0]."""
     if getattr(orbit, "shadow", "none") != "none":
         raise NotImplementedError("reference: Earth heating in permanent sunlight only")
+    model, coupled = options["model"], options["coupled"]
+    y0 = options["y0"]
     if y0 is None:
-        y0 = (
-            *steady_state_loaded(
-                panel, absorbed_loads(panel, orbit, attitude, t_span[0], 1.0), coupled
-            ),
-            0.0,
-        )
+        start = absorbed_loads(panel, orbit, attitude, t_span[0], 1.0)
+        y0 = (*steady_state_loaded(panel, start, coupled), 0.0)
 
     def fun(t: float, y: FloatArray, s: float) -> FloatArray:
         return rhs_loaded(y, panel, absorbed_loads(panel, orbit, attitude, t, s), model, coupled)
 
     names = ("T_front", "T_back", "theta", "theta_dot")
-    return _integrate_segments(fun, y0, t_span, None, rtol, atol, t_eval, "RK45", names, max_step)
+    return _integrate_segments(
+        fun, y0, t_span, None, options["rtol"], options["atol"], options["t_eval"],
+        options["method"], names, options["max_step"],
+    )  # fmt: skip
 
 
 # --------------------------------------------------------------------------- model equations
@@ -582,12 +572,24 @@ def simulate(
     y0: ArrayLike | None = None,
     method: str = "RK45",
     max_step: float = np.inf,
+    attitude: Any = None,
 ) -> ReferenceSolution:
     """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses.
 
     ``max_step`` (s) caps solve_ivp's step; near an equilibrium its steps can otherwise span
     several hinge periods, and its interpolant between them does not resolve the oscillation.
+
+    With an ``attitude`` (``kind``, ``offset``, ``normal``) or an orbit heated by the Earth
+    (``albedo``, ``earth_ir``), each face takes its loads (:func:`absorbed_loads`), in permanent
+    sunlight only.
     """
+    earth = float(getattr(orbit, "albedo", 0.0)) + float(getattr(orbit, "earth_ir", 0.0))
+    if attitude is not None or earth > 0.0:
+        options = {
+            "model": model, "coupled": coupled, "rtol": rtol, "atol": atol, "t_eval": t_eval,
+            "y0": y0, "method": method, "max_step": max_step,
+        }  # fmt: skip
+        return _simulate_loaded(panel, orbit, attitude, t_span, options)
     if y0 is None:
         y0 = (*steady_state(panel, coupled), 0.0)
 

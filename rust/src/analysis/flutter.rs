@@ -16,7 +16,7 @@ use crate::models::thermal::ThermalModel;
 use crate::models::thermal::STEFAN_BOLTZMANN;
 use crate::numerics::integrate::State;
 use nalgebra::allocator::Allocator;
-use nalgebra::{Complex, DMatrix, DVector, DefaultAllocator, Dim, Matrix4, U1};
+use nalgebra::{Complex, DMatrix, DVector, DefaultAllocator, Dim, Matrix4, U1, U4};
 
 /// Linear stability of the sunlit equilibrium.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -236,31 +236,19 @@ where
 /// Linear stability of any coupled system at its sunlit equilibrium under every load of its
 /// orbit at time t (the Sun's distance, the Earth's infrared and albedo and the attitude's
 /// incidence there, s = 1), as [`analyse_system`] does under a flux factor.
-pub fn analyse_system_at<T, S, D>(
-    system: &Coupled<T, S, D>,
-    t: f64,
-) -> Result<(State<D>, DMatrix<f64>, Spectrum)>
-where
-    T: ThermalModel,
-    S: StructuralModel,
-    D: Dim,
-    DefaultAllocator: Allocator<D>,
-{
+pub fn analyse_system_at(system: &Coupled, t: f64) -> Result<(State<U4>, DMatrix<f64>, Spectrum)> {
     Orbit::check_time(t)?;
     let eq = system.sunlit_steady_state(t)?;
     spectrum_of(system, eq, system.sunlit_loads(t))
 }
 
 /// The Jacobian at the equilibrium `eq` under constant `loads`, and its spectrum.
-fn spectrum_of<T, S, D>(
+fn spectrum_of<T: ThermalModel, S: StructuralModel, D: Dim>(
     system: &Coupled<T, S, D>,
     eq: State<D>,
     loads: Loads,
 ) -> Result<(State<D>, DMatrix<f64>, Spectrum)>
 where
-    T: ThermalModel,
-    S: StructuralModel,
-    D: Dim,
     DefaultAllocator: Allocator<D>,
 {
     let y = DVector::from_column_slice(eq.as_slice());

@@ -46,7 +46,7 @@ fn flutter<'py>(
 /// Linear stability of the paper's model at the sunlit equilibrium under every load of `orbit`
 /// at time `t` (its Earth heating and attitude there): the same mapping as [`flutter`].
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t, model, coupled, with_critical=true))]
+#[pyo3(signature = (panel, orbit, *, t, model, coupled, with_critical=true))]
 fn flutter_at<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
