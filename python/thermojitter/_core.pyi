@@ -1,6 +1,8 @@
 """Typed stub of the native engine module (built from rust/src/py by maturin)."""
 
-from typing import Any, final
+from typing import Any, TypedDict, final
+
+from typing_extensions import NotRequired
 
 import numpy as np
 from numpy.typing import NDArray
@@ -131,6 +133,23 @@ MAX_THREADS: int
 MAX_TIME: float
 VALIDITY_LIMIT: float
 
+class _Limit(TypedDict):
+    """The validity limit a run watches (``thermojitter.simulate.limit_args``)."""
+
+    theta_limit: float
+    on_limit: str
+
+class _Run(TypedDict):
+    """How one transient is run: every transient run function takes this one mapping (``RunOptions``
+    in rust/src/bindings/convert.rs; built by ``thermojitter.simulate.run_settings``)."""
+
+    span: tuple[float, float]
+    solver: dict[str, Any]
+    t_eval: _F | None
+    dt_out: float | None
+    y0: NotRequired[list[float] | None]
+    limit: NotRequired[_Limit | None]
+
 class IntegrationError(RuntimeError): ...
 
 @final
@@ -161,45 +180,28 @@ def hinge_points(panel: dict[str, float], zeta: float, theta: _F) -> tuple[_F, _
 def simulate(
     panel: dict[str, float],
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     model: str,
     coupled: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
     layers: int = 2,
-    theta_limit: float = ...,
-    on_limit: str = "flag",
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def simulate_thermal(
     panel: dict[str, float],
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     layers: int,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def simulate_hinge(
     panel: dict[str, float],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     model: str,
     moment: _F,
     moment_t: _F | None,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float],
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
@@ -239,14 +241,10 @@ def beam_response(
     n_elements: int,
     moment_t: _F,
     moment: _F,
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     damping_ratio: float,
     residual: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
@@ -262,15 +260,8 @@ def simulate_distributed(
     panel: dict[str, float],
     orbit: dict[str, Any],
     settings: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: _F | None,
-    theta_limit: float = ...,
-    on_limit: str = "flag",
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
@@ -384,17 +375,10 @@ def simulate_layers(
     layup: dict[str, Any] | None,
     nodes: int,
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     model: str,
     coupled: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
-    theta_limit: float = ...,
-    on_limit: str = "flag",
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def cpu_info() -> dict[str, Any]: ...

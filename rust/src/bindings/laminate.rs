@@ -2,7 +2,7 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, float_item, hinge_model, integration, orbit_from, panel_dict, panel_from, type_error,
+    coupling, float_item, orbit_from, panel_dict, panel_from, type_error, RunOptions,
 };
 use super::error::{invalid, shield};
 use super::flutter::{flutter_inputs, set_spectrum};
@@ -11,8 +11,8 @@ use crate::analysis::layered::LayeredEquilibrium;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
-use crate::runs::request::{RunRequest, ThermalChoice};
-use numpy::{PyArray1, PyReadonlyArray1};
+use crate::runs::request::ThermalChoice;
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -270,7 +270,7 @@ fn layered_flutter<'py>(
 /// Integrates the N-node laminate coupled to the hinge; node temperatures as a (time × node)
 /// array. The validity limit and Ctrl-C as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, theta_limit=crate::models::hinge::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
+#[pyo3(signature = (panel, layup, nodes, orbit, run, *, model, coupled, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_layers<'py>(
     py: Python<'py>,
@@ -278,41 +278,22 @@ fn simulate_layers<'py>(
     layup: Option<&Bound<'py, PyDict>>,
     nodes: usize,
     orbit: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     model: &str,
     coupled: bool,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Option<Vec<f64>>,
-    theta_limit: f64,
-    on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
-        let p = panel_from(panel)?;
-        let (o, hinge) = (orbit_from(orbit)?, hinge_model(model)?);
-        let (method, out) = integration(solver, t_eval, dt_out, t0, t1)?;
-        let limit = super::convert::on_limit(theta_limit, on_limit)?;
-        let c = conduction_from(&p, layup, nodes)?;
-        let (depth, labels) = (c.depth.clone(), c.node_labels());
-        let req = RunRequest {
-            panel: p,
-            orbit: o,
-            thermal: ThermalChoice::Laminate(c),
-            model: hinge,
-            coupling: coupling(coupled),
-            method,
-            span: (t0, t1),
-            output: out,
-            y0,
-            limit,
-        };
-        let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
-        let d = super::transient_dict(py, run)?;
-        d.set_item("depth", PyArray1::from_vec(py, depth))?;
-        d.set_item("node_labels", labels)?;
+        let mut grid = None;
+        let d = super::coupled_transient(py, panel, orbit, (model, coupled), run, cancel, |p| {
+            let c = conduction_from(p, layup, nodes)?;
+            grid = Some((c.depth.clone(), c.node_labels()));
+            Ok(ThermalChoice::Laminate(c))
+        })?;
+        if let Some((depth, labels)) = grid {
+            d.set_item("depth", PyArray1::from_vec(py, depth))?;
+            d.set_item("node_labels", labels)?;
+        }
         Ok(d)
     })
 }
