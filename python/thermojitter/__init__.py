@@ -6,7 +6,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
-from thermojitter import _core, beam, materials
+from thermojitter import _core, beam, materials, nastran
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
@@ -43,6 +43,7 @@ from thermojitter.montecarlo import (
     sensitivity,
     sweep,
 )
+from thermojitter.nastran import NastranBeam, from_nastran, to_nastran
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.results import (
@@ -100,6 +101,7 @@ __all__ = [
     "InternalError",
     "LimitCrossing",
     "LinearThermalResponse",
+    "NastranBeam",
     "Orbit",
     "OrbitSummaries",
     "Panel",
@@ -121,11 +123,13 @@ __all__ = [
     "distributed_defaults",
     "distributed_flutter",
     "distributed_frequencies",
+    "from_nastran",
     "hinge_energy",
     "hinge_stiffness",
     "linear_thermal_response",
     "materials",
     "monte_carlo",
+    "nastran",
     "natural_frequency",
     "sensitivity",
     "simulate",
@@ -136,4 +140,5 @@ __all__ = [
     "stability_map",
     "steady_state",
     "sweep",
+    "to_nastran",
 ]
