@@ -150,6 +150,13 @@ class _Run(TypedDict):
     y0: NotRequired[list[float] | None]
     limit: NotRequired[_Limit | None]
 
+class _Grid(TypedDict):
+    """The N-node model's grid: every function of that model takes this one mapping (``Grid`` in
+    rust/src/bindings/convert.rs; built by ``thermojitter.simulate.grid_args``)."""
+
+    layup: dict[str, Any] | None
+    nodes: int
+
 class IntegrationError(RuntimeError): ...
 
 @final
@@ -343,28 +350,23 @@ def validate_laminate(laminate: dict[str, Any]) -> None: ...
 def laminate_properties(laminate: dict[str, Any]) -> dict[str, float]: ...
 def equivalent_panel(laminate: dict[str, Any], panel: dict[str, float]) -> dict[str, float]: ...
 def materials() -> list[dict[str, Any]]: ...
-def conduction_grid(
-    panel: dict[str, float], layup: dict[str, Any] | None, nodes: int
-) -> dict[str, Any]: ...
+def conduction_grid(panel: dict[str, float], grid: _Grid) -> dict[str, Any]: ...
 def layered_steady_state(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     coupled: bool = True,
     flux: float = 1.0,
 ) -> dict[str, Any]: ...
 def layered_start_state(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     orbit: dict[str, Any],
     t0: float,
     coupled: bool,
 ) -> list[float]: ...
 def layered_flutter(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     model: str,
     coupled: bool,
     flux: float,
@@ -372,8 +374,7 @@ def layered_flutter(
 ) -> dict[str, Any]: ...
 def simulate_layers(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     orbit: dict[str, Any],
     run: _Run,
     *,

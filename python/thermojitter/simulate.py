@@ -196,6 +196,12 @@ def layup_dict(panel: Panel) -> dict[str, Any] | None:
     return None if panel.layup is None else panel.layup.as_dict()
 
 
+def grid_args(panel: Panel, nodes: int) -> dict[str, Any]:
+    """The engine's ``grid`` mapping of the N-node model (``Grid`` in
+    rust/src/bindings/convert.rs): the panel's layup and ``nodes`` (checked: :func:`check_layers`)."""
+    return {"layup": layup_dict(panel), "nodes": nodes}
+
+
 def simulate(
     panel: Panel,
     orbit: Orbit,
@@ -275,8 +281,7 @@ def simulate(
         raw = interruptible(
             _core.simulate_layers,
             panel.as_dict(),
-            layup_dict(panel),
-            nodes,
+            grid_args(panel, nodes),
             orbit.as_dict(),
             run,
             **hinge,

@@ -220,6 +220,30 @@ pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
     }
 }
 
+// The groups of parameters that several pyfunctions take: each group is ONE struct read from ONE
+// Python mapping (pyo3's `FromPyObject`, `from_item_all`: a key per field), converted here, once,
+// with the errors every function gives. The Python side builds each mapping in one place too
+// (`thermojitter.simulate`: `run_settings` and `limit_args` for [`RunOptions`], `grid_args` for
+// [`Grid`]); `_core.pyi` declares each as one TypedDict. A new binding (a new model's run, a new
+// analysis of the N-node model) takes these structs rather than restating their parameters.
+
+/// The N-node through-thickness model's grid, as the functions of that model receive it: the
+/// mapping `grid` = {layup (a laminate mapping, or None: the panel as one homogeneous layer),
+/// nodes}.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct Grid<'py> {
+    pub layup: Option<Bound<'py, PyDict>>,
+    pub nodes: usize,
+}
+
+impl Grid<'_> {
+    /// The conduction model of `panel` on this grid ([`super::laminate::conduction_from`]).
+    pub fn conduction(&self, panel: &Panel) -> PyResult<crate::models::conduction::Conduction> {
+        super::laminate::conduction_from(panel, self.layup.as_ref(), self.nodes)
+    }
+}
+
 /// The validity limit a run watches, as the `limit` entry of a [`RunOptions`] mapping
 /// {theta_limit, on_limit}: converted by [`on_limit`].
 #[derive(FromPyObject)]

@@ -2,7 +2,7 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, float_item, orbit_from, panel_dict, panel_from, type_error, RunOptions,
+    coupling, float_item, orbit_from, panel_dict, panel_from, type_error, Grid, RunOptions,
 };
 use super::error::{invalid, shield};
 use super::flutter::{flutter_inputs, set_spectrum};
@@ -159,16 +159,14 @@ fn materials<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
 /// The node grid of the N-node model: depth (m), capacity (J/(m² K)), moment weight (N m/K)
 /// and the moment offset (N m).
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes))]
 fn conduction_grid<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let p = panel_from(panel)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         let d = PyDict::new(py);
         d.set_item("depth", c.depth.clone())?;
         d.set_item("capacity", c.capacity.clone())?;
@@ -190,19 +188,18 @@ fn equilibrium_dict<'py>(py: Python<'py>, eq: &LayeredEquilibrium) -> PyResult<B
 
 /// Sunlit equilibrium of the N-node system: node temperatures, θ and M_T.
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, coupled=true, flux=1.0))]
+#[pyo3(signature = (panel, grid, coupled=true, flux=1.0))]
 fn layered_steady_state<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
     coupled: bool,
     flux: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let p = panel_from(panel)?;
         check_flux(flux)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         let eq = crate::analysis::layered::equilibrium(&p, &c, coupling(coupled), flux)?;
         let d = equilibrium_dict(py, &eq)?;
         d.set_item("depth", c.depth)?;
@@ -215,8 +212,7 @@ fn layered_steady_state<'py>(
 #[pyfunction]
 fn layered_start_state(
     panel: &Bound<'_, PyDict>,
-    layup: Option<&Bound<'_, PyDict>>,
-    nodes: usize,
+    grid: Grid<'_>,
     orbit: &Bound<'_, PyDict>,
     t0: f64,
     coupled: bool,
@@ -224,7 +220,7 @@ fn layered_start_state(
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         Ok(crate::analysis::layered::start_state(
             &p,
             &c,
@@ -237,13 +233,11 @@ fn layered_start_state(
 
 /// Flutter analysis of the N-node system (full nodal Jacobian).
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, model, coupled, flux, with_critical=true))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, grid, model, coupled, flux, with_critical=true))]
 fn layered_flutter<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
     model: &str,
     coupled: bool,
     flux: f64,
@@ -251,7 +245,7 @@ fn layered_flutter<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let (p, m) = flutter_inputs(panel, model, flux)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         let k = coupling(coupled);
         let a = py.detach(|| crate::analysis::layered::analyse(&p, &c, m, k, flux))?;
         let d = equilibrium_dict(py, &a.equilibrium)?;
@@ -270,13 +264,12 @@ fn layered_flutter<'py>(
 /// Integrates the N-node laminate coupled to the hinge; node temperatures as a (time × node)
 /// array. The validity limit and Ctrl-C as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, orbit, run, *, model, coupled, cancel=None))]
+#[pyo3(signature = (panel, grid, orbit, run, *, model, coupled, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_layers<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
     orbit: &Bound<'py, PyDict>,
     run: RunOptions<'py>,
     model: &str,
@@ -284,13 +277,13 @@ fn simulate_layers<'py>(
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
-        let mut grid = None;
+        let mut nodes = None;
         let d = super::coupled_transient(py, panel, orbit, (model, coupled), run, cancel, |p| {
-            let c = conduction_from(p, layup, nodes)?;
-            grid = Some((c.depth.clone(), c.node_labels()));
+            let c = grid.conduction(p)?;
+            nodes = Some((c.depth.clone(), c.node_labels()));
             Ok(ThermalChoice::Laminate(c))
         })?;
-        if let Some((depth, labels)) = grid {
+        if let Some((depth, labels)) = nodes {
             d.set_item("depth", PyArray1::from_vec(py, depth))?;
             d.set_item("node_labels", labels)?;
         }

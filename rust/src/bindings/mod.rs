@@ -221,6 +221,7 @@ fn energy<'py>(
 /// stops with KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
 #[pyo3(signature = (panel, orbit, run, *, model, coupled, layers=2, cancel=None))]
+#[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
