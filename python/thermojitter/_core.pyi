@@ -2,10 +2,9 @@
 
 from typing import Any, TypedDict, final
 
-from typing_extensions import NotRequired
-
 import numpy as np
 from numpy.typing import NDArray
+from typing_extensions import NotRequired
 
 _F = NDArray[np.float64]
 

@@ -255,9 +255,7 @@ def simulate_distributed(
     )  # fmt: skip
     run["limit"] = limit_args(theta_limit, on_limit)
     run["y0"] = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
-    raw = interruptible(
-        _core.simulate_distributed, panel.as_dict(), orbit.as_dict(), settings, run
-    )
+    raw = interruptible(_core.simulate_distributed, panel.as_dict(), orbit.as_dict(), settings, run)
     limit = limit_record(raw)
     warn_crossing(limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(

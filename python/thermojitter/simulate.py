@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -24,6 +24,9 @@ from thermojitter.results import (
     ThermalSolution,
 )
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
+
+if TYPE_CHECKING:
+    from thermojitter._core import _Grid
 
 Model = Literal["nonlinear", "linear"]
 Method = Literal["rk45", "rk4"]
@@ -196,9 +199,9 @@ def layup_dict(panel: Panel) -> dict[str, Any] | None:
     return None if panel.layup is None else panel.layup.as_dict()
 
 
-def grid_args(panel: Panel, nodes: int) -> dict[str, Any]:
-    """The engine's ``grid`` mapping of the N-node model (``Grid`` in
-    rust/src/bindings/convert.rs): the panel's layup and ``nodes`` (checked: :func:`check_layers`)."""
+def grid_args(panel: Panel, nodes: int) -> _Grid:
+    """The engine's ``grid`` mapping of the N-node model (``Grid`` in rust/src/bindings/convert.rs):
+    the panel's layup and ``nodes`` (checked by :func:`check_layers`)."""
     return {"layup": layup_dict(panel), "nodes": nodes}
 
 
