@@ -35,6 +35,7 @@ from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
     check_inputs,
     check_layers,
+    grid_args,
     layup_dict,
     start_state,
     warn_crossing,
@@ -357,7 +358,7 @@ def simulate_orbits(
         assert nodes is not None
         y0 = tuple(
             _core.layered_start_state(
-                panel.as_dict(), layup_dict(panel), nodes, orbit.as_dict(), t_start, coupled
+                panel.as_dict(), grid_args(panel, nodes), orbit.as_dict(), t_start, coupled
             )
         )
     settings: dict[str, Any] = {
