@@ -164,8 +164,8 @@ class FreeFreeBeam:
             else checks.finite("damping_ratio", damping_ratio)
         )
         residual = checks.flag("residual", residual)
-        used, args = run_settings(
-            solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        used, run = run_settings(
+            solver, (t0, t1), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
             max_step=max_step, max_steps=max_steps,
         )  # fmt: skip
         raw = interruptible(
@@ -174,11 +174,9 @@ class FreeFreeBeam:
             self.n_elements,
             ts,
             ms,
-            t0,
-            t1,
+            run,
             damping_ratio=float(zeta),
             residual=bool(residual),
-            **args,
         )
         return BeamResponse(
             t=raw["t"],

@@ -250,25 +250,15 @@ def simulate_distributed(
         coupled=coupled,
         layers=layers,
     )
-    used, args = run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
+    used, run = run_settings(
+        solver, (t0, t1), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        max_step=max_step, max_steps=max_steps,
     )  # fmt: skip
-    args.update(limit_args(theta_limit, on_limit))
-    y = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
-    start = None if y is None else np.ascontiguousarray(np.asarray(y, dtype=float))
-    raw = interruptible(
-        _core.simulate_distributed,
-        panel.as_dict(),
-        orbit.as_dict(),
-        settings,
-        t0,
-        t1,
-        y0=start,
-        **args,
-    )
+    run["limit"] = limit_args(theta_limit, on_limit)
+    run["y0"] = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
+    raw = interruptible(_core.simulate_distributed, panel.as_dict(), orbit.as_dict(), settings, run)
     limit = limit_record(raw)
-    warn_crossing(limit["limit_crossing"], args["theta_limit"], on_limit, "θ_f")
+    warn_crossing(limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(
         **run_record(raw, used),
         settings={
@@ -278,8 +268,7 @@ def simulate_distributed(
             "atol": used.atol,
             "dt": used.dt,
             "solver": used.as_dict(),
-            "theta_limit": args["theta_limit"],
-            "on_limit": on_limit,
+            **run["limit"],
         },
         x=raw["x"],
         x_node=raw["x_node"],

@@ -18,7 +18,7 @@ from thermojitter.panel import Panel
 from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible, progress_bar
 from thermojitter.results import Equilibrium
-from thermojitter.simulate import check_layers, layup_dict
+from thermojitter.simulate import check_layers, grid_args
 
 MAP_BLOCK = 20_000
 """Grid points per engine call of :func:`stability_map` (about 40 ms each)."""
@@ -131,7 +131,7 @@ def _layered_flutter(
 ) -> FlutterResult:
     """The N-node model's flutter analysis: the Jacobian over (node temperatures…, θ, θ̇)."""
     nodes = check_layers(layers)
-    raw = _core.layered_flutter(panel.as_dict(), layup_dict(panel), nodes, model, coupled, flux)
+    raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), model, coupled, flux)
     temps = raw["temperatures"]
     equilibrium = Equilibrium(
         T_front=float(temps[0]),

@@ -37,6 +37,7 @@ from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
     check_inputs,
     check_layers,
+    grid_args,
     layup_dict,
     start_state,
     warn_crossing,
@@ -376,7 +377,7 @@ def simulate_orbits(
         assert nodes is not None
         y0 = tuple(
             _core.layered_start_state(
-                panel.as_dict(), layup_dict(panel), nodes, engine_orbit_args, t_start, coupled
+                panel.as_dict(), grid_args(panel, nodes), engine_orbit_args, t_start, coupled
             )
         )
     settings: dict[str, Any] = {
