@@ -11,6 +11,7 @@ mod flutter;
 mod laminate;
 mod orbit;
 mod orbits;
+mod spacecraft;
 
 use crate::analysis::steady::equilibrium;
 use crate::inputs::panel::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
@@ -471,5 +472,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     ensemble::register(m)?;
     cancel::register(m)?;
     laminate::register(m)?;
+    spacecraft::register(m)?;
     Ok(())
 }
