@@ -60,6 +60,7 @@ from thermojitter.simulate import (
     steady_state,
 )
 from thermojitter.solver import HybridSettings, SolverSettings
+from thermojitter.spacecraft import PD, Spacecraft, SpacecraftSolution, simulate_spacecraft
 
 __version__ = "0.1.0"
 
@@ -101,6 +102,7 @@ __all__ = [
     "LimitCrossing",
     "LinearThermalResponse",
     "Orbit",
+    "PD",
     "OrbitSummaries",
     "Panel",
     "ParameterError",
@@ -109,6 +111,8 @@ __all__ = [
     "SensitivityResult",
     "Solution",
     "SolverSettings",
+    "Spacecraft",
+    "SpacecraftSolution",
     "StabilityMap",
     "ThermalSolution",
     "ValidityLimitWarning",
@@ -132,6 +136,7 @@ __all__ = [
     "simulate_distributed",
     "simulate_hinge",
     "simulate_orbits",
+    "simulate_spacecraft",
     "simulate_thermal",
     "stability_map",
     "steady_state",

@@ -44,6 +44,7 @@ __all__ = [
     "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
+    "ARCSEC_PER_RADIAN",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -85,6 +86,7 @@ __all__ = [
     "simulate",
     "simulate_distributed",
     "simulate_hinge",
+    "simulate_spacecraft",
     "simulate_layers",
     "simulate_thermal",
     "stability_map",
@@ -130,6 +132,7 @@ STEFAN_BOLTZMANN: float
 MAX_THREADS: int
 MAX_TIME: float
 VALIDITY_LIMIT: float
+ARCSEC_PER_RADIAN: float  # 648000/π
 
 class IntegrationError(RuntimeError): ...
 
@@ -200,6 +203,26 @@ def simulate_hinge(
     t_eval: _F | None,
     dt_out: float | None,
     y0: list[float],
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+
+# --- the spacecraft bus --------------------------------------------------------------------------
+def simulate_spacecraft(
+    bus_inertia: float,
+    panels: list[dict[str, float]],
+    offsets: list[float],
+    senses: list[float],
+    controller: tuple[float, float] | None,
+    orbit: dict[str, Any],
+    t0: float,
+    t1: float,
+    *,
+    disturbance: float,
+    bus_rate: float,
+    solver: dict[str, Any],
+    t_eval: _F | None,
+    dt_out: float | None,
+    y0: list[float] | None,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 

@@ -5,7 +5,7 @@ use super::convert::{orbit_from, output, panel_from, solver_from};
 use crate::error::Error;
 use crate::models::spacecraft::{Appendage, Pd, Spacecraft, ARCSEC_PER_RADIAN, MAX_APPENDAGES};
 use crate::runs::spacecraft::{simulate_spacecraft as run, SpacecraftRequest};
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
