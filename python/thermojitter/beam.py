@@ -15,7 +15,6 @@ model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly 
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -362,22 +361,4 @@ FIGURES = {
     "fig23": "fig23_fft_deflection.png",
     "fig24": "fig24_fft_frequency.png",
 }
-"""File names written by :func:`beam_comparison_figures`."""
-
-
-_REPORTS = (
-    "beam_comparison_figures",
-    "beam_report_markdown",
-    "calibration_note",
-    "frequency_convergence",
-    "write_beam_comparison",
-)
-
-
-def __getattr__(name: str) -> Any:
-    # The report half of this module moved up to thermojitter.reports.beam (a report builds on
-    # this module, never the reverse). Scripts that import them from here keep working: the
-    # report module is loaded on first use, so importing this module does not load it.
-    if name in _REPORTS:
-        return getattr(importlib.import_module("thermojitter.reports.beam"), name)
-    raise AttributeError(f"module 'thermojitter.beam' has no attribute {name!r}", name=name)
+"""File names of the beam comparison figures (paper Figs. 22–24), by figure."""

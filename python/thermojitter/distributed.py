@@ -38,7 +38,7 @@ from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
 from thermojitter.progress import interruptible
-from thermojitter.results import LimitCrossing, Run
+from thermojitter.results import LimitCrossing, Run, _dataframes_module, _FaceDifference
 from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
     Method,
@@ -123,7 +123,7 @@ class _FaceTemperatures:
 
 
 @dataclass(frozen=True)
-class DistributedSolution(_FaceTemperatures, Run):
+class DistributedSolution(_FaceTemperatures, _FaceDifference, Run):
     """The distributed panel at the reported times.
 
     ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
@@ -155,11 +155,6 @@ class DistributedSolution(_FaceTemperatures, Run):
     def theta_f_deg(self) -> Array:
         return np.degrees(self.theta_f)
 
-    @property
-    def delta_T(self) -> Array:
-        """T_front − T_back per element, K, shape (time, element)."""
-        return self.T_front - self.T_back
-
     def _columns(self) -> dict[str, Array]:
         return {
             "theta_f": self.theta_f,
@@ -170,12 +165,7 @@ class DistributedSolution(_FaceTemperatures, Run):
     def to_xarray(self) -> Any:
         """An xarray Dataset: element fields over (time, x), nodal fields over (time, x_node),
         θ_f and s over time; needs xarray."""
-        try:
-            import xarray as xr
-        except ImportError as exc:  # pragma: no cover
-            raise ImportError(
-                "to_xarray() needs xarray: pip install 'thermojitter[dataframes]'"
-            ) from exc
+        xr = _dataframes_module("xarray", "to_xarray()")
         return xr.Dataset(
             {
                 **{

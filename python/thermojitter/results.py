@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,6 +32,31 @@ class LimitCrossing(NamedTuple):
     def of(cls, raw: Any) -> LimitCrossing | None:
         """The engine's (t, orbit, θ), or None."""
         return None if raw is None else cls(float(raw[0]), int(raw[1]), float(raw[2]))
+
+
+def _dataframes_module(name: str, method: str) -> Any:
+    """The optional module ``name`` (pandas or xarray) that the export ``method`` needs; an
+    ImportError saying how to install it when it is missing."""
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError(f"{method} needs {name}: pip install 'thermojitter[dataframes]'") from exc
+
+
+class _Faces(Protocol):
+    @property
+    def T_front(self) -> Array: ...
+    @property
+    def T_back(self) -> Array: ...
+
+
+class _FaceDifference:
+    """``delta_T`` of a run result holding both faces' temperatures."""
+
+    @property
+    def delta_T(self: _Faces) -> Array:
+        """T_front − T_back, K (over time; over time × element for the distributed panel)."""
+        return self.T_front - self.T_back
 
 
 @dataclass(frozen=True)
@@ -79,23 +105,13 @@ class _Run:
 
     def to_pandas(self) -> Any:
         """A pandas DataFrame indexed by time (s); needs pandas."""
-        try:
-            import pandas as pd
-        except ImportError as exc:  # pragma: no cover - depends on the environment
-            raise ImportError(
-                "to_pandas() needs pandas: pip install 'thermojitter[dataframes]'"
-            ) from exc
+        pd = _dataframes_module("pandas", "to_pandas()")
         frame = pd.DataFrame(self._columns(), index=pd.Index(self.t, name="t"))
         return frame
 
     def to_xarray(self) -> Any:
         """An xarray Dataset over the time coordinate t (s); needs xarray."""
-        try:
-            import xarray as xr
-        except ImportError as exc:  # pragma: no cover
-            raise ImportError(
-                "to_xarray() needs xarray: pip install 'thermojitter[dataframes]'"
-            ) from exc
+        xr = _dataframes_module("xarray", "to_xarray()")
         return xr.Dataset(
             {name: ("t", values) for name, values in self._columns().items()},
             coords={"t": self.t},
@@ -109,7 +125,7 @@ modules, such as :class:`thermojitter.distributed.DistributedSolution`)."""
 
 
 @dataclass(frozen=True)
-class Solution(_Run):
+class Solution(_FaceDifference, _Run):
     """The coupled thermo-structural solution at the reported times.
 
     Temperatures in K, angles in rad, θ̇ in rad/s, the thermal moment in N m, ``sunlit`` the
@@ -176,10 +192,6 @@ class Solution(_Run):
     def y(self) -> Array:
         """The state (T_front, T_back, theta, theta_dot) as a (4, n) array."""
         return np.vstack([self.T_front, self.T_back, self.theta, self.theta_dot])
-
-    @property
-    def delta_T(self) -> Array:
-        return self.T_front - self.T_back
 
     def _columns(self) -> dict[str, Array]:
         return {

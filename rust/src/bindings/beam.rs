@@ -1,7 +1,7 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{output, panel_from, set_counters, solver_dict, solver_from};
+use super::convert::{integration, panel_from, set_counters, solver_dict};
 use super::error::invalid;
 use super::error::shield;
 use crate::models::beam::{FreeFreeBeam, BEAM_MODES};
@@ -122,8 +122,7 @@ fn beam_response<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let beam = beam_from(panel, n_elements)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (m, out) = integration(solver, t_eval, dt_out, t0, t1)?;
         let history = MomentHistory::Samples {
             t: moment_t.as_array().to_vec(),
             moment: moment.as_array().to_vec(),

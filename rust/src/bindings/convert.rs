@@ -220,12 +220,17 @@ pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
     }
 }
 
-pub fn output(
+/// How a transient over [t0, t1] is integrated and sampled, as every run function receives it:
+/// the integrator of the `solver` mapping ([`solver_from`]), then the span and the output times
+/// (`t_eval` or every `dt_out`), converted in that order.
+pub fn integration(
+    solver: &Bound<'_, PyDict>,
     t_eval: Option<PyReadonlyArray1<'_, f64>>,
     dt_out: Option<f64>,
     t0: f64,
     t1: f64,
-) -> PyResult<Output> {
+) -> PyResult<(Method, Output)> {
+    let method = solver_from(solver)?;
     crate::numerics::integrate::check_span(t0, t1)?;
     let out = match (t_eval, dt_out) {
         (Some(_), Some(_)) => {
@@ -240,7 +245,7 @@ pub fn output(
         (None, None) => return Err(invalid("dt_out", "None", "t_eval or dt_out is required")),
     };
     out.sample_times(t0, t1)?;
-    Ok(out)
+    Ok((method, out))
 }
 
 /// A run's step counters into `d`, under the names every run's result uses.

@@ -2,8 +2,8 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item,
-    set_counters, solver_from,
+    coupling, crossing_tuple, integration, on_limit, orbit_from, panel_from, required_item,
+    set_counters,
 };
 use super::error::{invalid, shield};
 use crate::analysis::flutter::check_flux;
@@ -181,8 +181,7 @@ fn simulate_distributed<'py>(
     cancellable(cancel, |cancel| {
         let m = model_from(panel, settings)?;
         let o = orbit_from(orbit)?;
-        let method = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (method, out) = integration(solver, t_eval, dt_out, t0, t1)?;
         let limit = self::on_limit(theta_limit, on_limit)?;
         let start = match y0 {
             Some(v) => {

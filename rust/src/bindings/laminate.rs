@@ -2,8 +2,7 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, float_item, hinge_model, orbit_from, output, panel_dict, panel_from, solver_from,
-    type_error,
+    coupling, float_item, hinge_model, integration, orbit_from, panel_dict, panel_from, type_error,
 };
 use super::error::{invalid, shield};
 use super::flutter::{flutter_inputs, set_spectrum};
@@ -294,7 +293,7 @@ fn simulate_layers<'py>(
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let (o, hinge) = (orbit_from(orbit)?, hinge_model(model)?);
-        let (method, out) = (solver_from(solver)?, output(t_eval, dt_out, t0, t1)?);
+        let (method, out) = integration(solver, t_eval, dt_out, t0, t1)?;
         let limit = super::convert::on_limit(theta_limit, on_limit)?;
         let c = conduction_from(&p, layup, nodes)?;
         let (depth, labels) = (c.depth.clone(), c.node_labels());

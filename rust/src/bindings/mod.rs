@@ -23,8 +23,8 @@ use crate::runs::request::{coupled_run, CoupledRun, RunRequest, ThermalChoice, T
 use crate::runs::simulate::{run_watched, state_from};
 use cancel::{cancellable, CancelToken};
 use convert::{
-    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_dict, panel_from,
-    set_counters, solver_from,
+    coupling, crossing_tuple, hinge_model, integration, on_limit, orbit_from, panel_dict,
+    panel_from, set_counters, solver_from,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -241,15 +241,17 @@ fn simulate<'py>(
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
+        let (p, o, hinge) = (panel_from(panel)?, orbit_from(orbit)?, hinge_model(model)?);
+        let (method, out) = integration(solver, t_eval, dt_out, t0, t1)?;
         let req = RunRequest {
-            panel: panel_from(panel)?,
-            orbit: orbit_from(orbit)?,
+            panel: p,
+            orbit: o,
             thermal: ThermalChoice::Layers(layers),
-            model: hinge_model(model)?,
+            model: hinge,
             coupling: coupling(coupled),
-            method: solver_from(solver)?,
+            method,
             span: (t0, t1),
-            output: output(t_eval, dt_out, t0, t1)?,
+            output: out,
             y0,
             limit: self::on_limit(theta_limit, on_limit)?,
         };
@@ -316,8 +318,7 @@ fn simulate_thermal<'py>(
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (m, out) = integration(solver, t_eval, dt_out, t0, t1)?;
         let thermal = crate::models::thermal_model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o);
         let run = py.detach(|| coupled_run(sys, &m, (t0, t1), y0, &out, None, cancel))?;
@@ -346,8 +347,7 @@ fn simulate_hinge<'py>(
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let hinge = hinge_model(model)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (m, out) = integration(solver, t_eval, dt_out, t0, t1)?;
         let values = moment.as_array().to_vec();
         let history = match moment_t {
             None if values.len() == 1 => MomentHistory::Constant(values[0]),
