@@ -21,6 +21,7 @@ from thermojitter.signals import power_spectral_density
 
 LEO = tj.Orbit.leo()
 LEO_ENTRY = LEO.shadow_intervals(0.0, LEO.period)[0][0]
+FINE = tj.SolverSettings(rtol=1e-12, atol=1e-15)
 
 
 def hinge_inertia(panel: tj.Panel) -> float:
@@ -74,7 +75,7 @@ def hubble_like(controller: tj.PD | None = None) -> tj.Spacecraft:
 def test_angular_momentum_is_conserved_over_an_orbit() -> None:
     craft = hubble_like()
     sol = tj.simulate_spacecraft(
-        craft, LEO, (0.0, LEO.period), bus_rate=1e-7, rtol=1e-12, atol=1e-15, dt_out=5.0
+        craft, LEO, (0.0, LEO.period), bus_rate=1e-7, solver=FINE, dt_out=5.0
     )
     # The eclipse exchanged momentum between the bus and the wings: the test is not empty.
     assert np.ptp(sol.phi) > 1e-6 and np.max(np.abs(sol.reaction_torque)) > 1e-3
@@ -111,8 +112,7 @@ def test_momentum_is_conserved_for_drawn_spacecraft(
                                                     where[1], senses[1])],
     )  # fmt: skip
     sol = tj.simulate_spacecraft(
-        craft, LEO, (LEO_ENTRY - 60.0, LEO_ENTRY + 600.0), bus_rate=rate, rtol=1e-12,
-        atol=1e-15, dt_out=2.0,
+        craft, LEO, (LEO_ENTRY - 60.0, LEO_ENTRY + 600.0), bus_rate=rate, solver=FINE, dt_out=2.0,
     )  # fmt: skip
     assert drift(craft, sol) < 1e-9
 
@@ -129,7 +129,7 @@ def test_a_locked_hinge_leaves_the_rigid_body_closed_form() -> None:
     tau, w0 = 0.5, 1e-5
     span = (1000.0, 1300.0)
     sol = tj.simulate_spacecraft(
-        craft, GEO, span, disturbance=tau, bus_rate=w0, rtol=1e-11, atol=1e-14, dt_out=10.0
+        craft, GEO, span, disturbance=tau, bus_rate=w0, solver=FINE, dt_out=10.0
     )
     t = sol.t - span[0]
     want = w0 * t + tau * t**2 / (2.0 * inertia)
@@ -154,7 +154,9 @@ def test_the_pointing_error_of_a_stiffening_hinge_vanishes_as_its_compliance() -
 def test_an_infinitely_heavy_bus_gives_the_paper_hinge_to_the_bit(sense: int) -> None:
     craft = tj.Spacecraft(math.inf, appendages=[(PAPER, (0.0, 3.0), sense)])
     span = (ENTRY - 300.0, ENTRY + 900.0)
-    sol = tj.simulate_spacecraft(craft, GEO, span, method="rk4", dt=0.05, dt_out=0.1)
+    sol = tj.simulate_spacecraft(
+        craft, GEO, span, solver=tj.SolverSettings("rk4", dt=0.05), dt_out=0.1
+    )
     ref = tj.simulate(PAPER, GEO, span, model="linear", method="rk4", dt=0.05, dt_out=0.1)
     assert np.array_equal(sol.theta[:, 0], ref.theta)
     assert np.array_equal(sol.T_front[:, 0], ref.T_front)
@@ -182,7 +184,7 @@ def test_the_pd_controller_settles_at_the_closed_form_offset() -> None:
     inertia = craft.bus_inertia + 2 * lumped(damped)[0] * (2.0 + lumped(damped)[1]) ** 2
     tau = 0.3
     sol = tj.simulate_spacecraft(
-        craft, GEO, (1000.0, 3000.0), disturbance=tau, rtol=1e-11, atol=1e-14, dt_out=5.0
+        craft, GEO, (1000.0, 3000.0), disturbance=tau, solver=FINE, dt_out=5.0
     )
     k_p = inertia * 0.05**2
     assert sol.gains == pytest.approx((k_p, 2 * 0.8 * 0.05 * inertia), rel=1e-14)

@@ -217,13 +217,13 @@ def simulate_spacecraft(
     t0: float,
     t1: float,
     *,
-    disturbance: float,
-    bus_rate: float,
     solver: dict[str, Any],
     t_eval: _F | None,
     dt_out: float | None,
-    y0: list[float] | None,
     cancel: CancelToken | None = None,
+    y0: list[float] | None = None,
+    disturbance: float = 0.0,
+    bus_rate: float = 0.0,
 ) -> dict[str, Any]: ...
 
 # --- flutter analysis ---------------------------------------------------------------------------

@@ -36,13 +36,19 @@ from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import interruptible
 from thermojitter.signals import power_spectral_density, window
-from thermojitter.simulate import Method, run_record, run_settings, start_state, time_span
-from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
+from thermojitter.simulate import run_record, run_settings, start_state, time_span
+from thermojitter.solver import SolverSettings
 
 Array = NDArray[np.float64]
 
 ARCSEC_PER_RADIAN: float = _core.ARCSEC_PER_RADIAN
 """Arcseconds in a radian (648000/π)."""
+
+_COLUMNS = (
+    "phi", "phi_dot", "theta", "theta_dot", "T_front", "T_back", "thermal_moment",
+    "reaction_torque", "bus_torque", "angular_momentum",
+)  # fmt: skip
+"""The engine's columns a :class:`SpacecraftSolution` holds as they come."""
 
 _AXIS_TOLERANCE = 1e-9
 """How far (relative) a hinge axis given as a vector may lean off the bus axis."""
@@ -286,16 +292,10 @@ def simulate_spacecraft(
     disturbance: float = 0.0,
     bus_rate: float = 0.0,
     budget: float | None = None,
-    method: Method = "rk45",
-    rtol: float = RTOL,
-    atol: float = ATOL,
-    dt: float | None = None,
+    y0: Sequence[float] | None = None,
+    solver: SolverSettings | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
-    y0: Sequence[float] | None = None,
-    max_step: float = MAX_STEP,
-    max_steps: int = MAX_STEPS,
-    solver: SolverSettings | None = None,
 ) -> SpacecraftSolution:
     """Integrates a :class:`Spacecraft` over ``t_span`` (s) in ``orbit``.
 
@@ -306,8 +306,8 @@ def simulate_spacecraft(
     - ``y0``: the whole start state instead, (φ, φ̇, then T_front, T_back, θ, θ̇ per appendage).
     - ``budget``: an rms pointing budget in arcsec (Hubble's was 0.007″); ``sol.passed`` says
       whether the rms after every terminator crossing is within it.
-    - The solver and reporting settings are those of :func:`thermojitter.simulate` (reporting
-      every ``dt_out`` = 0.5 s by default).
+    - ``solver``: a :class:`thermojitter.SolverSettings` (default: :func:`thermojitter.simulate`'s
+      rk45 settings); reporting at ``t_eval`` or every ``dt_out`` s (default 0.5 s).
 
     Raises :class:`thermojitter.ParameterError` naming a bad input, ``IntegrationError`` if the
     integrator cannot finish.
@@ -318,10 +318,7 @@ def simulate_spacecraft(
     torque = checks.finite("disturbance", disturbance)
     rate = checks.finite("bus_rate", bus_rate)
     limit = None if budget is None else checks.positive("budget", budget)
-    used, args = run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
-    )  # fmt: skip
+    used, args = run_settings(solver, t_eval, dt_out)
     parts = spacecraft.appendages
     pd = spacecraft.controller
     raw = interruptible(
@@ -342,16 +339,7 @@ def simulate_spacecraft(
     gains = raw["gains"]
     return SpacecraftSolution(
         **run_record(raw, used),
-        phi=raw["phi"],
-        phi_dot=raw["phi_dot"],
-        theta=raw["theta"],
-        theta_dot=raw["theta_dot"],
-        T_front=raw["T_front"],
-        T_back=raw["T_back"],
-        thermal_moment=raw["thermal_moment"],
-        reaction_torque=raw["reaction_torque"],
-        bus_torque=raw["bus_torque"],
-        angular_momentum=raw["angular_momentum"],
+        **{name: raw[name] for name in _COLUMNS},
         gains=None if gains is None else (float(gains[0]), float(gains[1])),
         inertia_at_rest=float(raw["inertia_at_rest"]),
         crossings=_crossings(orbit, t0, t1),

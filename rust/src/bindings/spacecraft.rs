@@ -1,10 +1,10 @@
 //! Bindings of the spacecraft run (`crate::runs::spacecraft`).
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{orbit_from, output, panel_from, solver_from};
+use super::convert::{integration, orbit_from, panel_from};
 use crate::error::Error;
 use crate::models::spacecraft::{Appendage, Pd, Spacecraft, ARCSEC_PER_RADIAN, MAX_APPENDAGES};
-use crate::runs::spacecraft::{simulate_spacecraft as run, SpacecraftRequest};
+use crate::runs::spacecraft::{simulate_spacecraft as run, AppendageColumns, SpacecraftRequest};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -32,7 +32,7 @@ fn per_appendage<'py>(
 /// sense (`senses`, ±1), an optional PD controller (bandwidth rad/s, damping ratio), a constant
 /// `disturbance` torque (N m) on the bus.
 #[pyfunction]
-#[pyo3(signature = (bus_inertia, panels, offsets, senses, controller, orbit, t0, t1, *, disturbance, bus_rate, solver, t_eval, dt_out, y0, cancel=None))]
+#[pyo3(signature = (bus_inertia, panels, offsets, senses, controller, orbit, t0, t1, *, solver, t_eval, dt_out, cancel=None, y0=None, disturbance=0.0, bus_rate=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_spacecraft<'py>(
     py: Python<'py>,
@@ -44,13 +44,13 @@ pub fn simulate_spacecraft<'py>(
     orbit: &Bound<'py, PyDict>,
     t0: f64,
     t1: f64,
-    disturbance: f64,
-    bus_rate: f64,
     solver: &Bound<'py, PyDict>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     dt_out: Option<f64>,
-    y0: Option<Vec<f64>>,
     cancel: Option<&Bound<'py, CancelToken>>,
+    y0: Option<Vec<f64>>,
+    disturbance: f64,
+    bus_rate: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         if panels.len() != offsets.len() || panels.len() != senses.len() {
@@ -77,6 +77,7 @@ pub fn simulate_spacecraft<'py>(
                 sense,
             });
         }
+        let (method, output) = integration(solver, t_eval, dt_out, t0, t1)?;
         let req = SpacecraftRequest {
             craft: Spacecraft {
                 bus_inertia,
@@ -85,11 +86,11 @@ pub fn simulate_spacecraft<'py>(
             },
             orbit: orbit_from(orbit)?,
             disturbance,
-            method: solver_from(solver)?,
+            method,
             span: (t0, t1),
             y0,
             bus_rate,
-            output: output(t_eval, dt_out, t0, t1)?,
+            output,
         };
         let r = py.detach(|| run(&req, cancel))?;
         let n_t = r.t.len();
@@ -102,27 +103,17 @@ pub fn simulate_spacecraft<'py>(
             r.angular_momentum.map(|h| PyArray1::from_vec(py, h)),
         )?;
         let a = &r.appendages;
-        d.set_item(
-            "T_front",
-            per_appendage(py, n_t, a.iter().map(|c| &c.t_front)),
-        )?;
-        d.set_item(
-            "T_back",
-            per_appendage(py, n_t, a.iter().map(|c| &c.t_back)),
-        )?;
-        d.set_item("theta", per_appendage(py, n_t, a.iter().map(|c| &c.theta)))?;
-        d.set_item(
-            "theta_dot",
-            per_appendage(py, n_t, a.iter().map(|c| &c.theta_dot)),
-        )?;
-        d.set_item(
-            "thermal_moment",
-            per_appendage(py, n_t, a.iter().map(|c| &c.thermal_moment)),
-        )?;
-        d.set_item(
-            "reaction_torque",
-            per_appendage(py, n_t, a.iter().map(|c| &c.reaction_torque)),
-        )?;
+        let columns: [(&str, fn(&AppendageColumns) -> &Vec<f64>); 6] = [
+            ("T_front", |c| &c.t_front),
+            ("T_back", |c| &c.t_back),
+            ("theta", |c| &c.theta),
+            ("theta_dot", |c| &c.theta_dot),
+            ("thermal_moment", |c| &c.thermal_moment),
+            ("reaction_torque", |c| &c.reaction_torque),
+        ];
+        for (name, column) in columns {
+            d.set_item(name, per_appendage(py, n_t, a.iter().map(column)))?;
+        }
         d.set_item("gains", r.gains)?;
         d.set_item("inertia_at_rest", r.inertia_at_rest)?;
         Ok(d)

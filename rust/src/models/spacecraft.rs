@@ -216,6 +216,20 @@ impl Spacecraft {
         self.controller.map(|pd| pd.gains(self.inertia_at_rest()))
     }
 
+    /// Checks a value that acts on the bus (a torque, a rate): finite, and 0 on a bus of
+    /// infinite inertia, which does not turn.
+    pub fn check_bus_value(&self, name: &str, value: f64) -> Result<()> {
+        require_finite(name, value)?;
+        if value != 0.0 && self.bus_inertia.is_infinite() {
+            return Err(Error::invalid(
+                name,
+                value,
+                "must be 0 on a bus of infinite inertia",
+            ));
+        }
+        Ok(())
+    }
+
     /// The state's size: 2 + 4 N.
     pub fn size(&self) -> usize {
         BUS_STATES + APPENDAGE_STATES * self.appendages.len()
@@ -261,14 +275,7 @@ impl SpacecraftSystem {
     /// The system of `craft` under a constant disturbance torque `disturbance` (N m) on the bus.
     pub fn new(craft: &Spacecraft, orbit: Orbit, disturbance: f64) -> Result<Self> {
         craft.validate()?;
-        require_finite("disturbance", disturbance)?;
-        if disturbance != 0.0 && craft.bus_inertia.is_infinite() {
-            return Err(Error::invalid(
-                "disturbance",
-                disturbance,
-                "must be 0 on a bus of infinite inertia",
-            ));
-        }
+        craft.check_bus_value("disturbance", disturbance)?;
         let members = craft
             .appendages
             .iter()

@@ -3,7 +3,7 @@
 
 use crate::analysis::steady::equilibrium;
 use crate::cancel::Cancel;
-use crate::error::{require_finite, Error, Result};
+use crate::error::Result;
 use crate::inputs::orbit::Orbit;
 use crate::models::coupled::Coupling;
 use crate::models::spacecraft::{Spacecraft, SpacecraftSystem, APPENDAGE_STATES, BUS_STATES};
@@ -56,14 +56,7 @@ pub fn default_start(
     t0: f64,
     bus_rate: f64,
 ) -> Result<Vec<f64>> {
-    require_finite("bus_rate", bus_rate)?;
-    if bus_rate != 0.0 && craft.bus_inertia.is_infinite() {
-        return Err(Error::invalid(
-            "bus_rate",
-            bus_rate,
-            "must be 0 on a bus of infinite inertia",
-        ));
-    }
+    craft.check_bus_value("bus_rate", bus_rate)?;
     let flux = orbit.flux_scale(t0);
     let mut y = vec![0.0, bus_rate];
     for a in &craft.appendages {
