@@ -9,6 +9,9 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+/// Where one sampled column of an appendage is.
+type Column = fn(&AppendageColumns) -> &Vec<f64>;
+
 /// A (time × appendage) array from per-appendage columns.
 fn per_appendage<'py>(
     py: Python<'py>,
@@ -103,7 +106,7 @@ pub fn simulate_spacecraft<'py>(
             r.angular_momentum.map(|h| PyArray1::from_vec(py, h)),
         )?;
         let a = &r.appendages;
-        let columns: [(&str, fn(&AppendageColumns) -> &Vec<f64>); 6] = [
+        let columns: [(&str, Column); 6] = [
             ("T_front", |c| &c.t_front),
             ("T_back", |c| &c.t_back),
             ("theta", |c| &c.theta),

@@ -171,7 +171,7 @@ pub const MAX_APPENDAGES: usize = 64;
 
 impl Spacecraft {
     pub fn validate(&self) -> Result<()> {
-        if !(self.bus_inertia > 0.0) || self.bus_inertia.is_nan() {
+        if self.bus_inertia.is_nan() || self.bus_inertia <= 0.0 {
             return Err(Error::invalid(
                 "bus_inertia",
                 self.bus_inertia,
