@@ -5,12 +5,17 @@ from __future__ import annotations
 import importlib
 import math
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
+from thermojitter.persist import Persistent
 from thermojitter.solver import SolverSettings
+
+if TYPE_CHECKING:
+    from thermojitter.orbit import Orbit
+    from thermojitter.panel import Panel
 
 Array = NDArray[np.float64]
 
@@ -60,7 +65,7 @@ class _FaceDifference:
 
 
 @dataclass(frozen=True)
-class Equilibrium:
+class Equilibrium(Persistent):
     """The sunlit steady state: temperatures (K), hinge angle (rad) and thermal moment (N m)."""
 
     T_front: float
@@ -79,7 +84,7 @@ class Equilibrium:
 
 
 @dataclass(frozen=True)
-class _Run:
+class _Run(Persistent):
     """Counters common to every run (names as in scipy's solve_ivp where they exist)."""
 
     t: Array
@@ -88,6 +93,10 @@ class _Run:
     n_rhs: int
     method: str
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel the run was made with (saved with the result)."""
+    orbit: Orbit | None = field(default=None, repr=False, compare=False)
+    """The orbit the run was made on (None for a run without one, such as the hinge alone)."""
 
     @property
     def solver(self) -> SolverSettings | None:
@@ -109,7 +118,7 @@ class _Run:
         frame = pd.DataFrame(self._columns(), index=pd.Index(self.t, name="t"))
         return frame
 
-    def to_xarray(self) -> Any:
+    def _dataset(self) -> Any:
         """An xarray Dataset over the time coordinate t (s); needs xarray."""
         xr = _dataframes_module("xarray", "to_xarray()")
         return xr.Dataset(
@@ -177,10 +186,10 @@ class Solution(_FaceDifference, _Run):
             frame.attrs["depth"] = [float(v) for v in np.asarray(self.depth)]
         return frame
 
-    def to_xarray(self) -> Any:
+    def _dataset(self) -> Any:
         """An xarray Dataset over t (s); with ``layers=N`` also ``T_nodes`` over (t, node),
         with the node depth (m) and label (``node_labels``) as coordinates."""
-        ds = super().to_xarray()
+        ds = super()._dataset()
         if self.T_nodes is not None and self.depth is not None:
             ds = ds.assign_coords(depth=("node", np.asarray(self.depth)))
             if self.node_labels is not None:

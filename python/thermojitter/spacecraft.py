@@ -318,7 +318,8 @@ def simulate_spacecraft(
     torque = checks.finite("disturbance", disturbance)
     rate = checks.finite("bus_rate", bus_rate)
     limit = None if budget is None else checks.positive("budget", budget)
-    used, args = run_settings(solver, t_eval, dt_out)
+    used, run = run_settings(solver, (t0, t1), t_eval, dt_out)
+    run["y0"] = start_state(y0, 2 + 4 * len(spacecraft.appendages))
     parts = spacecraft.appendages
     pd = spacecraft.controller
     raw = interruptible(
@@ -329,12 +330,9 @@ def simulate_spacecraft(
         [float(a.sense) for a in parts],
         None if pd is None else (pd.bandwidth, pd.damping),
         orbit.as_dict(),
-        t0,
-        t1,
+        run,
         disturbance=torque,
         bus_rate=rate,
-        y0=start_state(y0, 2 + 4 * len(parts)),
-        **args,
     )
     gains = raw["gains"]
     return SpacecraftSolution(

@@ -1,11 +1,13 @@
 //! Bindings of the spacecraft run (`crate::runs::spacecraft`).
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{integration, orbit_from, panel_from};
+use super::convert::{orbit_from, panel_from, RunOptions};
 use crate::error::Error;
 use crate::models::spacecraft::{Appendage, Pd, Spacecraft, ARCSEC_PER_RADIAN, MAX_APPENDAGES};
-use crate::runs::spacecraft::{simulate_spacecraft as run, AppendageColumns, SpacecraftRequest};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
+use crate::runs::spacecraft::{
+    simulate_spacecraft as simulate, AppendageColumns, SpacecraftRequest,
+};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -35,7 +37,7 @@ fn per_appendage<'py>(
 /// sense (`senses`, ±1), an optional PD controller (bandwidth rad/s, damping ratio), a constant
 /// `disturbance` torque (N m) on the bus.
 #[pyfunction]
-#[pyo3(signature = (bus_inertia, panels, offsets, senses, controller, orbit, t0, t1, *, solver, t_eval, dt_out, cancel=None, y0=None, disturbance=0.0, bus_rate=0.0))]
+#[pyo3(signature = (bus_inertia, panels, offsets, senses, controller, orbit, run, *, disturbance=0.0, bus_rate=0.0, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_spacecraft<'py>(
     py: Python<'py>,
@@ -45,15 +47,10 @@ pub fn simulate_spacecraft<'py>(
     senses: Vec<f64>,
     controller: Option<(f64, f64)>,
     orbit: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    cancel: Option<&Bound<'py, CancelToken>>,
-    y0: Option<Vec<f64>>,
+    run: RunOptions<'py>,
     disturbance: f64,
     bus_rate: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         if panels.len() != offsets.len() || panels.len() != senses.len() {
@@ -80,7 +77,7 @@ pub fn simulate_spacecraft<'py>(
                 sense,
             });
         }
-        let (method, output) = integration(solver, t_eval, dt_out, t0, t1)?;
+        let (method, output) = run.integration()?;
         let req = SpacecraftRequest {
             craft: Spacecraft {
                 bus_inertia,
@@ -90,12 +87,12 @@ pub fn simulate_spacecraft<'py>(
             orbit: orbit_from(orbit)?,
             disturbance,
             method,
-            span: (t0, t1),
-            y0,
+            span: run.span,
+            y0: run.y0,
             bus_rate,
             output,
         };
-        let r = py.detach(|| run(&req, cancel))?;
+        let r = py.detach(|| simulate(&req, cancel))?;
         let n_t = r.t.len();
         let d = super::run_info(py, r.t, &r.stats, r.y_end, &r.method)?;
         d.set_item("phi", PyArray1::from_vec(py, r.phi))?;
