@@ -64,6 +64,7 @@ from thermojitter.simulate import (
     steady_state,
 )
 from thermojitter.solver import HybridSettings, SolverSettings
+from thermojitter.spacecraft import PD, Spacecraft, SpacecraftSolution, simulate_spacecraft
 
 __version__ = "0.1.0"
 
@@ -108,6 +109,7 @@ __all__ = [
     "Orbit",
     "Attitude",
     "HybridFallbackWarning",
+    "PD",
     "OrbitSummaries",
     "Panel",
     "ParameterError",
@@ -117,6 +119,8 @@ __all__ = [
     "SensitivityResult",
     "Solution",
     "SolverSettings",
+    "Spacecraft",
+    "SpacecraftSolution",
     "StabilityMap",
     "ThermalSolution",
     "ValidityLimitWarning",
@@ -144,6 +148,7 @@ __all__ = [
     "simulate_distributed",
     "simulate_hinge",
     "simulate_orbits",
+    "simulate_spacecraft",
     "simulate_thermal",
     "stability_map",
     "steady_state",

@@ -45,6 +45,7 @@ __all__ = [
     "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
+    "ARCSEC_PER_RADIAN",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -89,6 +90,7 @@ __all__ = [
     "simulate",
     "simulate_distributed",
     "simulate_hinge",
+    "simulate_spacecraft",
     "simulate_layers",
     "simulate_thermal",
     "stability_map",
@@ -136,6 +138,7 @@ STEFAN_BOLTZMANN: float
 MAX_THREADS: int
 MAX_TIME: float
 VALIDITY_LIMIT: float
+ARCSEC_PER_RADIAN: float  # 648000/π
 
 class _Limit(TypedDict):
     """The validity limit a run watches (``thermojitter.simulate.limit_args``)."""
@@ -213,6 +216,21 @@ def simulate_hinge(
     model: str,
     moment: _F,
     moment_t: _F | None,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+
+# --- the spacecraft bus --------------------------------------------------------------------------
+def simulate_spacecraft(
+    bus_inertia: float,
+    panels: list[dict[str, float]],
+    offsets: list[float],
+    senses: list[float],
+    controller: tuple[float, float] | None,
+    orbit: dict[str, Any],
+    run: _Run,
+    *,
+    disturbance: float = 0.0,
+    bus_rate: float = 0.0,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 

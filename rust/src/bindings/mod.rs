@@ -11,6 +11,7 @@ mod flutter;
 mod laminate;
 mod orbit;
 mod orbits;
+mod spacecraft;
 
 use crate::analysis::steady::equilibrium;
 use crate::inputs::heating::Optics;
@@ -485,5 +486,6 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     ensemble::register(m)?;
     cancel::register(m)?;
     laminate::register(m)?;
+    spacecraft::register(m)?;
     Ok(())
 }
