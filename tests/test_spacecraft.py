@@ -245,3 +245,21 @@ def test_bad_inputs_are_refused_by_name(make, name: str) -> None:  # type: ignor
     with pytest.raises(tj.ParameterError) as info:
         make()
     assert info.value.parameter == name
+
+
+@pytest.mark.parametrize(
+    ("orbit", "name"),
+    [
+        (tj.Orbit.circular(540e3, inclination=0.5), "albedo"),
+        (tj.Orbit.circular(540e3, inclination=0.5, albedo=0.0), "earth_ir"),
+    ],
+)
+def test_earth_heating_the_bus_model_does_not_take_is_refused_by_name(
+    orbit: tj.Orbit, name: str
+) -> None:
+    # The bus model heats each panel's front by sunlight only: an orbit that also heats by the
+    # Earth is refused, not run without it.
+    craft = tj.Spacecraft(7.7e4, appendages=[(PAPER, (2.0, 0.0), 1)])
+    with pytest.raises(tj.ParameterError) as info:
+        tj.simulate_spacecraft(craft, orbit, (0.0, 10.0))
+    assert info.value.parameter == name

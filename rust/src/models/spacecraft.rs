@@ -296,12 +296,16 @@ impl SpacecraftSystem {
                 }
             })
             .collect();
+        // The bus model takes the front's sunlight only: an orbit with the Earth's heat or
+        // another attitude is refused by name rather than run without them.
+        let sun = Sunlight::new(orbit);
+        sun.check("the spacecraft model")?;
         Ok(SpacecraftSystem {
             bus_inertia: craft.bus_inertia,
             members,
             gains: craft.gains(),
             disturbance,
-            sun: Sunlight::new(orbit),
+            sun,
         })
     }
 
