@@ -88,6 +88,12 @@ def _results() -> dict[str, Any]:
             PAPER, GEO, t_span=(ENTRY - 30.0, ENTRY + 60.0), n_elements=10
         ),
         "calibration": _calibration,
+        "spacecraft solution": lambda: tj.simulate_spacecraft(
+            tj.Spacecraft(7.7e4, appendages=[(PAPER, (2.0, 0.0), 1)], controller=tj.PD(0.1, 0.7)),
+            GEO,
+            (ENTRY - 30.0, ENTRY + 30.0),
+            budget=0.007,
+        ),
     }
 
 

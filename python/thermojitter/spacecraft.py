@@ -34,6 +34,7 @@ from thermojitter import errors as checks
 from thermojitter.errors import ParameterError
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible
 from thermojitter.signals import power_spectral_density, window
 from thermojitter.simulate import run_record, run_settings, start_state, time_span
@@ -173,7 +174,7 @@ class CrossingPointing(NamedTuple):
 
 
 @dataclass
-class SpacecraftSolution:
+class SpacecraftSolution(Persistent):
     """A spacecraft run. Angles are in rad, the pointing error in arcsec; the per-appendage
     columns are (time × appendage) arrays."""
 
