@@ -8,6 +8,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 
 from thermojitter import _core, beam, materials, nastran
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.attitude import Attitude
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
@@ -20,6 +21,7 @@ from thermojitter.distributed import (
     simulate_distributed,
 )
 from thermojitter.errors import (
+    HybridFallbackWarning,
     InternalError,
     ParameterError,
     ParameterTypeError,
@@ -104,6 +106,8 @@ __all__ = [
     "LinearThermalResponse",
     "NastranBeam",
     "Orbit",
+    "Attitude",
+    "HybridFallbackWarning",
     "OrbitSummaries",
     "Panel",
     "ParameterError",

@@ -57,6 +57,8 @@ __all__ = [
     "beta",
     "nodal_rate",
     "J2",
+    "EARTH_ALBEDO",
+    "EARTH_IR",
     "OBLIQUITY",
     "YEAR_DAYS",
     "DAY",
@@ -68,6 +70,7 @@ __all__ = [
     "energy",
     "equivalent_panel",
     "flutter",
+    "flutter_at",
     "flux_scale",
     "hinge_points",
     "hinge_equivalent_damping_ratio",
@@ -122,6 +125,8 @@ MU_EARTH: float
 EQUINOX_DAY: float
 PERIHELION_DAY: float
 J2: float
+EARTH_ALBEDO: float
+EARTH_IR: float
 OBLIQUITY: float
 YEAR_DAYS: float
 DAY: float
@@ -214,6 +219,15 @@ def simulate_hinge(
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(
     panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
+) -> dict[str, Any]: ...
+def flutter_at(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    t: float,
+    model: str,
+    coupled: bool,
+    with_critical: bool = True,
 ) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------
