@@ -19,7 +19,7 @@ use thermojitter::models::hinge::HingeModel;
 use thermojitter::numerics::cpu::ScalarKernel;
 use thermojitter::numerics::integrate::dopri5;
 use thermojitter::numerics::integrate::{
-    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, StepCounter, Tolerances,
+    solve, solve_on, FusedRhs, Method, OdeSystem, Recorder, Span, StepCounter, Tolerances,
 };
 use thermojitter::runs::ensemble::{pool, run_batch_on, EnsembleSettings, Path};
 use thermojitter::runs::lockstep::RUNS_PER_CORE;
@@ -161,9 +161,11 @@ fn main() {
                 kernel,
                 &mut sys,
                 &method,
-                0.0,
-                black_box(y0),
-                orbit.period,
+                Span {
+                    t0: 0.0,
+                    y0: black_box(y0),
+                    t1: orbit.period,
+                },
                 &mut counter,
             )
             .expect("orbit");

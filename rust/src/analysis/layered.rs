@@ -112,42 +112,6 @@ pub fn start_state(
     Ok(y)
 }
 
-/// The analytic Jacobian of the nodal system (N node temperatures, θ, θ̇) at a steady state.
-pub fn jacobian(
-    panel: &Panel,
-    c: &Conduction,
-    model: HingeModel,
-    coupling: Coupling,
-    flux: f64,
-    eq: &LayeredEquilibrium,
-) -> DMatrix<f64> {
-    let n = c.nodes();
-    let t = &eq.temperatures;
-    let mut j = DMatrix::zeros(n + 2, n + 2);
-    let k = c.conduction_matrix();
-    for r in 0..n {
-        for col in 0..n {
-            j[(r, col)] = -k[(r, col)] / c.capacity[r];
-        }
-    }
-    j[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3) / c.capacity[0];
-    j[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3) / c.capacity[n - 1];
-    let s = eq.theta.sin();
-    if coupling == Coupling::ProjectedArea {
-        j[(0, n)] = -c.absorbed * flux * s / c.capacity[0];
-    }
-    j[(n, n + 1)] = 1.0;
-    // The static residual is zero at the equilibrium, so the derivative of the non-linear
-    // inertia factor drops out (as in the two-layer Jacobian).
-    let inertia = panel.hinge_inertia() * model.inertia_factor(s);
-    for col in 0..n {
-        j[(n + 1, col)] = c.moment_weight[col] / inertia;
-    }
-    j[(n + 1, n)] = -panel.hinge_stiffness / inertia;
-    j[(n + 1, n + 1)] = -panel.damping / inertia;
-    j
-}
-
 /// Linear stability of the N-node system's sunlit equilibrium (the full nodal Jacobian: an
 /// eigen-analysis has no step to protect from fast modes).
 #[derive(Debug, Clone, PartialEq)]
@@ -163,23 +127,84 @@ pub struct LayeredFlutter {
     pub frequency_hz: f64,
 }
 
-pub fn analyse(
-    panel: &Panel,
-    c: &Conduction,
-    model: HingeModel,
-    coupling: Coupling,
-    flux: f64,
-) -> Result<LayeredFlutter> {
-    let eq = equilibrium(panel, c, coupling, flux)?;
-    let jac = jacobian(panel, c, model, coupling, flux, &eq);
-    let (growth_rate, frequency_hz, eigenvalues) = growth(panel, &jac, &eq)?;
-    Ok(LayeredFlutter {
-        jacobian: jac,
-        equilibrium: eq,
-        eigenvalues,
-        growth_rate,
-        frequency_hz,
-    })
+/// One operating point of the N-node laminate on the hinge: the inputs that its Jacobian,
+/// flutter analysis and critical damping all read.
+#[derive(Debug, Clone, Copy)]
+pub struct LayeredPoint<'a> {
+    pub panel: &'a Panel,
+    pub conduction: &'a Conduction,
+    pub model: HingeModel,
+    pub coupling: Coupling,
+    /// The illumination factor (flux scale) held constant.
+    pub flux: f64,
+}
+
+impl LayeredPoint<'_> {
+    /// The steady state at this point.
+    pub fn equilibrium(&self) -> Result<LayeredEquilibrium> {
+        equilibrium(self.panel, self.conduction, self.coupling, self.flux)
+    }
+
+    /// The analytic Jacobian of the nodal system (N node temperatures, θ, θ̇) at a steady state.
+    pub fn jacobian(&self, eq: &LayeredEquilibrium) -> DMatrix<f64> {
+        let LayeredPoint {
+            panel,
+            conduction: c,
+            model,
+            coupling,
+            flux,
+        } = *self;
+        let n = c.nodes();
+        let t = &eq.temperatures;
+        let mut j = DMatrix::zeros(n + 2, n + 2);
+        let k = c.conduction_matrix();
+        for r in 0..n {
+            for col in 0..n {
+                j[(r, col)] = -k[(r, col)] / c.capacity[r];
+            }
+        }
+        j[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3) / c.capacity[0];
+        j[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3) / c.capacity[n - 1];
+        let s = eq.theta.sin();
+        if coupling == Coupling::ProjectedArea {
+            j[(0, n)] = -c.absorbed * flux * s / c.capacity[0];
+        }
+        j[(n, n + 1)] = 1.0;
+        // The static residual is zero at the equilibrium, so the derivative of the non-linear
+        // inertia factor drops out (as in the two-layer Jacobian).
+        let inertia = panel.hinge_inertia() * model.inertia_factor(s);
+        for col in 0..n {
+            j[(n + 1, col)] = c.moment_weight[col] / inertia;
+        }
+        j[(n + 1, n)] = -panel.hinge_stiffness / inertia;
+        j[(n + 1, n + 1)] = -panel.damping / inertia;
+        j
+    }
+
+    /// The flutter analysis of this point: equilibrium, Jacobian, spectrum.
+    pub fn analyse(&self) -> Result<LayeredFlutter> {
+        let eq = self.equilibrium()?;
+        let jac = self.jacobian(&eq);
+        let (growth_rate, frequency_hz, eigenvalues) = growth(self.panel, &jac, &eq)?;
+        Ok(LayeredFlutter {
+            jacobian: jac,
+            equilibrium: eq,
+            eigenvalues,
+            growth_rate,
+            frequency_hz,
+        })
+    }
+
+    /// The damping c_d (N m s/rad) at which the growth rate crosses zero (bisection); 0 when
+    /// the panel is stable without damping.
+    pub fn critical_damping(&self) -> Result<f64> {
+        // The equilibrium does not depend on c_d.
+        let eq = self.equilibrium()?;
+        crate::analysis::flutter::critical_hinge_damping(self.panel, |p| {
+            let jac = LayeredPoint { panel: p, ..*self }.jacobian(&eq);
+            Ok(growth(p, &jac, &eq)?.0)
+        })
+    }
 }
 
 /// (growth rate, frequency, eigenvalues by decreasing real part) of `jac`, the Jacobian of
@@ -202,21 +227,4 @@ fn growth(
         spectrum.frequency_hz,
         spectrum.eigenvalues,
     ))
-}
-
-/// The damping c_d (N m s/rad) at which the growth rate crosses zero (bisection); 0 when the
-/// panel is stable without damping.
-pub fn critical_damping(
-    panel: &Panel,
-    c: &Conduction,
-    model: HingeModel,
-    coupling: Coupling,
-    flux: f64,
-) -> Result<f64> {
-    // The equilibrium does not depend on c_d.
-    let eq = equilibrium(panel, c, coupling, flux)?;
-    crate::analysis::flutter::critical_hinge_damping(panel, |p| {
-        let jac = jacobian(p, c, model, coupling, flux, &eq);
-        Ok(growth(p, &jac, &eq)?.0)
-    })
 }

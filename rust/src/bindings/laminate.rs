@@ -246,15 +246,20 @@ fn layered_flutter<'py>(
     shield(|| {
         let (p, m) = flutter_inputs(panel, model, flux)?;
         let c = grid.conduction(&p)?;
-        let k = coupling(coupled);
-        let a = py.detach(|| crate::analysis::layered::analyse(&p, &c, m, k, flux))?;
+        let point = crate::analysis::layered::LayeredPoint {
+            panel: &p,
+            conduction: &c,
+            model: m,
+            coupling: coupling(coupled),
+            flux,
+        };
+        let a = py.detach(|| point.analyse())?;
         let d = equilibrium_dict(py, &a.equilibrium)?;
         let size = a.jacobian.nrows();
         let rows = (0..size).map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect());
         set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
         if with_critical {
-            let cd =
-                py.detach(|| crate::analysis::layered::critical_damping(&p, &c, m, k, flux))?;
+            let cd = py.detach(|| point.critical_damping())?;
             d.set_item("critical_damping", cd)?;
         }
         Ok(d)

@@ -291,7 +291,7 @@ pub struct Layers {
 
 /// One sample with the N-node model: the N-node flutter analysis and the summarised N-node run
 /// of `panel` from its sunlit equilibrium, the same computations as a single run of it
-/// (`layered::analyse`, `layered::critical_damping`, `layered::run_orbits`).
+/// (`LayeredPoint::analyse`, `LayeredPoint::critical_damping`, `layered::run_orbits`).
 pub fn run_sample_layered(
     panel: &Panel,
     settings: &EnsembleSettings,
@@ -305,8 +305,15 @@ pub fn run_sample_layered(
         Some(l) => crate::models::conduction::Conduction::new(panel, l, layers.nodes)?,
         None => crate::models::conduction::Conduction::homogeneous(panel, layers.nodes)?,
     };
-    let flutter = crate::analysis::layered::analyse(panel, &c, s.model, s.coupling, 1.0)?;
-    let critical = crate::analysis::layered::critical_damping(panel, &c, s.model, s.coupling, 1.0)?;
+    let point = crate::analysis::layered::LayeredPoint {
+        panel,
+        conduction: &c,
+        model: s.model,
+        coupling: s.coupling,
+        flux: 1.0,
+    };
+    let flutter = point.analyse()?;
+    let critical = point.critical_damping()?;
     let eq = crate::analysis::layered::equilibrium(panel, &c, s.coupling, s.orbit.flux_scale(0.0))?;
     let mut y0 = eq.temperatures;
     y0.extend([eq.theta, 0.0]);

@@ -1,8 +1,6 @@
 //! Tests of the N-node laminate on the hinge: the model, its steady state and flutter, its runs.
 
-use crate::analysis::layered::{
-    analyse, critical_damping, equilibrium, jacobian, start_state, LayeredEquilibrium,
-};
+use crate::analysis::layered::{equilibrium, start_state, LayeredEquilibrium, LayeredPoint};
 use crate::error::Error;
 use crate::inputs::laminate::{wing_layup, Laminate, MATERIALS};
 use crate::inputs::orbit::Orbit;
@@ -16,6 +14,22 @@ use crate::runs::layered::{
     run_orbits, run_orbits_reading, simulate, LayeredOrbit, LayeredRun, LayeredRunRequest,
 };
 use nalgebra::{DMatrix, DVector};
+
+/// The operating point of `p` and `c` at full sun.
+fn point<'a>(
+    p: &'a Panel,
+    c: &'a Conduction,
+    model: HingeModel,
+    coupling: Coupling,
+) -> LayeredPoint<'a> {
+    LayeredPoint {
+        panel: p,
+        conduction: c,
+        model,
+        coupling,
+        flux: 1.0,
+    }
+}
 
 /// The non-linear, two-way coupled system of `p` and `c`, its conduction modes faster than
 /// `fast_mode_factor` (see [`FAST_MODE_FACTOR`]) slaved; infinity slaves none.
@@ -54,7 +68,9 @@ fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
             let two_eq = crate::analysis::steady::equilibrium(&p, coupling, 1.0).unwrap();
             assert!((eq.theta / two_eq.theta - 1.0).abs() < 1e-10);
             assert!((eq.temperatures[0] / two_eq.t_front - 1.0).abs() < 1e-12);
-            let a = analyse(&p, &sys.conduction, model, coupling, 1.0).unwrap();
+            let a = point(&p, &sys.conduction, model, coupling)
+                .analyse()
+                .unwrap();
             let b = crate::analysis::flutter::analyse(&p, model, coupling, 1.0).unwrap();
             assert!((a.growth_rate - b.growth_rate).abs() < 1e-9 * b.growth_rate.abs().max(1e-6));
         }
@@ -102,14 +118,7 @@ fn jacobian_matches_finite_differences() {
     let c = Conduction::new(&p, &wing_layup(), 9).unwrap();
     let sys = nonlinear_system(&p, &c, f64::INFINITY);
     let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
-    let jac = jacobian(
-        &p,
-        &c,
-        HingeModel::Nonlinear,
-        Coupling::ProjectedArea,
-        1.0,
-        &eq,
-    );
+    let jac = point(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea).jacobian(&eq);
     let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
     let n = y.len();
     let mut f0 = vec![0.0; n];
@@ -207,9 +216,12 @@ fn fast_mode_factor_measurement() {
         let p = Panel { damping: 0.0, ..p };
         let c = Conduction::new(&p, &lam, 20).unwrap();
         let eq = equilibrium(&p, &c, Coupling::ProjectedArea, 1.0).unwrap();
-        let full = analyse(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0).unwrap();
-        let cd =
-            critical_damping(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0).unwrap();
+        let full = point(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea)
+            .analyse()
+            .unwrap();
+        let cd = point(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea)
+            .critical_damping()
+            .unwrap();
         let wn = p.natural_angular_frequency();
         let rates = c.modes().rates;
         println!(
@@ -426,7 +438,9 @@ fn reduced_growth_measurement() {
     for (name, p, lam) in examples() {
         let p = Panel { damping: 0.0, ..p };
         let c = Conduction::new(&p, &lam, 20).unwrap();
-        let full = analyse(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea, 1.0).unwrap();
+        let full = point(&p, &c, HingeModel::Nonlinear, Coupling::ProjectedArea)
+            .analyse()
+            .unwrap();
         let eq = full.equilibrium.clone();
         println!("{name}: full growth {:.6e}", full.growth_rate);
         for factor in [1.0, 2.0, 5.0, 10.0, 20.0, 1e9] {
@@ -471,7 +485,7 @@ fn critical_damping_converges_with_the_nodes_and_two_nodes_are_the_two_layer_mod
     let (model, coupling) = (HingeModel::Nonlinear, Coupling::ProjectedArea);
     let cd = |nodes: usize| {
         let c = Conduction::homogeneous(&p, nodes).unwrap();
-        critical_damping(&p, &c, model, coupling, 1.0).unwrap()
+        point(&p, &c, model, coupling).critical_damping().unwrap()
     };
     // (1) Two nodes: the two-layer model's c_d* (to the bisection's tolerance).
     let two = crate::analysis::flutter::critical_damping(&p, model, coupling, 1.0).unwrap();
@@ -484,7 +498,9 @@ fn critical_damping_converges_with_the_nodes_and_two_nodes_are_the_two_layer_mod
         ..p
     };
     let c2 = Conduction::homogeneous(&equal, 2).unwrap();
-    let exact = critical_damping(&equal, &c2, HingeModel::Linear, coupling, 1.0).unwrap();
+    let exact = point(&equal, &c2, HingeModel::Linear, coupling)
+        .critical_damping()
+        .unwrap();
     let closed = crate::analysis::linear::LinearThermal::new(&equal, 1.0, None, None)
         .unwrap()
         .critical_damping_estimate();

@@ -32,7 +32,7 @@ use crate::numerics::integrate::dopri5::{
     self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
 };
 use crate::numerics::integrate::{
-    check_span, solve_on, DenseStep, FusedRhs, Method, Observer, OdeSystem, Stats, Tolerances,
+    check_span, solve_on, DenseStep, FusedRhs, Method, Observer, OdeSystem, Span, Stats, Tolerances,
 };
 #[cfg(target_arch = "x86_64")]
 use crate::numerics::simd::{Avx, Avx512};
@@ -775,9 +775,11 @@ impl<V: Lanes, O: LaneObserver> Group<V, O> {
                         kernel_of::<V>(),
                         &mut job.system,
                         &Method::Dopri5(job.tol),
-                        job.t0,
-                        job.y0,
-                        job.t1,
+                        Span {
+                            t0: job.t0,
+                            y0: job.y0,
+                            t1: job.t1,
+                        },
                         &mut job.observer,
                     );
                     done(job.observer, outcome);
@@ -988,17 +990,13 @@ mod tests {
         jobs.into_iter()
             .map(|mut j| {
                 let method = Method::Dopri5(j.tol);
-                let (t0, y0, t1) = (j.t0, j.y0, j.t1);
-                let (stats, y_end) = solve_on(
-                    kernel,
-                    &mut j.system,
-                    &method,
-                    t0,
-                    y0,
-                    t1,
-                    &mut j.observer.1,
-                )
-                .unwrap();
+                let span = Span {
+                    t0: j.t0,
+                    y0: j.y0,
+                    t1: j.t1,
+                };
+                let (stats, y_end) =
+                    solve_on(kernel, &mut j.system, &method, span, &mut j.observer.1).unwrap();
                 bits(&j.observer.1, &y_end, stats)
             })
             .collect()

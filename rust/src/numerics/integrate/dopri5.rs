@@ -6,7 +6,7 @@
 //! It takes the same steps as SciPy's RK45 (tests/test_controller.py); the arithmetic is arranged
 //! for short dependency chains (benches/README.md), which moves results by rounding only.
 
-use super::{rms_scaled, DenseStep, Observer, OdeSystem, State, Stats, Tolerances};
+use super::{rms_scaled, DenseStep, Integration, Observer, OdeSystem, State, Stats, Tolerances};
 use crate::error::{Error, Result};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim};
@@ -169,20 +169,18 @@ where
 #[inline(always)]
 pub(super) fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &S,
-    a: f64,
-    b: f64,
-    y: &mut State<D>,
+    (a, b): (f64, f64),
     tol: &Tolerances,
-    stats: &mut Stats,
-    observer: &mut O,
+    run: &mut Integration<'_, D, O>,
 ) -> Result<ControlFlow<()>>
 where
     DefaultAllocator: Allocator<D>,
 {
     let mut t = a;
-    let mut k1 = system.rhs(t, y);
-    stats.n_rhs += 1;
-    let mut h_abs = initial_step(system, t, y, &k1, b - a, tol, stats).min(tol.max_step);
+    let mut k1 = system.rhs(t, &run.y);
+    run.stats.n_rhs += 1;
+    let mut h_abs =
+        initial_step(system, t, &run.y, &k1, b - a, tol, &mut run.stats).min(tol.max_step);
 
     while t < b {
         let min_step = 10.0 * (next_up(t) - t);
@@ -191,7 +189,7 @@ where
         }
         let mut rejected = false;
         loop {
-            if stats.n_steps + stats.n_rejected >= tol.max_steps {
+            if run.stats.n_steps + run.stats.n_rejected >= tol.max_steps {
                 return Err(Error::Integration {
                     t,
                     reason: format!("max_steps = {} reached", tol.max_steps),
@@ -200,9 +198,9 @@ where
             let t_new = if t + h_abs >= b { b } else { t + h_abs };
             let h = t_new - t;
 
-            let y0 = y.clone();
+            let y0 = run.y.clone();
             let Step { y_new, k, err } = step(system, t, t_new, &y0, &k1);
-            stats.n_rhs += 6;
+            run.stats.n_rhs += 6;
             // The error's scale is known before the last stage is, so its reciprocal is ready
             // by the time the error is; the growth factor comes straight from the mean square.
             let weight = y0.zip_map(&y_new, |u, v| {
@@ -214,21 +212,21 @@ where
 
             if mean_square < 1.0 {
                 // NaN fails this test, so a non-finite state is rejected and shrinks h.
-                stats.n_steps += 1;
+                run.stats.n_steps += 1;
                 let [_, _, k3, k4, k5, k6, k7] = k;
-                *y = y_new.clone();
+                run.y = y_new.clone();
                 let next_k1 = k7.clone();
                 let dense = DenseStep::dopri5(t, t_new, y0, y_new, [k1, k3, k4, k5, k6, k7]);
                 t = t_new;
-                stats.t_end = t;
+                run.stats.t_end = t;
                 k1 = next_k1;
                 h_abs = next_step(h, mean_square, rejected, tol.max_step);
-                if observer.on_step(&dense).is_break() {
+                if run.observer.on_step(&dense).is_break() {
                     return Ok(ControlFlow::Break(()));
                 }
                 break;
             }
-            stats.n_rejected += 1;
+            run.stats.n_rejected += 1;
             let err_norm = mean_square.sqrt();
             let shrink = if err_norm.is_finite() {
                 MIN_FACTOR.max(SAFETY * err_norm.powf(ERROR_EXPONENT))

@@ -341,6 +341,17 @@ pub struct Stats {
     pub stopped: bool,
 }
 
+/// The problem of one integration: from (t0, y0) to t1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Span<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    pub t0: f64,
+    pub y0: State<D>,
+    pub t1: f64,
+}
+
 /// Integrates `system` from (t0, y0) to t1 with `method`, cutting at the system's breakpoints.
 /// Returns the counters and the state at `stats.t_end`. Runs on [`ScalarKernel::detect`].
 pub fn solve<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
@@ -354,23 +365,23 @@ pub fn solve<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
 where
     DefaultAllocator: Allocator<D>,
 {
-    solve_on(ScalarKernel::detect(), system, method, t0, y0, t1, observer)
+    let span = Span { t0, y0, t1 };
+    solve_on(ScalarKernel::detect(), system, method, span, observer)
 }
 
-/// [`solve`] on a given compilation of its loop (the portable one when the processor lacks the
-/// kernel's instruction set).
+/// [`solve`] of `span` on a given compilation of its loop (the portable one when the processor
+/// lacks the kernel's instruction set).
 pub fn solve_on<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     kernel: ScalarKernel,
     system: &mut S,
     method: &Method,
-    t0: f64,
-    y0: State<D>,
-    t1: f64,
+    span: Span<D>,
     observer: &mut O,
 ) -> Result<(Stats, State<D>)>
 where
     DefaultAllocator: Allocator<D>,
 {
+    let Span { t0, y0, t1 } = span;
     method.validate()?;
     system.check_span(t0, t1)?;
     if let Method::Rk4 { dt } = method {
@@ -396,29 +407,50 @@ where
     let mut cuts = vec![t0];
     cuts.extend(system.breakpoints(t0, t1));
     cuts.push(t1);
+    let run = Integration {
+        method,
+        cuts,
+        y: y0,
+        stats: Stats {
+            t_end: t0,
+            ..Stats::default()
+        },
+        observer,
+    };
     match kernel {
         #[cfg(target_arch = "x86_64")]
         ScalarKernel::Fma if kernel.runs_here() => {
             // SAFETY: the processor has AVX and FMA (checked just above).
-            unsafe { integrate_fma(system, method, &cuts, y0, observer) }
+            unsafe { integrate_fma(system, run) }
         }
-        _ => integrate::<false, D, S, O>(system, method, &cuts, y0, observer),
+        _ => integrate::<false, D, S, O>(system, run),
     }
+}
+
+/// An integration under way: the method, the span's cuts (its ends and the system's
+/// breakpoints), the state reached, the work counters and the observer, carried from segment to
+/// segment and through each stepper.
+pub(super) struct Integration<'r, D: Dim, O>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    method: &'r Method,
+    cuts: Vec<f64>,
+    pub(super) y: State<D>,
+    pub(super) stats: Stats,
+    pub(super) observer: &'r mut O,
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,fma")]
 unsafe fn integrate_fma<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &mut S,
-    method: &Method,
-    cuts: &[f64],
-    y0: State<D>,
-    observer: &mut O,
+    run: Integration<'_, D, O>,
 ) -> Result<(Stats, State<D>)>
 where
     DefaultAllocator: Allocator<D>,
 {
-    integrate::<true, D, S, O>(system, method, cuts, y0, observer)
+    integrate::<true, D, S, O>(system, run)
 }
 
 /// `system` seen through its fused right-hand side ([`OdeSystem::rhs_fused`]), for the steppers.
@@ -434,26 +466,18 @@ where
     }
 }
 
-/// The segments between successive `cuts` (the span's ends and breakpoints), one after another,
-/// on the fused right-hand side when `FUSED`. Always inlined, with the steppers and the
-/// right-hand side, into each compilation.
+/// The segments between successive cuts, one after another, on the fused right-hand side when
+/// `FUSED`. Always inlined, with the steppers and the right-hand side, into each compilation.
 #[inline(always)]
 fn integrate<const FUSED: bool, D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &mut S,
-    method: &Method,
-    cuts: &[f64],
-    y0: State<D>,
-    observer: &mut O,
+    mut run: Integration<'_, D, O>,
 ) -> Result<(Stats, State<D>)>
 where
     DefaultAllocator: Allocator<D>,
 {
+    let cuts = std::mem::take(&mut run.cuts);
     let t1 = cuts[cuts.len() - 1];
-    let mut stats = Stats {
-        t_end: cuts[0],
-        ..Stats::default()
-    };
-    let mut y = y0;
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
         if b <= a {
@@ -461,43 +485,29 @@ where
         }
         system.enter_segment(a, b);
         let flow = if FUSED {
-            segment(
-                &FusedRhs(&*system),
-                method,
-                a,
-                b,
-                &mut y,
-                &mut stats,
-                observer,
-            )?
+            run.segment(&FusedRhs(&*system), (a, b))?
         } else {
-            segment(&*system, method, a, b, &mut y, &mut stats, observer)?
+            run.segment(&*system, (a, b))?
         };
         if flow.is_break() {
-            stats.stopped = stats.t_end < t1;
+            run.stats.stopped = run.stats.t_end < t1;
             break;
         }
     }
-    Ok((stats, y))
+    Ok((run.stats, run.y))
 }
 
-/// One segment [a, b] by `method`.
-#[inline(always)]
-fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
-    system: &S,
-    method: &Method,
-    a: f64,
-    b: f64,
-    y: &mut State<D>,
-    stats: &mut Stats,
-    observer: &mut O,
-) -> Result<ControlFlow<()>>
+impl<D: Dim, O: Observer<D>> Integration<'_, D, O>
 where
     DefaultAllocator: Allocator<D>,
 {
-    match method {
-        Method::Rk4 { dt } => rk4::segment(system, a, b, y, *dt, stats, observer),
-        Method::Dopri5(tol) => dopri5::segment(system, a, b, y, tol, stats, observer),
+    /// One segment [a, b] by the run's method.
+    #[inline(always)]
+    fn segment<S: OdeSystem<D>>(&mut self, system: &S, ab: (f64, f64)) -> Result<ControlFlow<()>> {
+        match self.method {
+            Method::Rk4 { dt } => rk4::segment(system, ab, *dt, self),
+            Method::Dopri5(tol) => dopri5::segment(system, ab, tol, self),
+        }
     }
 }
 

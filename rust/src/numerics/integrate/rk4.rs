@@ -1,6 +1,6 @@
 //! Classical fourth-order Runge–Kutta with a fixed step.
 
-use super::{DenseStep, Observer, OdeSystem, State, Stats};
+use super::{DenseStep, Integration, Observer, OdeSystem};
 use crate::error::Result;
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim};
@@ -11,12 +11,9 @@ use std::ops::ControlFlow;
 #[inline(always)]
 pub(super) fn segment<D: Dim, S: OdeSystem<D>, O: Observer<D>>(
     system: &S,
-    a: f64,
-    b: f64,
-    y: &mut State<D>,
+    (a, b): (f64, f64),
     dt: f64,
-    stats: &mut Stats,
-    observer: &mut O,
+    run: &mut Integration<'_, D, O>,
 ) -> Result<ControlFlow<()>>
 where
     DefaultAllocator: Allocator<D>,
@@ -24,8 +21,8 @@ where
     // The small allowance keeps a span that is a whole number of dt from gaining a sliver step.
     let n = (((b - a) / dt) * (1.0 - 1e-12)).ceil().max(1.0) as u64;
     let h = (b - a) / n as f64;
-    let mut k1 = system.rhs(a, y);
-    stats.n_rhs += 1;
+    let mut k1 = system.rhs(a, &run.y);
+    run.stats.n_rhs += 1;
     for i in 0..n {
         let t = a + i as f64 * h;
         let t_new = if i + 1 == n {
@@ -33,26 +30,26 @@ where
         } else {
             a + (i + 1) as f64 * h
         };
-        let y0 = y.clone();
+        let y0 = run.y.clone();
         let k2 = system.rhs(t + 0.5 * h, &(&y0 + &k1 * (0.5 * h)));
         let k3 = system.rhs(t + 0.5 * h, &(&y0 + &k2 * (0.5 * h)));
         let k4 = system.rhs(t_new, &(&y0 + &k3 * h));
         let y_new = &y0 + (&k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0);
         // Slope at the step end: the next step's first stage, so it costs nothing extra.
         let f_new = system.rhs(t_new, &y_new);
-        stats.n_rhs += 4;
-        stats.n_steps += 1;
+        run.stats.n_rhs += 4;
+        run.stats.n_steps += 1;
         if let Some(i) = y_new.iter().position(|v| !v.is_finite()) {
             return Err(crate::error::Error::Integration {
                 t: t_new,
                 reason: format!("state component {i} is not finite; reduce dt"),
             });
         }
-        *y = y_new.clone();
-        stats.t_end = t_new;
+        run.y = y_new.clone();
+        run.stats.t_end = t_new;
         let dense = DenseStep::hermite(t, t_new, y0, y_new, k1, f_new.clone());
         k1 = f_new;
-        if observer.on_step(&dense).is_break() {
+        if run.observer.on_step(&dense).is_break() {
             return Ok(ControlFlow::Break(()));
         }
     }

@@ -422,7 +422,18 @@ fn paper_theta(kernel: ScalarKernel, rtol: f64, atol: f64) -> (Vec<f64>, Stats) 
         atol,
         ..Tolerances::default()
     });
-    let (stats, _) = solve_on(kernel, &mut sys, &method, 0.0, y0, o.period, &mut samples).unwrap();
+    let (stats, _) = solve_on(
+        kernel,
+        &mut sys,
+        &method,
+        Span {
+            t0: 0.0,
+            y0,
+            t1: o.period,
+        },
+        &mut samples,
+    )
+    .unwrap();
     (samples.y.iter().map(|y| y[2]).collect(), stats)
 }
 

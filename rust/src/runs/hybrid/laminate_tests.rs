@@ -3,7 +3,7 @@
 
 use super::tests::{compare, spec};
 use super::HybridSettings;
-use crate::analysis::layered::{analyse, critical_damping, start_state};
+use crate::analysis::layered::{start_state, LayeredPoint};
 use crate::cancel::Cancel;
 use crate::inputs::orbit::{Orbit, Shadow};
 use crate::inputs::panel::Panel;
@@ -15,6 +15,17 @@ use crate::runs::layered::{run_orbits, LayeredRunRequest, LayeredSummaries};
 
 const MODEL: HingeModel = HingeModel::Nonlinear;
 const COUPLING: Coupling = Coupling::ProjectedArea;
+
+/// The operating point of `panel` and `c` at full sun.
+fn point<'a>(panel: &'a Panel, c: &'a Conduction) -> LayeredPoint<'a> {
+    LayeredPoint {
+        panel,
+        conduction: c,
+        model: MODEL,
+        coupling: COUPLING,
+        flux: 1.0,
+    }
+}
 
 fn start(panel: &Panel, c: &Conduction, orbit: &Orbit, kick: f64) -> Vec<f64> {
     let mut y = start_state(panel, c, COUPLING, orbit, 0.0).unwrap();
@@ -83,7 +94,7 @@ fn weak_flutter_of_three_nodes_grows_at_the_n_node_eigenvalue() {
         ..Panel::paper()
     };
     let c = Conduction::homogeneous(&base, 3).unwrap();
-    let crit = critical_damping(&base, &c, MODEL, COUPLING, 1.0).unwrap();
+    let crit = point(&base, &c).critical_damping().unwrap();
     let orbit = Orbit {
         shadow: Shadow::None,
         ..Orbit::geo_equinox()
@@ -91,9 +102,7 @@ fn weak_flutter_of_three_nodes_grows_at_the_n_node_eigenvalue() {
     for damping in [crit - 0.1, crit + 0.1] {
         let panel = Panel { damping, ..base };
         let c = Conduction::homogeneous(&panel, 3).unwrap();
-        let predicted = analyse(&panel, &c, MODEL, COUPLING, 1.0)
-            .unwrap()
-            .growth_rate;
+        let predicted = point(&panel, &c).analyse().unwrap().growth_rate;
         let run = hybrid(&panel, &c, &orbit, 4, &start(&panel, &c, &orbit, 1e-6));
         let s = &run.run.summaries;
         let measured = (s[3].amplitude / s[1].amplitude).ln() / (2.0 * orbit.period);
