@@ -66,7 +66,6 @@ __all__ = [
     "distributed_info",
     "eclipses",
     "energy",
-    "equivalent_panel",
     "flutter",
     "flux_scale",
     "hinge_points",
@@ -156,6 +155,14 @@ class _Grid(TypedDict):
     layup: dict[str, Any] | None
     nodes: int
 
+class _FlutterPoint(TypedDict):
+    """The point a flutter analysis linearises about: both flutter analyses take this one
+    mapping (``FlutterPoint`` in rust/src/bindings/convert.rs; built by ``tj.flutter``)."""
+
+    model: str
+    coupled: bool
+    flux: float
+
 class IntegrationError(RuntimeError): ...
 
 @final
@@ -212,9 +219,7 @@ def simulate_hinge(
 ) -> dict[str, Any]: ...
 
 # --- flutter analysis ---------------------------------------------------------------------------
-def flutter(
-    panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
-) -> dict[str, Any]: ...
+def flutter(panel: dict[str, float], point: _FlutterPoint) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------
 def run_orbits(
@@ -346,8 +351,9 @@ REFERENCE_TEMPERATURE: float
 
 def validate_layer(layer: dict[str, Any]) -> None: ...
 def validate_laminate(laminate: dict[str, Any]) -> None: ...
-def laminate_properties(laminate: dict[str, Any]) -> dict[str, float]: ...
-def equivalent_panel(laminate: dict[str, Any], panel: dict[str, float]) -> dict[str, float]: ...
+def laminate_properties(
+    laminate: dict[str, Any], panel: dict[str, float] | None = None
+) -> dict[str, Any]: ...
 def materials() -> list[dict[str, Any]]: ...
 def conduction_grid(panel: dict[str, float], grid: _Grid) -> dict[str, Any]: ...
 def layered_steady_state(
@@ -364,12 +370,7 @@ def layered_start_state(
     coupled: bool,
 ) -> list[float]: ...
 def layered_flutter(
-    panel: dict[str, float],
-    grid: _Grid,
-    model: str,
-    coupled: bool,
-    flux: float,
-    with_critical: bool = True,
+    panel: dict[str, float], grid: _Grid, point: _FlutterPoint
 ) -> dict[str, Any]: ...
 def simulate_layers(
     panel: dict[str, float],

@@ -23,7 +23,7 @@ use crate::runs::simulate::{run_watched, state_from};
 use cancel::{cancellable, CancelToken};
 use convert::{
     coupling, crossing_tuple, hinge_model, orbit_from, panel_dict, panel_from, set_counters,
-    solver_from, RunOptions,
+    set_named, solver_from, RunOptions,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -134,20 +134,12 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
     shield(|| {
         let p = panel_from(panel)?;
         let d = PyDict::new(py);
-        d.set_item("half_arm", p.half_arm())?;
-        d.set_item("hinge_inertia", p.hinge_inertia())?;
-        d.set_item(
-            "natural_frequency_hz",
-            p.natural_angular_frequency() / (2.0 * PI),
-        )?;
-        d.set_item(
-            "beam_frequency_hz",
-            beam_first_angular_frequency(&p) / (2.0 * PI),
-        )?;
-        d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
-        d.set_item("flexural_stiffness", p.flexural_stiffness())?;
-        d.set_item("rigidity_per_length", p.rigidity_per_length())?;
-        d.set_item("matching_moment_scale", p.matching_moment_scale())?;
+        set_named!(d, p; half_arm, hinge_inertia, moment_per_kelvin, flexural_stiffness,
+            rigidity_per_length, matching_moment_scale);
+        let natural = p.natural_angular_frequency() / (2.0 * PI);
+        d.set_item("natural_frequency_hz", natural)?;
+        let beam = beam_first_angular_frequency(&p) / (2.0 * PI);
+        d.set_item("beam_frequency_hz", beam)?;
         Ok(d)
     })
 }
