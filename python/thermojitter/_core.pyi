@@ -155,6 +155,18 @@ class _Grid(TypedDict):
     layup: dict[str, Any] | None
     nodes: int
 
+class _Orbits(TypedDict):
+    """One run over whole orbits: ``run_orbits`` and ``MonteCarloPool.run`` take this one
+    mapping (``OrbitsRun`` in rust/src/bindings/convert.rs; built by ``simulate.orbits_args``)."""
+
+    model: str
+    coupled: bool
+    solver: dict[str, Any]
+    n_orbits: int
+    window: float
+    hybrid: NotRequired[dict[str, float] | None]
+    grid: NotRequired[_Grid | None]
+
 class _FlutterPoint(TypedDict):
     """The point a flutter analysis linearises about: both flutter analyses take this one
     mapping (``FlutterPoint`` in rust/src/bindings/convert.rs; built by ``tj.flutter``)."""
@@ -225,22 +237,15 @@ def flutter(panel: dict[str, float], point: _FlutterPoint) -> dict[str, Any]: ..
 def run_orbits(
     panel: dict[str, float],
     orbit: dict[str, Any],
+    orbits: _Orbits,
     *,
-    model: str,
-    coupled: bool,
-    solver: dict[str, Any],
     t_start: float,
     first_index: int,
-    n_orbits: int,
     y0: list[float],
-    window: float,
     theta_limit: float,
     stop_at_limit: bool,
     steps_per_period: float,
     cancel: CancelToken | None = None,
-    layup: dict[str, Any] | None = None,
-    nodes: int | None = None,
-    hybrid: dict[str, float] | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---
@@ -326,20 +331,13 @@ class MonteCarloPool:
         self,
         panels: _F,
         orbit: dict[str, Any],
+        orbits: _Orbits,
         *,
-        model: str,
-        coupled: bool,
-        solver: dict[str, Any],
-        n_orbits: int,
-        window: float,
         threshold: float | None,
         stop_at_threshold: bool,
         validity_limit: float = ...,
-        hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
         lockstep: bool = True,
-        layup: dict[str, Any] | None = None,
-        nodes: int | None = None,
     ) -> dict[str, Any]: ...
 
 EnsemblePool = MonteCarloPool

@@ -291,6 +291,41 @@ impl FlutterPoint {
     }
 }
 
+/// One run over whole orbits, as both the long run (`run_orbits`, one call a chunk of orbits)
+/// and the Monte Carlo batches (`MonteCarloPool.run`, one sample a row) receive it: the mapping
+/// `orbits` = {model, coupled, solver, n_orbits, window[, hybrid][, grid]}, built in one place on
+/// the Python side (`thermojitter.simulate.orbits_args`). `hybrid` (its settings; None: the
+/// solver alone) runs the hybrid propagator; `grid` (None: the two-layer model) the N-node model.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct OrbitsRun<'py> {
+    pub model: String,
+    pub coupled: bool,
+    pub solver: Bound<'py, PyDict>,
+    pub n_orbits: u64,
+    pub window: f64,
+    #[pyo3(default)]
+    pub hybrid: Option<Bound<'py, PyDict>>,
+    #[pyo3(default)]
+    pub grid: Option<Grid<'py>>,
+}
+
+impl OrbitsRun<'_> {
+    /// The hinge model, the coupling and the integrator of the run, converted in that order.
+    pub fn hinge(&self) -> PyResult<(HingeModel, Coupling, Method)> {
+        let m = hinge_model(&self.model)?;
+        Ok((m, coupling(self.coupled), solver_from(&self.solver)?))
+    }
+
+    /// The hybrid propagator's settings (None: the solver alone).
+    pub fn hybrid(&self) -> PyResult<Option<crate::runs::hybrid::HybridSettings>> {
+        self.hybrid
+            .as_ref()
+            .map(super::orbits::hybrid_from)
+            .transpose()
+    }
+}
+
 /// The validity limit a run watches, as the `limit` entry of a [`RunOptions`] mapping
 /// {theta_limit, on_limit}: converted by [`on_limit`].
 #[derive(FromPyObject)]
