@@ -75,7 +75,6 @@ __all__ = [
     "linear_delta_t",
     "linear_thermal",
     "layered_flutter",
-    "layered_start_state",
     "layered_steady_state",
     "materials",
     "moment",
@@ -193,7 +192,11 @@ def steady_state(
     panel: dict[str, float], coupled: bool = True, flux: float = 1.0
 ) -> tuple[float, float, float]: ...
 def start_state(
-    panel: dict[str, float], orbit: dict[str, Any], t0: float, coupled: bool
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    t0: float,
+    coupled: bool,
+    grid: _Grid | None = None,
 ) -> list[float]: ...
 def stiffness(panel: dict[str, float], criterion: str, moment: float = 0.0) -> float: ...
 def derived(panel: dict[str, float]) -> dict[str, float]: ...
@@ -360,13 +363,6 @@ def layered_steady_state(
     coupled: bool = True,
     flux: float = 1.0,
 ) -> dict[str, Any]: ...
-def layered_start_state(
-    panel: dict[str, float],
-    grid: _Grid,
-    orbit: dict[str, Any],
-    t0: float,
-    coupled: bool,
-) -> list[float]: ...
 def layered_flutter(
     panel: dict[str, float], grid: _Grid, point: _FlutterPoint
 ) -> dict[str, Any]: ...

@@ -352,16 +352,10 @@ def simulate_orbits(
     full = used.as_dict()
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None and nodes is None:
+    if y0 is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
-        y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
-    elif y0 is None:
-        assert nodes is not None
-        y0 = tuple(
-            _core.layered_start_state(
-                panel.as_dict(), grid_args(panel, nodes), orbit.as_dict(), t_start, coupled
-            )
-        )
+        grid = None if nodes is None else grid_args(panel, nodes)
+        y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled, grid))
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_record(),

@@ -195,30 +195,6 @@ fn layered_steady_state<'py>(
     })
 }
 
-/// The default start of an N-node run beginning at `t0`: the sunlit equilibrium at that time's
-/// solar flux, at rest (node temperatures, θ, θ̇).
-#[pyfunction]
-fn layered_start_state(
-    panel: &Bound<'_, PyDict>,
-    grid: Grid<'_>,
-    orbit: &Bound<'_, PyDict>,
-    t0: f64,
-    coupled: bool,
-) -> PyResult<Vec<f64>> {
-    shield(|| {
-        let p = panel_from(panel)?;
-        let o = orbit_from(orbit)?;
-        let c = grid.conduction(&p)?;
-        Ok(crate::analysis::layered::start_state(
-            &p,
-            &c,
-            coupling(coupled),
-            &o,
-            t0,
-        )?)
-    })
-}
-
 /// Flutter analysis of the N-node system at the flutter `point` (full nodal Jacobian), with the
 /// critical damping.
 #[pyfunction]
@@ -285,7 +261,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(materials, m)?)?;
     m.add_function(wrap_pyfunction!(conduction_grid, m)?)?;
     m.add_function(wrap_pyfunction!(layered_steady_state, m)?)?;
-    m.add_function(wrap_pyfunction!(layered_start_state, m)?)?;
     m.add_function(wrap_pyfunction!(layered_flutter, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_layers, m)?)?;
     Ok(())

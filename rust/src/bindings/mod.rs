@@ -23,7 +23,7 @@ use crate::runs::simulate::{run_watched, state_from};
 use cancel::{cancellable, CancelToken};
 use convert::{
     coupling, crossing_tuple, hinge_model, orbit_from, panel_dict, panel_from, set_counters,
-    set_named, solver_from, RunOptions,
+    set_named, solver_from, Grid, RunOptions,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -88,19 +88,28 @@ fn steady_state(panel: &Bound<'_, PyDict>, coupled: bool, flux: f64) -> PyResult
 }
 
 /// The default start of a run beginning at `t0`: the sunlit equilibrium at that time's solar
-/// flux, at rest, as the state (T_f, T_b, θ, θ̇).
+/// flux, at rest, as the state (T_f, T_b, θ, θ̇), or with a `grid` the N-node model's state
+/// (node temperatures…, θ, θ̇).
 #[pyfunction]
+#[pyo3(signature = (panel, orbit, t0, coupled, grid=None))]
 fn start_state(
     panel: &Bound<'_, PyDict>,
     orbit: &Bound<'_, PyDict>,
     t0: f64,
     coupled: bool,
+    grid: Option<Grid<'_>>,
 ) -> PyResult<Vec<f64>> {
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        crate::Orbit::check_time(t0)?;
         let coupling = coupling(coupled);
+        if let Some(grid) = grid {
+            let c = grid.conduction(&p)?;
+            return Ok(crate::analysis::layered::start_state(
+                &p, &c, coupling, &o, t0,
+            )?);
+        }
+        crate::Orbit::check_time(t0)?;
         let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
         Ok(eq.state().as_slice().to_vec())
     })
