@@ -86,7 +86,12 @@ pub fn dict_of<'py, V: IntoPyObject<'py>>(
 /// Sets into the dict `$d` each named quantity of `$of`, read by the method of that name and
 /// stored under it: `set_named!(d, laminate; thickness, mass_per_area)`. The names of a result's
 /// derived quantities are written once, in that list, never as a key and again as a call.
+/// `set_named!(d, run; fields a, b)` reads the fields of those names instead.
 macro_rules! set_named {
+    ($d:expr, $of:expr; fields $($name:ident),+ $(,)?) => {{
+        let (d, of) = (&$d, &$of);
+        $(d.set_item(stringify!($name), of.$name)?;)+
+    }};
     ($d:expr, $of:expr; $($name:ident),+ $(,)?) => {{
         let (d, of) = (&$d, &$of);
         $(d.set_item(stringify!($name), of.$name())?;)+

@@ -2,8 +2,8 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, dict_of, float_item, orbit_from, panel_dict, panel_from, set_named, type_error,
-    FlutterPoint, Grid, RunOptions,
+    coupling, dict_of, float_item, panel_dict, panel_from, set_named, type_error, FlutterPoint,
+    Grid, RunOptions,
 };
 use super::error::{invalid, shield};
 use super::flutter::set_spectrum;

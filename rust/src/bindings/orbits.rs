@@ -2,7 +2,7 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    crossing_tuple, orbit_from, panel_from, set_counters, solver_dict, OrbitsRun,
+    crossing_tuple, orbit_from, panel_from, set_counters, set_named, solver_dict, OrbitsRun,
 };
 use crate::runs::hybrid::HybridSettings;
 use crate::runs::layered::LayeredRunRequest;
@@ -83,13 +83,8 @@ fn hybrid_counters<'py>(
     d: Bound<'py, PyDict>,
     out: &crate::runs::hybrid::HybridRun,
 ) -> PyResult<Bound<'py, PyDict>> {
-    d.set_item("t_linear", out.t_linear)?;
-    d.set_item("t_exponential", out.t_exponential)?;
-    d.set_item("t_fallback", out.t_fallback)?;
-    d.set_item("n_arcs", out.n_arcs)?;
-    d.set_item("n_exp_steps", out.n_exp_steps)?;
-    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
-    d.set_item("n_reread_steps", out.n_reread_steps)?;
+    set_named!(d, out; fields t_linear, t_exponential, t_fallback, n_arcs, n_exp_steps,
+        n_fallback_steps, n_reread_steps);
     Ok(d)
 }
 
