@@ -8,6 +8,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 
 from thermojitter import _core, beam, materials, nastran
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.attitude import Attitude
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
@@ -20,6 +21,7 @@ from thermojitter.distributed import (
     simulate_distributed,
 )
 from thermojitter.errors import (
+    HybridFallbackWarning,
     InternalError,
     ParameterError,
     ParameterTypeError,
@@ -62,6 +64,7 @@ from thermojitter.simulate import (
     steady_state,
 )
 from thermojitter.solver import HybridSettings, SolverSettings
+from thermojitter.spacecraft import PD, Spacecraft, SpacecraftSolution, simulate_spacecraft
 
 __version__ = "0.1.0"
 
@@ -104,6 +107,9 @@ __all__ = [
     "LinearThermalResponse",
     "NastranBeam",
     "Orbit",
+    "Attitude",
+    "HybridFallbackWarning",
+    "PD",
     "OrbitSummaries",
     "Panel",
     "ParameterError",
@@ -113,6 +119,8 @@ __all__ = [
     "SensitivityResult",
     "Solution",
     "SolverSettings",
+    "Spacecraft",
+    "SpacecraftSolution",
     "StabilityMap",
     "ThermalSolution",
     "ValidityLimitWarning",
@@ -140,6 +148,7 @@ __all__ = [
     "simulate_distributed",
     "simulate_hinge",
     "simulate_orbits",
+    "simulate_spacecraft",
     "simulate_thermal",
     "stability_map",
     "steady_state",

@@ -45,6 +45,7 @@ __all__ = [
     "REFERENCE_TEMPERATURE",
     "SOLVER_DEFAULTS",
     "VALIDITY_LIMIT",
+    "ARCSEC_PER_RADIAN",
     "STEFAN_BOLTZMANN",
     "beam_modes",
     "beam_response",
@@ -57,6 +58,8 @@ __all__ = [
     "beta",
     "nodal_rate",
     "J2",
+    "EARTH_ALBEDO",
+    "EARTH_IR",
     "OBLIQUITY",
     "YEAR_DAYS",
     "DAY",
@@ -67,6 +70,7 @@ __all__ = [
     "eclipses",
     "energy",
     "flutter",
+    "flutter_at",
     "flux_scale",
     "hinge_points",
     "hinge_equivalent_damping_ratio",
@@ -84,6 +88,7 @@ __all__ = [
     "simulate",
     "simulate_distributed",
     "simulate_hinge",
+    "simulate_spacecraft",
     "simulate_layers",
     "simulate_thermal",
     "stability_map",
@@ -120,6 +125,8 @@ MU_EARTH: float
 EQUINOX_DAY: float
 PERIHELION_DAY: float
 J2: float
+EARTH_ALBEDO: float
+EARTH_IR: float
 OBLIQUITY: float
 YEAR_DAYS: float
 DAY: float
@@ -129,6 +136,7 @@ STEFAN_BOLTZMANN: float
 MAX_THREADS: int
 MAX_TIME: float
 VALIDITY_LIMIT: float
+ARCSEC_PER_RADIAN: float  # 648000/π
 
 class _Limit(TypedDict):
     """The validity limit a run watches (``thermojitter.simulate.limit_args``)."""
@@ -233,8 +241,32 @@ def simulate_hinge(
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
+# --- the spacecraft bus --------------------------------------------------------------------------
+def simulate_spacecraft(
+    bus_inertia: float,
+    panels: list[dict[str, float]],
+    offsets: list[float],
+    senses: list[float],
+    controller: tuple[float, float] | None,
+    orbit: dict[str, Any],
+    run: _Run,
+    *,
+    disturbance: float = 0.0,
+    bus_rate: float = 0.0,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(panel: dict[str, float], point: _FlutterPoint) -> dict[str, Any]: ...
+def flutter_at(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    t: float,
+    model: str,
+    coupled: bool,
+    with_critical: bool = True,
+) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------
 def run_orbits(

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.persist import Persistent
@@ -73,6 +74,7 @@ def flutter(
     orbit: Orbit | None = None,
     t: float = 0.0,
     layers: int | None = None,
+    attitude: Attitude | None = None,
 ) -> FlutterResult:
     """Linear stability of the sunlit equilibrium of ``panel``.
 
@@ -84,6 +86,12 @@ def flutter(
 
     ``layers=N`` analyses the N-node through-thickness model on the panel's layup (or one
     homogeneous layer for a plain panel); ``jacobian`` is then over (node temperatures…, θ, θ̇).
+
+    With an ``orbit`` that heats the panel from the Earth (``orbit.albedo``, ``orbit.earth_ir``)
+    or an ``attitude`` other than Sun-pointing, the equilibrium is the one in full sunlight under
+    every load at the point ``t`` of the orbit (the Earth's infrared and albedo and the
+    incidence there), and the critical damping is that equilibrium's (the N-node model takes the
+    front's sunlight only and refuses them).
     """
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     # t is checked even without an orbit: a t of the wrong type is a mistake either way.
@@ -95,14 +103,26 @@ def flutter(
         flux = float(orbit.flux_scale(t)[0])
     elif flux is None:
         flux = 1.0
+    if attitude is not None and orbit is None:
+        raise checks.ParameterError("attitude", attitude, "needs an orbit (and t)")
     flux = checks.real("flux", flux)
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
     point: _FlutterPoint = {"model": model, "coupled": coupled, "flux": flux}
+    loaded = orbit is not None and has_face_loads(orbit, attitude)
     if layers is not None:
+        if loaded:
+            raise checks.ParameterError(
+                "layers", layers, "takes the front's sunlight only: no Earth heating or attitude"
+            )
         result = _layered_flutter(panel, point, layers)
     else:
-        raw = _core.flutter(panel.as_dict(), point)
+        if loaded:
+            assert orbit is not None
+            at = engine_orbit(orbit, attitude)
+            raw = _core.flutter_at(panel.as_dict(), at, t=t, model=model, coupled=coupled)
+        else:
+            raw = _core.flutter(panel.as_dict(), point)
         tf, tb, th = raw["equilibrium"]
         moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
         equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)

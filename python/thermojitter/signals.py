@@ -53,6 +53,17 @@ def spectrum(t: ArrayLike, x: ArrayLike, *, pad: int = 1) -> tuple[Array, Array]
     return np.fft.rfftfreq(size, steps[0]), amp
 
 
+def power_spectral_density(t: ArrayLike, x: ArrayLike) -> tuple[Array, Array]:
+    """One-sided power spectral density of a uniformly sampled signal (mean removed, Hann
+    window): frequencies (Hz) and densities (x's unit squared per Hz). It is :func:`spectrum`'s
+    amplitude A rescaled, PSD = A² (Σw)² / (2 f_s Σw²) for the window w and sampling rate f_s,
+    so that the densities summed over the bins (times the bin width) give x's variance."""
+    f, amp = spectrum(t, x)
+    taper = np.hanning(np.asarray(x, dtype=float).size)
+    rate = float(f[1]) * taper.size
+    return f, amp**2 * taper.sum() ** 2 / (2.0 * rate * np.sum(taper**2))
+
+
 def dominant_frequency(
     t: ArrayLike, x: ArrayLike, f_min: float = DEFAULT_F_MIN, *, pad: int = 1
 ) -> float:

@@ -7,6 +7,7 @@ pub mod coupled;
 pub mod distributed;
 pub mod hinge;
 pub mod layered;
+pub mod spacecraft;
 pub mod thermal;
 
 use crate::error::{Error, Result};

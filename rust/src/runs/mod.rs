@@ -12,3 +12,4 @@ pub mod lockstep;
 pub mod orbits;
 pub mod request;
 pub mod simulate;
+pub mod spacecraft;
