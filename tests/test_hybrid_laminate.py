@@ -82,9 +82,7 @@ def weak_flutter_growth(fraction: float) -> tuple[float, float]:
     sunlit = tj.Orbit.sunlit()
     panel = base.replace(damping=fraction * crit)
     predicted = tj.flutter(panel, layers=20).growth_rate
-    start = _core.layered_start_state(
-        panel.as_dict(), grid_args(panel, 20), sunlit.as_dict(), 0.0, True
-    )
+    start = _core.start_state(panel.as_dict(), sunlit.as_dict(), 0.0, True, grid_args(panel, 20))
     y0 = [*start[:-2], start[-2] + 1e-6, 0.0]
     run = tj.simulate_orbits(panel, sunlit, 4, layers=20, method="hybrid", y0=y0)
     measured = math.log(run.amplitude[3] / run.amplitude[1]) / (2.0 * sunlit.period)

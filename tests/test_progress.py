@@ -180,11 +180,13 @@ def test_interruptible_cancels_the_engine_call() -> None:
                 pool.run,
                 row,
                 tj.Orbit.geo_equinox().as_dict(),
-                model="nonlinear",
-                coupled=True,
-                solver=solver_settings("rk45", 1e-8, 1e-10, None, math.inf, 500_000_000),
-                n_orbits=100_000,
-                window=600.0,
+                {
+                    "model": "nonlinear",
+                    "coupled": True,
+                    "solver": solver_settings("rk45", 1e-8, 1e-10, None, math.inf, 500_000_000),
+                    "n_orbits": 100_000,
+                    "window": 600.0,
+                },
                 threshold=None,
                 stop_at_threshold=False,
             )

@@ -69,7 +69,6 @@ __all__ = [
     "distributed_info",
     "eclipses",
     "energy",
-    "equivalent_panel",
     "flutter",
     "flutter_at",
     "flux_scale",
@@ -80,7 +79,6 @@ __all__ = [
     "linear_delta_t",
     "linear_thermal",
     "layered_flutter",
-    "layered_start_state",
     "layered_steady_state",
     "materials",
     "moment",
@@ -164,6 +162,26 @@ class _Grid(TypedDict):
     layup: dict[str, Any] | None
     nodes: int
 
+class _Orbits(TypedDict):
+    """One run over whole orbits: ``run_orbits`` and ``MonteCarloPool.run`` take this one
+    mapping (``OrbitsRun`` in rust/src/bindings/convert.rs; built by ``simulate.orbits_args``)."""
+
+    model: str
+    coupled: bool
+    solver: dict[str, Any]
+    n_orbits: int
+    window: float
+    hybrid: NotRequired[dict[str, float] | None]
+    grid: NotRequired[_Grid | None]
+
+class _FlutterPoint(TypedDict):
+    """The point a flutter analysis linearises about: both flutter analyses take this one
+    mapping (``FlutterPoint`` in rust/src/bindings/convert.rs; built by ``tj.flutter``)."""
+
+    model: str
+    coupled: bool
+    flux: float
+
 class IntegrationError(RuntimeError): ...
 
 @final
@@ -182,7 +200,11 @@ def steady_state(
     panel: dict[str, float], coupled: bool = True, flux: float = 1.0
 ) -> tuple[float, float, float]: ...
 def start_state(
-    panel: dict[str, float], orbit: dict[str, Any], t0: float, coupled: bool
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    t0: float,
+    coupled: bool,
+    grid: _Grid | None = None,
 ) -> list[float]: ...
 def stiffness(panel: dict[str, float], criterion: str, moment: float = 0.0) -> float: ...
 def derived(panel: dict[str, float]) -> dict[str, float]: ...
@@ -235,9 +257,7 @@ def simulate_spacecraft(
 ) -> dict[str, Any]: ...
 
 # --- flutter analysis ---------------------------------------------------------------------------
-def flutter(
-    panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
-) -> dict[str, Any]: ...
+def flutter(panel: dict[str, float], point: _FlutterPoint) -> dict[str, Any]: ...
 def flutter_at(
     panel: dict[str, float],
     orbit: dict[str, Any],
@@ -252,22 +272,15 @@ def flutter_at(
 def run_orbits(
     panel: dict[str, float],
     orbit: dict[str, Any],
+    orbits: _Orbits,
     *,
-    model: str,
-    coupled: bool,
-    solver: dict[str, Any],
     t_start: float,
     first_index: int,
-    n_orbits: int,
     y0: list[float],
-    window: float,
     theta_limit: float,
     stop_at_limit: bool,
     steps_per_period: float,
     cancel: CancelToken | None = None,
-    layup: dict[str, Any] | None = None,
-    nodes: int | None = None,
-    hybrid: dict[str, float] | None = None,
 ) -> dict[str, Any]: ...
 
 # --- finite-element beam comparator (rust/src/py/beam.rs) ---
@@ -353,20 +366,13 @@ class MonteCarloPool:
         self,
         panels: _F,
         orbit: dict[str, Any],
+        orbits: _Orbits,
         *,
-        model: str,
-        coupled: bool,
-        solver: dict[str, Any],
-        n_orbits: int,
-        window: float,
         threshold: float | None,
         stop_at_threshold: bool,
         validity_limit: float = ...,
-        hybrid: dict[str, float] | None = None,
         cancel: CancelToken | None = None,
         lockstep: bool = True,
-        layup: dict[str, Any] | None = None,
-        nodes: int | None = None,
     ) -> dict[str, Any]: ...
 
 EnsemblePool = MonteCarloPool
@@ -378,8 +384,9 @@ REFERENCE_TEMPERATURE: float
 
 def validate_layer(layer: dict[str, Any]) -> None: ...
 def validate_laminate(laminate: dict[str, Any]) -> None: ...
-def laminate_properties(laminate: dict[str, Any]) -> dict[str, float]: ...
-def equivalent_panel(laminate: dict[str, Any], panel: dict[str, float]) -> dict[str, float]: ...
+def laminate_properties(
+    laminate: dict[str, Any], panel: dict[str, float] | None = None
+) -> dict[str, Any]: ...
 def materials() -> list[dict[str, Any]]: ...
 def conduction_grid(panel: dict[str, float], grid: _Grid) -> dict[str, Any]: ...
 def layered_steady_state(
@@ -388,20 +395,8 @@ def layered_steady_state(
     coupled: bool = True,
     flux: float = 1.0,
 ) -> dict[str, Any]: ...
-def layered_start_state(
-    panel: dict[str, float],
-    grid: _Grid,
-    orbit: dict[str, Any],
-    t0: float,
-    coupled: bool,
-) -> list[float]: ...
 def layered_flutter(
-    panel: dict[str, float],
-    grid: _Grid,
-    model: str,
-    coupled: bool,
-    flux: float,
-    with_critical: bool = True,
+    panel: dict[str, float], grid: _Grid, point: _FlutterPoint
 ) -> dict[str, Any]: ...
 def simulate_layers(
     panel: dict[str, float],

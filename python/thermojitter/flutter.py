@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,6 +19,9 @@ from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible, progress_bar
 from thermojitter.results import Equilibrium
 from thermojitter.simulate import check_layers, grid_args
+
+if TYPE_CHECKING:
+    from thermojitter._core import _FlutterPoint
 
 MAP_BLOCK = 20_000
 """Grid points per engine call of :func:`stability_map` (about 40 ms each)."""
@@ -105,33 +108,32 @@ def flutter(
     flux = checks.real("flux", flux)
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
+    point: _FlutterPoint = {"model": model, "coupled": coupled, "flux": flux}
     loaded = orbit is not None and has_face_loads(orbit, attitude)
     if layers is not None:
         if loaded:
             raise checks.ParameterError(
                 "layers", layers, "takes the front's sunlight only: no Earth heating or attitude"
             )
-        result = _layered_flutter(panel, model, coupled, flux, layers)
+        result = _layered_flutter(panel, point, layers)
     else:
         if loaded:
             assert orbit is not None
             at = engine_orbit(orbit, attitude)
             raw = _core.flutter_at(panel.as_dict(), at, t=t, model=model, coupled=coupled)
         else:
-            raw = _core.flutter(panel.as_dict(), model, coupled, flux)
+            raw = _core.flutter(panel.as_dict(), point)
         tf, tb, th = raw["equilibrium"]
         moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
         equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
-        result = _result(raw, equilibrium, model, coupled, flux)
+        result = _result(raw, equilibrium, point)
     return dataclasses.replace(result, panel=panel, orbit=orbit)
 
 
-def _layered_flutter(
-    panel: Panel, model: str, coupled: bool, flux: float, layers: int
-) -> FlutterResult:
+def _layered_flutter(panel: Panel, point: _FlutterPoint, layers: int) -> FlutterResult:
     """The N-node model's flutter analysis: the Jacobian over (node temperatures…, θ, θ̇)."""
     nodes = check_layers(layers)
-    raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), model, coupled, flux)
+    raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), point)
     temps = raw["temperatures"]
     equilibrium = Equilibrium(
         T_front=float(temps[0]),
@@ -139,12 +141,10 @@ def _layered_flutter(
         theta=float(raw["theta"]),
         thermal_moment=float(raw["thermal_moment"]),
     )
-    return _result(raw, equilibrium, model, coupled, flux)
+    return _result(raw, equilibrium, point)
 
 
-def _result(
-    raw: dict[str, Any], equilibrium: Equilibrium, model: str, coupled: bool, flux: float
-) -> FlutterResult:
+def _result(raw: dict[str, Any], equilibrium: Equilibrium, point: _FlutterPoint) -> FlutterResult:
     """The result from the engine's analysis (two-layer or N-node alike) about ``equilibrium``."""
     return FlutterResult(
         equilibrium=equilibrium,
@@ -153,9 +153,9 @@ def _result(
         growth_rate=float(raw["growth_rate"]),
         frequency_hz=float(raw["frequency_hz"]),
         critical_damping=float(raw["critical_damping"]),
-        model=model,
-        coupled=coupled,
-        flux=float(flux),
+        model=point["model"],
+        coupled=point["coupled"],
+        flux=float(point["flux"]),
     )
 
 

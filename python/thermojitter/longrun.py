@@ -39,6 +39,7 @@ from thermojitter.simulate import (
     check_layers,
     grid_args,
     layup_dict,
+    orbits_args,
     start_state,
     warn_crossing,
 )
@@ -370,16 +371,10 @@ def simulate_orbits(
     full = used.as_dict()
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None and nodes is None:
+    if y0 is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
-        y0 = tuple(_core.start_state(panel.as_dict(), engine_orbit_args, t_start, coupled))
-    elif y0 is None:
-        assert nodes is not None
-        y0 = tuple(
-            _core.layered_start_state(
-                panel.as_dict(), grid_args(panel, nodes), engine_orbit_args, t_start, coupled
-            )
-        )
+        grid = None if nodes is None else grid_args(panel, nodes)
+        y0 = tuple(_core.start_state(panel.as_dict(), engine_orbit_args, t_start, coupled, grid))
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
         "orbit": orbit.as_record(),
@@ -409,25 +404,21 @@ def simulate_orbits(
     if method == "hybrid" and has_face_loads(orbit, attitude):
         settings["hybrid_fallback"] = HYBRID_FALLBACK
         warnings.warn(HYBRID_FALLBACK, HybridFallbackWarning, stacklevel=2)
-    core_args: dict[str, Any] = {
-        "model": model,
-        "coupled": coupled,
-        "solver": full,
-        "window": window,
+    run: dict[str, Any] = {"model": model, "coupled": coupled, "solver": full, "window": window}
+    if nodes is not None:
+        run.update(layup=layup_dict(panel), nodes=nodes)
+    if method == "hybrid":
+        run["hybrid"] = hybrid_settings
+    watch = {
         "theta_limit": theta_limit,
         "stop_at_limit": on_limit == "stop",
         "steps_per_period": steps_per_period,
     }
-    if nodes is not None:
-        core_args["layup"] = layup_dict(panel)
-        core_args["nodes"] = nodes
 
-    budget = int(core_args["solver"]["max_steps"])  # for the whole run, every orbit together
+    budget = int(full["max_steps"])  # for the whole run, every orbit together
     if method != "hybrid":
         row = np.array([[panel.as_dict()[f] for f in _core.PANEL_FIELDS]])
-        least = float(
-            _core.least_steps(row, core_args["solver"], orbit.period, steps_per_period)[0]
-        )
+        least = float(_core.least_steps(row, full, orbit.period, steps_per_period)[0])
         cap = (
             "a fixed step dt" if method == "rk4" else f"the step capped at T_n/{steps_per_period:g}"
         )
@@ -463,17 +454,15 @@ def simulate_orbits(
                 # places.
                 count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
                 t0 = float(t_start) + next_index * orbit.period
-                extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
                 raw = engine.call(
                     _core.run_orbits,
                     panel.as_dict(),
                     engine_orbit_args,
+                    orbits_args(run, count),
                     t_start=t0,
                     first_index=next_index,
-                    n_orbits=count,
                     y0=y,
-                    **core_args,
-                    **extra,
+                    **watch,
                 )
                 with ctrl_c.hold():
                     for name in SUMMARY_FIELDS:

@@ -194,7 +194,8 @@ class Panel:
             moment_scale=moment_scale,
             hinge_stiffness=1.0 if hinge_stiffness is None else hinge_stiffness,
         )
-        fields_ = dict(_core.equivalent_panel(laminate.as_dict(), base.as_dict()))
+        properties = _core.laminate_properties(laminate.as_dict(), base.as_dict())
+        fields_ = dict(properties["equivalent_panel"])
         panel = cls(**fields_)
         if hinge_stiffness is None:
             k_el = _hinge_stiffness(panel, criterion)

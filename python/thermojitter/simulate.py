@@ -27,7 +27,7 @@ from thermojitter.results import (
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 if TYPE_CHECKING:
-    from thermojitter._core import _Grid
+    from thermojitter._core import _Grid, _Orbits
 
 Model = Literal["nonlinear", "linear"]
 Method = Literal["rk45", "rk4"]
@@ -204,6 +204,23 @@ def grid_args(panel: Panel, nodes: int) -> _Grid:
     """The engine's ``grid`` mapping of the N-node model (``Grid`` in rust/src/bindings/convert.rs):
     the panel's layup and ``nodes`` (checked by :func:`check_layers`)."""
     return {"layup": layup_dict(panel), "nodes": nodes}
+
+
+def orbits_args(options: Mapping[str, Any], n_orbits: int) -> _Orbits:
+    """The engine's ``orbits`` mapping of a run of ``n_orbits`` whole orbits (``OrbitsRun`` in
+    rust/src/bindings/convert.rs), for the long run and the Monte Carlo batches alike, from run
+    options naming ``model``, ``coupled``, ``solver``, ``window`` and optionally ``hybrid`` (its
+    settings) and the N-node model's ``nodes`` and ``layup``."""
+    nodes = options.get("nodes")
+    return {
+        "model": options["model"],
+        "coupled": options["coupled"],
+        "solver": options["solver"],
+        "n_orbits": n_orbits,
+        "window": options["window"],
+        "hybrid": options.get("hybrid"),
+        "grid": None if nodes is None else {"layup": options.get("layup"), "nodes": nodes},
+    }
 
 
 def simulate(

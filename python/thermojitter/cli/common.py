@@ -199,7 +199,37 @@ def _run_handler(args: argparse.Namespace) -> int:
         return _fail(str(exc))
 
 
-def run_command(add_parser: Callable[[Any], None], argv: Sequence[str]) -> int:
+class Command:
+    """A subcommand declared once, where it lives: its ``name``, the texts of its parser
+    (``texts``: help, description, epilog...), the ``options`` it adds to that parser and the
+    ``handler`` that runs it (with or without the Ctrl-C ``stop_flag``). ``add_parser`` puts it
+    under ``thermojitter``; ``main`` runs it alone (``thermojitter NAME ARGS``)."""
+
+    def __init__(
+        self,
+        name: str,
+        options: Callable[[argparse.ArgumentParser], None],
+        handler: Callable[[argparse.Namespace], int],
+        *,
+        stop_flag: bool,
+        **texts: Any,
+    ) -> None:
+        self.name, self.options, self.handler = name, options, handler
+        self.stop_flag, self.texts = stop_flag, texts
+
+    def add_parser(self, sub: Any) -> argparse.ArgumentParser:
+        parser: argparse.ArgumentParser = sub.add_parser(self.name, **self.texts)
+        self.options(parser)
+        parser.set_defaults(handler=self.handler, stop_flag=self.stop_flag)
+        return parser
+
+    def main(self, argv: Sequence[str] | None = None) -> int:
+        """``thermojitter NAME ARGV`` (default: this script's arguments); returns the exit code
+        (0, 2 for bad input, 3 for failed samples, 130 for Ctrl-C)."""
+        return run_command(self.add_parser, [self.name, *(sys.argv[1:] if argv is None else argv)])
+
+
+def run_command(add_parser: Callable[[Any], object], argv: Sequence[str]) -> int:
     """``thermojitter ARGV`` with only the subcommand that ``add_parser`` adds (the scripts that
     predate the subcommands: ``python -m thermojitter.montecarlo_cli``): the same parser, error
     path and exit codes as the whole command."""

@@ -18,15 +18,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal, cast
 
 import numpy as np
 
 from thermojitter import _core
-from thermojitter.cli.common import UserError, add_out, out_dir, run_command, write_output
+from thermojitter.cli.common import Command, UserError, add_out, out_dir, write_output
 from thermojitter.flutter import (
     FlutterResult,
     flutter,
@@ -82,24 +80,11 @@ def _analysis_record(r: FlutterResult) -> dict[str, Any]:
     }
 
 
-def flutter_command(argv: Sequence[str] | None = None) -> int:
-    """``thermojitter flutter ARGS``; returns the exit code (0, or 2 for bad input)."""
-    return run_command(add_parser, ["flutter", *(sys.argv[1:] if argv is None else argv)])
-
-
 DEFAULT_OUT = "out/flutter"
 """Where ``thermojitter flutter`` writes without --out (relative to the working folder)."""
 
 
-def add_parser(sub: Any) -> None:
-    parser = sub.add_parser(
-        "flutter",
-        help="flutter analysis without integration: growth rate, critical damping, stability map",
-        description="Flutter analysis of a scenario without integration: growth rate, "
-        "frequency and critical damping at the sunlit equilibrium, and a stability map "
-        "(stability_map.png, flutter.json).",
-        epilog="Example: thermojitter flutter examples/paper.toml --out out/flutter",
-    )
+def options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scenario", nargs="?", help="TOML scenario (default: Table 1 at GEO)")
     add_out(parser, default=DEFAULT_OUT, help=f"output folder (created; default {DEFAULT_OUT})")
     parser.add_argument("--x", default=None, help=f"map x axis NAME:START:STOP:N ({DEFAULT_X})")
@@ -110,7 +95,6 @@ def add_parser(sub: Any) -> None:
         "--uncoupled", action="store_true", help="freeze the projected area (no pumping)"
     )
     parser.add_argument("--no-plot", action="store_true", help="skip the PNG")
-    parser.set_defaults(handler=run, stop_flag=False)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -236,3 +220,18 @@ def run(args: argparse.Namespace) -> int:
     write_output(out / "flutter.json", lambda fh: fh.write(json.dumps(record, indent=2).encode()))
     print(f"  wrote {out / 'flutter.json'}" + ("" if args.no_plot else f" and {png}"))
     return 0
+
+
+COMMAND = Command(
+    "flutter",
+    options,
+    run,
+    stop_flag=False,
+    help="flutter analysis without integration: growth rate, critical damping, stability map",
+    description="Flutter analysis of a scenario without integration: growth rate, "
+    "frequency and critical damping at the sunlit equilibrium, and a stability map "
+    "(stability_map.png, flutter.json).",
+    epilog="Example: thermojitter flutter examples/paper.toml --out out/flutter",
+)
+add_parser = COMMAND.add_parser
+flutter_command = COMMAND.main

@@ -25,9 +25,7 @@ sample failed.
 from __future__ import annotations
 
 import argparse
-import sys
 import warnings
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -35,11 +33,11 @@ import numpy as np
 
 from thermojitter.cli.common import (
     EXIT_SAMPLES_FAILED,
+    Command,
     Interrupted,
     SamplesFailed,
     add_out,
     out_dir,
-    run_command,
     write_output,
 )
 from thermojitter.errors import SampleFailureWarning
@@ -85,22 +83,7 @@ def read_scenario(path: str | Path) -> dict[str, Any]:
     return {"panel": scenario.panel, "orbit": scenario.orbit, "vary": vary, "settings": settings}
 
 
-def mc_command(argv: Sequence[str] | None = None) -> int:
-    """``thermojitter mc ARGS``; returns the exit status."""
-    return run_command(add_parser, ["mc", *(sys.argv[1:] if argv is None else argv)])
-
-
-def add_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "mc",
-        help="Monte Carlo study of a scenario with a [vary] table (Parquet, histograms)",
-        description="Monte Carlo study of a scenario file: panels drawn from the [vary] "
-        "distributions, each run over whole orbits; writes samples.parquet, histograms.png and "
-        "scatter.png, and resumes a killed run from DIR/checkpoint/.",
-        epilog="Example: thermojitter mc examples/montecarlo.toml --n 200 --out out/mc. "
-        f"Exit codes: 0 done, 2 bad input, {EXIT_SAMPLES_FAILED} samples failed (see "
-        "--allow-failures), 130 Ctrl-C.",
-    )
+def options(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="scenario TOML with [panel], [orbit], [vary] tables")
     add_out(p, required=True, help="output folder (created)")
     p.add_argument("--n", type=int, help="number of samples (default 1000)")
@@ -126,8 +109,6 @@ def add_parser(sub: Any) -> None:
         f"samples.parquet with their error); without it the exit code is {EXIT_SAMPLES_FAILED}. "
         f"A study whose every sample failed exits {EXIT_SAMPLES_FAILED} all the same",
     )
-    # No stop flag: Ctrl-C reaches monte_carlo, which stops at once and keeps finished chunks.
-    p.set_defaults(handler=run, stop_flag=False)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -209,3 +190,21 @@ def run(args: argparse.Namespace) -> int:
             "accept a study with failed samples"
         )
     return 0
+
+
+COMMAND = Command(
+    "mc",
+    options,
+    run,
+    # No stop flag: Ctrl-C reaches monte_carlo, which stops at once and keeps finished chunks.
+    stop_flag=False,
+    help="Monte Carlo study of a scenario with a [vary] table (Parquet, histograms)",
+    description="Monte Carlo study of a scenario file: panels drawn from the [vary] "
+    "distributions, each run over whole orbits; writes samples.parquet, histograms.png and "
+    "scatter.png, and resumes a killed run from DIR/checkpoint/.",
+    epilog="Example: thermojitter mc examples/montecarlo.toml --n 200 --out out/mc. "
+    f"Exit codes: 0 done, 2 bad input, {EXIT_SAMPLES_FAILED} samples failed (see "
+    "--allow-failures), 130 Ctrl-C.",
+)
+add_parser = COMMAND.add_parser
+mc_command = COMMAND.main

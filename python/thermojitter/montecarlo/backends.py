@@ -16,6 +16,7 @@ from thermojitter.errors import ParameterError
 from thermojitter.montecarlo.metrics import (
     FLOAT_METRICS,
 )
+from thermojitter.simulate import orbits_args
 
 _LOCKSTEP = True
 
@@ -23,9 +24,16 @@ _LOCKSTEP = True
 def run_chunk(
     pool: Any, panels: NDArray[np.float64], options: dict[str, Any], cancel: Any = None
 ) -> dict[str, Any]:
-    opts = dict(options)
-    orbit = opts.pop("orbit")
-    raw = pool.run(panels, orbit, cancel=cancel, lockstep=_LOCKSTEP, **opts)
+    raw = pool.run(
+        panels,
+        options["orbit"],
+        orbits_args(options, options["n_orbits"]),
+        threshold=options["threshold"],
+        stop_at_threshold=options["stop_at_threshold"],
+        validity_limit=options["validity_limit"],
+        cancel=cancel,
+        lockstep=_LOCKSTEP,
+    )
     out: dict[str, Any] = {m: np.asarray(raw[m], dtype=float) for m in FLOAT_METRICS}
     out["stable"] = np.asarray(raw["stable"], dtype=bool)
     out["n_steps"] = np.asarray(raw["n_steps"], dtype=np.int64)

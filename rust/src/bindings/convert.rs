@@ -70,6 +70,36 @@ pub fn panel_dict<'py>(py: Python<'py>, p: &Panel) -> PyResult<Bound<'py, PyDict
     Ok(d)
 }
 
+/// A result mapping of `(name, value)` pairs, in order: the engine lists a type's named values
+/// where they are defined (`LinearThermal::FIELDS` with `values()`, `Material::properties`), and
+/// every binding turns them into a dict here.
+pub fn dict_of<'py, V: IntoPyObject<'py>>(
+    py: Python<'py>,
+    pairs: impl IntoIterator<Item = (&'static str, V)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (name, value) in pairs {
+        d.set_item(name, value)?;
+    }
+    Ok(d)
+}
+
+/// Sets into the dict `$d` each named quantity of `$of`, read by the method of that name and
+/// stored under it: `set_named!(d, laminate; thickness, mass_per_area)`. The names of a result's
+/// derived quantities are written once, in that list, never as a key and again as a call.
+/// `set_named!(d, run; fields a, b)` reads the fields of those names instead.
+macro_rules! set_named {
+    ($d:expr, $of:expr; fields $($name:ident),+ $(,)?) => {{
+        let (d, of) = (&$d, &$of);
+        $(d.set_item(stringify!($name), of.$name)?;)+
+    }};
+    ($d:expr, $of:expr; $($name:ident),+ $(,)?) => {{
+        let (d, of) = (&$d, &$of);
+        $(d.set_item(stringify!($name), of.$name())?;)+
+    }};
+}
+pub(super) use set_named;
+
 /// An optional entry of a mapping of type T, named in any error.
 pub(super) fn optional_item<'py, T: FromPyObjectOwned<'py>>(
     d: &Bound<'py, PyDict>,
@@ -283,6 +313,63 @@ impl Grid<'_> {
     /// The conduction model of `panel` on this grid ([`super::laminate::conduction_from`]).
     pub fn conduction(&self, panel: &Panel) -> PyResult<crate::models::conduction::Conduction> {
         super::laminate::conduction_from(panel, self.layup.as_ref(), self.nodes)
+    }
+}
+
+/// The point a flutter analysis linearises about, as both flutter analyses (`flutter` of the
+/// two-layer model, `layered_flutter` of the N-node model) receive it: the mapping `point` =
+/// {model, coupled, flux}, converted by [`FlutterPoint::inputs`] in the same order with the same
+/// errors for both.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct FlutterPoint {
+    pub model: String,
+    pub coupled: bool,
+    pub flux: f64,
+}
+
+impl FlutterPoint {
+    /// The panel, the hinge model and the coupling of the analysis, its flux factor checked.
+    pub fn inputs(&self, panel: &Bound<'_, PyDict>) -> PyResult<(Panel, HingeModel, Coupling)> {
+        let p = panel_from(panel)?;
+        let m = hinge_model(&self.model)?;
+        crate::analysis::flutter::check_flux(self.flux)?;
+        Ok((p, m, coupling(self.coupled)))
+    }
+}
+
+/// One run over whole orbits, as both the long run (`run_orbits`, one call a chunk of orbits)
+/// and the Monte Carlo batches (`MonteCarloPool.run`, one sample a row) receive it: the mapping
+/// `orbits` = {model, coupled, solver, n_orbits, window[, hybrid][, grid]}, built in one place on
+/// the Python side (`thermojitter.simulate.orbits_args`). `hybrid` (its settings; None: the
+/// solver alone) runs the hybrid propagator; `grid` (None: the two-layer model) the N-node model.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct OrbitsRun<'py> {
+    pub model: String,
+    pub coupled: bool,
+    pub solver: Bound<'py, PyDict>,
+    pub n_orbits: u64,
+    pub window: f64,
+    #[pyo3(default)]
+    pub hybrid: Option<Bound<'py, PyDict>>,
+    #[pyo3(default)]
+    pub grid: Option<Grid<'py>>,
+}
+
+impl OrbitsRun<'_> {
+    /// The hinge model, the coupling and the integrator of the run, converted in that order.
+    pub fn hinge(&self) -> PyResult<(HingeModel, Coupling, Method)> {
+        let m = hinge_model(&self.model)?;
+        Ok((m, coupling(self.coupled), solver_from(&self.solver)?))
+    }
+
+    /// The hybrid propagator's settings (None: the solver alone).
+    pub fn hybrid(&self) -> PyResult<Option<crate::runs::hybrid::HybridSettings>> {
+        self.hybrid
+            .as_ref()
+            .map(super::orbits::hybrid_from)
+            .transpose()
     }
 }
 

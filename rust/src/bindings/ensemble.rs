@@ -4,11 +4,10 @@
 //! front.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{coupling, hinge_model, orbit_from, solver_dict, solver_from};
+use super::convert::{orbit_from, solver_dict, solver_from, OrbitsRun};
 use super::error::invalid;
 use super::error::shield;
 use super::laminate::laminate_from;
-use super::orbits::hybrid_from;
 use crate::runs::ensemble::{
     pool, run_batch_layered, run_batch_on, EnsembleSettings, Layers, Path, SampleMetrics,
 };
@@ -113,30 +112,24 @@ impl MonteCarloPool {
         self.pool.current_num_threads()
     }
 
-    /// Runs one sample per row of `panels`; returns the metrics as columns. `lockstep`: several
-    /// samples per thread in SIMD lanes (the same rows, bit for bit, as one at a time).
-    /// `nodes`: the N-node through-thickness model with that many nodes, on `layup` (a laminate
-    /// mapping) or, without one, on each sample's panel as one homogeneous layer.
-    #[pyo3(signature = (panels, orbit, *, model, coupled, solver, n_orbits, window, threshold, stop_at_threshold, validity_limit=crate::models::hinge::VALIDITY_LIMIT, hybrid=None, cancel=None, lockstep=true, layup=None, nodes=None))]
+    /// Runs one sample per row of `panels` over the `orbits` run; returns the metrics as
+    /// columns. `lockstep`: several samples per thread in SIMD lanes (the same rows, bit for
+    /// bit, as one at a time). The `orbits` run's `grid`: the N-node through-thickness model with
+    /// that many nodes, on its `layup` (a laminate mapping) or, without one, on each sample's
+    /// panel as one homogeneous layer.
+    #[pyo3(signature = (panels, orbit, orbits, *, threshold, stop_at_threshold, validity_limit=crate::models::hinge::VALIDITY_LIMIT, cancel=None, lockstep=true))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
         py: Python<'py>,
         panels: PyReadonlyArray2<'py, f64>,
         orbit: &Bound<'py, PyDict>,
-        model: &str,
-        coupled: bool,
-        solver: &Bound<'py, PyDict>,
-        n_orbits: u64,
-        window: f64,
+        orbits: OrbitsRun<'py>,
         threshold: Option<f64>,
         stop_at_threshold: bool,
         validity_limit: f64,
-        hybrid: Option<&Bound<'py, PyDict>>,
         cancel: Option<&Bound<'py, CancelToken>>,
         lockstep: bool,
-        layup: Option<&Bound<'py, PyDict>>,
-        nodes: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let path = if lockstep {
             Path::Lockstep
@@ -145,24 +138,26 @@ impl MonteCarloPool {
         };
         cancellable(cancel, |cancel| {
             let ps = panels_from(&panels)?;
+            let orbit = orbit_from(orbit)?;
+            let (model, coupling, method) = orbits.hinge()?;
             let settings = EnsembleSettings {
-                orbit: orbit_from(orbit)?,
-                model: hinge_model(model)?,
-                coupling: coupling(coupled),
-                method: solver_from(solver)?,
-                n_orbits,
-                window,
+                orbit,
+                model,
+                coupling,
+                method,
+                n_orbits: orbits.n_orbits,
+                window: orbits.window,
                 threshold,
                 stop_at_threshold,
                 validity_limit,
-                hybrid: hybrid.map(hybrid_from).transpose()?,
+                hybrid: orbits.hybrid()?,
             };
             let pool = &self.pool;
-            // `nodes`: the N-node model on `layup` (None: each sample's panel as one layer).
-            let layers = match nodes {
-                Some(nodes) => Some(Layers {
-                    layup: layup.map(laminate_from).transpose()?,
-                    nodes,
+            // The N-node model on the grid's layup (None: each sample's panel as one layer).
+            let layers = match &orbits.grid {
+                Some(grid) => Some(Layers {
+                    layup: grid.layup.as_ref().map(laminate_from).transpose()?,
+                    nodes: grid.nodes,
                 }),
                 None => None,
             };

@@ -1,44 +1,35 @@
 //! Bindings of the flutter analysis.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{coupling, hinge_model, orbit_from, panel_from};
-use super::error::shield;
-use crate::analysis::flutter::{
-    analyse, analyse_system_at, check_flux, critical_damping, critical_damping_at,
+use super::convert::{
+    coupling, dict_of, hinge_model, orbit_from, panel_from, set_named, FlutterPoint,
 };
+use super::error::shield;
+use crate::analysis::flutter::{analyse, analyse_system_at, critical_damping, critical_damping_at};
 use crate::analysis::linear::LinearThermal;
 use crate::analysis::stability::Axis;
-use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupled;
-use crate::models::hinge::HingeModel;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// Eigen-analysis at the sunlit equilibrium; with `with_critical`, also the critical damping.
+/// Eigen-analysis at the sunlit equilibrium of the flutter `point`, with the critical damping.
 #[pyfunction]
-#[pyo3(signature = (panel, model, coupled, flux, with_critical=true))]
 fn flutter<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    model: &str,
-    coupled: bool,
-    flux: f64,
-    with_critical: bool,
+    point: FlutterPoint,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let (p, m) = flutter_inputs(panel, model, flux)?;
-        let c = coupling(coupled);
-        let a = analyse(&p, m, c, flux)?;
+        let (p, m, c) = point.inputs(panel)?;
+        let a = analyse(&p, m, c, point.flux)?;
         let d = PyDict::new(py);
         let eq = a.equilibrium;
         d.set_item("equilibrium", (eq.t_front, eq.t_back, eq.theta))?;
         let jacobian = a.jacobian;
         let rows = (0..4).map(|i| (0..4).map(|j| jacobian[(i, j)]).collect());
         set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
-        if with_critical {
-            d.set_item("critical_damping", critical_damping(&p, m, c, flux)?)?;
-        }
+        d.set_item("critical_damping", critical_damping(&p, m, c, point.flux)?)?;
         Ok(d)
     })
 }
@@ -79,19 +70,6 @@ fn flutter_at<'py>(
         }
         Ok(d)
     })
-}
-
-/// The panel and the hinge model of a flutter analysis, its flux factor checked: the inputs of
-/// the two-layer and the N-node analyses, checked in the same order.
-pub(super) fn flutter_inputs(
-    panel: &Bound<'_, PyDict>,
-    model: &str,
-    flux: f64,
-) -> PyResult<(Panel, HingeModel)> {
-    let p = panel_from(panel)?;
-    let m = hinge_model(model)?;
-    check_flux(flux)?;
-    Ok((p, m))
 }
 
 /// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as
@@ -168,17 +146,9 @@ fn linear_thermal<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let lt = LinearThermal::new(&panel_from(panel)?, flux, omega, t_star)?;
-        let d = PyDict::new(py);
-        for (name, v) in LinearThermal::FIELDS.iter().zip(lt.values()) {
-            d.set_item(name, v)?;
-        }
-        d.set_item("amplitude", lt.amplitude())?;
-        d.set_item("phase_lag", lt.phase_lag())?;
-        d.set_item("time_constant", lt.time_constant())?;
-        d.set_item("resonant", lt.resonant())?;
-        d.set_item("thermal_damping", lt.thermal_damping())?;
-        d.set_item("critical_damping_estimate", lt.critical_damping_estimate())?;
-        d.set_item("growth_rate_estimate", lt.growth_rate_estimate())?;
+        let d = dict_of(py, LinearThermal::FIELDS.into_iter().zip(lt.values()))?;
+        set_named!(d, lt; amplitude, phase_lag, time_constant, resonant, thermal_damping,
+            critical_damping_estimate, growth_rate_estimate);
         Ok(d)
     })
 }

@@ -2,10 +2,11 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, float_item, orbit_from, panel_dict, panel_from, type_error, Grid, RunOptions,
+    coupling, dict_of, float_item, panel_dict, panel_from, set_named, type_error, FlutterPoint,
+    Grid, RunOptions,
 };
 use super::error::{invalid, shield};
-use super::flutter::{flutter_inputs, set_spectrum};
+use super::flutter::set_spectrum;
 use crate::analysis::flutter::check_flux;
 use crate::analysis::layered::LayeredEquilibrium;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
@@ -102,37 +103,28 @@ fn validate_laminate(laminate: &Bound<'_, PyDict>) -> PyResult<()> {
     shield(|| laminate_from(laminate).map(|_| ()))
 }
 
-/// Lamination-theory properties of a laminate.
+/// Lamination-theory properties of a laminate; with a `panel`, also the `equivalent_panel`: the
+/// panel fields equivalent to the laminate, the others taken from `panel`.
 #[pyfunction]
+#[pyo3(signature = (laminate, panel=None))]
 fn laminate_properties<'py>(
     py: Python<'py>,
     laminate: &Bound<'py, PyDict>,
+    panel: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let lam = laminate_from(laminate)?;
         let d = PyDict::new(py);
-        d.set_item("thickness", lam.thickness())?;
-        d.set_item("mass_per_area", lam.mass_per_area())?;
-        d.set_item("heat_capacity", lam.heat_capacity())?;
-        d.set_item("thermal_resistance", lam.thermal_resistance())?;
-        d.set_item("neutral_axis", lam.neutral_axis())?;
-        d.set_item("bending_stiffness", lam.bending_stiffness())?;
-        d.set_item("extensional_stiffness", lam.extensional_stiffness())?;
+        set_named!(d, lam; thickness, mass_per_area, heat_capacity, thermal_resistance,
+            neutral_axis, bending_stiffness, extensional_stiffness);
+        if let Some(panel) = panel {
+            let base = panel_from(panel)?;
+            d.set_item(
+                "equivalent_panel",
+                panel_dict(py, &lam.equivalent_panel(&base)?)?,
+            )?;
+        }
         Ok(d)
-    })
-}
-
-/// The panel fields equivalent to a laminate, the others taken from `panel`.
-#[pyfunction]
-fn equivalent_panel<'py>(
-    py: Python<'py>,
-    laminate: &Bound<'py, PyDict>,
-    panel: &Bound<'py, PyDict>,
-) -> PyResult<Bound<'py, PyDict>> {
-    shield(|| {
-        let lam = laminate_from(laminate)?;
-        let base = panel_from(panel)?;
-        panel_dict(py, &lam.equivalent_panel(&base)?)
     })
 }
 
@@ -142,14 +134,10 @@ fn materials<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
     MATERIALS
         .iter()
         .map(|m| {
-            let d = PyDict::new(py);
-            d.set_item("key", m.key)?;
-            d.set_item("name", m.name)?;
-            d.set_item("conductivity", m.conductivity)?;
-            d.set_item("density", m.density)?;
-            d.set_item("specific_heat", m.specific_heat)?;
-            d.set_item("youngs_modulus", m.youngs_modulus)?;
-            d.set_item("expansion_coeff", m.expansion_coeff)?;
+            let d = dict_of(py, [("key", m.key), ("name", m.name)])?;
+            for (name, value) in m.properties() {
+                d.set_item(name, value)?;
+            }
             d.set_item("source", m.source)?;
             Ok(d)
         })
@@ -207,61 +195,32 @@ fn layered_steady_state<'py>(
     })
 }
 
-/// The default start of an N-node run beginning at `t0`: the sunlit equilibrium at that time's
-/// solar flux, at rest (node temperatures, θ, θ̇).
+/// Flutter analysis of the N-node system at the flutter `point` (full nodal Jacobian), with the
+/// critical damping.
 #[pyfunction]
-fn layered_start_state(
-    panel: &Bound<'_, PyDict>,
-    grid: Grid<'_>,
-    orbit: &Bound<'_, PyDict>,
-    t0: f64,
-    coupled: bool,
-) -> PyResult<Vec<f64>> {
-    shield(|| {
-        let p = panel_from(panel)?;
-        let o = orbit_from(orbit)?;
-        let c = grid.conduction(&p)?;
-        Ok(crate::analysis::layered::start_state(
-            &p,
-            &c,
-            coupling(coupled),
-            &o,
-            t0,
-        )?)
-    })
-}
-
-/// Flutter analysis of the N-node system (full nodal Jacobian).
-#[pyfunction]
-#[pyo3(signature = (panel, grid, model, coupled, flux, with_critical=true))]
 fn layered_flutter<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     grid: Grid<'py>,
-    model: &str,
-    coupled: bool,
-    flux: f64,
-    with_critical: bool,
+    point: FlutterPoint,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let (p, m) = flutter_inputs(panel, model, flux)?;
+        let (p, m, k) = point.inputs(panel)?;
         let c = grid.conduction(&p)?;
-        let point = crate::analysis::layered::LayeredPoint {
+        let layered = crate::analysis::layered::LayeredPoint {
             panel: &p,
             conduction: &c,
             model: m,
-            coupling: coupling(coupled),
-            flux,
+            coupling: k,
+            flux: point.flux,
         };
-        let a = py.detach(|| point.analyse())?;
+        let a = py.detach(|| layered.analyse())?;
         let d = equilibrium_dict(py, &a.equilibrium)?;
         let size = a.jacobian.nrows();
         let rows = (0..size).map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect());
         set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
-        if with_critical {
-            let cd = py.detach(|| point.critical_damping())?;
-            d.set_item("critical_damping", cd)?;
-        }
+        let cd = py.detach(|| layered.critical_damping())?;
+        d.set_item("critical_damping", cd)?;
         Ok(d)
     })
 }
@@ -305,11 +264,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(validate_layer, m)?)?;
     m.add_function(wrap_pyfunction!(validate_laminate, m)?)?;
     m.add_function(wrap_pyfunction!(laminate_properties, m)?)?;
-    m.add_function(wrap_pyfunction!(equivalent_panel, m)?)?;
     m.add_function(wrap_pyfunction!(materials, m)?)?;
     m.add_function(wrap_pyfunction!(conduction_grid, m)?)?;
     m.add_function(wrap_pyfunction!(layered_steady_state, m)?)?;
-    m.add_function(wrap_pyfunction!(layered_start_state, m)?)?;
     m.add_function(wrap_pyfunction!(layered_flutter, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_layers, m)?)?;
     Ok(())

@@ -25,7 +25,7 @@ use crate::runs::simulate::{run_watched, state_from};
 use cancel::{cancellable, CancelToken};
 use convert::{
     coupling, crossing_tuple, hinge_model, orbit_from, panel_dict, panel_from, set_counters,
-    solver_from, RunOptions,
+    set_named, solver_from, Grid, RunOptions,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -90,19 +90,28 @@ fn steady_state(panel: &Bound<'_, PyDict>, coupled: bool, flux: f64) -> PyResult
 }
 
 /// The default start of a run beginning at `t0`: the sunlit equilibrium at that time's solar
-/// flux, at rest, as the state (T_f, T_b, θ, θ̇).
+/// flux, at rest, as the state (T_f, T_b, θ, θ̇), or with a `grid` the N-node model's state
+/// (node temperatures…, θ, θ̇).
 #[pyfunction]
+#[pyo3(signature = (panel, orbit, t0, coupled, grid=None))]
 fn start_state(
     panel: &Bound<'_, PyDict>,
     orbit: &Bound<'_, PyDict>,
     t0: f64,
     coupled: bool,
+    grid: Option<Grid<'_>>,
 ) -> PyResult<Vec<f64>> {
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        crate::Orbit::check_time(t0)?;
         let coupling = coupling(coupled);
+        if let Some(grid) = grid {
+            let c = grid.conduction(&p)?;
+            return Ok(crate::analysis::layered::start_state(
+                &p, &c, coupling, &o, t0,
+            )?);
+        }
+        crate::Orbit::check_time(t0)?;
         if o.has_face_loads() {
             p.validate()?;
             let system = Coupled::new(p, o, crate::models::hinge::HingeModel::Nonlinear, coupling);
@@ -141,20 +150,12 @@ fn derived<'py>(py: Python<'py>, panel: &Bound<'py, PyDict>) -> PyResult<Bound<'
     shield(|| {
         let p = panel_from(panel)?;
         let d = PyDict::new(py);
-        d.set_item("half_arm", p.half_arm())?;
-        d.set_item("hinge_inertia", p.hinge_inertia())?;
-        d.set_item(
-            "natural_frequency_hz",
-            p.natural_angular_frequency() / (2.0 * PI),
-        )?;
-        d.set_item(
-            "beam_frequency_hz",
-            beam_first_angular_frequency(&p) / (2.0 * PI),
-        )?;
-        d.set_item("moment_per_kelvin", p.moment_per_kelvin())?;
-        d.set_item("flexural_stiffness", p.flexural_stiffness())?;
-        d.set_item("rigidity_per_length", p.rigidity_per_length())?;
-        d.set_item("matching_moment_scale", p.matching_moment_scale())?;
+        set_named!(d, p; half_arm, hinge_inertia, moment_per_kelvin, flexural_stiffness,
+            rigidity_per_length, matching_moment_scale);
+        let natural = p.natural_angular_frequency() / (2.0 * PI);
+        d.set_item("natural_frequency_hz", natural)?;
+        let beam = beam_first_angular_frequency(&p) / (2.0 * PI);
+        d.set_item("beam_frequency_hz", beam)?;
         Ok(d)
     })
 }

@@ -1,6 +1,6 @@
 //! Bindings of the orbit options: eclipses, umbra, the Sun over the year.
 
-use super::convert::orbit_from;
+use super::convert::{orbit_from, set_named};
 use super::error::shield;
 use crate::inputs::orbit::Orbit;
 use numpy::{PyArray1, PyReadonlyArray1};
@@ -119,19 +119,10 @@ fn eclipse_duration(orbit: &Bound<'_, PyDict>) -> PyResult<f64> {
 /// An orbit as the mapping `orbit_from` reads.
 fn orbit_dict<'py>(py: Python<'py>, o: &Orbit) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("radius", o.radius)?;
-    d.set_item("earth_radius", o.earth_radius)?;
-    d.set_item("period", o.period)?;
-    d.set_item("phase0", o.phase0)?;
+    set_named!(d, o; fields radius, earth_radius, period, phase0);
     d.set_item("shadow", o.shadow.name())?;
-    d.set_item("season", o.season)?;
-    d.set_item("eccentric_sun", o.eccentric_sun)?;
-    d.set_item("epoch_day", o.epoch_day)?;
-    d.set_item("inclination", o.inclination)?;
-    d.set_item("raan", o.raan)?;
-    d.set_item("j2", o.j2)?;
-    d.set_item("albedo", o.albedo)?;
-    d.set_item("earth_ir", o.earth_ir)?;
+    set_named!(d, o; fields season, eccentric_sun, epoch_day, inclination, raan, j2, albedo,
+        earth_ir);
     Ok(d)
 }
 

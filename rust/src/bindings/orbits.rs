@@ -2,10 +2,8 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, crossing_tuple, hinge_model, orbit_from, panel_from, set_counters, solver_dict,
-    solver_from,
+    crossing_tuple, orbit_from, panel_from, set_counters, set_named, solver_dict, OrbitsRun,
 };
-use super::laminate::conduction_from;
 use crate::runs::hybrid::HybridSettings;
 use crate::runs::layered::LayeredRunRequest;
 use crate::runs::orbits::{OrbitRunRequest, OrbitRunSpec, SummaryOptions};
@@ -17,38 +15,29 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// Integrates whole orbits and returns one summary per orbit (columns as arrays): the two-layer
-/// model, or the N-node model (`nodes`, `layup`), or with `hybrid` (its settings) the hybrid
-/// propagator, whose fallback is the solver's full integration; a hybrid run adds how the
-/// simulated time was split between linear arcs, the exponential integrator and the fallback.
+/// model, or the N-node model (`grid`), or with `hybrid` (its settings) the hybrid propagator,
+/// whose fallback is the solver's full integration; a hybrid run adds how the simulated time was
+/// split between linear arcs, the exponential integrator and the fallback.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, layup=None, nodes=None, hybrid=None))]
+#[pyo3(signature = (panel, orbit, orbits, *, t_start, first_index, y0, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_orbits<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
-    model: &str,
-    coupled: bool,
-    solver: &Bound<'py, PyDict>,
+    orbits: OrbitsRun<'py>,
     t_start: f64,
     first_index: u64,
-    n_orbits: u64,
     y0: Vec<f64>,
-    window: f64,
     theta_limit: f64,
     stop_at_limit: bool,
     steps_per_period: f64,
     cancel: Option<&Bound<'py, CancelToken>>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: Option<usize>,
-    hybrid: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        let hinge = hinge_model(model)?;
-        let coupling = coupling(coupled);
-        let m = solver_from(solver)?;
+        let (hinge, coupling, m) = orbits.hinge()?;
         crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
         let spec = OrbitRunSpec {
             panel: p,
@@ -58,20 +47,20 @@ fn run_orbits<'py>(
             method: m,
             t_start,
             first_index,
-            n_orbits,
+            n_orbits: orbits.n_orbits,
             options: SummaryOptions {
-                window,
+                window: orbits.window,
                 theta_limit,
                 stop_at_limit,
                 steps_per_period,
             },
         };
-        let hybrid = hybrid.map(hybrid_from).transpose()?;
-        let model = match nodes {
+        let hybrid = orbits.hybrid()?;
+        let model = match &orbits.grid {
             // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
-            Some(n) => OrbitsModel::Laminate(LayeredRunRequest {
+            Some(grid) => OrbitsModel::Laminate(LayeredRunRequest {
                 spec,
-                conduction: conduction_from(&p, layup, n)?,
+                conduction: grid.conduction(&p)?,
                 y0,
             }),
             None => OrbitsModel::TwoLayer(OrbitRunRequest {
@@ -94,13 +83,8 @@ fn hybrid_counters<'py>(
     d: Bound<'py, PyDict>,
     out: &crate::runs::hybrid::HybridRun,
 ) -> PyResult<Bound<'py, PyDict>> {
-    d.set_item("t_linear", out.t_linear)?;
-    d.set_item("t_exponential", out.t_exponential)?;
-    d.set_item("t_fallback", out.t_fallback)?;
-    d.set_item("n_arcs", out.n_arcs)?;
-    d.set_item("n_exp_steps", out.n_exp_steps)?;
-    d.set_item("n_fallback_steps", out.n_fallback_steps)?;
-    d.set_item("n_reread_steps", out.n_reread_steps)?;
+    set_named!(d, out; fields t_linear, t_exponential, t_fallback, n_arcs, n_exp_steps,
+        n_fallback_steps, n_reread_steps);
     Ok(d)
 }
 

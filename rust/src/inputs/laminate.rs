@@ -308,6 +308,16 @@ pub struct Material {
 }
 
 impl Material {
+    /// The properties a layer of this material takes, named as in [`LAYER_FIELDS`] (all but the
+    /// thickness).
+    pub fn properties(&self) -> impl Iterator<Item = (&'static str, f64)> {
+        let values = [self.conductivity, self.density, self.specific_heat];
+        let values = values
+            .into_iter()
+            .chain([self.youngs_modulus, self.expansion_coeff]);
+        LAYER_FIELDS[1..].iter().copied().zip(values)
+    }
+
     /// A layer of this material, `thickness` m thick.
     pub fn layer(&self, thickness: f64) -> Layer {
         Layer {
