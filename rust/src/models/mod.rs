@@ -8,6 +8,7 @@ pub mod distributed;
 pub mod hinge;
 pub mod layered;
 pub mod thermal;
+pub mod tube;
 
 use crate::error::{Error, Result};
 use crate::inputs::panel::Panel;
