@@ -8,6 +8,14 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 
 from thermojitter import _core, beam, materials
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.boom import (
+    Boom,
+    BoomEquilibrium,
+    BoomSolution,
+    BoomStabilityMap,
+    boom_stability_map,
+    boom_steady_state,
+)
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
@@ -84,6 +92,10 @@ _check_kernel_variable()
 __all__ = [
     "AllSamplesFailedError",
     "BeamComparison",
+    "Boom",
+    "BoomEquilibrium",
+    "BoomSolution",
+    "BoomStabilityMap",
     "CalibrationResult",
     "CheckpointError",
     "ConvergenceError",
@@ -114,6 +126,8 @@ __all__ = [
     "ValidityLimitWarning",
     "beam",
     "beam_frequency",
+    "boom_stability_map",
+    "boom_steady_state",
     "flutter",
     "calibrate",
     "calibrate_from_csv",

@@ -11,6 +11,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.boom import Boom
+from thermojitter.boom import _equilibrium as _boom_equilibrium
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import interruptible, progress_bar
@@ -70,7 +72,14 @@ def flutter(
 
     ``layers=N`` analyses the N-node through-thickness model on the panel's layup (or one
     homogeneous layer for a plain panel); ``jacobian`` is then over (node temperatures…, θ, θ̇).
+
+    A :class:`thermojitter.Boom` in place of the panel: the tube's analysis, ``jacobian`` over
+    (T_mean, T_circ, θ, θ̇), ``equilibrium`` a :class:`thermojitter.BoomEquilibrium`, and
+    ``critical_damping`` the first mode's damping ratio ζ at which the growth rate crosses zero
+    (not a c_d); ``model`` is ``"tube"``.
     """
+    if isinstance(panel, Boom):
+        return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     # t is checked even without an orbit: a t of the wrong type is a mistake either way.
     t = checks.finite("t", t)
@@ -91,6 +100,24 @@ def flutter(
     moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
     equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
     return _result(raw, equilibrium, model, coupled, flux)
+
+
+def _boom_flutter(
+    boom: Boom, model: str, coupled: bool, flux: float | None, orbit: Orbit | None, t: float
+) -> FlutterResult:
+    """The tube's flutter analysis (see :func:`flutter`)."""
+    checks.choice("model", model, ("nonlinear", "linear"))
+    t = checks.finite("t", t)
+    if orbit is not None:
+        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
+        if flux is not None:
+            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
+        flux = float(orbit.flux_scale(t)[0])
+    flux = checks.real("flux", 1.0 if flux is None else flux)
+    coupled = checks.flag("coupled", coupled)
+    raw = _core.boom_flutter(boom.as_dict(), coupled, flux)
+    equilibrium = _boom_equilibrium(boom, raw["equilibrium"])
+    return _result(raw, equilibrium, "tube", coupled, flux)  # type: ignore[arg-type]
 
 
 def _layered_flutter(

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
+from thermojitter.boom import Boom
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.progress import (
@@ -83,6 +84,9 @@ class OrbitSummaries:
     (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
     full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``, and
     ``n_reread_steps``: exponential steps whose band of θ failed its check and were read again)."""
+    fallback: str | None = None
+    """Why a run asked for ``method="hybrid"`` ran the full integration instead (a boom), or
+    None."""
     solver: SolverSettings | None = None
     """The integrator settings the engine ran with, as it reports them (with ``method="hybrid"``,
     those of its rk45 fallback); rk45's step is further capped at T_n/``steps_per_period``.
@@ -306,8 +310,20 @@ def simulate_orbits(
     - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
       and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback);
       ``result.solver`` is what the engine ran with.
+
+    A :class:`thermojitter.Boom` in place of the panel runs the tube: ``y0`` and ``y_end`` are
+    (T_mean, T_circ, θ, θ̇), the summaries read θ (the tip deflection over the length) and its
+    quasi-static part as the panel's. ``method="hybrid"`` runs it with the full integration
+    (the hybrid's linear arcs are the plate's modal form) and says so: ``result.fallback`` gives
+    the reason and ``propagation`` puts all the time in ``t_fallback``.
     """
-    check_inputs(panel, orbit)
+    boom = isinstance(panel, Boom)
+    if boom:
+        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
+        if layers is not None:
+            raise checks.ParameterError("layers", layers, "a Boom has its own thermal model")
+    else:
+        check_inputs(panel, orbit)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
     orbits_per_call = checks.integer("orbits_per_call", orbits_per_call, 1)
     on_limit = checks.choice("on_limit", on_limit, ("stop", "flag", "ignore"))  # type: ignore[assignment]
@@ -340,7 +356,9 @@ def simulate_orbits(
     full = used.as_dict()
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None and nodes is None:
+    if y0 is None and boom:
+        y0 = tuple(_core.boom_start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
+    elif y0 is None and nodes is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
         y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
     elif y0 is None:
@@ -389,7 +407,9 @@ def simulate_orbits(
 
     budget = int(core_args["solver"]["max_steps"])  # for the whole run, every orbit together
     if method != "hybrid":
-        row = np.array([[panel.as_dict()[f] for f in _core.PANEL_FIELDS]])
+        # A boom's step is capped by its equivalent hinge's period, the panel's of the same hinge.
+        hinge = panel.derived["hinge_panel"] if isinstance(panel, Boom) else panel.as_dict()
+        row = np.array([[hinge[f] for f in _core.PANEL_FIELDS]])
         least = float(
             _core.least_steps(row, core_args["solver"], orbit.period, steps_per_period)[0]
         )
@@ -415,6 +435,7 @@ def simulate_orbits(
             _check_extension(path, saved, n_orbits, orbits_per_call, next_index)
 
     ran_with: dict[str, Any] | None = None  # the settings the engine reports it ran with
+    fallback: str | None = None
     bar = progress_bar(n_orbits, initial=next_index, unit="orbit", enabled=progress)
     interrupted = report = False
     stopped = crossing is not None and on_limit == "stop"
@@ -430,7 +451,7 @@ def simulate_orbits(
                 t0 = float(t_start) + next_index * orbit.period
                 extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
                 raw = engine.call(
-                    _core.run_orbits,
+                    _core.run_boom_orbits if boom else _core.run_orbits,
                     panel.as_dict(),
                     orbit.as_dict(),
                     t_start=t0,
@@ -445,6 +466,7 @@ def simulate_orbits(
                         columns[name].extend(np.asarray(raw[name]).tolist())
                     y = list(raw["y_end"])
                     ran_with = raw["solver"]
+                    fallback = raw.get("fallback", fallback)
                     counters["n_steps"] += int(raw["n_steps"])
                     counters["n_rhs"] += int(raw["n_rhs"])
                     for name in HYBRID_COUNTERS if method == "hybrid" else ():
@@ -508,6 +530,7 @@ def simulate_orbits(
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,
+        fallback=fallback,
         # A run all read from its checkpoint made no engine call: the engine's reading of the
         # same settings (the check every run makes of them) stands for it.
         solver=SolverSettings(**(_core.check_solver(full) if ran_with is None else ran_with)),

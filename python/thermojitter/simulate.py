@@ -244,7 +244,22 @@ def simulate(
 
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
+
+    A :class:`thermojitter.Boom` in place of the panel runs the tube
+    (:func:`thermojitter.boom.simulate_boom`: a :class:`thermojitter.BoomSolution`, ``y0`` =
+    (T_mean, T_circ, θ, θ̇); its rigid link has one equation of motion, whatever ``model``).
     """
+    from thermojitter.boom import Boom, simulate_boom
+
+    if isinstance(panel, Boom):
+        checks.choice("model", model, _MODELS)
+        if layers is not None:
+            raise ParameterError("layers", layers, "a Boom has its own thermal model")
+        return simulate_boom(  # type: ignore[return-value]
+            panel, orbit, t_span, coupled=coupled, method=method, rtol=rtol, atol=atol, dt=dt,
+            t_eval=t_eval, dt_out=dt_out, y0=y0, max_step=max_step, max_steps=max_steps,
+            solver=solver, theta_limit=theta_limit, on_limit=on_limit,
+        )  # fmt: skip
     check_inputs(panel, orbit)
     t0, t1 = time_span(t_span)
     used, args = run_settings(

@@ -145,10 +145,12 @@ def simulate_scenario(
             )
             # the sample at b starts the next orbit's piece; only the last piece keeps its end
             keep = slice(None) if last else slice(0, len(inside))
-            piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in COLUMNS}}
+            # A boom's columns are its own (T_mean, T_circ in place of T_front, T_back).
+            names_of = sol._columns() if not hasattr(sol, "T_front") else COLUMNS
+            piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in names_of}}
             # With layers = N: a column per node, named as in Solution.to_pandas().
-            node_names = sol.node_columns
-            if sol.T_nodes is not None:
+            node_names = getattr(sol, "node_columns", ())
+            if getattr(sol, "T_nodes", None) is not None:
                 piece.update({n: sol.T_nodes[keep, k] for k, n in enumerate(node_names)})
             pieces.append(piece)
             for key in counters:
@@ -163,7 +165,7 @@ def simulate_scenario(
     finally:
         if bar is not None:
             bar.close()
-    names = ("t", *COLUMNS, *(node_names if pieces else ()))
+    names = tuple(pieces[0]) if pieces else ("t", *COLUMNS)
     columns = {
         name: np.concatenate([p[name] for p in pieces]) if pieces else np.empty(0) for name in names
     }

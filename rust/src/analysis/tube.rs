@@ -51,6 +51,43 @@ pub fn flutter(boom: &Boom, coupling: Coupling, flux: f64) -> Result<BoomFlutter
     })
 }
 
+/// The growth rate and the critical damping ratio over solar inclinations ψ (rows) and ratios
+/// B = ω₁ τ of the thermal to the structural response time (columns, set through the
+/// conductivity, [`Boom::with_response_time_ratio`]), row-major.
+pub struct TubeStabilityMap {
+    pub growth_rate: Vec<f64>,
+    pub critical_damping_ratio: Vec<f64>,
+}
+
+/// [`TubeStabilityMap`] of `boom` under `flux`, stopping within a point of `cancel`.
+pub fn stability_map(
+    boom: &Boom,
+    inclinations: &[f64],
+    ratios: &[f64],
+    coupling: Coupling,
+    flux: f64,
+    cancel: &crate::cancel::Cancel,
+) -> Result<TubeStabilityMap> {
+    let mut map = TubeStabilityMap {
+        growth_rate: Vec::with_capacity(inclinations.len() * ratios.len()),
+        critical_damping_ratio: Vec::with_capacity(inclinations.len() * ratios.len()),
+    };
+    for &psi in inclinations {
+        let tilted = Boom {
+            solar_inclination: psi,
+            ..*boom
+        };
+        for &ratio in ratios {
+            cancel.check()?;
+            let point = tilted.with_response_time_ratio(ratio)?;
+            let f = flutter(&point, coupling, flux)?;
+            map.growth_rate.push(f.spectrum.growth_rate);
+            map.critical_damping_ratio.push(f.critical_damping_ratio);
+        }
+    }
+    Ok(map)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,6 +118,20 @@ mod tests {
             assert!(want > 0.0);
             assert!((got / want - 1.0).abs() < 1e-6, "ψ {psi}: {got} vs {want}");
         }
+    }
+
+    #[test]
+    fn the_response_time_ratio_is_set_by_the_conductivity() {
+        let boom = Boom {
+            length: 10.0,
+            ..Boom::example()
+        };
+        for ratio in [0.1, 1.0, 20.0] {
+            let b = boom.with_response_time_ratio(ratio).unwrap();
+            let got = b.first_angular_frequency() * b.time_constant();
+            assert!((got / ratio - 1.0).abs() < 1e-12, "{got}");
+        }
+        assert!(boom.with_response_time_ratio(1e6).is_err());
     }
 
     #[test]

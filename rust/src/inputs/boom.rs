@@ -325,6 +325,33 @@ impl Boom {
         self.hinge_moment_scale() * self.physical_moment_per_kelvin()
     }
 
+    /// This boom with the conductivity that gives B = ω₁ τ = `ratio` (Boley's ratio of the
+    /// thermal to the structural response time): k = (ρ c h/τ − radiation) r² / (η h) with
+    /// τ = ratio/ω₁. Refused beyond the radiation's own time constant (k would be negative).
+    pub fn with_response_time_ratio(&self, ratio: f64) -> Result<Boom> {
+        let tau = ratio / self.first_angular_frequency();
+        let conduction = self.heat_capacity() / tau - self.radiation_relaxation();
+        let most =
+            self.first_angular_frequency() * self.heat_capacity() / self.radiation_relaxation();
+        if !(ratio.is_finite() && ratio > 0.0 && conduction >= 0.0) {
+            return Err(Error::invalid(
+                "ratio",
+                ratio,
+                &format!(
+                    "must be in (0, {most:.6e}]: beyond it the radiation alone relaxes T_m \
+                     faster (no conductivity gives it)"
+                ),
+            ));
+        }
+        let b = Boom {
+            conductivity: conduction * self.radius * self.radius
+                / (self.conduction_scale * self.wall),
+            ..*self
+        };
+        b.validate()?;
+        Ok(b)
+    }
+
     /// A panel with the boom's hinge (inertia, stiffness and damping): what the runs of whole
     /// orbits read of a panel (the hinge's period, which caps the step, and its fastest start).
     pub fn hinge_panel(&self) -> Panel {

@@ -79,6 +79,13 @@ pub trait ThermalModel {
     /// A starting point for the steady state under `flux`: every temperature at the isothermal
     /// plate's equilibrium.
     fn initial_guess(&self, flux: f64, out: &mut [f64]);
+
+    /// Refuses a start of the temperatures `temps` the model does not describe: by default each
+    /// an absolute temperature, finite and > 0 K (a model whose states include a perturbation
+    /// checks those as it must).
+    fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
+        crate::models::hinge::check_start_state(temps, temps.len(), None)
+    }
 }
 
 /// A boxed model is a model (what [`crate::models::thermal_model`] returns).
@@ -110,6 +117,9 @@ impl<M: ThermalModel + ?Sized> ThermalModel for Box<M> {
     fn initial_guess(&self, flux: f64, out: &mut [f64]) {
         (**self).initial_guess(flux, out)
     }
+    fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
+        (**self).check_start(temps)
+    }
 }
 
 /// A thermal model whose rates are computed as written, heat flows over capacities: the form of
@@ -138,6 +148,9 @@ impl<M: ThermalModel> ThermalModel for AsWritten<M> {
     }
     fn initial_guess(&self, flux: f64, out: &mut [f64]) {
         self.0.initial_guess(flux, out)
+    }
+    fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
+        self.0.check_start(temps)
     }
 }
 

@@ -142,6 +142,14 @@ impl ThermalModel for TubeThermal {
     fn moment_per_kelvin(&self) -> f64 {
         self.moment_per_kelvin
     }
+    /// T̄ is an absolute temperature (> 0 K), T_m a perturbation about it (any sign, finite).
+    fn check_start(&self, temps: &[f64]) -> Result<()> {
+        crate::models::hinge::check_start_state(&temps[..1], 1, None)?;
+        if !temps[1].is_finite() {
+            return Err(Error::invalid("y0[1]", temps[1], "T_circ must be finite"));
+        }
+        Ok(())
+    }
     fn initial_guess(&self, flux: f64, out: &mut [f64]) {
         let (mean, circ) = self.equilibrium(flux);
         out[0] = mean;
