@@ -28,15 +28,20 @@ from machine import describe, load  # noqa: E402
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-def timed(run: Callable[[], tj.OrbitSummaries], repeats: int) -> tuple[float, int, int]:
-    """Median wall time of `repeats` calls, and the steps and right-hand sides of one."""
-    times, steps, rhs = [], 0, 0
+def timed(
+    runs: dict[str, Callable[[], tj.OrbitSummaries]], repeats: int
+) -> dict[str, tuple[float, int, int]]:
+    """Each run's median wall time over `repeats` calls made alternately (so that a change of
+    the machine's load falls on both), and the steps and right-hand sides of one call."""
+    times: dict[str, list[float]] = {name: [] for name in runs}
+    counts: dict[str, tuple[int, int]] = {}
     for _ in range(repeats):
-        start = time.perf_counter()
-        out = run()
-        times.append(time.perf_counter() - start)
-        steps, rhs = out.n_steps, out.n_rhs
-    return statistics.median(times), steps, rhs
+        for name, run in runs.items():
+            start = time.perf_counter()
+            out = run()
+            times[name].append(time.perf_counter() - start)
+            counts[name] = (out.n_steps, out.n_rhs)
+    return {name: (statistics.median(times[name]), *counts[name]) for name in runs}
 
 
 def matching_boom(frequency: float) -> tj.Boom:
@@ -74,9 +79,7 @@ def main() -> None:
         return tj.simulate_orbits(boom, orbit, 1, method="rk45", progress=False)
 
     run_plate(), run_boom()  # warm up
-    results = {}
-    for name, run in (("plate", run_plate), ("boom", run_boom)):
-        results[name] = timed(run, args.repeats)
+    results = timed({"plate": run_plate, "boom": run_boom}, args.repeats)
     for name, (wall, steps, rhs) in results.items():
         print(f"{name:>5}: {wall * 1e3:8.2f} ms per orbit, {steps} steps, {rhs} rhs, "
               f"{wall / rhs * 1e9:6.1f} ns per rhs")  # fmt: skip

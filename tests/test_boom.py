@@ -97,7 +97,11 @@ def test_boley_suddenly_heated_boom(B: float) -> None:
     # τ = ρ c h / (k h/r² + 4 σ T̄³ ε): the conductivity that gives it.
     mean, _, _ = closed_form_steady(base)
     radiative = 4 * SIGMA * mean**3 * base.emissivity
-    k = (base.density * base.specific_heat * base.wall / tau - radiative) * base.radius**2 / base.wall
+    k = (
+        (base.density * base.specific_heat * base.wall / tau - radiative)
+        * base.radius**2
+        / base.wall
+    )
     b = base.replace(conductivity=k)
     assert b.response_time_ratio == pytest.approx(B, rel=1e-9)
     static = closed_form_steady(b)[2] / b.length
@@ -157,7 +161,9 @@ def test_yu_orientation() -> None:
         eq = tj.steady_state(b)
         period = 1 / b.first_frequency
         y0 = (eq.T_mean, eq.T_circ, eq.theta + 1e-4, 0.0)
-        sol = tj.simulate(b, GEO, (0.0, 40 * period), y0=y0, dt_out=period / 50, rtol=1e-10, atol=1e-14)
+        sol = tj.simulate(
+            b, GEO, (0.0, 40 * period), y0=y0, dt_out=period / 50, rtol=1e-10, atol=1e-14
+        )
         swing = np.abs(sol.theta - eq.theta)
         first, last = swing[: 5 * 50].max(), swing[-5 * 50 :].max()
         assert (last > first) == grows, (psi, first, last)
@@ -188,7 +194,10 @@ def test_engine_transient_matches_the_reference(params: dict[str, object], coupl
     b = tj.Boom(**p)  # type: ignore[arg-type]
     # Through the shadow entry from the sunlit steady state: the cooling transient, over at
     # most 20 periods of the boom after it (both integrators' phase errors grow with them).
-    span = (ENTRY - min(300.0, 5.0 / b.first_frequency), ENTRY + min(900.0, 20.0 / b.first_frequency))
+    span = (
+        ENTRY - min(300.0, 5.0 / b.first_frequency),
+        ENTRY + min(900.0, 20.0 / b.first_frequency),
+    )
     t = np.linspace(*span, 121)
     y0 = ref.tube_steady_state(b, coupled)
     got = tj.simulate(b, GEO, span, coupled=coupled, t_eval=t, y0=y0, rtol=1e-11, atol=1e-13)
@@ -274,5 +283,33 @@ def test_a_boom_runs_whole_orbits_and_the_hybrid_says_it_fell_back() -> None:
     for name in ("theta_max", "jitter_peak", "jitter_rms"):
         assert np.array_equal(getattr(rk45, name), getattr(hybrid, name)), name
     # The summaries agree with a sampled transient of the same orbits.
-    sol = tj.simulate(b, orbit, (0.0, 2 * orbit.period), dt_out=0.5, max_step=1 / b.first_frequency / 40)
+    sol = tj.simulate(
+        b, orbit, (0.0, 2 * orbit.period), dt_out=0.5, max_step=1 / b.first_frequency / 40
+    )
     assert rk45.theta_max.max() == pytest.approx(sol.theta.max(), rel=1e-4)
+
+
+def test_the_stability_map_is_the_flutter_analysis_point_by_point() -> None:
+    # Weakly absorbing: the steady deflection stays small, so that ψ + θ stays on ψ's side of
+    # 90° (a boom bent past normal incidence changes the feedback's sign).
+    b = bare_becu(length=15.0, absorptivity=0.05)
+    psi = np.radians([60.0, 120.0, 150.0])
+    ratios = [0.5, 2.0, 8.0]
+    m = tj.boom_stability_map(b, psi, ratios)
+    assert m.growth_rate.shape == (3, 3) == m.critical_damping.shape
+    # Leaning toward the Sun needs no damping; leaning away it does, at every ratio.
+    assert np.all(m.critical_damping[0] == 0.0) and np.all(m.critical_damping[1:] > 0.0)
+    assert np.all(m.stable[0]) and not np.any(m.stable[1:])
+    # Each point is the boom with the conductivity that gives B = ω₁ τ.
+    for i, j in [(1, 0), (2, 2)]:
+        mean, _, _ = closed_form_steady(b.replace(solar_inclination=psi[i]))
+        tau = ratios[j] / b.derived["first_angular_frequency"]
+        radiative = 4 * SIGMA * mean**3 * b.emissivity
+        k = (b.density * b.specific_heat * b.wall / tau - radiative) * b.radius**2 / b.wall
+        point = b.replace(solar_inclination=psi[i], conductivity=k)
+        res = tj.flutter(point)
+        assert m.growth_rate[i, j] == pytest.approx(res.growth_rate, rel=1e-9)
+        assert m.critical_damping[i, j] == pytest.approx(res.critical_damping, rel=1e-9)
+    with pytest.raises(tj.ParameterError) as e:
+        tj.boom_stability_map(b, psi, [1e6])
+    assert e.value.parameter == "ratio"

@@ -8,6 +8,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 
 from thermojitter import _core, beam, materials
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.boom import (
     Boom,
     BoomEquilibrium,
@@ -16,7 +17,6 @@ from thermojitter.boom import (
     boom_stability_map,
     boom_steady_state,
 )
-from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
 from thermojitter.distributed import (

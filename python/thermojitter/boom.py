@@ -25,9 +25,8 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
-from thermojitter import _core
+from thermojitter import _core, materials
 from thermojitter import errors as checks
-from thermojitter import materials
 from thermojitter.orbit import Orbit
 from thermojitter.progress import interruptible
 from thermojitter.results import Array, LimitCrossing, _Run
@@ -44,7 +43,10 @@ DEFAULT_MATERIAL = "beryllium_copper"
 """The material of a boom given none: beryllium copper, the STEM booms' classical alloy."""
 
 BOOM_RANGES: Mapping[str, tuple[float, float, bool]] = MappingProxyType(
-    {name: tuple(bounds) for name, bounds in _core.BOOM_RANGES.items()}
+    {
+        name: (float(lo), float(hi), bool(open_))
+        for name, (lo, hi, open_) in _core.BOOM_RANGES.items()
+    }
 )
 """Every boom parameter's range as the engine checks it: (low, high, low end open)."""
 
@@ -152,7 +154,7 @@ class Boom:
         unknown = sorted(set(changes) - set(self.field_names()))
         if unknown:
             raise checks.ParameterError(unknown[0], changes[unknown[0]], "is not a boom parameter")
-        return dataclasses.replace(self, **changes)
+        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]
 
     def as_dict(self) -> dict[str, float]:
         return {f.name: getattr(self, f.name) for f in fields(self)}

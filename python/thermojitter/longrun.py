@@ -246,7 +246,7 @@ def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
 
 
 def simulate_orbits(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     n_orbits: int,
     *,
@@ -318,7 +318,7 @@ def simulate_orbits(
     the reason and ``propagation`` puts all the time in ``t_fallback``.
     """
     boom = isinstance(panel, Boom)
-    if boom:
+    if isinstance(panel, Boom):
         checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
         if layers is not None:
             raise checks.ParameterError("layers", layers, "a Boom has its own thermal model")
@@ -342,6 +342,8 @@ def simulate_orbits(
     n_orbits = orbit_count("n_orbits", n_orbits, orbit, t_start)
     method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
     nodes = None if layers is None else check_layers(layers)
+    # The N-node model's layup (layers is refused for a boom).
+    layup = None if isinstance(panel, Boom) or nodes is None else layup_dict(panel)
     used = SolverSettings.of(
         solver,
         method=None if method == "hybrid" else method,
@@ -365,7 +367,7 @@ def simulate_orbits(
         assert nodes is not None
         y0 = tuple(
             _core.layered_start_state(
-                panel.as_dict(), layup_dict(panel), nodes, orbit.as_dict(), t_start, coupled
+                panel.as_dict(), layup, nodes, orbit.as_dict(), t_start, coupled
             )
         )
     settings: dict[str, Any] = {
@@ -388,7 +390,7 @@ def simulate_orbits(
     }
     if nodes is not None:
         settings["layers"] = nodes
-        settings["layup"] = layup_dict(panel)
+        settings["layup"] = layup
     hybrid_settings = HybridSettings.of(hybrid).as_dict()
     if method == "hybrid":
         settings["hybrid"] = hybrid_settings
@@ -402,7 +404,7 @@ def simulate_orbits(
         "steps_per_period": steps_per_period,
     }
     if nodes is not None:
-        core_args["layup"] = layup_dict(panel)
+        core_args["layup"] = layup
         core_args["nodes"] = nodes
 
     budget = int(core_args["solver"]["max_steps"])  # for the whole run, every orbit together

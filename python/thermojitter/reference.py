@@ -476,8 +476,10 @@ def tube_cantilever_beta(mu: float) -> float:
     from scipy.optimize import brentq
 
     def f(b: float) -> float:
-        return 1 + math.cos(b) * math.cosh(b) + mu * b * (
-            math.cos(b) * math.sinh(b) - math.sin(b) * math.cosh(b)
+        return (
+            1
+            + math.cos(b) * math.cosh(b)
+            + mu * b * (math.cos(b) * math.sinh(b) - math.sin(b) * math.cosh(b))
         )
 
     return float(brentq(f, 1e-4, 1.8751040687119611 + 1e-9, xtol=1e-15, rtol=1e-15))
@@ -549,7 +551,11 @@ def tube_rhs(
             (c["mean"] * f - c["radiation"] * mean_t**4) / c["capacity"],
             (c["harmonic"] * f - c["relaxation"] * circ) / c["capacity"],
             rate,
-            (hinge["chi"] * c["moment"] * circ - hinge["damping"] * rate - hinge["stiffness"] * theta)
+            (
+                hinge["chi"] * c["moment"] * circ
+                - hinge["damping"] * rate
+                - hinge["stiffness"] * theta
+            )
             / hinge["inertia"],
         ]
     )

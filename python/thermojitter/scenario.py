@@ -500,7 +500,9 @@ def parse_scenario(
     if "boom" in data:
         for other in ("panel", "laminate"):
             if other in data:
-                raise ScenarioError(where, other, "a scenario with [boom] has no [panel] or [laminate]")
+                raise ScenarioError(
+                    where, other, "a scenario with [boom] has no [panel] or [laminate]"
+                )
         panel = _boom(where, _table(where, data, "boom"))
     elif "laminate" in data:
         layup = _laminate(where, _table(where, data, "laminate"))

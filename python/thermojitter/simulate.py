@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -24,6 +24,9 @@ from thermojitter.results import (
     ThermalSolution,
 )
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
+
+if TYPE_CHECKING:
+    from thermojitter.boom import Boom
 
 Model = Literal["nonlinear", "linear"]
 Method = Literal["rk45", "rk4"]
@@ -186,7 +189,7 @@ def layup_dict(panel: Panel) -> dict[str, Any] | None:
 
 
 def simulate(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     t_span: Sequence[float],
     *,
@@ -249,7 +252,7 @@ def simulate(
     (:func:`thermojitter.boom.simulate_boom`: a :class:`thermojitter.BoomSolution`, ``y0`` =
     (T_mean, T_circ, θ, θ̇); its rigid link has one equation of motion, whatever ``model``).
     """
-    from thermojitter.boom import Boom, simulate_boom
+    from thermojitter.boom import Boom, simulate_boom  # noqa: F811 (the annotation's, at run time)
 
     if isinstance(panel, Boom):
         checks.choice("model", model, _MODELS)

@@ -150,8 +150,9 @@ def simulate_scenario(
             piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in names_of}}
             # With layers = N: a column per node, named as in Solution.to_pandas().
             node_names = getattr(sol, "node_columns", ())
-            if getattr(sol, "T_nodes", None) is not None:
-                piece.update({n: sol.T_nodes[keep, k] for k, n in enumerate(node_names)})
+            nodes = getattr(sol, "T_nodes", None)
+            if nodes is not None:
+                piece.update({n: nodes[keep, k] for k, n in enumerate(node_names)})
             pieces.append(piece)
             for key in counters:
                 counters[key] += int(getattr(sol, key))
