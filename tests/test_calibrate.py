@@ -75,6 +75,25 @@ def test_reads_telemetry_from_csv(tmp_path: Path) -> None:
         tj.calibrate_from_csv(tmp_path / "missing.csv")
 
 
+def test_reads_the_time_series_of_the_run_command_with_its_units(tmp_path: Path) -> None:
+    """timeseries.csv says its units in its header (t [s], theta [rad]); the column names alone
+    find them."""
+    from thermojitter.cli import main
+
+    scenario = tmp_path / "s.toml"
+    span = f"t_start = {ENTRY - 60.0!r}\nt_end = {ENTRY + 600.0!r}\ndt_out = 2.0\n"
+    scenario.write_text(f"[simulation]\n{span}[output]\nplots = false\n")
+    assert main(["run", str(scenario), "--out", str(tmp_path / "out"), "--no-progress"]) == 0
+    series = tmp_path / "out" / "timeseries.csv"
+    assert series.read_text().splitlines()[0].startswith("t [s],T_front [K],T_back [K],theta [rad]")
+    start = PAPER.replace(hinge_stiffness=4000.0)
+    fit = tj.calibrate_from_csv(series, panel=start, orbit=GEO, fit=("hinge_stiffness",))
+    table = np.loadtxt(series, delimiter=",", skiprows=1)
+    same = tj.calibrate(table[:, 0], table[:, 3], panel=start, orbit=GEO, fit=("hinge_stiffness",))
+    assert fit.parameters == same.parameters
+    assert fit.theta_model.tobytes() == same.theta_model.tobytes()
+
+
 def test_refuses_bad_series() -> None:
     theta = np.zeros(T.size)
     with pytest.raises(ValueError, match="too short"):

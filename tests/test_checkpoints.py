@@ -271,7 +271,7 @@ def test_full_disk_in_the_command_names_the_file_and_leaves_nothing_partial(
     # The time series computed before the failure is complete; nothing partial is left.
     assert leftovers(out) == ["timeseries.csv"]
     frame = pd.read_csv(out / "timeseries.csv")
-    assert frame["t"].iloc[-1] == 60.0
+    assert frame["t [s]"].iloc[-1] == 60.0
 
 
 def test_report_writes_name_the_file_and_leave_nothing_partial(
@@ -305,3 +305,23 @@ def test_command_refuses_a_non_empty_out_unless_overwrite(
     assert cli_main(["run", str(scenario), "--out", str(out), "--no-progress", "--overwrite"]) == 0
     assert (out / "earlier.csv").read_text() == "kept\n"
     assert (out / "timeseries.csv").exists()
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o077, 0o002])
+def test_written_files_honour_the_umask(tmp_path: Path, mask: int) -> None:
+    """Output files get the permissions of any new file (0o666 less the umask), not the
+    owner-only 0o600 of a temporary file."""
+    old = os.umask(mask)
+    try:
+        checkpoint.write_bytes_atomic(tmp_path / "plain.bin", b"x")
+        tj.steady_state(tj.Panel.paper()).save(tmp_path / "eq.nc")
+        scenario = tmp_path / "s.toml"
+        scenario.write_text("[simulation]\nt_end = 20.0\n")
+        out = tmp_path / "out"
+        assert cli_main(["run", str(scenario), "--out", str(out), "--no-progress"]) == 0
+    finally:
+        os.umask(old)
+    written = [tmp_path / "plain.bin", tmp_path / "eq.nc", *sorted(out.iterdir())]
+    assert len(written) > 4
+    for path in written:
+        assert path.stat().st_mode & 0o777 == 0o666 & ~mask, path.name

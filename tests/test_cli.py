@@ -216,6 +216,16 @@ def test_module_entry_point_and_help(capsys: pytest.CaptureFixture[str]) -> None
 # run
 
 
+def _bare(frame: pd.DataFrame) -> pd.DataFrame:
+    """The time series with its columns' names without their units (``t [s]`` → ``t``)."""
+    return frame.rename(columns=lambda c: c.split(" [")[0])
+
+
+def read_series(path: Path) -> pd.DataFrame:
+    """timeseries.csv, its columns by name alone."""
+    return _bare(pd.read_csv(path))
+
+
 def _scenario(tmp_path: Path, text: str, name: str = "s.toml") -> Path:
     path = tmp_path / name
     path.write_text(text)
@@ -239,15 +249,14 @@ def test_run_writes_series_and_plots(tmp_path: Path, fmt: str) -> None:
     assert cli.main(["run", str(path), "--out", str(out), "--no-progress"]) == 0
     series = out / f"timeseries.{fmt}"
     frame = pd.read_csv(series) if fmt == "csv" else pd.read_parquet(series)
-    assert list(frame.columns) == [
-        "t",
-        "T_front",
-        "T_back",
-        "theta",
-        "theta_dot",
-        "thermal_moment",
-        "sunlit",
-    ]
+    units = ["s", "K", "K", "rad", "rad/s", "N m", "-"]
+    names = ["t", "T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit"]
+    if fmt == "csv":  # the header says the units, in the columns' order
+        assert list(frame.columns) == [f"{n} [{u}]" for n, u in zip(names, units, strict=True)]
+        frame = _bare(frame)
+    else:
+        assert frame.attrs["units"] == dict(zip(names, units, strict=True))
+    assert list(frame.columns) == names
     t0, t1 = 40999.63121743586 - 60.0, 40999.63121743586 + 240.0
     assert frame["t"].iloc[0] == pytest.approx(t0)
     assert frame["t"].iloc[-1] == pytest.approx(t1)
@@ -269,7 +278,7 @@ def test_run_splits_long_runs_per_orbit_without_changing_them(tmp_path: Path) ->
     text = "[simulation]\norbits = 2\ndt_out = 30.0\n[output]\nplots = false\n"
     out = tmp_path / "out"
     assert cli.main(["run", str(_scenario(tmp_path, text)), "--out", str(out)]) == 0
-    frame = pd.read_csv(out / "timeseries.csv")
+    frame = read_series(out / "timeseries.csv")
     period = tj.Orbit.geo_equinox().period
     assert len(frame) == math.floor(2 * period / 30.0) + 2  # the grid and the end point
     assert np.all(np.diff(frame["t"]) > 0)
@@ -373,7 +382,7 @@ def test_ctrl_c_keeps_finished_orbits(
     assert cli.main(["run", str(path), "--out", str(out), "--no-progress"]) == 130
     err = capsys.readouterr().err
     assert "Traceback" not in err and "interrupted" in err
-    frame = pd.read_csv(out / "timeseries.csv")
+    frame = read_series(out / "timeseries.csv")
     period = tj.Orbit.geo_equinox().period
     assert frame["t"].iloc[-1] < period  # the first orbit only, kept on disk
     assert len(frame) == math.ceil(period / 60.0)
@@ -615,3 +624,47 @@ def test_mc_help_names_the_failure_option_and_exit_code(
         cli.main(["mc", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "--allow-failures" in text and "3 samples failed" in text
+
+
+def test_a_scenario_of_orbit_summaries_defaults_to_the_apis_method(tmp_path: Path) -> None:
+    """keep = "orbits" runs what tj.simulate_orbits runs by default (the hybrid), a time series
+    what tj.simulate runs (rk45); the reference and run --help name the hybrid."""
+    import inspect
+
+    from thermojitter.cli.run import scenario_keys_help
+
+    long = _scenario(tmp_path, '[simulation]\norbits = 3\nkeep = "orbits"\n', "long.toml")
+    api = inspect.signature(tj.simulate_orbits).parameters["method"].default
+    assert load_scenario(long).simulation.method == api == "hybrid"
+    series = _scenario(tmp_path, "[simulation]\norbits = 1\n", "series.toml")
+    assert load_scenario(series).simulation.method == "rk45"
+    assert inspect.signature(tj.simulate).parameters["method"].default == "rk45"
+    chosen = _scenario(tmp_path, '[simulation]\nkeep = "orbits"\nmethod = "rk45"\n', "c.toml")
+    assert load_scenario(chosen).simulation.method == "rk45"
+    reference = (Path(__file__).parent.parent / "docs" / "scenarios.md").read_text()
+    row = next(line for line in reference.splitlines() if line.startswith("| `method` |"))
+    assert '"hybrid"' in row
+    assert "hybrid" in scenario_keys_help()
+
+
+def test_warnings_come_in_the_commands_one_line_format(tmp_path: Path) -> None:
+    """A warning during a command (here the hinge angle past its validity limit) is one line
+    in the command's own format, not Python's file:line and source line."""
+    scenario = _scenario(
+        tmp_path,
+        "[panel]\nhinge_stiffness = 1000.0\n[simulation]\nt_end = 50.0\n[output]\nplots = false\n",
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "thermojitter", "run", str(scenario), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("thermojitter: warning: θ passed theta_limit = 20°")
+    assert lines[0].endswith("(ValidityLimitWarning)")
+    # Code that records warnings still gets them as they are.
+    with pytest.warns(tj.ValidityLimitWarning):
+        assert cli.main(["run", str(scenario), "--out", str(tmp_path / "p")]) == 0

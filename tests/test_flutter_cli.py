@@ -79,3 +79,19 @@ def test_bad_input_gives_one_line_and_exit_code_2(tmp_path: Path, capsys, conten
 def test_missing_file(tmp_path: Path, capsys):
     assert flutter_command([str(tmp_path / "nope.toml"), "--out", str(tmp_path)]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+def test_it_says_where_it_writes_and_checks_the_folder_first(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    small = ["--x", "damping:0:4:3", "--y", "conductance:10:40:3", "--no-plot"]
+    assert flutter_command(small) == 0
+    first = capsys.readouterr().out
+    assert "writing to out/flutter/ (the default; --out DIR to choose)" in first
+    assert (tmp_path / "out" / "flutter" / "flutter.json").is_file()
+    # A second run refuses the non-empty folder before any analysis is printed.
+    assert flutter_command(small) == 2
+    second = capsys.readouterr()
+    assert second.out == ""
+    assert "out/flutter: the folder is not empty" in second.err

@@ -17,7 +17,7 @@ from test_hybrid import assert_gate
 import thermojitter as tj
 from conftest import PAPER
 from thermojitter import _core
-from thermojitter.simulate import layup_dict
+from thermojitter.simulate import grid_args
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 from laminates import boom, wing  # noqa: E402
@@ -83,7 +83,7 @@ def weak_flutter_growth(fraction: float) -> tuple[float, float]:
     panel = base.replace(damping=fraction * crit)
     predicted = tj.flutter(panel, layers=20).growth_rate
     start = _core.layered_start_state(
-        panel.as_dict(), layup_dict(panel), 20, sunlit.as_dict(), 0.0, True
+        panel.as_dict(), grid_args(panel, 20), sunlit.as_dict(), 0.0, True
     )
     y0 = [*start[:-2], start[-2] + 1e-6, 0.0]
     run = tj.simulate_orbits(panel, sunlit, 4, layers=20, method="hybrid", y0=y0)

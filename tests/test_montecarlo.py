@@ -437,3 +437,25 @@ def test_mc_command_writes_samples_and_plots(
     code = mc_command([str(scenario), "--n", "2", "--out", str(out / "x"), "--no-progress"])
     err = capsys.readouterr().err
     assert code == 2 and "colour" in err and err.count("\n") == 1
+
+
+def test_amplitude_slope_is_nan_on_one_orbit_and_the_summary_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    one = run(n=2)
+    assert one["amplitude_slope"].isna().all()  # one orbit: no slope, by definition
+    two = run(n=2, horizon=2)
+    assert np.isfinite(two["amplitude_slope"]).all()
+    # Its documentation says so, where the metrics are described.
+    described = " ".join(Path(montecarlo.metrics.__file__).read_text().split())
+    assert "NaN on the default one-orbit horizon" in described
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        "[orbit]\nradius = 7.0e6\nperiod = 5828.5\n[vary]\n"
+        'damping = ["uniform", 1.0, 4.0]\n[montecarlo]\nrtol = 1e-6\natol = 1e-8\n'
+    )
+    base = [str(scenario), "--n", "2", "--no-progress", "--no-plots", "--seed", "2"]
+    assert mc_command([*base, "--out", str(tmp_path / "one")]) == 0
+    assert "note: amplitude_slope is NaN for every sample" in capsys.readouterr().out
+    assert mc_command([*base, "--out", str(tmp_path / "two"), "--horizon", "2"]) == 0
+    assert "note: amplitude_slope" not in capsys.readouterr().out

@@ -99,6 +99,10 @@ def test_run_writes_a_column_per_node(tmp_path: Path) -> None:
     frame = pd.read_csv(next((tmp_path / "out").glob("*.csv")))
     nodes = [c for c in frame.columns if c.startswith("T_node")]
     assert len(nodes) == 12
+    # Each node's temperature in K, named as Solution.node_columns names it.
+    assert all(n.endswith(" [K]") for n in nodes)
+    nodes = [n.removesuffix(" [K]") for n in nodes]
+    frame = frame.rename(columns=lambda c: c.removesuffix(" [K]"))
     assert nodes[0] == "T_node00 (front, kapton)" and nodes[-1] == "T_node11 (back, cfrp_m55j_qi)"
     assert sum(n.endswith(" (cfrp_m55j_qi|core)") for n in nodes) == 1
     assert np.array_equal(frame[nodes[0]], frame["T_front"])

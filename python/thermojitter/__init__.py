@@ -6,7 +6,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
     sol = tj.simulate(tj.Panel.paper(), tj.Orbit.geo_equinox(), (0, 86164.0905))
 """
 
-from thermojitter import _core, beam, materials
+from thermojitter import _core, beam, materials, nastran
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.boom import (
@@ -51,8 +51,10 @@ from thermojitter.montecarlo import (
     sensitivity,
     sweep,
 )
+from thermojitter.nastran import NastranBeam, from_nastran, to_nastran
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
+from thermojitter.persist import ResultFileError, load, save
 from thermojitter.results import (
     Equilibrium,
     HingeSolution,
@@ -112,11 +114,13 @@ __all__ = [
     "InternalError",
     "LimitCrossing",
     "LinearThermalResponse",
+    "NastranBeam",
     "Orbit",
     "OrbitSummaries",
     "Panel",
     "ParameterError",
     "ParameterTypeError",
+    "ResultFileError",
     "SampleFailureWarning",
     "SensitivityResult",
     "Solution",
@@ -135,12 +139,16 @@ __all__ = [
     "distributed_defaults",
     "distributed_flutter",
     "distributed_frequencies",
+    "from_nastran",
     "hinge_energy",
     "hinge_stiffness",
     "linear_thermal_response",
+    "load",
     "materials",
     "monte_carlo",
+    "nastran",
     "natural_frequency",
+    "save",
     "sensitivity",
     "simulate",
     "simulate_distributed",
@@ -150,4 +158,5 @@ __all__ = [
     "stability_map",
     "steady_state",
     "sweep",
+    "to_nastran",
 ]

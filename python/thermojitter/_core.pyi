@@ -1,9 +1,10 @@
 """Typed stub of the native engine module (built from rust/src/py by maturin)."""
 
-from typing import Any, final
+from typing import Any, TypedDict, final
 
 import numpy as np
 from numpy.typing import NDArray
+from typing_extensions import NotRequired
 
 _F = NDArray[np.float64]
 
@@ -141,6 +142,30 @@ MAX_THREADS: int
 MAX_TIME: float
 VALIDITY_LIMIT: float
 
+class _Limit(TypedDict):
+    """The validity limit a run watches (``thermojitter.simulate.limit_args``)."""
+
+    theta_limit: float
+    on_limit: str
+
+class _Run(TypedDict):
+    """How one transient is run: every transient run function takes this one mapping (``RunOptions``
+    in rust/src/bindings/convert.rs; built by ``thermojitter.simulate.run_settings``)."""
+
+    span: tuple[float, float]
+    solver: dict[str, Any]
+    t_eval: _F | None
+    dt_out: float | None
+    y0: NotRequired[list[float] | None]
+    limit: NotRequired[_Limit | None]
+
+class _Grid(TypedDict):
+    """The N-node model's grid: every function of that model takes this one mapping (``Grid`` in
+    rust/src/bindings/convert.rs; built by ``thermojitter.simulate.grid_args``)."""
+
+    layup: dict[str, Any] | None
+    nodes: int
+
 class IntegrationError(RuntimeError): ...
 
 @final
@@ -171,45 +196,28 @@ def hinge_points(panel: dict[str, float], zeta: float, theta: _F) -> tuple[_F, _
 def simulate(
     panel: dict[str, float],
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     model: str,
     coupled: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
     layers: int = 2,
-    theta_limit: float = ...,
-    on_limit: str = "flag",
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def simulate_thermal(
     panel: dict[str, float],
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     layers: int,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def simulate_hinge(
     panel: dict[str, float],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     model: str,
     moment: _F,
     moment_t: _F | None,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float],
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
@@ -255,16 +263,9 @@ def boom_start_state(
 def simulate_boom(
     boom: dict[str, float],
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     coupled: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
-    theta_limit: float,
-    on_limit: str,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def run_boom_orbits(
@@ -307,14 +308,10 @@ def beam_response(
     n_elements: int,
     moment_t: _F,
     moment: _F,
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     damping_ratio: float,
     residual: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
@@ -330,15 +327,8 @@ def simulate_distributed(
     panel: dict[str, float],
     orbit: dict[str, Any],
     settings: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: _F | None,
-    theta_limit: float = ...,
-    on_limit: str = "flag",
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 
@@ -420,28 +410,23 @@ def validate_laminate(laminate: dict[str, Any]) -> None: ...
 def laminate_properties(laminate: dict[str, Any]) -> dict[str, float]: ...
 def equivalent_panel(laminate: dict[str, Any], panel: dict[str, float]) -> dict[str, float]: ...
 def materials() -> list[dict[str, Any]]: ...
-def conduction_grid(
-    panel: dict[str, float], layup: dict[str, Any] | None, nodes: int
-) -> dict[str, Any]: ...
+def conduction_grid(panel: dict[str, float], grid: _Grid) -> dict[str, Any]: ...
 def layered_steady_state(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     coupled: bool = True,
     flux: float = 1.0,
 ) -> dict[str, Any]: ...
 def layered_start_state(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     orbit: dict[str, Any],
     t0: float,
     coupled: bool,
 ) -> list[float]: ...
 def layered_flutter(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     model: str,
     coupled: bool,
     flux: float,
@@ -449,20 +434,12 @@ def layered_flutter(
 ) -> dict[str, Any]: ...
 def simulate_layers(
     panel: dict[str, float],
-    layup: dict[str, Any] | None,
-    nodes: int,
+    grid: _Grid,
     orbit: dict[str, Any],
-    t0: float,
-    t1: float,
+    run: _Run,
     *,
     model: str,
     coupled: bool,
-    solver: dict[str, Any],
-    t_eval: _F | None,
-    dt_out: float | None,
-    y0: list[float] | None,
-    theta_limit: float = ...,
-    on_limit: str = "flag",
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def cpu_info() -> dict[str, Any]: ...

@@ -15,10 +15,9 @@ model's tips rise by (L/2) sin θ above its centre, so θ and θ_f are directly 
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,6 +26,7 @@ from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.orbit import ECLIPSE_MARGIN, Orbit, eclipse_window
 from thermojitter.panel import Panel, hinge_stiffness, natural_frequency
+from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible
 from thermojitter.signals import DEFAULT_F_MIN, dominant_frequency
 from thermojitter.signals import spectrum as spectrum  # public here too, as before
@@ -164,8 +164,8 @@ class FreeFreeBeam:
             else checks.finite("damping_ratio", damping_ratio)
         )
         residual = checks.flag("residual", residual)
-        used, args = run_settings(
-            solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        used, run = run_settings(
+            solver, (t0, t1), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
             max_step=max_step, max_steps=max_steps,
         )  # fmt: skip
         raw = interruptible(
@@ -174,11 +174,9 @@ class FreeFreeBeam:
             self.n_elements,
             ts,
             ms,
-            t0,
-            t1,
+            run,
             damping_ratio=float(zeta),
             residual=bool(residual),
-            **args,
         )
         return BeamResponse(
             t=raw["t"],
@@ -205,7 +203,7 @@ CRITERION_LABELS = {
 
 
 @dataclass(frozen=True)
-class BeamComparison:
+class BeamComparison(Persistent):
     """The hinge model and the beam through an eclipse (paper Figs. 22–24).
 
     Angles in rad (``*_deg`` for degrees), frequencies in Hz, the moment in N m (the physical
@@ -230,6 +228,10 @@ class BeamComparison:
     damping_ratio: float
     criterion: str
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        name: ("t",) for name in ("t", "theta", "theta_f", "moment")
+    }
 
     @property
     def frequency_mismatch(self) -> float:
@@ -362,22 +364,4 @@ FIGURES = {
     "fig23": "fig23_fft_deflection.png",
     "fig24": "fig24_fft_frequency.png",
 }
-"""File names written by :func:`beam_comparison_figures`."""
-
-
-_REPORTS = (
-    "beam_comparison_figures",
-    "beam_report_markdown",
-    "calibration_note",
-    "frequency_convergence",
-    "write_beam_comparison",
-)
-
-
-def __getattr__(name: str) -> Any:
-    # The report half of this module moved up to thermojitter.reports.beam (a report builds on
-    # this module, never the reverse). Scripts that import them from here keep working: the
-    # report module is loaded on first use, so importing this module does not load it.
-    if name in _REPORTS:
-        return getattr(importlib.import_module("thermojitter.reports.beam"), name)
-    raise AttributeError(f"module 'thermojitter.beam' has no attribute {name!r}", name=name)
+"""File names of the beam comparison figures (paper Figs. 22–24), by figure."""

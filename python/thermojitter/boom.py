@@ -285,22 +285,19 @@ def simulate_boom(
 
     checks.instance("boom", boom, Boom, "a thermojitter.Boom")
     checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-    t0, t1 = run.time_span(t_span)
-    used, args = run.run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
+    used, options = run.run_settings(
+        solver, run.time_span(t_span), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        max_step=max_step, max_steps=max_steps,
     )  # fmt: skip
     limit = run.DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
-    args.update(run.limit_args(limit, on_limit))
+    options["limit"] = run.limit_args(limit, on_limit)
+    options["y0"] = run.start_state(y0, 4)
     raw = interruptible(
         _core.simulate_boom,
         boom.as_dict(),
         orbit.as_dict(),
-        t0,
-        t1,
+        options,
         coupled=checks.flag("coupled", coupled),
-        y0=run.start_state(y0, 4),
-        **args,
     )
     settings = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt, "coupled": coupled}
     sol = BoomSolution(

@@ -17,12 +17,14 @@ fitted panel's run over the series is, once the fit is done.
 
 from __future__ import annotations
 
+import csv
 import math
+import re
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -32,6 +34,7 @@ from thermojitter import errors as checks
 from thermojitter.errors import ValidityLimitWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.results import LimitCrossing
 from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
@@ -52,7 +55,7 @@ MIN_POINTS = 20
 
 
 @dataclass(frozen=True)
-class CalibrationResult:
+class CalibrationResult(Persistent):
     """Fitted hinge parameters with standard errors (same units as the panel fields), the RMS of
     the residual θ_model − θ_data (rad), and the model's θ at the series' times."""
 
@@ -70,6 +73,12 @@ class CalibrationResult:
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
     limit_crossing: LimitCrossing | None = None
     """Where the fitted model's θ first passed ``theta_limit`` over the series, or None."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "t": ("t",),
+        "theta_model": ("t",),
+        "covariance": ("parameter", "parameter_"),
+    }
 
     @property
     def residual_rms_deg(self) -> float:
@@ -295,19 +304,28 @@ def calibrate_from_csv(
     **kwargs: Any,
 ) -> CalibrationResult:
     """:func:`calibrate` on telemetry from a CSV file with a header row: ``time_column`` (s) and
-    ``angle_column`` (rad, or degrees with ``degrees=True``). Other keywords go to calibrate."""
+    ``angle_column`` (rad, or degrees with ``degrees=True``). A header may give a column's unit
+    after its name, as ``thermojitter run`` writes ``timeseries.csv`` (``t [s]``, ``theta
+    [rad]``): the name alone finds it. Other keywords go to calibrate."""
     p = checks.path("path", path)
     degrees = checks.flag("degrees", degrees)
     if not p.is_file():
         raise checks.ParameterError(
             "path", path, message=f"path = {str(p)!r} is invalid: no such file"
         )
-    data = np.genfromtxt(p, delimiter=",", names=True, dtype=float, encoding="utf-8")
-    columns = data.dtype.names or ()
+    with p.open(encoding="utf-8", newline="") as fh:
+        header = [h.strip() for h in next(csv.reader(fh), [])]
+    bare = [re.sub(r"\s*\[[^\]]*\]$", "", h) for h in header]
+    found = []
     for name, col in (("time_column", time_column), ("angle_column", angle_column)):
-        if col not in columns:
-            raise checks.ParameterError(name, col, f"the file's columns are {columns}")
-    theta = np.atleast_1d(data[angle_column]).astype(float)
+        where = [i for i, (h, b) in enumerate(zip(header, bare, strict=True)) if col in (h, b)]
+        if not where:
+            raise checks.ParameterError(name, col, f"the file's columns are {tuple(header)}")
+        found.append(where[0])
+    data = np.genfromtxt(
+        p, delimiter=",", skip_header=1, usecols=found, dtype=float, encoding="utf-8", ndmin=2
+    )
+    theta = data[:, 1].astype(float)
     if degrees:
         theta = np.radians(theta)
-    return calibrate(np.atleast_1d(data[time_column]).astype(float), theta, **kwargs)
+    return calibrate(data[:, 0].astype(float), theta, **kwargs)

@@ -6,9 +6,10 @@ Reading one checks both: a truncated, bit-flipped or edited file, or one written
 request, is refused with a :class:`CheckpointError` naming the file and what differs. It is
 never merged into a run, nor returned.
 
-Every file is written to a temporary name in the same folder, flushed to disk, then renamed over
-the old one, so a killed or failed writer leaves either the previous file or the new one, and no
-partial file: the temporary file is removed when the write fails (a full disk, say).
+Every file is written to a temporary name in the same folder, flushed to disk, given the
+permissions the umask allows (as any new file), then renamed over the old one, so a killed or
+failed writer leaves either the previous file or the new one, and no partial file: the temporary
+file is removed when the write fails (a full disk, say).
 """
 
 from __future__ import annotations
@@ -65,6 +66,9 @@ def write_atomic(path: str | os.PathLike[str], write: Callable[[BinaryIO], objec
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())
+        # mkstemp makes the file readable by its owner only: give it the permissions any new
+        # file gets (0o666 less the umask), as open() would.
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, target)
     except BaseException as exc:
         with contextlib.suppress(OSError):
@@ -73,6 +77,20 @@ def write_atomic(path: str | os.PathLike[str], write: Callable[[BinaryIO], objec
             exc.filename = str(target)  # a failed fsync or write names no file otherwise
         raise
     _sync_folder(target.parent)
+
+
+def _umask() -> int:
+    """The process's umask (read from /proc where it can be, which changes nothing; else set
+    and put back)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:

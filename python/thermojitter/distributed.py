@@ -28,7 +28,7 @@ import math
 import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,8 +37,9 @@ from thermojitter import _core
 from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible
-from thermojitter.results import LimitCrossing, Run
+from thermojitter.results import LimitCrossing, Run, _dataframes_module, _FaceDifference
 from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
     Method,
@@ -123,7 +124,7 @@ class _FaceTemperatures:
 
 
 @dataclass(frozen=True)
-class DistributedSolution(_FaceTemperatures, Run):
+class DistributedSolution(_FaceTemperatures, _FaceDifference, Run):
     """The distributed panel at the reported times.
 
     ``x``: element centres (m), ``x_node``: nodes (m). ``temperatures`` maps each name of the
@@ -155,11 +156,6 @@ class DistributedSolution(_FaceTemperatures, Run):
     def theta_f_deg(self) -> Array:
         return np.degrees(self.theta_f)
 
-    @property
-    def delta_T(self) -> Array:
-        """T_front − T_back per element, K, shape (time, element)."""
-        return self.T_front - self.T_back
-
     def _columns(self) -> dict[str, Array]:
         return {
             "theta_f": self.theta_f,
@@ -167,15 +163,10 @@ class DistributedSolution(_FaceTemperatures, Run):
             "sunlit": self.sunlit,
         }
 
-    def to_xarray(self) -> Any:
+    def _dataset(self) -> Any:
         """An xarray Dataset: element fields over (time, x), nodal fields over (time, x_node),
         θ_f and s over time; needs xarray."""
-        try:
-            import xarray as xr
-        except ImportError as exc:  # pragma: no cover
-            raise ImportError(
-                "to_xarray() needs xarray: pip install 'thermojitter[dataframes]'"
-            ) from exc
+        xr = _dataframes_module("xarray", "to_xarray()")
         return xr.Dataset(
             {
                 **{
@@ -259,25 +250,15 @@ def simulate_distributed(
         coupled=coupled,
         layers=layers,
     )
-    used, args = run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
+    used, run = run_settings(
+        solver, (t0, t1), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        max_step=max_step, max_steps=max_steps,
     )  # fmt: skip
-    args.update(limit_args(theta_limit, on_limit))
-    y = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
-    start = None if y is None else np.ascontiguousarray(np.asarray(y, dtype=float))
-    raw = interruptible(
-        _core.simulate_distributed,
-        panel.as_dict(),
-        orbit.as_dict(),
-        settings,
-        t0,
-        t1,
-        y0=start,
-        **args,
-    )
+    run["limit"] = limit_args(theta_limit, on_limit)
+    run["y0"] = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
+    raw = interruptible(_core.simulate_distributed, panel.as_dict(), orbit.as_dict(), settings, run)
     limit = limit_record(raw)
-    warn_crossing(limit["limit_crossing"], args["theta_limit"], on_limit, "θ_f")
+    warn_crossing(limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(
         **run_record(raw, used),
         settings={
@@ -287,8 +268,7 @@ def simulate_distributed(
             "atol": used.atol,
             "dt": used.dt,
             "solver": used.as_dict(),
-            "theta_limit": args["theta_limit"],
-            "on_limit": on_limit,
+            **run["limit"],
         },
         x=raw["x"],
         x_node=raw["x_node"],
@@ -299,6 +279,8 @@ def simulate_distributed(
         theta_f=raw["theta_f"],
         sunlit=raw["sunlit"],
         y_end=raw["y_end"],
+        panel=panel,
+        orbit=orbit,
         support=support,
         frequencies_hz=raw["frequencies_hz"],
         damping_ratio=float(raw["damping_ratio"]),
@@ -317,7 +299,7 @@ class OscillatoryMode:
 
 
 @dataclass(frozen=True)
-class DistributedFlutterResult(_FaceTemperatures):
+class DistributedFlutterResult(_FaceTemperatures, Persistent):
     """Linear stability of the distributed panel's sunlit equilibrium.
 
     ``growth_rate`` (1/s) is the largest real part of all eigenvalues; ``oscillatory_modes`` lists
@@ -345,6 +327,17 @@ class DistributedFlutterResult(_FaceTemperatures):
     modes: int
     flux: float
     sun_angle: float
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel analysed (saved with the result)."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "x": ("x",),
+        "x_node": ("x_node",),
+        "temperatures": ("x",),
+        "deflection": ("x_node",),
+        "slope": ("x_node",),
+        "eigenvalues": ("eigenvalue",),
+    }
 
     @property
     def stable(self) -> bool:
@@ -409,6 +402,7 @@ def distributed_flutter(
         modes=settings["modes"],
         flux=float(flux),
         sun_angle=float(sun_angle),
+        panel=panel,
     )
 
 

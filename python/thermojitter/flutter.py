@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass
-from typing import Any, Literal
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -15,16 +16,17 @@ from thermojitter.boom import Boom
 from thermojitter.boom import _equilibrium as _boom_equilibrium
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.progress import interruptible, progress_bar
 from thermojitter.results import Equilibrium
-from thermojitter.simulate import check_layers, layup_dict
+from thermojitter.simulate import check_layers, grid_args
 
 MAP_BLOCK = 20_000
 """Grid points per engine call of :func:`stability_map` (about 40 ms each)."""
 
 
 @dataclass(frozen=True)
-class FlutterResult:
+class FlutterResult(Persistent):
     """Eigen-analysis of the coupled system linearised at the sunlit equilibrium.
 
     ``growth_rate`` (1/s) is the largest real part of the eigenvalues: positive means the
@@ -41,6 +43,15 @@ class FlutterResult:
     model: str
     coupled: bool
     flux: float
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel analysed (saved with the result)."""
+    orbit: Orbit | None = field(default=None, repr=False, compare=False)
+    """The orbit whose flux at ``t`` was taken (None: ``flux`` given)."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "jacobian": ("row", "column"),
+        "eigenvalues": ("eigenvalue",),
+    }
 
     @property
     def stable(self) -> bool:
@@ -94,12 +105,14 @@ def flutter(
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
     if layers is not None:
-        return _layered_flutter(panel, model, coupled, flux, layers)
-    raw = _core.flutter(panel.as_dict(), model, coupled, flux)
-    tf, tb, th = raw["equilibrium"]
-    moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
-    equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
-    return _result(raw, equilibrium, model, coupled, flux)
+        result = _layered_flutter(panel, model, coupled, flux, layers)
+    else:
+        raw = _core.flutter(panel.as_dict(), model, coupled, flux)
+        tf, tb, th = raw["equilibrium"]
+        moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
+        equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
+        result = _result(raw, equilibrium, model, coupled, flux)
+    return dataclasses.replace(result, panel=panel, orbit=orbit)
 
 
 def _boom_flutter(
@@ -125,7 +138,7 @@ def _layered_flutter(
 ) -> FlutterResult:
     """The N-node model's flutter analysis: the Jacobian over (node temperatures…, θ, θ̇)."""
     nodes = check_layers(layers)
-    raw = _core.layered_flutter(panel.as_dict(), layup_dict(panel), nodes, model, coupled, flux)
+    raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), model, coupled, flux)
     temps = raw["temperatures"]
     equilibrium = Equilibrium(
         T_front=float(temps[0]),
@@ -166,7 +179,7 @@ DEFAULT_Y: tuple[str, NDArray[np.float64]] = ("conductance", np.linspace(5.0, 60
 
 
 @dataclass(frozen=True)
-class StabilityMap:
+class StabilityMap(Persistent):
     """Flutter growth rate over a grid of two panel parameters.
 
     ``growth_rate[i, j]`` and ``frequency_hz[i, j]`` belong to ``y[i]`` and ``x[j]`` (rows follow
@@ -182,6 +195,15 @@ class StabilityMap:
     model: str
     coupled: bool
     flux: float
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel whose other fields the grid kept (saved with the result)."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "x": ("x",),
+        "y": ("y",),
+        "growth_rate": ("y", "x"),
+        "frequency_hz": ("y", "x"),
+    }
 
     @property
     def stable(self) -> NDArray[np.bool_]:
@@ -278,6 +300,7 @@ def stability_map(
         model=model,
         coupled=coupled,
         flux=float(flux),
+        panel=panel,
     )
 
 
@@ -285,7 +308,7 @@ def stability_map(
 
 
 @dataclass(frozen=True)
-class LinearThermalResponse:
+class LinearThermalResponse(Persistent):
     """The linear analysis of paper Sec. 4.2.
 
     With ε_f = ε_b = ε and T⁴ linearised about a common T*, the gradient ΔT = T_f − T_b obeys
@@ -340,6 +363,8 @@ class LinearThermalResponse:
     """c_d at which the lag's pumping is balanced, N m s/rad: I_B · thermal_damping."""
     growth_rate_estimate: float
     """Growth rate of the swing, 1/s: (thermal_damping − r)/2."""
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel analysed (saved with the result)."""
 
     def delta_T(
         self, t: ArrayLike, *, phi: float = 0.0, delta_T0: float | None = None
@@ -395,4 +420,4 @@ def linear_thermal_response(
         None if omega is None else checks.real("omega", omega),
         None if T_star is None else checks.real("T_star", T_star),
     )
-    return LinearThermalResponse(**raw)
+    return LinearThermalResponse(**raw, panel=panel)

@@ -13,7 +13,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +24,7 @@ from thermojitter import errors as checks
 from thermojitter.boom import Boom
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
+from thermojitter.persist import Persistent
 from thermojitter.progress import (
     DeferredInterrupt,
     Interruptible,
@@ -35,6 +36,7 @@ from thermojitter.simulate import (
     DEFAULT_THETA_LIMIT,
     check_inputs,
     check_layers,
+    grid_args,
     layup_dict,
     start_state,
     warn_crossing,
@@ -57,7 +59,7 @@ integrator of the non-linear model and the hinge-resolved fallback."""
 
 
 @dataclass
-class OrbitSummaries:
+class OrbitSummaries(Persistent):
     """Per-orbit summaries of a long run, with how it ended.
 
     Columns (one value per orbit): ``index``, ``t_start``, ``t_end``, ``theta_eq`` (sunlit
@@ -91,6 +93,15 @@ class OrbitSummaries:
     """The integrator settings the engine ran with, as it reports them (with ``method="hybrid"``,
     those of its rk45 fallback); rk45's step is further capped at T_n/``steps_per_period``.
     ``settings`` holds the request as given (the checkpoint's identity)."""
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel the run was made with (saved with the result)."""
+    orbit: Orbit | None = field(default=None, repr=False, compare=False)
+    """The orbit the run was made on."""
+
+    xarray_dims: ClassVar[dict[str, tuple[str, ...]]] = {
+        "columns": ("orbit",),
+        "y_end": ("state",),
+    }
 
     @property
     def nonlinear_fraction(self) -> float:
@@ -364,10 +375,10 @@ def simulate_orbits(
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
         y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
     elif y0 is None:
-        assert nodes is not None
+        assert nodes is not None and isinstance(panel, Panel)  # layers is refused for a boom
         y0 = tuple(
             _core.layered_start_state(
-                panel.as_dict(), layup, nodes, orbit.as_dict(), t_start, coupled
+                panel.as_dict(), grid_args(panel, nodes), orbit.as_dict(), t_start, coupled
             )
         )
     settings: dict[str, Any] = {
@@ -536,4 +547,6 @@ def simulate_orbits(
         # A run all read from its checkpoint made no engine call: the engine's reading of the
         # same settings (the check every run makes of them) stands for it.
         solver=SolverSettings(**(_core.check_solver(full) if ran_with is None else ran_with)),
+        panel=panel,
+        orbit=orbit,
     )

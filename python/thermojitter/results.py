@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
+from thermojitter.persist import Persistent
 from thermojitter.solver import SolverSettings
+
+if TYPE_CHECKING:
+    from thermojitter.orbit import Orbit
+    from thermojitter.panel import Panel
 
 Array = NDArray[np.float64]
 
@@ -33,8 +39,33 @@ class LimitCrossing(NamedTuple):
         return None if raw is None else cls(float(raw[0]), int(raw[1]), float(raw[2]))
 
 
+def _dataframes_module(name: str, method: str) -> Any:
+    """The optional module ``name`` (pandas or xarray) that the export ``method`` needs; an
+    ImportError saying how to install it when it is missing."""
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError(f"{method} needs {name}: pip install 'thermojitter[dataframes]'") from exc
+
+
+class _Faces(Protocol):
+    @property
+    def T_front(self) -> Array: ...
+    @property
+    def T_back(self) -> Array: ...
+
+
+class _FaceDifference:
+    """``delta_T`` of a run result holding both faces' temperatures."""
+
+    @property
+    def delta_T(self: _Faces) -> Array:
+        """T_front − T_back, K (over time; over time × element for the distributed panel)."""
+        return self.T_front - self.T_back
+
+
 @dataclass(frozen=True)
-class Equilibrium:
+class Equilibrium(Persistent):
     """The sunlit steady state: temperatures (K), hinge angle (rad) and thermal moment (N m)."""
 
     T_front: float
@@ -53,7 +84,7 @@ class Equilibrium:
 
 
 @dataclass(frozen=True)
-class _Run:
+class _Run(Persistent):
     """Counters common to every run (names as in scipy's solve_ivp where they exist)."""
 
     t: Array
@@ -62,6 +93,10 @@ class _Run:
     n_rhs: int
     method: str
     settings: dict[str, Any] = field(default_factory=dict, repr=False)
+    panel: Panel | None = field(default=None, repr=False, compare=False)
+    """The panel the run was made with (saved with the result)."""
+    orbit: Orbit | None = field(default=None, repr=False, compare=False)
+    """The orbit the run was made on (None for a run without one, such as the hinge alone)."""
 
     @property
     def solver(self) -> SolverSettings | None:
@@ -79,23 +114,13 @@ class _Run:
 
     def to_pandas(self) -> Any:
         """A pandas DataFrame indexed by time (s); needs pandas."""
-        try:
-            import pandas as pd
-        except ImportError as exc:  # pragma: no cover - depends on the environment
-            raise ImportError(
-                "to_pandas() needs pandas: pip install 'thermojitter[dataframes]'"
-            ) from exc
+        pd = _dataframes_module("pandas", "to_pandas()")
         frame = pd.DataFrame(self._columns(), index=pd.Index(self.t, name="t"))
         return frame
 
-    def to_xarray(self) -> Any:
+    def _dataset(self) -> Any:
         """An xarray Dataset over the time coordinate t (s); needs xarray."""
-        try:
-            import xarray as xr
-        except ImportError as exc:  # pragma: no cover
-            raise ImportError(
-                "to_xarray() needs xarray: pip install 'thermojitter[dataframes]'"
-            ) from exc
+        xr = _dataframes_module("xarray", "to_xarray()")
         return xr.Dataset(
             {name: ("t", values) for name, values in self._columns().items()},
             coords={"t": self.t},
@@ -109,7 +134,7 @@ modules, such as :class:`thermojitter.distributed.DistributedSolution`)."""
 
 
 @dataclass(frozen=True)
-class Solution(_Run):
+class Solution(_FaceDifference, _Run):
     """The coupled thermo-structural solution at the reported times.
 
     Temperatures in K, angles in rad, θ̇ in rad/s, the thermal moment in N m, ``sunlit`` the
@@ -161,10 +186,10 @@ class Solution(_Run):
             frame.attrs["depth"] = [float(v) for v in np.asarray(self.depth)]
         return frame
 
-    def to_xarray(self) -> Any:
+    def _dataset(self) -> Any:
         """An xarray Dataset over t (s); with ``layers=N`` also ``T_nodes`` over (t, node),
         with the node depth (m) and label (``node_labels``) as coordinates."""
-        ds = super().to_xarray()
+        ds = super()._dataset()
         if self.T_nodes is not None and self.depth is not None:
             ds = ds.assign_coords(depth=("node", np.asarray(self.depth)))
             if self.node_labels is not None:
@@ -176,10 +201,6 @@ class Solution(_Run):
     def y(self) -> Array:
         """The state (T_front, T_back, theta, theta_dot) as a (4, n) array."""
         return np.vstack([self.T_front, self.T_back, self.theta, self.theta_dot])
-
-    @property
-    def delta_T(self) -> Array:
-        return self.T_front - self.T_back
 
     def _columns(self) -> dict[str, Array]:
         return {

@@ -98,7 +98,10 @@ class SimulationSettings:
     orbits: float | None = None
     model: str = "nonlinear"
     coupled: bool = True
-    method: str = "rk45"
+    method: str | None = None
+    """"rk45", "rk4" or "hybrid" (keep = "orbits" only); None: the API's default, "hybrid" with
+    keep = "orbits" (as :func:`thermojitter.simulate_orbits`) and "rk45" for a time series (as
+    :func:`thermojitter.simulate`)."""
     rtol: float = RTOL
     atol: float = ATOL
     dt: float | None = None
@@ -117,6 +120,10 @@ class SimulationSettings:
     None: the two-layer model."""
     max_steps: int = MAX_STEPS
     """The run's step budget (every orbit together with keep = "orbits")."""
+
+    def __post_init__(self) -> None:
+        if self.method is None:
+            object.__setattr__(self, "method", "hybrid" if self.keep == "orbits" else "rk45")
 
     @property
     def solver(self) -> SolverSettings:

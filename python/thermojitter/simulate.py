@@ -26,6 +26,7 @@ from thermojitter.results import (
 from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 if TYPE_CHECKING:
+    from thermojitter._core import _Grid
     from thermojitter.boom import Boom
 
 Model = Literal["nonlinear", "linear"]
@@ -78,12 +79,18 @@ def start_state(y0: Any, size: int | None) -> list[float] | None:
 
 
 def solver_args(
-    solver: SolverSettings, t_eval: ArrayLike | None, dt_out: float | None
+    solver: SolverSettings,
+    span: tuple[float, float],
+    t_eval: ArrayLike | None,
+    dt_out: float | None,
 ) -> dict[str, Any]:
-    """The engine's keyword arguments for the integrator and the reporting times."""
+    """The engine's ``run`` mapping (``RunOptions`` in rust/src/bindings/convert.rs) for the
+    integrator, the span and the reporting times; a run adds its ``y0`` and, when it watches the
+    validity limit, its ``limit`` (:func:`limit_args`)."""
     if t_eval is None and dt_out is None:
         dt_out = DEFAULT_DT_OUT
     return {
+        "span": span,
         "solver": solver.as_dict(),
         "t_eval": _times(t_eval),
         "dt_out": None if dt_out is None else checks.real("dt_out", dt_out),
@@ -91,13 +98,18 @@ def solver_args(
 
 
 def run_settings(
-    solver: SolverSettings | None, t_eval: ArrayLike | None, dt_out: float | None, **keywords: Any
+    solver: SolverSettings | None,
+    span: tuple[float, float],
+    t_eval: ArrayLike | None,
+    dt_out: float | None,
+    **keywords: Any,
 ) -> tuple[SolverSettings, dict[str, Any]]:
-    """The integrator settings of one run (``solver``, or the run function's ``keywords``: see
-    :meth:`SolverSettings.of`) and the engine's keyword arguments for them and the reporting
-    times."""
+    """The integrator settings of one run over ``span`` (``solver``, or the run function's
+    ``keywords``: see :meth:`SolverSettings.of`) and the engine's ``run`` mapping for them and the
+    reporting times (:func:`solver_args`): every run function builds its engine call's options
+    here, once."""
     used = SolverSettings.of(solver, **keywords)
-    return used, solver_args(used, t_eval, dt_out)
+    return used, solver_args(used, span, t_eval, dt_out)
 
 
 def run_record(raw: Mapping[str, Any], used: SolverSettings) -> dict[str, Any]:
@@ -188,6 +200,12 @@ def layup_dict(panel: Panel) -> dict[str, Any] | None:
     return None if panel.layup is None else panel.layup.as_dict()
 
 
+def grid_args(panel: Panel, nodes: int) -> _Grid:
+    """The engine's ``grid`` mapping of the N-node model (``Grid`` in rust/src/bindings/convert.rs):
+    the panel's layup and ``nodes`` (checked by :func:`check_layers`)."""
+    return {"layup": layup_dict(panel), "nodes": nodes}
+
+
 def simulate(
     panel: Panel | Boom,
     orbit: Orbit,
@@ -264,34 +282,35 @@ def simulate(
             solver=solver, theta_limit=theta_limit, on_limit=on_limit,
         )  # fmt: skip
     check_inputs(panel, orbit)
-    t0, t1 = time_span(t_span)
-    used, args = run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
+    used, run = run_settings(
+        solver, time_span(t_span), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        max_step=max_step, max_steps=max_steps,
     )  # fmt: skip
-    args.update(limit_args(theta_limit, on_limit))
+    run["limit"] = limit_args(theta_limit, on_limit)
     settings: dict[str, Any] = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt}
     settings.update(model=model, coupled=coupled)
-    settings.update(theta_limit=args["theta_limit"], on_limit=on_limit)
-    if layers is not None:
-        nodes = check_layers(layers)
+    settings.update(run["limit"])
+    nodes = None if layers is None else check_layers(layers)
+    hinge = {
+        "model": checks.choice("model", model, _MODELS),
+        "coupled": checks.flag("coupled", coupled),
+    }
+    run["y0"] = start_state(y0, 4 if nodes is None else None)
+    if nodes is not None:
         raw = interruptible(
             _core.simulate_layers,
             panel.as_dict(),
-            layup_dict(panel),
-            nodes,
+            grid_args(panel, nodes),
             orbit.as_dict(),
-            t0,
-            t1,
-            model=checks.choice("model", model, _MODELS),
-            coupled=checks.flag("coupled", coupled),
-            y0=start_state(y0, None),
-            **args,
+            run,
+            **hinge,
         )
         temps = np.asarray(raw["T_nodes"])
         sol = Solution(
             **run_record(raw, used),
             settings={**settings, "layers": nodes, "solver": dict(raw["solver"])},
+            panel=panel,
+            orbit=orbit,
             T_front=temps[:, 0],
             T_back=temps[:, -1],
             **_hinge_columns(raw),
@@ -301,20 +320,12 @@ def simulate(
         )
         warn_crossing(sol.limit_crossing, theta_limit, on_limit)
         return sol
-    raw = interruptible(
-        _core.simulate,
-        panel.as_dict(),
-        orbit.as_dict(),
-        t0,
-        t1,
-        model=checks.choice("model", model, _MODELS),
-        coupled=checks.flag("coupled", coupled),
-        y0=start_state(y0, 4),
-        **args,
-    )
+    raw = interruptible(_core.simulate, panel.as_dict(), orbit.as_dict(), run, **hinge)
     sol = Solution(
         **run_record(raw, used),
         settings={**settings, "solver": dict(raw["solver"])},
+        panel=panel,
+        orbit=orbit,
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         **_hinge_columns(raw),
@@ -344,24 +355,19 @@ def simulate_thermal(
     (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
     check_inputs(panel, orbit)
     layers = checks.integer("layers", layers, 1, 2)  # type: ignore[assignment]
-    t0, t1 = time_span(t_span)
-    used, args = run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
+    used, run = run_settings(
+        solver, time_span(t_span), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        max_step=max_step, max_steps=max_steps,
     )  # fmt: skip
+    run["y0"] = start_state(y0, int(layers))
     raw = interruptible(
-        _core.simulate_thermal,
-        panel.as_dict(),
-        orbit.as_dict(),
-        t0,
-        t1,
-        layers=int(layers),
-        y0=start_state(y0, int(layers)),
-        **args,
+        _core.simulate_thermal, panel.as_dict(), orbit.as_dict(), run, layers=int(layers)
     )
     return ThermalSolution(
         **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
+        panel=panel,
+        orbit=orbit,
         layers=int(layers),
         T=raw.get("T"),
         T_front=raw.get("T_front"),
@@ -391,27 +397,21 @@ def simulate_hinge(
     ``moment`` at times ``moment_t`` (linear in between, held beyond the ends).
     ``y0`` = (θ rad, θ̇ rad/s)."""
     check_inputs(panel)
-    t0, t1 = time_span(t_span)
-    used, args = run_settings(
-        solver, t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt, max_step=max_step,
-        max_steps=max_steps,
+    used, run = run_settings(
+        solver, time_span(t_span), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
+        max_step=max_step, max_steps=max_steps,
     )  # fmt: skip
     m = checks.real_array("moment", moment)
     mt = None if moment_t is None else checks.real_array("moment_t", moment_t)
+    hinge = checks.choice("model", model, _MODELS)
+    run["y0"] = start_state(y0, 2) or []
     raw = interruptible(
-        _core.simulate_hinge,
-        panel.as_dict(),
-        t0,
-        t1,
-        model=checks.choice("model", model, _MODELS),
-        moment=m,
-        moment_t=mt,
-        y0=start_state(y0, 2) or [],
-        **args,
+        _core.simulate_hinge, panel.as_dict(), run, model=hinge, moment=m, moment_t=mt
     )
     return HingeSolution(
         **run_record(raw, used),
         settings={"solver": dict(raw["solver"])},
+        panel=panel,
         theta=raw["theta"],
         theta_dot=raw["theta_dot"],
     )

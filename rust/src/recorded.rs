@@ -23,7 +23,9 @@ use crate::models::hinge::HingeModel;
 use crate::numerics::cpu::on_portable;
 use crate::numerics::cpu::ScalarKernel;
 use crate::numerics::integrate::{Method, Tolerances};
-use crate::runs::orbits::{run_orbits, OrbitRunRequest, SummaryOptions, STEPS_PER_HINGE_PERIOD};
+use crate::runs::orbits::{
+    run_orbits, OrbitRunRequest, OrbitRunSpec, SummaryOptions, STEPS_PER_HINGE_PERIOD,
+};
 use crate::runs::simulate::{run, Output};
 
 /// The penumbral year orbit: 1 October, inside the autumn eclipse season.
@@ -106,7 +108,7 @@ fn summaries_here() -> Vec<u64> {
         stop_at_limit: false,
         steps_per_period: STEPS_PER_HINGE_PERIOD,
     };
-    let run = run_orbits(&OrbitRunRequest {
+    let spec = OrbitRunSpec {
         panel: p,
         orbit: o,
         model: HingeModel::Nonlinear,
@@ -115,8 +117,11 @@ fn summaries_here() -> Vec<u64> {
         t_start: 0.0,
         first_index: 0,
         n_orbits: 2,
-        y0: state(eq.t_front, eq.t_back, eq.theta, 0.0),
         options,
+    };
+    let run = run_orbits(&OrbitRunRequest {
+        spec,
+        y0: state(eq.t_front, eq.t_back, eq.theta, 0.0),
     })
     .unwrap();
     let mut v = Vec::new();

@@ -4,9 +4,11 @@ error path that gives them, the output folder, number options and the Ctrl-C fla
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
-from collections.abc import Callable, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, BinaryIO, NoReturn
 
@@ -132,12 +134,43 @@ def _fail(message: str, code: int = EXIT_USER_ERROR) -> int:
     return code
 
 
+def one_line_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    line: str | None = None,
+) -> str:
+    """A warning as the command shows it: one line, like its errors, without the Python file,
+    line and source a warning shows by default."""
+    text = " ".join(str(message).split())
+    return f"thermojitter: warning: {text} ({category.__name__})\n"
+
+
+@contextlib.contextmanager
+def command_warnings() -> Iterator[None]:
+    """Warnings shown in the command's one-line format while a command runs (then as before);
+    which are shown, and code recording them, are unchanged."""
+    before = warnings.formatwarning
+    warnings.formatwarning = one_line_warning
+    try:
+        yield
+    finally:
+        warnings.formatwarning = before
+
+
 def run_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     """Runs the subcommand ``parser`` parsed into ``args``, through the command's one error path
     (the module's docstring of ``thermojitter.cli``); returns the exit code."""
     if getattr(args, "handler", None) is None:
         parser.print_help(sys.stderr)
         return EXIT_USER_ERROR
+    with command_warnings():
+        return _run_handler(args)
+
+
+def _run_handler(args: argparse.Namespace) -> int:
+    """The subcommand's handler through the one error path."""
     try:
         if args.stop_flag:
             with STOP:

@@ -87,6 +87,10 @@ def flutter_command(argv: Sequence[str] | None = None) -> int:
     return run_command(add_parser, ["flutter", *(sys.argv[1:] if argv is None else argv)])
 
 
+DEFAULT_OUT = "out/flutter"
+"""Where ``thermojitter flutter`` writes without --out (relative to the working folder)."""
+
+
 def add_parser(sub: Any) -> None:
     parser = sub.add_parser(
         "flutter",
@@ -97,7 +101,7 @@ def add_parser(sub: Any) -> None:
         epilog="Example: thermojitter flutter examples/paper.toml --out out/flutter",
     )
     parser.add_argument("scenario", nargs="?", help="TOML scenario (default: Table 1 at GEO)")
-    add_out(parser, default="out/flutter", help="output folder (created)")
+    add_out(parser, default=DEFAULT_OUT, help=f"output folder (created; default {DEFAULT_OUT})")
     parser.add_argument("--x", default=None, help=f"map x axis NAME:START:STOP:N ({DEFAULT_X})")
     parser.add_argument("--y", default=None, help=f"map y axis NAME:START:STOP:N ({DEFAULT_Y})")
     parser.add_argument("--model", choices=MODELS, default=None, help="hinge model of the map")
@@ -145,6 +149,9 @@ def run(args: argparse.Namespace) -> int:
     y = parse_axis(args.y or options.get("y", DEFAULT_Y), "y")
     if x[0] == y[0]:
         raise UserError(f"x and y are both {x[0]!r}: choose two different parameters")
+    # The folder is checked before any work: a non-empty one is refused at once, not after the
+    # whole analysis is printed.
+    out = out_dir(args.out, args.overwrite)
 
     try:
         results = {m: flutter(panel, m, coupled=coupled, flux=flux) for m in MODELS}
@@ -165,6 +172,8 @@ def run(args: argparse.Namespace) -> int:
     eq = results["nonlinear"].equilibrium
     lines = [
         f"thermal flutter analysis: {source}",
+        f"  writing to {out}/"
+        + (" (the default; --out DIR to choose)" if args.out == DEFAULT_OUT else ""),
         f"  flux factor {flux:.4f}, projected area {'coupled' if coupled else 'frozen'}, "
         f"c_d = {panel.damping:g} N m s/rad",
         f"  sunlit equilibrium: T_front {eq.T_front:.2f} K, T_back {eq.T_back:.2f} K, "
@@ -189,7 +198,6 @@ def run(args: argparse.Namespace) -> int:
         )
     print("\n".join(lines))
 
-    out = out_dir(args.out, args.overwrite)
     png = out / "stability_map.png"
     if not args.no_plot:
         from thermojitter.reports.plots import stability_map_figure

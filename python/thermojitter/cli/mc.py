@@ -190,6 +190,13 @@ def run(args: argparse.Namespace) -> int:
     for m in ("exit_peak", "jitter_rms", "theta_abs_max"):
         q = np.nanpercentile(frame[m].to_numpy(float), [5, 50, 95])
         print(f"{m:>14}: 5% {q[0]:.4g}  median {q[1]:.4g}  95% {q[2]:.4g} rad")
+    horizon = int(run.get("horizon", 1))
+    if horizon < 2:
+        print(
+            f"note: amplitude_slope is NaN for every sample: it is the slope over the orbits of "
+            f"the run and needs 2 or more (the horizon is {horizon}; --horizon N or horizon = N "
+            "in [montecarlo])"
+        )
     if not args.no_plots:
         from thermojitter.reports.plots import monte_carlo_figures
 

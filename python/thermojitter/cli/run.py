@@ -9,6 +9,7 @@ import math
 import textwrap
 import time
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +34,17 @@ MAX_ORBITS = 100_000
 """Longest run ``run`` accepts, in orbits (about 270 years of GEO)."""
 
 COLUMNS = ("T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit")
+SERIES_UNITS = {
+    "t": "s", "T_front": "K", "T_back": "K", "theta": "rad", "theta_dot": "rad/s",
+    "thermal_moment": "N m", "sunlit": "-",
+}  # fmt: skip
+"""The unit of each column of the time series: in the CSV header (``t [s]``), and in the
+Parquet file's ``attrs["units"]``; a node's temperature (``T_node07 (core)``) is in K."""
+
+
+def series_units(names: Sequence[str]) -> dict[str, str]:
+    """The unit of each of the time series' columns ``names``."""
+    return {name: SERIES_UNITS.get(name, "K" if name.startswith("T_") else "-") for name in names}
 
 
 def scenario_keys_help() -> str:
@@ -71,9 +83,10 @@ def scenario_keys_help() -> str:
                 "simulation",
                 [f.name for f in fields(SimulationSettings)],
                 "the span is one of t_end (s), orbits, years; model = nonlinear | linear; "
-                "method = rk45 | rk4 (dt = step, s); dt_out = output interval, s; keep = "
-                '"samples" | "orbits" (one summary row per orbit, resumable, with '
-                'theta_limit_deg and on_limit = "stop" | "flag"); layers = nodes through '
+                "method = rk45 | rk4 (dt = step, s) | hybrid (keep = orbits; its default); "
+                'dt_out = output interval, s; keep = "samples" | "orbits" (one summary row per '
+                'orbit, resumable, with theta_limit_deg and on_limit = "stop" | "flag"); '
+                "layers = nodes through "
                 "the thickness (the N-node model); max_steps = the run's step budget",
             ),
             table("output", ["format", "plots"], 'format = "csv" | "parquet"; plots = true'),
@@ -189,11 +202,17 @@ def check_writer(fmt: str) -> None:
             raise UserError("Parquet output needs pyarrow: pip install pyarrow") from None
 
 
-def write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
+def write_series(
+    path: Path, columns: dict[str, np.ndarray], fmt: str, units: dict[str, str] | None = None
+) -> Path:
+    """Writes the table ``columns`` as ``path``.csv or .parquet; ``units`` (by column) go in the
+    CSV header as ``name [unit]`` and in the Parquet file's ``attrs["units"]``."""
     check_writer(fmt)
     import pandas as pd
 
     frame = pd.DataFrame(columns)
+    if units:
+        frame.attrs["units"] = dict(units)
     if fmt == "parquet":
         try:
             import pyarrow  # noqa: F401
@@ -202,6 +221,8 @@ def write_series(path: Path, columns: dict[str, np.ndarray], fmt: str) -> Path:
         target = path.with_suffix(".parquet")
         return write_output(target, lambda fh: frame.to_parquet(fh, index=False))
     target = path.with_suffix(".csv")
+    if units:
+        frame.columns = [f"{c} [{units[c]}]" if c in units else c for c in frame.columns]
     # Shortest round-trip representation of each float.
     return write_output(target, lambda fh: fh.write(frame.to_csv(index=False).encode()))
 
@@ -316,7 +337,8 @@ def run_command(args: argparse.Namespace) -> int:
     t = columns["t"]
     written = []
     if len(t):
-        written.append(write_series(out / "timeseries", columns, fmt).name)
+        units = series_units(list(columns))
+        written.append(write_series(out / "timeseries", columns, fmt, units).name)
     intervals = scenario.orbit.shadow_intervals(float(t[0]), float(t[-1])) if len(t) else []
     if make_plots and len(t) > 1 and not interrupted:
         from thermojitter.reports.plots import run_figures
@@ -380,7 +402,8 @@ def add_parser(sub: Any) -> None:
         description=(
             "Run one simulation from a TOML scenario file and write the time series "
             "(timeseries.csv or .parquet: t [s], T_front, T_back [K], theta [rad], "
-            "theta_dot [rad/s], thermal_moment [N m], sunlit), run.json (settings, step counts) "
+            "theta_dot [rad/s], thermal_moment [N m], sunlit [-]; the CSV header says the "
+            "units, the Parquet file's attrs['units']), run.json (settings, step counts) "
             'and plots (temperatures.png, theta.png) into --out; with keep = "orbits", one '
             "summary row per orbit (orbits.csv, orbits.png), resumable from checkpoint.json."
         ),

@@ -32,7 +32,7 @@ from thermojitter.montecarlo.store import (
 from thermojitter.orbit import Orbit
 from thermojitter.panel import LAYUP_FIELDS, Panel
 from thermojitter.progress import DeferredInterrupt, progress_bar, report_interrupted
-from thermojitter.simulate import check_layers, layup_dict
+from thermojitter.simulate import check_layers, grid_args, layup_dict
 from thermojitter.solver import SolverSettings
 
 
@@ -90,7 +90,7 @@ def with_layers(
         return options
     nodes = check_layers(layers)
     # Run-wide: a node count the layup cannot take is refused here, not by every sample.
-    _core.conduction_grid(panel.as_dict(), layup_dict(panel), nodes)
+    _core.conduction_grid(panel.as_dict(), grid_args(panel, nodes))
     if panel.layup is not None:
         fixed = [name for name in names if name in LAYUP_FIELDS]
         if fixed:

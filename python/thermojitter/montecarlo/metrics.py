@@ -34,7 +34,8 @@ METRICS = (
   ``threshold`` (NaN: never, or no threshold);
 - ``orbit_limit``: first orbit whose abs(θ) passed the validity limit (20°; NaN: none);
 - ``amplitude_slope``: growth (> 0) or decay of the per-orbit amplitude over the run, the
-  least-squares slope of ln(amplitude) against the orbit index, 1/orbit;
+  least-squares slope of ln(amplitude) against the orbit index, 1/orbit; it needs two orbits or
+  more, so it is NaN on the default one-orbit horizon (``horizon=1``: pass ``horizon >= 2``);
 - ``t_nonlinear``: simulated time integrated with the full non-linear model, s (the whole run
   unless ``method="hybrid"``);
 - ``t_reached``: where the integration ended (the horizon, unless stopped at the threshold);

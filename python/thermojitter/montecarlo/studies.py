@@ -80,7 +80,8 @@ def monte_carlo(
       larger n extends a study), ``"lhs"`` (Latin hypercube) or ``"sobol"``
       (scrambled; best with n a power of 2), all seeded by ``seed`` (None: a fresh seed, kept in
       ``frame.attrs["seed"]``; required with ``checkpoint``).
-    - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium.
+    - ``horizon``: whole orbits integrated from t = 0, starting at the sunlit equilibrium
+      (``amplitude_slope``, a slope over the orbits, needs 2 or more: NaN on the default 1).
     - ``method``: ``"hybrid"`` (exact linear arcs in sunlight, the non-linear model through the
       shadows; see ``simulate_orbits``), ``"rk45"`` (hinge-resolved) or ``"rk4"``; None: hybrid
       for horizons of a month or more, rk45 below.

@@ -299,14 +299,26 @@ pub fn critical_damping(
     coupling: Coupling,
     flux: f64,
 ) -> Result<f64> {
-    let growth = |cd: f64| -> Result<f64> {
-        let p = Panel {
+    critical_hinge_damping(
+        panel,
+        |p| Ok(analyse(p, model, coupling, flux)?.growth_rate),
+    )
+}
+
+/// The hinge damping c_d at which `growth_of` (the growth rate of `panel` with a given c_d)
+/// crosses zero, by [`critical_value`] from the panel's own c_d (at least 1e-3 √(K_el I_B)); 0
+/// when the panel is stable without damping. The equilibrium does not depend on c_d; only the
+/// hinge row of the Jacobian does.
+pub fn critical_hinge_damping(
+    panel: &Panel,
+    growth_of: impl Fn(&Panel) -> Result<f64>,
+) -> Result<f64> {
+    let growth = |cd: f64| {
+        growth_of(&Panel {
             damping: cd,
             ..*panel
-        };
-        Ok(analyse(&p, model, coupling, flux)?.growth_rate)
+        })
     };
-    // The equilibrium does not depend on c_d; only the hinge row of the Jacobian does.
     let start = panel
         .damping
         .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());

@@ -215,16 +215,8 @@ pub fn critical_damping(
 ) -> Result<f64> {
     // The equilibrium does not depend on c_d.
     let eq = equilibrium(panel, c, coupling, flux)?;
-    let rate = |cd: f64| -> Result<f64> {
-        let p = Panel {
-            damping: cd,
-            ..*panel
-        };
-        let jac = jacobian(&p, c, model, coupling, flux, &eq);
-        Ok(growth(&p, &jac, &eq)?.0)
-    };
-    let start = panel
-        .damping
-        .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
-    crate::analysis::flutter::critical_value(rate, start, 1e-12)
+    crate::analysis::flutter::critical_hinge_damping(panel, |p| {
+        let jac = jacobian(p, c, model, coupling, flux, &eq);
+        Ok(growth(p, &jac, &eq)?.0)
+    })
 }

@@ -1,7 +1,7 @@
 //! Bindings of the finite-element beam comparator: modes, static deflection, modal transient.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{output, panel_from, set_counters, solver_dict, solver_from};
+use super::convert::{panel_from, set_counters, solver_dict, RunOptions};
 use super::error::invalid;
 use super::error::shield;
 use crate::models::beam::{FreeFreeBeam, BEAM_MODES};
@@ -103,7 +103,7 @@ fn beam_static(
 /// Modal transient response to end moments ±M(t) given as samples (`moment_t`, `moment`);
 /// stops with KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, n_elements, moment_t, moment, t0, t1, *, damping_ratio, residual, solver, t_eval, dt_out, cancel=None))]
+#[pyo3(signature = (panel, n_elements, moment_t, moment, run, *, damping_ratio, residual, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn beam_response<'py>(
     py: Python<'py>,
@@ -111,26 +111,21 @@ fn beam_response<'py>(
     n_elements: i64,
     moment_t: PyReadonlyArray1<'py, f64>,
     moment: PyReadonlyArray1<'py, f64>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     damping_ratio: f64,
     residual: bool,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let beam = beam_from(panel, n_elements)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (m, out) = run.integration()?;
+        let span = run.span;
         let history = MomentHistory::Samples {
             t: moment_t.as_array().to_vec(),
             moment: moment.as_array().to_vec(),
         };
         history.validate()?;
         let r = py.detach(|| {
-            let span = (t0, t1);
             respond(
                 &beam,
                 history,

@@ -2,7 +2,7 @@
 //! transient, its runs of whole orbits and its flutter analysis.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{coupling, float_item, on_limit, orbit_from, output, solver_from};
+use super::convert::{coupling, float_item, orbit_from, solver_from, RunOptions};
 use super::error::shield;
 use super::flutter::set_spectrum;
 use super::orbits::summary_dict;
@@ -13,7 +13,6 @@ use crate::models::hinge::check_hinge_angle;
 use crate::models::tube::boom_system;
 use crate::runs::orbits::SummaryOptions;
 use crate::runs::request::Transient;
-use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -93,32 +92,24 @@ fn boom_start_state(
 /// A transient of the boom: the columns T_mean, T_circ, theta, theta_dot, thermal_moment and
 /// sunlit, with the counters, the end state and the limit's crossing (as `simulate`'s).
 #[pyfunction]
-#[pyo3(signature = (boom, orbit, t0, t1, *, coupled, solver, t_eval, dt_out, y0, theta_limit, on_limit, cancel=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (boom, orbit, run, *, coupled, cancel=None))]
 fn simulate_boom<'py>(
     py: Python<'py>,
     boom: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     coupled: bool,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Option<Vec<f64>>,
-    theta_limit: f64,
-    on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let b = boom_from(boom)?;
         let o = orbit_from(orbit)?;
-        let method = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
-        let limit = self::on_limit(theta_limit, on_limit)?;
+        let (method, out) = run.integration()?;
+        let limit = run.watch()?;
         let c = coupling(coupled);
+        let (span, y0) = (run.span, run.y0);
         let run = py.detach(|| {
-            crate::runs::boom::simulate(&b, o, c, &method, (t0, t1), &out, y0, limit, cancel)
+            crate::runs::boom::simulate(&b, o, c, &method, span, &out, y0, limit, cancel)
         })?;
         transient_dict(py, Transient::Coupled(run))
     })

@@ -220,27 +220,92 @@ pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
     }
 }
 
-pub fn output(
-    t_eval: Option<PyReadonlyArray1<'_, f64>>,
-    dt_out: Option<f64>,
-    t0: f64,
-    t1: f64,
-) -> PyResult<Output> {
-    crate::numerics::integrate::check_span(t0, t1)?;
-    let out = match (t_eval, dt_out) {
-        (Some(_), Some(_)) => {
-            return Err(invalid(
-                "dt_out",
-                "given",
-                "give t_eval or dt_out, not both",
-            ))
+// The groups of parameters that several pyfunctions take: each group is ONE struct read from ONE
+// Python mapping (pyo3's `FromPyObject`, `from_item_all`: a key per field), converted here, once,
+// with the errors every function gives. The Python side builds each mapping in one place too
+// (`thermojitter.simulate`: `run_settings` and `limit_args` for [`RunOptions`], `grid_args` for
+// [`Grid`]); `_core.pyi` declares each as one TypedDict. A new binding (a new model's run, a new
+// analysis of the N-node model) takes these structs rather than restating their parameters.
+
+/// The N-node through-thickness model's grid, as the functions of that model receive it: the
+/// mapping `grid` = {layup (a laminate mapping, or None: the panel as one homogeneous layer),
+/// nodes}.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct Grid<'py> {
+    pub layup: Option<Bound<'py, PyDict>>,
+    pub nodes: usize,
+}
+
+impl Grid<'_> {
+    /// The conduction model of `panel` on this grid ([`super::laminate::conduction_from`]).
+    pub fn conduction(&self, panel: &Panel) -> PyResult<crate::models::conduction::Conduction> {
+        super::laminate::conduction_from(panel, self.layup.as_ref(), self.nodes)
+    }
+}
+
+/// The validity limit a run watches, as the `limit` entry of a [`RunOptions`] mapping
+/// {theta_limit, on_limit}: converted by [`on_limit`].
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct Limit {
+    pub theta_limit: f64,
+    pub on_limit: String,
+}
+
+/// How one transient is run, as every transient run function (`simulate`, `simulate_thermal`,
+/// `simulate_hinge`, `simulate_layers`, `simulate_distributed`, `beam_response`) receives it:
+/// ONE mapping `run` = {span: (t0, t1), solver, t_eval, dt_out[, y0][, limit]}, built in one place
+/// on the Python side (`thermojitter.simulate.run_settings`, with `limit_args` for the limit).
+///
+/// This is the group a new run function takes, rather than its own list of `solver`, `t_eval`,
+/// `dt_out`, `y0`, `theta_limit`, `on_limit` parameters: it is converted here once, in the same
+/// order with the same errors for every run ([`RunOptions::integration`], [`RunOptions::watch`]).
+/// `y0` (the start state, None: the model's default) and `limit` (None: nothing watched) may be
+/// left out of the mapping by runs that take no start state or watch no angle.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct RunOptions<'py> {
+    pub span: (f64, f64),
+    pub solver: Bound<'py, PyDict>,
+    pub t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    pub dt_out: Option<f64>,
+    #[pyo3(default)]
+    pub y0: Option<Vec<f64>>,
+    #[pyo3(default)]
+    pub limit: Option<Limit>,
+}
+
+impl RunOptions<'_> {
+    /// The integrator of the `solver` mapping ([`solver_from`]), then the span and the output
+    /// times (`t_eval` or every `dt_out`), converted in that order.
+    pub fn integration(&self) -> PyResult<(Method, Output)> {
+        let method = solver_from(&self.solver)?;
+        let (t0, t1) = self.span;
+        crate::numerics::integrate::check_span(t0, t1)?;
+        let out = match (&self.t_eval, self.dt_out) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "dt_out",
+                    "given",
+                    "give t_eval or dt_out, not both",
+                ))
+            }
+            (Some(ts), None) => Output::Times(ts.as_array().to_vec()),
+            (None, Some(dt)) => Output::Every(dt),
+            (None, None) => return Err(invalid("dt_out", "None", "t_eval or dt_out is required")),
+        };
+        out.sample_times(t0, t1)?;
+        Ok((method, out))
+    }
+
+    /// The validity limit the run watches (None without a `limit` entry, or with "ignore").
+    pub fn watch(&self) -> PyResult<Option<crate::runs::simulate::OnLimit>> {
+        match &self.limit {
+            Some(l) => on_limit(l.theta_limit, &l.on_limit),
+            None => Ok(None),
         }
-        (Some(ts), None) => Output::Times(ts.as_array().to_vec()),
-        (None, Some(dt)) => Output::Every(dt),
-        (None, None) => return Err(invalid("dt_out", "None", "t_eval or dt_out is required")),
-    };
-    out.sample_times(t0, t1)?;
-    Ok(out)
+    }
 }
 
 /// A run's step counters into `d`, under the names every run's result uses.

@@ -2,13 +2,12 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, crossing_tuple, on_limit, orbit_from, output, panel_from, required_item,
-    set_counters, solver_from,
+    coupling, crossing_tuple, orbit_from, panel_from, required_item, set_counters, RunOptions,
 };
 use super::error::{invalid, shield};
 use crate::analysis::flutter::check_flux;
 use crate::models::distributed::{DistributedPanel, Settings, Support};
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -161,42 +160,27 @@ fn matrix<'py>(
 /// |θ_f| against `theta_limit` as `on_limit` says ("flag", "stop", "ignore") and stops with
 /// KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, settings, t0, t1, *, solver, t_eval, dt_out, y0, theta_limit=crate::models::hinge::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, orbit, settings, run, *, cancel=None))]
 fn simulate_distributed<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
     settings: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Option<PyReadonlyArray1<'py, f64>>,
-    theta_limit: f64,
-    on_limit: &str,
+    run: RunOptions<'py>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let m = model_from(panel, settings)?;
         let o = orbit_from(orbit)?;
-        let method = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
-        let limit = self::on_limit(theta_limit, on_limit)?;
-        let start = match y0 {
-            Some(v) => {
-                let v = v.as_array().to_vec();
-                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-                    return Err(invalid("y0", x, "every component must be finite"));
-                }
-                Some(v)
-            }
-            None => None,
-        };
+        let (method, out) = run.integration()?;
+        let limit = run.watch()?;
+        let span = run.span;
+        let start = run.y0;
+        if let Some(x) = start.iter().flatten().find(|x| !x.is_finite()) {
+            return Err(invalid("y0", x, "every component must be finite"));
+        }
         let r = py
             .detach(|| {
-                let span = (t0, t1);
                 crate::runs::distributed::simulate(&m, o, &method, span, start, &out, limit, cancel)
             })
             .map_err(PyErr::from)?;

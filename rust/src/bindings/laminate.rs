@@ -2,8 +2,7 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, float_item, hinge_model, orbit_from, output, panel_dict, panel_from, solver_from,
-    type_error,
+    coupling, float_item, orbit_from, panel_dict, panel_from, type_error, Grid, RunOptions,
 };
 use super::error::{invalid, shield};
 use super::flutter::{flutter_inputs, set_spectrum};
@@ -12,8 +11,8 @@ use crate::analysis::layered::LayeredEquilibrium;
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
-use crate::runs::request::{RunRequest, ThermalChoice};
-use numpy::{PyArray1, PyReadonlyArray1};
+use crate::runs::request::ThermalChoice;
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -160,16 +159,14 @@ fn materials<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
 /// The node grid of the N-node model: depth (m), capacity (J/(m² K)), moment weight (N m/K)
 /// and the moment offset (N m).
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes))]
 fn conduction_grid<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let p = panel_from(panel)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         let d = PyDict::new(py);
         d.set_item("depth", c.depth.clone())?;
         d.set_item("capacity", c.capacity.clone())?;
@@ -191,19 +188,18 @@ fn equilibrium_dict<'py>(py: Python<'py>, eq: &LayeredEquilibrium) -> PyResult<B
 
 /// Sunlit equilibrium of the N-node system: node temperatures, θ and M_T.
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, coupled=true, flux=1.0))]
+#[pyo3(signature = (panel, grid, coupled=true, flux=1.0))]
 fn layered_steady_state<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
     coupled: bool,
     flux: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let p = panel_from(panel)?;
         check_flux(flux)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         let eq = crate::analysis::layered::equilibrium(&p, &c, coupling(coupled), flux)?;
         let d = equilibrium_dict(py, &eq)?;
         d.set_item("depth", c.depth)?;
@@ -216,8 +212,7 @@ fn layered_steady_state<'py>(
 #[pyfunction]
 fn layered_start_state(
     panel: &Bound<'_, PyDict>,
-    layup: Option<&Bound<'_, PyDict>>,
-    nodes: usize,
+    grid: Grid<'_>,
     orbit: &Bound<'_, PyDict>,
     t0: f64,
     coupled: bool,
@@ -225,7 +220,7 @@ fn layered_start_state(
     shield(|| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         Ok(crate::analysis::layered::start_state(
             &p,
             &c,
@@ -238,13 +233,11 @@ fn layered_start_state(
 
 /// Flutter analysis of the N-node system (full nodal Jacobian).
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, model, coupled, flux, with_critical=true))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, grid, model, coupled, flux, with_critical=true))]
 fn layered_flutter<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
     model: &str,
     coupled: bool,
     flux: f64,
@@ -252,7 +245,7 @@ fn layered_flutter<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let (p, m) = flutter_inputs(panel, model, flux)?;
-        let c = conduction_from(&p, layup, nodes)?;
+        let c = grid.conduction(&p)?;
         let k = coupling(coupled);
         let a = py.detach(|| crate::analysis::layered::analyse(&p, &c, m, k, flux))?;
         let d = equilibrium_dict(py, &a.equilibrium)?;
@@ -271,49 +264,29 @@ fn layered_flutter<'py>(
 /// Integrates the N-node laminate coupled to the hinge; node temperatures as a (time × node)
 /// array. The validity limit and Ctrl-C as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (panel, layup, nodes, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, theta_limit=crate::models::hinge::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
+#[pyo3(signature = (panel, grid, orbit, run, *, model, coupled, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_layers<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    layup: Option<&Bound<'py, PyDict>>,
-    nodes: usize,
+    grid: Grid<'py>,
     orbit: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     model: &str,
     coupled: bool,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Option<Vec<f64>>,
-    theta_limit: f64,
-    on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
-        let p = panel_from(panel)?;
-        let (o, hinge) = (orbit_from(orbit)?, hinge_model(model)?);
-        let (method, out) = (solver_from(solver)?, output(t_eval, dt_out, t0, t1)?);
-        let limit = super::convert::on_limit(theta_limit, on_limit)?;
-        let c = conduction_from(&p, layup, nodes)?;
-        let (depth, labels) = (c.depth.clone(), c.node_labels());
-        let req = RunRequest {
-            panel: p,
-            orbit: o,
-            thermal: ThermalChoice::Laminate(c),
-            model: hinge,
-            coupling: coupling(coupled),
-            method,
-            span: (t0, t1),
-            output: out,
-            y0,
-            limit,
-        };
-        let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
-        let d = super::transient_dict(py, run)?;
-        d.set_item("depth", PyArray1::from_vec(py, depth))?;
-        d.set_item("node_labels", labels)?;
+        let mut nodes = None;
+        let d = super::coupled_transient(py, panel, orbit, (model, coupled), run, cancel, |p| {
+            let c = grid.conduction(p)?;
+            nodes = Some((c.depth.clone(), c.node_labels()));
+            Ok(ThermalChoice::Laminate(c))
+        })?;
+        if let Some((depth, labels)) = nodes {
+            d.set_item("depth", PyArray1::from_vec(py, depth))?;
+            d.set_item("node_labels", labels)?;
+        }
         Ok(d)
     })
 }

@@ -23,8 +23,8 @@ use crate::runs::request::{coupled_run, CoupledRun, RunRequest, ThermalChoice, T
 use crate::runs::simulate::{run_watched, state_from};
 use cancel::{cancellable, CancelToken};
 use convert::{
-    coupling, crossing_tuple, hinge_model, on_limit, orbit_from, output, panel_dict, panel_from,
-    set_counters, solver_from,
+    coupling, crossing_tuple, hinge_model, orbit_from, panel_dict, panel_from, set_counters,
+    solver_from, RunOptions,
 };
 use error::{invalid, shield, ConvergenceError, IntegrationError};
 use nalgebra::U2;
@@ -218,44 +218,58 @@ fn energy<'py>(
 }
 
 /// Integrates the coupled thermo-structural system: the thermal model with `layers`, the hinge;
-/// watches |θ| against `theta_limit` as `on_limit` says ("flag", "stop", "ignore") and stops
-/// with KeyboardInterrupt within a step of `cancel`.
+/// watches |θ| against the `run`'s limit as its `on_limit` says ("flag", "stop", "ignore") and
+/// stops with KeyboardInterrupt within a step of `cancel`.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, model, coupled, solver, t_eval, dt_out, y0, layers=2, theta_limit=crate::models::hinge::VALIDITY_LIMIT, on_limit="flag", cancel=None))]
+#[pyo3(signature = (panel, orbit, run, *, model, coupled, layers=2, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     model: &str,
     coupled: bool,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Option<Vec<f64>>,
     layers: u32,
-    theta_limit: f64,
-    on_limit: &str,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
-        let req = RunRequest {
-            panel: panel_from(panel)?,
-            orbit: orbit_from(orbit)?,
-            thermal: ThermalChoice::Layers(layers),
-            model: hinge_model(model)?,
-            coupling: coupling(coupled),
-            method: solver_from(solver)?,
-            span: (t0, t1),
-            output: output(t_eval, dt_out, t0, t1)?,
-            y0,
-            limit: self::on_limit(theta_limit, on_limit)?,
-        };
-        let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
-        transient_dict(py, run)
+        let hinge = (model, coupled);
+        coupled_transient(py, panel, orbit, hinge, run, cancel, |_| {
+            Ok(ThermalChoice::Layers(layers))
+        })
     })
+}
+
+/// A coupled run (the two-layer or N-node thermal model, `thermal` of the checked panel, and the
+/// hinge `model` with the `coupled` flag) converted and integrated with the GIL released: what
+/// `simulate` and `simulate_layers` share.
+pub(crate) fn coupled_transient<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    (model, coupled): (&str, bool),
+    run: RunOptions<'py>,
+    cancel: &crate::cancel::Cancel,
+    thermal: impl FnOnce(&crate::Panel) -> PyResult<ThermalChoice>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (p, o, hinge) = (panel_from(panel)?, orbit_from(orbit)?, hinge_model(model)?);
+    let (method, output) = run.integration()?;
+    let limit = run.watch()?;
+    let req = RunRequest {
+        panel: p,
+        orbit: o,
+        thermal: thermal(&p)?,
+        model: hinge,
+        coupling: coupling(coupled),
+        method,
+        span: run.span,
+        output,
+        y0: run.y0,
+        limit,
+    };
+    let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
+    transient_dict(py, run)
 }
 
 /// A transient as a mapping: the counters, the end state and the settings used, every state
@@ -298,56 +312,44 @@ pub(crate) fn transient_dict(py: Python<'_>, run: Transient) -> PyResult<Bound<'
 
 /// Integrates a thermal model alone: one node (eq. 1) or two layers (eq. 2, θ = 0).
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, t0, t1, *, layers, solver, t_eval, dt_out, y0, cancel=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, orbit, run, *, layers, cancel=None))]
 fn simulate_thermal<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     layers: u32,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Option<Vec<f64>>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (m, out) = run.integration()?;
         let thermal = crate::models::thermal_model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o);
-        let run = py.detach(|| coupled_run(sys, &m, (t0, t1), y0, &out, None, cancel))?;
+        let (span, y0) = (run.span, run.y0);
+        let run = py.detach(|| coupled_run(sys, &m, span, y0, &out, None, cancel))?;
         transient_dict(py, Transient::Coupled(run))
     })
 }
 
-/// Integrates the hinge alone under a prescribed moment: a constant, or samples (t, M).
+/// Integrates the hinge alone under a prescribed moment: a constant, or samples (t, M); the
+/// `run`'s `y0` is (θ, θ̇).
 #[pyfunction]
-#[pyo3(signature = (panel, t0, t1, *, model, moment, moment_t, solver, t_eval, dt_out, y0, cancel=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, run, *, model, moment, moment_t, cancel=None))]
 fn simulate_hinge<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
-    t0: f64,
-    t1: f64,
+    run: RunOptions<'py>,
     model: &str,
     moment: PyReadonlyArray1<'py, f64>,
     moment_t: Option<PyReadonlyArray1<'py, f64>>,
-    solver: &Bound<'py, PyDict>,
-    t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    dt_out: Option<f64>,
-    y0: Vec<f64>,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let hinge = hinge_model(model)?;
-        let m = solver_from(solver)?;
-        let out = output(t_eval, dt_out, t0, t1)?;
+        let (m, out) = run.integration()?;
         let values = moment.as_array().to_vec();
         let history = match moment_t {
             None if values.len() == 1 => MomentHistory::Constant(values[0]),
@@ -365,7 +367,8 @@ fn simulate_hinge<'py>(
         };
         history.validate()?;
         history.check_against(&p)?;
-        let y_start = state_from(&y0, U2)?;
+        let span = run.span;
+        let y_start = state_from(&run.y0.unwrap_or_default(), U2)?;
         let start_hinge = Hinge::new(&p, hinge);
         crate::models::hinge::check_start_state(y_start.as_slice(), 0, Some(&start_hinge))?;
         let traj = py.detach(|| {
@@ -374,7 +377,7 @@ fn simulate_hinge<'py>(
                 model: hinge,
                 moment: history,
             };
-            run_watched(&mut sys, &m, (t0, t1), y_start, &out, None, cancel)
+            run_watched(&mut sys, &m, span, y_start, &out, None, cancel)
         })?;
         let d = run_info(
             py,

@@ -142,24 +142,21 @@ fn leo_orbit(py: Python<'_>, altitude: f64) -> PyResult<Bound<'_, PyDict>> {
     })
 }
 
+/// Adds each named constant to the module `m` under its own name.
+macro_rules! add_constants {
+    ($m:ident: $($name:ident),+) => {
+        $($m.add(stringify!($name), $name)?;)+
+    };
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     use crate::inputs::orbit::{
         DAY, EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, J2, LEO_ALTITUDE, MAX_LEO_ALTITUDE,
         MIN_LEO_ALTITUDE, MU_EARTH, OBLIQUITY, PERIHELION_DAY, SIDEREAL_DAY, YEAR_DAYS,
     };
-    m.add("GEO_RADIUS", GEO_RADIUS)?;
-    m.add("LEO_ALTITUDE", LEO_ALTITUDE)?;
-    m.add("MIN_LEO_ALTITUDE", MIN_LEO_ALTITUDE)?;
-    m.add("MAX_LEO_ALTITUDE", MAX_LEO_ALTITUDE)?;
-    m.add("EARTH_RADIUS", EARTH_RADIUS)?;
-    m.add("SIDEREAL_DAY", SIDEREAL_DAY)?;
-    m.add("MU_EARTH", MU_EARTH)?;
-    m.add("EQUINOX_DAY", EQUINOX_DAY)?;
-    m.add("PERIHELION_DAY", PERIHELION_DAY)?;
-    m.add("J2", J2)?;
-    m.add("OBLIQUITY", OBLIQUITY)?;
-    m.add("YEAR_DAYS", YEAR_DAYS)?;
-    m.add("DAY", DAY)?;
+    add_constants!(m: GEO_RADIUS, LEO_ALTITUDE, MIN_LEO_ALTITUDE, MAX_LEO_ALTITUDE,
+        EARTH_RADIUS, SIDEREAL_DAY, MU_EARTH, EQUINOX_DAY, PERIHELION_DAY, J2, OBLIQUITY,
+        YEAR_DAYS, DAY);
     m.add(
         "GEO_EQUINOX_ORBIT",
         orbit_dict(m.py(), &Orbit::geo_equinox())?,

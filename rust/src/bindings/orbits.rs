@@ -8,7 +8,7 @@ use super::convert::{
 use super::laminate::conduction_from;
 use crate::runs::hybrid::HybridSettings;
 use crate::runs::layered::LayeredRunRequest;
-use crate::runs::orbits::{OrbitRunRequest, SummaryOptions};
+use crate::runs::orbits::{OrbitRunRequest, OrbitRunSpec, SummaryOptions};
 use crate::runs::request::{OrbitsModel, OrbitsRequest};
 use crate::runs::simulate::state_from;
 use nalgebra::U4;
@@ -50,39 +50,33 @@ fn run_orbits<'py>(
         let coupling = coupling(coupled);
         let m = solver_from(solver)?;
         crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
-        let options = SummaryOptions {
-            window,
-            theta_limit,
-            stop_at_limit,
-            steps_per_period,
+        let spec = OrbitRunSpec {
+            panel: p,
+            orbit: o,
+            model: hinge,
+            coupling,
+            method: m,
+            t_start,
+            first_index,
+            n_orbits,
+            options: SummaryOptions {
+                window,
+                theta_limit,
+                stop_at_limit,
+                steps_per_period,
+            },
         };
         let hybrid = hybrid.map(hybrid_from).transpose()?;
         let model = match nodes {
             // The N-node model: y0 and y_end are (node temperatures, θ, θ̇).
             Some(n) => OrbitsModel::Laminate(LayeredRunRequest {
-                panel: p,
+                spec,
                 conduction: conduction_from(&p, layup, n)?,
-                orbit: o,
-                model: hinge,
-                coupling,
-                method: m,
-                t_start,
-                first_index,
-                n_orbits,
                 y0,
-                options,
             }),
             None => OrbitsModel::TwoLayer(OrbitRunRequest {
-                panel: p,
-                orbit: o,
-                model: hinge,
-                coupling,
-                method: m,
-                t_start,
-                first_index,
-                n_orbits,
+                spec,
                 y0: state_from(&y0, U4)?,
-                options,
             }),
         };
         let req = OrbitsRequest { model, hybrid };

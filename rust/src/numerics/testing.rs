@@ -29,3 +29,21 @@ pub(crate) fn assert_jacobian(
         }
     }
 }
+
+/// Column `j` of the Jacobian of `f` (which writes f(y) into its second argument) at `y`, by
+/// central differences with step `h`.
+pub(crate) fn central_difference(
+    f: impl Fn(&[f64], &mut [f64]),
+    y: &[f64],
+    j: usize,
+    h: f64,
+) -> Vec<f64> {
+    let n = y.len();
+    let (mut yp, mut ym) = (y.to_vec(), y.to_vec());
+    yp[j] += h;
+    ym[j] -= h;
+    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+    f(&yp, &mut fp);
+    f(&ym, &mut fm);
+    (0..n).map(|i| (fp[i] - fm[i]) / (2.0 * h)).collect()
+}

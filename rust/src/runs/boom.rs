@@ -6,11 +6,12 @@ use crate::error::Result;
 use crate::inputs::boom::Boom;
 use crate::inputs::orbit::Orbit;
 use crate::models::coupled::Coupling;
+use crate::models::hinge::HingeModel;
 use crate::models::thermal::ThermalModel;
 use crate::models::tube::{boom_system, TubeSystem};
 use crate::numerics::integrate::Method;
 use crate::runs::layered::LayeredSummaries;
-use crate::runs::orbits::{run_summarised, SummaryOptions, SummaryView};
+use crate::runs::orbits::{run_summarised, OrbitRunSpec, SummaryOptions, SummaryView};
 use crate::runs::request::{coupled_run, CoupledRun};
 use crate::runs::simulate::{state_from, OnLimit, Output};
 use nalgebra::U4;
@@ -76,19 +77,21 @@ pub fn run_orbits(
         system,
         stiffness: boom.hinge_stiffness(),
     };
-    let panel = boom.hinge_panel();
-    let run = run_summarised(
-        &mut system,
-        view,
-        &panel,
-        &orbit,
-        method,
-        span,
-        y0,
-        2,
+    let (t_start, first_index, n_orbits) = span;
+    let spec = OrbitRunSpec {
+        // The panel of the same hinge: its period caps the step, its rates bound the start.
+        panel: boom.hinge_panel(),
+        orbit,
+        // The rigid link has one equation of motion (no 1 + 3 sin²θ).
+        model: HingeModel::Linear,
+        coupling,
+        method: *method,
+        t_start,
+        first_index,
+        n_orbits,
         options,
-        cancel,
-    )?;
+    };
+    let run = run_summarised(&mut system, view, &spec, y0, 2, cancel)?;
     Ok(run.into())
 }
 

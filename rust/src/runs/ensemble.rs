@@ -19,7 +19,7 @@ use crate::numerics::integrate::{DenseStep, Method, Observer};
 use crate::runs::hybrid::{run_orbits_hybrid, HybridSettings};
 use crate::runs::lockstep::{solve_lockstep, Job, LaneObserver, StepReads, RUNS_PER_CORE};
 use crate::runs::orbits::{
-    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, OrbitRunRequest,
+    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, OrbitRunRequest, OrbitRunSpec,
     SummaryObserver, SummaryOptions, TwoLayerView,
 };
 use nalgebra::{Vector4, U4};
@@ -246,16 +246,8 @@ fn sample_head(
     let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
     let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
     let req = OrbitRunRequest {
-        panel: *panel,
-        orbit: s.orbit,
-        model: s.model,
-        coupling: s.coupling,
-        method: s.method,
-        t_start: 0.0,
-        first_index: 0,
-        n_orbits: s.n_orbits,
+        spec: orbit_spec(panel, s),
         y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-        options: summary_options(s),
     };
     let head = SampleHead {
         theta_eq: flutter.equilibrium.theta,
@@ -266,14 +258,25 @@ fn sample_head(
     Ok((head, req))
 }
 
-/// The per-orbit summaries every sample of a batch takes.
-fn summary_options(s: &EnsembleSettings) -> SummaryOptions {
-    SummaryOptions {
-        window: s.window,
-        // Without a threshold nothing is timed: a limit no angle reaches.
-        theta_limit: s.threshold.unwrap_or(f64::MAX),
-        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
-        steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+/// The run over orbits every sample of a batch takes (`panel` being the sample's), from t = 0,
+/// with its per-orbit summaries.
+fn orbit_spec(panel: &Panel, s: &EnsembleSettings) -> OrbitRunSpec {
+    OrbitRunSpec {
+        panel: *panel,
+        orbit: s.orbit,
+        model: s.model,
+        coupling: s.coupling,
+        method: s.method,
+        t_start: 0.0,
+        first_index: 0,
+        n_orbits: s.n_orbits,
+        options: SummaryOptions {
+            window: s.window,
+            // Without a threshold nothing is timed: a limit no angle reaches.
+            theta_limit: s.threshold.unwrap_or(f64::MAX),
+            stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
+            steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+        },
     }
 }
 
@@ -314,17 +317,9 @@ pub fn run_sample_layered(
         critical_damping: critical,
     };
     let req = crate::runs::layered::LayeredRunRequest {
-        panel: *panel,
+        spec: orbit_spec(panel, s),
         conduction: c,
-        orbit: s.orbit,
-        model: s.model,
-        coupling: s.coupling,
-        method: s.method,
-        t_start: 0.0,
-        first_index: 0,
-        n_orbits: s.n_orbits,
         y0,
-        options: summary_options(s),
     };
     let (out, t_nonlinear) = match &s.hybrid {
         None => {
@@ -701,26 +696,23 @@ mod tests {
         }
     }
 
-    /// The one long run a sample of `s` should equal, built here from the settings' parts (from
-    /// the sunlit equilibrium, the summary's θ limit `theta_limit`) rather than by the ensemble.
+    /// The one long run a sample of `s` should equal: the batch's run over orbits (as
+    /// [`orbit_spec`] sets it) through [`run_orbits_cancellable`] alone, from the sunlit
+    /// equilibrium, the summary's θ limit `theta_limit` (built here rather than by the ensemble).
     fn single_run(panel: Panel, s: &EnsembleSettings, theta_limit: f64) -> OrbitRunRequest {
         let eq = equilibrium(&panel, s.coupling, s.orbit.flux_scale(0.0)).unwrap();
+        let options = SummaryOptions {
+            window: s.window,
+            theta_limit,
+            stop_at_limit: false,
+            steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+        };
         OrbitRunRequest {
-            panel,
-            orbit: s.orbit,
-            model: s.model,
-            coupling: s.coupling,
-            method: s.method,
-            t_start: 0.0,
-            first_index: 0,
-            n_orbits: s.n_orbits,
-            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-            options: SummaryOptions {
-                window: s.window,
-                theta_limit,
-                stop_at_limit: false,
-                steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+            spec: OrbitRunSpec {
+                options,
+                ..orbit_spec(&panel, s)
             },
+            y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
         }
     }
 

@@ -323,22 +323,14 @@ impl crate::runs::orbits::SummaryView for LayeredView {
     }
 }
 
-/// What a run of the N-node system over whole orbits is asked, as
-/// [`crate::runs::orbits::OrbitRunRequest`] is for the two-layer model: its conduction model, and
-/// `y0` = (node temperatures, θ, θ̇).
+/// A run of the N-node system over whole orbits, as [`crate::runs::orbits::OrbitRunRequest`] is
+/// for the two-layer model: `spec` with its conduction model, from `y0` = (node temperatures, θ,
+/// θ̇).
 #[derive(Debug, Clone)]
 pub struct LayeredRunRequest {
-    pub panel: Panel,
+    pub spec: crate::runs::orbits::OrbitRunSpec,
     pub conduction: Conduction,
-    pub orbit: Orbit,
-    pub model: HingeModel,
-    pub coupling: Coupling,
-    pub method: crate::numerics::integrate::Method,
-    pub t_start: f64,
-    pub first_index: u64,
-    pub n_orbits: u64,
     pub y0: Vec<f64>,
-    pub options: crate::runs::orbits::SummaryOptions,
 }
 
 /// Per-orbit summaries of the N-node system (as [`crate::runs::orbits::run_orbits`]); the end state
@@ -356,11 +348,12 @@ pub(crate) fn run_orbits_reading(
     cancel: &crate::cancel::Cancel,
     slope_reads: bool,
 ) -> Result<LayeredSummaries> {
-    check_start(&req.panel, &req.y0, req.conduction.nodes())?;
+    let s = &req.spec;
+    check_start(&s.panel, &req.y0, req.conduction.nodes())?;
     let (system, start) = req.system()?;
-    let mut view = LayeredView::new(system.clone(), req.panel, req.orbit, req.coupling);
+    let mut view = LayeredView::new(system.clone(), s.panel, s.orbit, s.coupling);
     view.slope_reads = slope_reads;
-    let orb = LayeredOrbit::new(system.clone(), req.orbit);
+    let orb = LayeredOrbit::new(system.clone(), s.orbit);
     let size = start.len();
     let theta_index = system.thermal_size();
     let mut run = on_fastest_state!(
@@ -377,10 +370,10 @@ impl LayeredRunRequest {
     pub(crate) fn system(&self) -> Result<(Layered, Vec<f64>)> {
         let n = self.conduction.nodes();
         let system = Layered::new(
-            &self.panel,
+            &self.spec.panel,
             self.conduction.clone(),
-            self.model,
-            self.coupling,
+            self.spec.model,
+            self.spec.coupling,
             FAST_MODE_FACTOR,
         )?;
         let start = system.state_from_nodes(&self.y0[..n], self.y0[n], self.y0[n + 1]);
@@ -391,23 +384,16 @@ impl LayeredRunRequest {
     /// panel: `y0` = (T_front, T_back, θ, θ̇), checked by the caller).
     pub fn two_layer(&self) -> crate::runs::orbits::OrbitRunRequest {
         crate::runs::orbits::OrbitRunRequest {
-            panel: self.panel,
-            orbit: self.orbit,
-            model: self.model,
-            coupling: self.coupling,
-            method: self.method,
-            t_start: self.t_start,
-            first_index: self.first_index,
-            n_orbits: self.n_orbits,
+            spec: self.spec,
             y0: nalgebra::Vector4::from_column_slice(&self.y0),
-            options: self.options,
         }
     }
 
     /// A state `y` of `system` at time t as (node temperatures, θ, θ̇).
     pub(crate) fn nodal(&self, system: &Layered, t: f64, y: &[f64]) -> Vec<f64> {
         let m = system.thermal_size();
-        let flux = self.orbit.illumination(t) * self.orbit.flux_scale(t);
+        let orbit = &self.spec.orbit;
+        let flux = orbit.illumination(t) * orbit.flux_scale(t);
         let mut out = system.node_temperatures(flux, y);
         out.extend([y[m], y[m + 1]]);
         out
@@ -451,19 +437,9 @@ fn summarised_run<D: Dim, S: OdeSystem<D>>(
 where
     DefaultAllocator: Allocator<D>,
 {
-    let span = (req.t_start, req.first_index, req.n_orbits);
-    let run = crate::runs::orbits::run_summarised(
-        system,
-        view,
-        &req.panel,
-        &req.orbit,
-        &req.method,
-        span,
-        state_of::<D>(y0),
-        theta_index,
-        req.options,
-        cancel,
-    )?;
+    let y0 = state_of::<D>(y0);
+    let run =
+        crate::runs::orbits::run_summarised(system, view, &req.spec, y0, theta_index, cancel)?;
     Ok(run.into())
 }
 

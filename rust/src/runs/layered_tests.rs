@@ -24,6 +24,12 @@ fn nonlinear_system(p: &Panel, c: &Conduction, fast_mode_factor: f64) -> Layered
     Layered::new(p, c.clone(), model, coupling, fast_mode_factor).unwrap()
 }
 
+/// Column `j` of ∂f/∂y of `sys` at `y` in full sun, by central differences with step `h`.
+fn central_difference(sys: &Layered, y: &[f64], j: usize, h: f64) -> Vec<f64> {
+    let f = |y: &[f64], dy: &mut [f64]| sys.rhs_at_flux(1.0, y, dy);
+    crate::numerics::testing::central_difference(f, y, j, h)
+}
+
 #[test]
 fn two_nodes_on_a_plain_panel_are_the_two_layer_system() {
     let p = Panel {
@@ -111,15 +117,9 @@ fn jacobian_matches_finite_differences() {
     assert!(f0.iter().all(|v| v.abs() < 1e-9), "equilibrium: {f0:?}");
     for j in 0..n {
         let h = if j < n - 2 { 1e-6 * y[j] } else { 1e-5 };
-        let (mut yp, mut ym) = (y.clone(), y.clone());
-        yp[j] += h;
-        ym[j] -= h;
-        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-        sys.rhs_at_flux(1.0, &yp, &mut fp);
-        sys.rhs_at_flux(1.0, &ym, &mut fm);
+        let column = central_difference(&sys, &y, j, h);
         let scale = (0..n).map(|i| jac[(i, j)].abs()).fold(1e-12, f64::max);
-        for i in 0..n {
-            let fd = (fp[i] - fm[i]) / (2.0 * h);
+        for (i, &fd) in column.iter().enumerate() {
             assert!(
                 (fd - jac[(i, j)]).abs() < 1e-6 * scale,
                 "({i},{j}) {fd} vs {}",
@@ -357,12 +357,11 @@ fn one_orbit_from_equilibrium(
     eq: &LayeredEquilibrium,
 ) -> LayeredRunRequest {
     use crate::numerics::integrate::{Method, Tolerances};
-    use crate::runs::orbits::{SummaryOptions, STEPS_PER_HINGE_PERIOD};
+    use crate::runs::orbits::{OrbitRunSpec, SummaryOptions, STEPS_PER_HINGE_PERIOD};
     let mut y0 = eq.temperatures.clone();
     y0.extend([eq.theta, 0.0]);
-    LayeredRunRequest {
+    let spec = OrbitRunSpec {
         panel,
-        conduction,
         orbit,
         model: HingeModel::Nonlinear,
         coupling: Coupling::ProjectedArea,
@@ -370,13 +369,17 @@ fn one_orbit_from_equilibrium(
         t_start: 0.0,
         first_index: 0,
         n_orbits: 1,
-        y0,
         options: SummaryOptions {
             window: 600.0,
             theta_limit: 1.0,
             stop_at_limit: false,
             steps_per_period: STEPS_PER_HINGE_PERIOD,
         },
+    };
+    LayeredRunRequest {
+        spec,
+        conduction,
+        y0,
     }
 }
 
@@ -439,15 +442,8 @@ fn reduced_growth_measurement() {
                 } else {
                     1e-6 * y[j].abs().max(1e-6)
                 };
-                let (mut yp, mut ym) = (y.clone(), y.clone());
-                yp[j] += h;
-                ym[j] -= h;
-                let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-                sys.rhs_at_flux(1.0, &yp, &mut fp);
-                sys.rhs_at_flux(1.0, &ym, &mut fm);
-                for i in 0..n {
-                    jac[(i, j)] = (fp[i] - fm[i]) / (2.0 * h);
-                }
+                let column = central_difference(&sys, &y, j, h);
+                jac.set_column(j, &DVector::from_vec(column));
             }
             let g = jac
                 .complex_eigenvalues()
@@ -549,11 +545,21 @@ fn orbit_cost() {
         ..
     } = case;
     let orbits = std::env::var("LAMINATE_RUN").is_ok_and(|v| v == "orbits");
-    let options = crate::runs::orbits::SummaryOptions {
-        window: 600.0,
-        theta_limit: 0.5,
-        stop_at_limit: false,
-        steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+    let spec = crate::runs::orbits::OrbitRunSpec {
+        panel: p,
+        orbit: o,
+        model,
+        coupling,
+        method: *method,
+        t_start: 0.0,
+        first_index: 0,
+        n_orbits: 1,
+        options: crate::runs::orbits::SummaryOptions {
+            window: 600.0,
+            theta_limit: 0.5,
+            stop_at_limit: false,
+            steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+        },
     };
     let cancel = crate::cancel::Cancel::new();
     let steps = if nodes == 2 {
@@ -561,18 +567,7 @@ fn orbit_cost() {
             let y0 = Coupled::new(p, o, model, coupling)
                 .steady_state(1.0)
                 .unwrap();
-            let req = crate::runs::orbits::OrbitRunRequest {
-                panel: p,
-                orbit: o,
-                model,
-                coupling,
-                method: *method,
-                t_start: 0.0,
-                first_index: 0,
-                n_orbits: 1,
-                y0,
-                options,
-            };
+            let req = crate::runs::orbits::OrbitRunRequest { spec, y0 };
             crate::runs::orbits::run_orbits_cancellable(&req, &cancel)
                 .unwrap()
                 .stats
@@ -586,17 +581,9 @@ fn orbit_cost() {
             let mut y0 = eq.temperatures.clone();
             y0.extend([eq.theta, 0.0]);
             let req = LayeredRunRequest {
-                panel: p,
+                spec,
                 conduction: c,
-                orbit: o,
-                model,
-                coupling,
-                method: *method,
-                t_start: 0.0,
-                first_index: 0,
-                n_orbits: 1,
                 y0,
-                options,
             };
             run_orbits(&req, &cancel).unwrap().stats
         } else {

@@ -248,19 +248,19 @@ pub(crate) struct Collector<V> {
 }
 
 impl<V: SummaryView> Collector<V> {
-    /// A collector whose first orbit `first_index` starts at `t_start` with hinge angle θ0.
-    pub(crate) fn new(
-        view: V,
-        orbit: &Orbit,
-        options: SummaryOptions,
-        t_start: f64,
-        first_index: u64,
-        n_orbits: u64,
-        theta0: f64,
-    ) -> Result<Self> {
+    /// A collector of the orbits of `spec`, the first starting with hinge angle θ0.
+    pub(crate) fn new(view: V, spec: &OrbitRunSpec, theta0: f64) -> Result<Self> {
+        let OrbitRunSpec {
+            ref orbit,
+            options,
+            t_start,
+            first_index,
+            n_orbits,
+            ..
+        } = *spec;
         // The span (and with it the eclipses and the rows kept) is checked before anything is
         // allocated for it.
-        let t_end = t_start + n_orbits as f64 * orbit.period;
+        let t_end = spec.t_end();
         orbit.check_span(t_start, t_end).map_err(|_| {
             crate::Error::invalid(
                 "n_orbits",
@@ -776,11 +776,12 @@ impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
 /// Result of a summarised run of the two-layer panel over whole orbits.
 pub type OrbitRun = Summarised<U4>;
 
-/// What a summarised run of the two-layer panel over whole orbits is asked to do: integrate
-/// orbits `first_index .. first_index + n_orbits`, the first starting at `t_start`, from `y0`,
-/// with `method` (the hybrid propagator's fallback when it runs them).
+/// What every summarised run over whole orbits is asked, whatever its model's state: `panel` on
+/// `orbit` with the hinge `model` and `coupling`, integrated with `method` (the hybrid
+/// propagator's fallback when it runs them) over orbits `first_index .. first_index + n_orbits`,
+/// the first starting at `t_start`, each summarised as `options` ask.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OrbitRunRequest {
+pub struct OrbitRunSpec {
     pub panel: Panel,
     pub orbit: Orbit,
     pub model: HingeModel,
@@ -789,8 +790,21 @@ pub struct OrbitRunRequest {
     pub t_start: f64,
     pub first_index: u64,
     pub n_orbits: u64,
-    pub y0: Vector4<f64>,
     pub options: SummaryOptions,
+}
+
+impl OrbitRunSpec {
+    /// The end of the last orbit.
+    pub(crate) fn t_end(&self) -> f64 {
+        self.t_start + self.n_orbits as f64 * self.orbit.period
+    }
+}
+
+/// A summarised run of the two-layer panel over whole orbits: `spec` from `y0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrbitRunRequest {
+    pub spec: OrbitRunSpec,
+    pub y0: Vector4<f64>,
 }
 
 /// Integrates the coupled system over the orbits of `req` and summarises each orbit.
@@ -802,24 +816,13 @@ pub fn run_orbits(req: &OrbitRunRequest) -> Result<OrbitRun> {
 /// cancelled (the orbits finished before are lost with the call: callers that keep them run
 /// fewer orbits per call).
 pub fn run_orbits_cancellable(req: &OrbitRunRequest, cancel: &Cancel) -> Result<OrbitRun> {
-    let mut system = Coupled::new(req.panel, req.orbit, req.model, req.coupling);
+    let s = &req.spec;
+    let mut system = Coupled::new(s.panel, s.orbit, s.model, s.coupling);
     let view = TwoLayerView {
-        panel: req.panel,
-        coupling: req.coupling,
+        panel: s.panel,
+        coupling: s.coupling,
     };
-    let span = (req.t_start, req.first_index, req.n_orbits);
-    run_summarised(
-        &mut system,
-        view,
-        &req.panel,
-        &req.orbit,
-        &req.method,
-        span,
-        req.y0,
-        2,
-        req.options,
-        cancel,
-    )
+    run_summarised(&mut system, view, s, req.y0, 2, cancel)
 }
 
 /// A summarised run of the two-layer panel set up but not yet integrated: integrate `system` with
@@ -840,29 +843,20 @@ pub(crate) fn prepare_orbits<'c>(
     req: &OrbitRunRequest,
     cancel: &'c Cancel,
 ) -> Result<PreparedOrbits<'c>> {
-    let OrbitRunRequest {
-        panel,
-        orbit,
-        model,
-        coupling,
-        t_start,
-        y0,
-        ..
-    } = *req;
+    let OrbitRunRequest { spec, y0 } = *req;
     let (method, t1, observer) = prepare_summarised(
-        TwoLayerView { panel, coupling },
-        &panel,
-        &orbit,
-        &req.method,
-        (t_start, req.first_index, req.n_orbits),
+        TwoLayerView {
+            panel: spec.panel,
+            coupling: spec.coupling,
+        },
+        &spec,
         (2, [y0[2], y0[3]]),
-        req.options,
         cancel,
     )?;
     Ok(PreparedOrbits {
-        system: Coupled::new(panel, orbit, model, coupling),
+        system: Coupled::new(spec.panel, spec.orbit, spec.model, spec.coupling),
         method,
-        t0: t_start,
+        t0: spec.t_start,
         t1,
         y0,
         observer,
@@ -885,22 +879,17 @@ where
     Ok(observer.collector.finish(stats, y_end))
 }
 
-/// The checks of a summarised run of orbits `first_index .. first_index + n_orbits` from
-/// `t_start` (`span`) whose start state has θ and θ̇ = `hinge.1` at components `hinge.0` and
-/// the next (its temperatures, if any, checked by the caller), and what it
-/// integrates with: `method` with its step capped as `options` ask, the end time, the observer.
-#[allow(clippy::too_many_arguments)]
+/// The checks of a summarised run of the orbits of `spec` whose start state has θ and θ̇ =
+/// `hinge.1` at components `hinge.0` and the next (its temperatures, if any, checked by the
+/// caller), and what it integrates with: the method with its step capped as the options ask, the
+/// end time, the observer.
 fn prepare_summarised<'c, V: SummaryView>(
     view: V,
-    panel: &Panel,
-    orbit: &Orbit,
-    method: &Method,
-    span: (f64, u64, u64),
+    spec: &OrbitRunSpec,
     hinge: (usize, [f64; 2]),
-    options: SummaryOptions,
     cancel: &'c Cancel,
 ) -> Result<(Method, f64, SummaryObserver<'c, V>)> {
-    let (t_start, first_index, n_orbits) = span;
+    let (panel, options) = (&spec.panel, spec.options);
     cancel.check()?;
     crate::error::require_positive("window", options.window)?;
     crate::error::require_positive("theta_limit", options.theta_limit)?;
@@ -916,26 +905,17 @@ fn prepare_summarised<'c, V: SummaryView>(
             &format!("must be in [0, {MAX_STEPS_PER_PERIOD:e}] (0: error control alone)"),
         ));
     }
-    let method = resolve_hinge(method, panel, options.steps_per_period);
-    if n_orbits == 0 {
+    let method = resolve_hinge(&spec.method, panel, options.steps_per_period);
+    if spec.n_orbits == 0 {
         return Err(crate::Error::invalid("n_orbits", 0, "must be >= 1"));
     }
-    let t_end = t_start + n_orbits as f64 * orbit.period;
-    let collector = Collector::new(
-        view,
-        orbit,
-        options,
-        t_start,
-        first_index,
-        n_orbits,
-        start[0],
-    )?;
+    let collector = Collector::new(view, spec, start[0])?;
     let observer = SummaryObserver {
         collector,
         error: None,
         cancel,
     };
-    Ok((method, t_end, observer))
+    Ok((method, spec.t_end(), observer))
 }
 
 /// A summarised run of any model: the summaries, the counters and the end state.
@@ -950,37 +930,23 @@ where
     pub crossing: Option<LimitCrossing>,
 }
 
-/// Integrates `system` over orbits `first_index .. first_index + n_orbits` from `y0` at
-/// `t_start` (`span`; `y0`'s component `theta_index` is θ) and summarises each orbit through
-/// `view`; the step is capped by `panel`'s hinge period as
-/// [`SummaryOptions::steps_per_period`] asks.
-#[allow(clippy::too_many_arguments)]
+/// Integrates `system` over the orbits of `spec` from `y0` at its `t_start` (`y0`'s component
+/// `theta_index` is θ) and summarises each orbit through `view`; the step is capped by the
+/// panel's hinge period as [`SummaryOptions::steps_per_period`] asks.
 pub fn run_summarised<D: Dim, S: OdeSystem<D>, V: SummaryView>(
     system: &mut S,
     view: V,
-    panel: &Panel,
-    orbit: &Orbit,
-    method: &Method,
-    span: (f64, u64, u64),
+    spec: &OrbitRunSpec,
     y0: State<D>,
     theta_index: usize,
-    options: SummaryOptions,
     cancel: &Cancel,
 ) -> Result<Summarised<D>>
 where
     DefaultAllocator: Allocator<D>,
 {
-    let (method, t_end, mut observer) = prepare_summarised(
-        view,
-        panel,
-        orbit,
-        method,
-        span,
-        (theta_index, [y0[theta_index], y0[theta_index + 1]]),
-        options,
-        cancel,
-    )?;
-    let outcome = solve(system, &method, span.0, y0, t_end, &mut observer);
+    let hinge = (theta_index, [y0[theta_index], y0[theta_index + 1]]);
+    let (method, t_end, mut observer) = prepare_summarised(view, spec, hinge, cancel)?;
+    let outcome = solve(system, &method, spec.t_start, y0, t_end, &mut observer);
     finish_orbits(observer, outcome)
 }
 
@@ -1010,16 +976,18 @@ mod tests {
             steps_per_period: STEPS_PER_HINGE_PERIOD,
         };
         run_orbits(&OrbitRunRequest {
-            panel: *panel,
-            orbit: o,
-            model: HingeModel::Nonlinear,
-            coupling: Coupling::ProjectedArea,
-            method: Method::Dopri5(Tolerances::default()),
-            t_start: first as f64 * o.period,
-            first_index: first,
-            n_orbits: n,
+            spec: OrbitRunSpec {
+                panel: *panel,
+                orbit: o,
+                model: HingeModel::Nonlinear,
+                coupling: Coupling::ProjectedArea,
+                method: Method::Dopri5(Tolerances::default()),
+                t_start: first as f64 * o.period,
+                first_index: first,
+                n_orbits: n,
+                options: opts,
+            },
             y0,
-            options: opts,
         })
         .unwrap()
     }
@@ -1105,7 +1073,7 @@ mod tests {
                     stop_at_limit: false,
                     steps_per_period,
                 };
-                let req = OrbitRunRequest {
+                let spec = OrbitRunSpec {
                     panel,
                     orbit: o,
                     model,
@@ -1114,9 +1082,9 @@ mod tests {
                     t_start: 0.0,
                     first_index: 0,
                     n_orbits: 2,
-                    y0,
                     options: opts,
                 };
+                let req = OrbitRunRequest { spec, y0 };
                 let prepare = || prepare_orbits(&req, &cancel).unwrap();
                 let got = summarise(prepare(), |o| o, |o| o);
                 let want = summarise(prepare(), Fine, |fine| fine.0);

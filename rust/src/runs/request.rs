@@ -209,7 +209,7 @@ pub fn run_orbits(req: &OrbitsRequest, cancel: &Cancel) -> Result<OrbitsRun> {
             }
         }
         (OrbitsModel::TwoLayer(run), hybrid) => {
-            let hinge = Hinge::new(&run.panel, run.model);
+            let hinge = Hinge::new(&run.spec.panel, run.spec.model);
             crate::models::hinge::check_start_state(run.y0.as_slice(), 2, Some(&hinge))?;
             match hybrid {
                 None => OrbitsRun {

@@ -1,4 +1,5 @@
 use super::*;
+use crate::numerics::testing::central_difference;
 
 fn model(support: Support, n: usize, k: usize, coupling: Coupling) -> DistributedPanel {
     let panel = Panel {
@@ -47,15 +48,10 @@ fn analytic_jacobian_matches_finite_differences() {
         let size = y.len();
         for c in 0..size {
             let h = 1e-6 * y[c].abs().max(1e-2);
-            let (mut yp, mut ym) = (y.clone(), y.clone());
-            yp[c] += h;
-            ym[c] -= h;
-            let (mut fp, mut fm) = (vec![0.0; size], vec![0.0; size]);
-            m.rhs_at_flux(0.9, &yp, &mut fp);
-            m.rhs_at_flux(0.9, &ym, &mut fm);
+            let f = |y: &[f64], dy: &mut [f64]| m.rhs_at_flux(0.9, y, dy);
+            let column = central_difference(f, &y, c, h);
             let scale = jac.column(c).amax().max(1e-12);
-            for r in 0..size {
-                let fd = (fp[r] - fm[r]) / (2.0 * h);
+            for (r, &fd) in column.iter().enumerate() {
                 assert!(
                     (fd - jac[(r, c)]).abs() < 1e-6 * scale,
                     "{support:?} ({r},{c}): {fd} vs {}",

@@ -1,7 +1,7 @@
 //! The hybrid propagator on the N-node model, against the full integration of the same model
 //! and the N-node flutter analysis.
 
-use super::tests::{compare, options};
+use super::tests::{compare, spec};
 use super::HybridSettings;
 use crate::analysis::layered::{analyse, critical_damping, start_state};
 use crate::cancel::Cancel;
@@ -10,7 +10,6 @@ use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
-use crate::numerics::integrate::{Method, Tolerances};
 use crate::runs::hybrid::layered::{run_orbits_hybrid, LayeredHybrid};
 use crate::runs::layered::{run_orbits, LayeredRunRequest, LayeredSummaries};
 
@@ -27,17 +26,9 @@ fn start(panel: &Panel, c: &Conduction, orbit: &Orbit, kick: f64) -> Vec<f64> {
 /// The N-node run of `n` orbits from `y0` at the tests' settings.
 fn request(panel: &Panel, c: &Conduction, orbit: &Orbit, n: u64, y0: &[f64]) -> LayeredRunRequest {
     LayeredRunRequest {
-        panel: *panel,
+        spec: spec(panel, orbit, n),
         conduction: c.clone(),
-        orbit: *orbit,
-        model: MODEL,
-        coupling: COUPLING,
-        method: Method::Dopri5(Tolerances::default()),
-        t_start: 0.0,
-        first_index: 0,
-        n_orbits: n,
         y0: y0.to_vec(),
-        options: options(),
     }
 }
 

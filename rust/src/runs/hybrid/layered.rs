@@ -2,7 +2,6 @@
 
 use crate::analysis::layered::equilibrium;
 use crate::error::{Error, Result};
-use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
@@ -174,24 +173,15 @@ pub struct LayeredHybrid {
 pub const HYBRID_MAX_STATE: usize = 24;
 
 /// Per-orbit summaries of the N-node system by the hybrid propagator (as
-/// [`crate::runs::hybrid::run_orbits_hybrid`]); `req.method` is the full integration of its fallback.
+/// [`crate::runs::hybrid::run_orbits_hybrid`]); `req.spec.method` is the full integration of its fallback.
 pub fn run_orbits_hybrid(
     req: &LayeredRunRequest,
     settings: &crate::runs::hybrid::HybridSettings,
     cancel: &crate::cancel::Cancel,
 ) -> Result<LayeredHybrid> {
-    let (y0, n) = (&req.y0, req.conduction.nodes());
-    check_start(&req.panel, y0, n)?;
-    crate::runs::hybrid::check_request(
-        &req.orbit,
-        &req.method,
-        req.t_start,
-        req.n_orbits,
-        y0,
-        &req.options,
-        settings,
-        cancel,
-    )?;
+    let (y0, n, spec) = (&req.y0, req.conduction.nodes(), &req.spec);
+    check_start(&spec.panel, y0, n)?;
+    crate::runs::hybrid::check_request(spec, y0, settings, cancel)?;
     if req.conduction.two_layer {
         // Two nodes on a plain panel are eq. 2: the two-layer hybrid run, to the bit.
         let out = crate::runs::hybrid::run_orbits_hybrid(&req.two_layer(), settings, cancel)?;
@@ -200,12 +190,7 @@ pub fn run_orbits_hybrid(
     }
     let (system, start) = req.system()?;
     let args = HybridArgs {
-        orbit: &req.orbit,
-        method: &req.method,
-        t_start: req.t_start,
-        first_index: req.first_index,
-        n_orbits: req.n_orbits,
-        options: req.options,
+        spec,
         settings,
         cancel,
     };
@@ -214,9 +199,9 @@ pub fn run_orbits_hybrid(
             match start.len() {
                 $($s => hybrid_run::<$s>(
                     HybridLayered {
-                        orbit: LayeredOrbit::new(system.clone(), req.orbit),
-                        panel: req.panel,
-                        coupling: req.coupling,
+                        orbit: LayeredOrbit::new(system.clone(), spec.orbit),
+                        panel: spec.panel,
+                        coupling: spec.coupling,
                     },
                     &start,
                     &args,
@@ -239,12 +224,7 @@ pub fn run_orbits_hybrid(
 
 /// What a hybrid run is asked, passed through the size dispatch.
 struct HybridArgs<'a> {
-    orbit: &'a Orbit,
-    method: &'a crate::numerics::integrate::Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
-    options: crate::runs::orbits::SummaryOptions,
+    spec: &'a crate::runs::orbits::OrbitRunSpec,
     settings: &'a crate::runs::hybrid::HybridSettings,
     cancel: &'a crate::cancel::Cancel,
 }
@@ -254,17 +234,7 @@ fn hybrid_run<const S: usize>(
     y0: &[f64],
     a: &HybridArgs<'_>,
 ) -> Result<(LayeredSummaries, crate::runs::hybrid::HybridRun)> {
-    let done = crate::runs::hybrid::propagate(
-        model,
-        a.orbit,
-        a.method,
-        a.t_start,
-        a.first_index,
-        a.n_orbits,
-        SVector::from_column_slice(y0),
-        a.options,
-        a.settings,
-        a.cancel,
-    )?;
+    let y0 = SVector::from_column_slice(y0);
+    let done = crate::runs::hybrid::propagate(model, a.spec, y0, a.settings, a.cancel)?;
     Ok((done.run.into(), done.split))
 }

@@ -34,8 +34,8 @@ use crate::inputs::orbit::{breakpoints_of, Eclipse, EclipseTable, Orbit};
 use crate::inputs::panel::Panel;
 use crate::numerics::integrate::{solve, DenseStep, Method, Observer, OdeSystem, Stats};
 use crate::runs::orbits::{
-    resolve_hinge, Collector, OrbitRun, OrbitRunRequest, Summarised, SummaryObserver,
-    SummaryOptions, STEPS_PER_HINGE_PERIOD,
+    resolve_hinge, Collector, OrbitRun, OrbitRunRequest, OrbitRunSpec, Summarised, SummaryObserver,
+    STEPS_PER_HINGE_PERIOD,
 };
 use exprb::{ExpStep, ExpTolerances};
 use linear::{Arc, HingeMode};
@@ -139,110 +139,62 @@ pub(crate) struct Propagated<const N: usize> {
 }
 
 /// Integrates the orbits of `req` with the hybrid propagator and summarises each orbit;
-/// `req.method` is the full integration used as the fallback.
+/// `req.spec.method` is the full integration used as the fallback.
 pub fn run_orbits_hybrid(
     req: &OrbitRunRequest,
     settings: &HybridSettings,
     cancel: &Cancel,
 ) -> Result<HybridRun> {
-    let OrbitRunRequest {
-        ref panel,
-        ref orbit,
-        model,
-        coupling,
-        ref method,
-        t_start,
-        first_index,
-        n_orbits,
-        y0,
-        options,
-    } = *req;
-    panel.validate()?;
-    check_request(
-        orbit,
-        method,
-        t_start,
-        n_orbits,
-        y0.as_slice(),
-        &options,
-        settings,
-        cancel,
-    )?;
-    let done = propagate(
-        TwoLayerModel::new(panel, orbit, model, coupling),
-        orbit,
-        method,
-        t_start,
-        first_index,
-        n_orbits,
-        y0,
-        options,
-        settings,
-        cancel,
-    )?;
+    let OrbitRunRequest { ref spec, y0 } = *req;
+    spec.panel.validate()?;
+    check_request(spec, y0.as_slice(), settings, cancel)?;
+    let model = TwoLayerModel::new(&spec.panel, &spec.orbit, spec.model, spec.coupling);
+    let done = propagate(model, spec, y0, settings, cancel)?;
     let mut out = done.split;
     out.run = done.run;
     Ok(out)
 }
 
 /// Checks what every hybrid run is asked (the panel is checked by its model).
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn check_request(
-    orbit: &Orbit,
-    method: &Method,
-    t_start: f64,
-    n_orbits: u64,
+    spec: &OrbitRunSpec,
     y0: &[f64],
-    options: &SummaryOptions,
     settings: &HybridSettings,
     cancel: &Cancel,
 ) -> Result<()> {
     cancel.check()?;
-    options.check()?;
+    spec.options.check()?;
     settings.validate()?;
-    orbit.validate()?;
-    method.validate()?;
-    if n_orbits == 0 {
+    spec.orbit.validate()?;
+    spec.method.validate()?;
+    if spec.n_orbits == 0 {
         return Err(Error::invalid("n_orbits", 0, "must be >= 1"));
     }
-    crate::error::require_finite("t_start", t_start)?;
+    crate::error::require_finite("t_start", spec.t_start)?;
     if let Some(v) = y0.iter().find(|v| !v.is_finite()) {
         return Err(Error::invalid("y0", v, "every component must be finite"));
     }
     Ok(())
 }
 
-/// The hybrid propagation of `model` (checked by the caller) over orbits `first_index ..
-/// first_index + n_orbits` from (t_start, y0).
-#[allow(clippy::too_many_arguments)]
+/// The hybrid propagation of `model` (checked by the caller) over the orbits of `spec` from
+/// (t_start, y0).
 pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
     model: M,
-    orbit: &Orbit,
-    method: &Method,
-    t_start: f64,
-    first_index: u64,
-    n_orbits: u64,
+    spec: &OrbitRunSpec,
     y0: SVector<f64, N>,
-    options: SummaryOptions,
     settings: &HybridSettings,
     cancel: &Cancel,
 ) -> Result<Propagated<N>> {
+    let (orbit, t_start, options) = (&spec.orbit, spec.t_start, spec.options);
     let panel = *model.panel();
     let steps = if options.steps_per_period > 0.0 {
         options.steps_per_period
     } else {
         STEPS_PER_HINGE_PERIOD
     };
-    let collector = Collector::new(
-        model.view(),
-        orbit,
-        options,
-        t_start,
-        first_index,
-        n_orbits,
-        y0[N - 2],
-    )?;
-    let t_end = t_start + n_orbits as f64 * orbit.period;
+    let collector = Collector::new(model.view(), spec, y0[N - 2])?;
+    let t_end = spec.t_end();
     let flux0 = orbit.flux_scale(t_start);
     let y_eq = model.equilibrium(flux0, None).ok();
     let t_ref = y_eq.map(|e| e[0]).unwrap_or(300.0);
@@ -259,7 +211,7 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
     let mut d = Driver {
         orbit: *orbit,
         settings,
-        fallback: resolve_hinge(method, &panel, steps),
+        fallback: resolve_hinge(&spec.method, &panel, steps),
         system: model.clone(),
         obs: SummaryObserver {
             collector,
@@ -1225,9 +1177,9 @@ mod tests {
         Vector4::new(eq.t_front, eq.t_back, eq.theta + kick, 0.0)
     }
 
-    /// Orbits 0 .. n of `panel` from `y0`, the fallback (and the full run) rk45 at T_n/40.
-    fn request(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> OrbitRunRequest {
-        OrbitRunRequest {
+    /// Orbits 0 .. n of `panel`, the fallback (and the full run) rk45 at T_n/40.
+    pub(super) fn spec(panel: &Panel, orbit: &Orbit, n: u64) -> OrbitRunSpec {
+        OrbitRunSpec {
             panel: *panel,
             orbit: *orbit,
             model: HingeModel::Nonlinear,
@@ -1236,9 +1188,13 @@ mod tests {
             t_start: 0.0,
             first_index: 0,
             n_orbits: n,
-            y0,
             options: options(),
         }
+    }
+
+    fn request(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> OrbitRunRequest {
+        let spec = spec(panel, orbit, n);
+        OrbitRunRequest { spec, y0 }
     }
 
     fn hybrid(panel: &Panel, orbit: &Orbit, n: u64, y0: Vector4<f64>) -> HybridRun {
