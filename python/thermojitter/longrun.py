@@ -547,6 +547,7 @@ def simulate_orbits(
         # A run all read from its checkpoint made no engine call: the engine's reading of the
         # same settings (the check every run makes of them) stands for it.
         solver=SolverSettings(**(_core.check_solver(full) if ran_with is None else ran_with)),
-        panel=panel,
+        # A boom's runs are not saved with their input (persist knows panels).
+        panel=panel if isinstance(panel, Panel) else None,
         orbit=orbit,
     )
