@@ -271,20 +271,11 @@ def simulate_boom(
 def run_boom_orbits(
     boom: dict[str, float],
     orbit: dict[str, Any],
-    *,
-    model: str,
-    coupled: bool,
-    solver: dict[str, Any],
-    t_start: float,
-    first_index: int,
-    n_orbits: int,
+    spec: dict[str, Any],
     y0: list[float],
-    window: float,
-    theta_limit: float,
-    stop_at_limit: bool,
-    steps_per_period: float,
-    cancel: CancelToken | None = None,
+    *,
     hybrid: dict[str, float] | None = None,
+    cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 def boom_flutter(
     boom: dict[str, float], coupled: bool, flux: float, with_critical: bool = True

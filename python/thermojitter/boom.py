@@ -30,7 +30,7 @@ from thermojitter import errors as checks
 from thermojitter.orbit import Orbit
 from thermojitter.progress import interruptible
 from thermojitter.results import Array, LimitCrossing, _Run
-from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
+from thermojitter.solver import SolverSettings
 
 _EXAMPLE: dict[str, float] = dict(_core.BOOM_EXAMPLE)
 """The engine's example boom (a 1963-22A-like beryllium–copper tube), whose values are the
@@ -264,31 +264,25 @@ def simulate_boom(
     t_span: Sequence[float],
     *,
     coupled: bool = True,
-    method: str = "rk45",
-    rtol: float = RTOL,
-    atol: float = ATOL,
-    dt: float | None = None,
     t_eval: ArrayLike | None = None,
     dt_out: float | None = None,
     y0: Sequence[float] | None = None,
-    max_step: float = MAX_STEP,
-    max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
     theta_limit: float | None = None,
     on_limit: str = "flag",
+    **integrator: Any,
 ) -> BoomSolution:
     """Integrates the boom over ``t_span`` (s), as :func:`thermojitter.simulate` a panel (which
     calls this for a :class:`Boom`): ``y0`` is (T_mean K, T_circ K, θ rad, θ̇ rad/s), default
-    the steady state at the start's flux; ``coupled=False`` freezes the incidence."""
+    the steady state at the start's flux; ``coupled=False`` freezes the incidence;
+    ``integrator``: ``method``, ``rtol``, ``atol``, ``dt``, ``max_step``, ``max_steps`` as
+    :func:`thermojitter.simulate` takes them (or ``solver``)."""
     # The module, not the function of the same name the package exports.
     run = importlib.import_module("thermojitter.simulate")
 
     checks.instance("boom", boom, Boom, "a thermojitter.Boom")
     checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-    used, options = run.run_settings(
-        solver, run.time_span(t_span), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
-        max_step=max_step, max_steps=max_steps,
-    )  # fmt: skip
+    used, options = run.run_settings(solver, run.time_span(t_span), t_eval, dt_out, **integrator)
     limit = run.DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
     options["limit"] = run.limit_args(limit, on_limit)
     options["y0"] = run.start_state(y0, 4)

@@ -92,16 +92,7 @@ def flutter(
     if isinstance(panel, Boom):
         return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
-    # t is checked even without an orbit: a t of the wrong type is a mistake either way.
-    t = checks.finite("t", t)
-    if orbit is not None:
-        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-        if flux is not None:
-            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
-        flux = float(orbit.flux_scale(t)[0])
-    elif flux is None:
-        flux = 1.0
-    flux = checks.real("flux", flux)
+    flux = _flux(flux, orbit, t)
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
     if layers is not None:
@@ -115,18 +106,24 @@ def flutter(
     return dataclasses.replace(result, panel=panel, orbit=orbit)
 
 
-def _boom_flutter(
-    boom: Boom, model: str, coupled: bool, flux: float | None, orbit: Orbit | None, t: float
-) -> FlutterResult:
-    """The tube's flutter analysis (see :func:`flutter`)."""
-    checks.choice("model", model, ("nonlinear", "linear"))
+def _flux(flux: float | None, orbit: Orbit | None, t: float) -> float:
+    """The flux factor of an analysis: ``flux``, or ``orbit.flux_scale(t)``, or 1."""
+    # t is checked even without an orbit: a t of the wrong type is a mistake either way.
     t = checks.finite("t", t)
     if orbit is not None:
         checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
         if flux is not None:
             raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
         flux = float(orbit.flux_scale(t)[0])
-    flux = checks.real("flux", 1.0 if flux is None else flux)
+    return checks.real("flux", 1.0 if flux is None else flux)
+
+
+def _boom_flutter(
+    boom: Boom, model: str, coupled: bool, flux: float | None, orbit: Orbit | None, t: float
+) -> FlutterResult:
+    """The tube's flutter analysis (see :func:`flutter`)."""
+    checks.choice("model", model, ("nonlinear", "linear"))
+    flux = _flux(flux, orbit, t)
     coupled = checks.flag("coupled", coupled)
     raw = _core.boom_flutter(boom.as_dict(), coupled, flux)
     equilibrium = _boom_equilibrium(boom, raw["equilibrium"])

@@ -256,6 +256,20 @@ def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
     return columns, y, next_index, counters, LimitCrossing.of(crossing)
 
 
+def _boom_orbits(
+    boom: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    y0: list[float],
+    hybrid: dict[str, float] | None = None,
+    cancel: Any = None,
+    **spec: Any,
+) -> dict[str, Any]:
+    """``_core.run_boom_orbits`` called as ``_core.run_orbits`` is: the run's keys in one
+    mapping."""
+    return _core.run_boom_orbits(boom, orbit, spec, y0, hybrid=hybrid, cancel=cancel)
+
+
 def simulate_orbits(
     panel: Panel | Boom,
     orbit: Orbit,
@@ -464,7 +478,7 @@ def simulate_orbits(
                 t0 = float(t_start) + next_index * orbit.period
                 extra = {"hybrid": hybrid_settings} if method == "hybrid" else {}
                 raw = engine.call(
-                    _core.run_boom_orbits if boom else _core.run_orbits,
+                    _boom_orbits if boom else _core.run_orbits,
                     panel.as_dict(),
                     orbit.as_dict(),
                     t_start=t0,

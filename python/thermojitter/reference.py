@@ -587,14 +587,13 @@ def simulate_tube(
     method: str = "RK45",
     max_step: float = np.inf,
 ) -> ReferenceSolution:
-    """The tube's transient, y = [T_mean, T_circ, theta, theta_dot], split at eclipses."""
-    if y0 is None:
-        y0 = tube_steady_state(boom, coupled, illumination(orbit, float(t_span[0])))
-
+    """The tube's transient, y = [T_mean, T_circ, theta, theta_dot], split at eclipses (from
+    the steady state at t_span[0]'s illumination unless ``y0`` is given)."""
     parts = (tube_coefficients(boom), tube_hinge(boom))
-
-    def fun(t: float, y: FloatArray, s: float) -> FloatArray:
-        return tube_rhs(y, boom, s, coupled, parts)
-
-    names = ("T_mean", "T_circ", "theta", "theta_dot")
-    return _integrate_segments(fun, y0, t_span, orbit, rtol, atol, t_eval, method, names, max_step)
+    start = tube_steady_state(boom, coupled, illumination(orbit, float(t_span[0])))
+    return _integrate_segments(
+        lambda t, y, s: tube_rhs(y, boom, s, coupled, parts),
+        start if y0 is None else y0,
+        t_span, orbit, rtol, atol, t_eval, method,
+        ("T_mean", "T_circ", "theta", "theta_dot"), max_step,
+    )  # fmt: skip

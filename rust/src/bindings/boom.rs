@@ -115,36 +115,55 @@ fn simulate_boom<'py>(
     })
 }
 
-/// Whole orbits of the boom, summarised as `run_orbits`'s. With `hybrid` the run is the full
-/// integration (the hybrid propagator's modal form is the plate's, not the tube's), and says so:
-/// all its time in `t_fallback`, with `fallback` the reason.
-#[pyfunction]
-#[pyo3(signature = (boom, orbit, *, model, coupled, solver, t_start, first_index, n_orbits, y0, window, theta_limit, stop_at_limit, steps_per_period, cancel=None, hybrid=None))]
-#[allow(clippy::too_many_arguments)]
-fn run_boom_orbits<'py>(
-    py: Python<'py>,
-    boom: &Bound<'py, PyDict>,
-    orbit: &Bound<'py, PyDict>,
-    model: &str,
+/// How a run of a boom's orbits is asked for: one mapping with the keys `run_orbits` takes one
+/// by one (the same names and meanings), converted here once.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct OrbitsSpec<'py> {
+    model: String,
     coupled: bool,
-    solver: &Bound<'py, PyDict>,
+    solver: Bound<'py, PyDict>,
     t_start: f64,
     first_index: u64,
     n_orbits: u64,
-    y0: Vec<f64>,
     window: f64,
     theta_limit: f64,
     stop_at_limit: bool,
     steps_per_period: f64,
-    cancel: Option<&Bound<'py, CancelToken>>,
+}
+
+/// Whole orbits of the boom from `y0`, summarised as `run_orbits`'s, asked for by `spec`. With
+/// `hybrid` the run is the full integration (the hybrid propagator's modal form is the plate's,
+/// not the tube's), and says so: all its time in `t_fallback`, with `fallback` the reason.
+#[pyfunction]
+#[pyo3(signature = (boom, orbit, spec, y0, *, hybrid=None, cancel=None))]
+fn run_boom_orbits<'py>(
+    py: Python<'py>,
+    boom: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    spec: OrbitsSpec<'py>,
+    y0: Vec<f64>,
     hybrid: Option<&Bound<'py, PyDict>>,
+    cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let OrbitsSpec {
+        model,
+        coupled,
+        solver,
+        t_start,
+        first_index,
+        n_orbits,
+        window,
+        theta_limit,
+        stop_at_limit,
+        steps_per_period,
+    } = spec;
     cancellable(cancel, |cancel| {
         let b = boom_from(boom)?;
         let o = orbit_from(orbit)?;
         // The rigid link has no (1 + 3 sin²θ): both hinge models are the same equation.
-        super::convert::hinge_model(model)?;
-        let method = solver_from(solver)?;
+        super::convert::hinge_model(&model)?;
+        let method = solver_from(&solver)?;
         check_hinge_angle("theta_limit", theta_limit)?;
         if let Some(h) = hybrid {
             super::orbits::hybrid_from(h)?;

@@ -58,7 +58,7 @@ use crate::error::{Error, Result};
 use crate::inputs::boom::Boom;
 use crate::inputs::orbit::Orbit;
 use crate::models::coupled::{Coupled, Coupling};
-use crate::models::hinge::{check_hinge_angle, generalised_moment, StructuralModel};
+use crate::models::hinge::{check_angle_and_rate, generalised_moment, StructuralModel};
 use crate::models::thermal::{ThermalModel, STEFAN_BOLTZMANN};
 use nalgebra::{DimName, U4};
 use std::f64::consts::PI;
@@ -230,23 +230,7 @@ impl StructuralModel for TubeHinge {
         Ok(())
     }
     fn check_start(&self, offset: usize, states: &[f64]) -> Result<()> {
-        let &[theta, rate, ..] = states else {
-            return Err(Error::invalid(
-                "y0",
-                format!("{} components", offset + states.len()),
-                &format!("must hold θ and θ̇ after its {offset} temperatures"),
-            ));
-        };
-        check_hinge_angle(&format!("y0[{offset}]"), theta)?;
-        let most = self.max_start_rate();
-        if !(rate.is_finite() && rate.abs() <= most) {
-            return Err(Error::invalid(
-                &format!("y0[{}]", offset + 1),
-                rate,
-                &format!("θ̇ must be within ±{most:.4e} rad/s: (π/2) max(ω₁, c_d/I_B)"),
-            ));
-        }
-        Ok(())
+        check_angle_and_rate(offset, states, self.max_start_rate())
     }
 }
 
