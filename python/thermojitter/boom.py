@@ -196,10 +196,6 @@ class BoomEquilibrium:
     thermal_moment: float
     tip_deflection: float
 
-    @property
-    def theta_deg(self) -> float:
-        return math.degrees(self.theta)
-
 
 def boom_steady_state(boom: Boom, *, coupled: bool = True, flux: float = 1.0) -> BoomEquilibrium:
     """The boom's steady state under the flux factor ``flux`` (1: the Sun at 1 au, unshadowed)."""
@@ -247,15 +243,13 @@ class BoomSolution(_Run):
         """The state (T_mean, T_circ, theta, theta_dot) as a (4, n) array."""
         return np.vstack([self.T_mean, self.T_circ, self.theta, self.theta_dot])
 
+    COLUMNS: ClassVar[tuple[str, ...]] = (
+        "T_mean", "T_circ", "theta", "theta_dot", "thermal_moment", "sunlit",
+    )  # fmt: skip
+    """The run's columns, in the engine's order."""
+
     def _columns(self) -> dict[str, Array]:
-        return {
-            "T_mean": self.T_mean,
-            "T_circ": self.T_circ,
-            "theta": self.theta,
-            "theta_dot": self.theta_dot,
-            "thermal_moment": self.thermal_moment,
-            "sunlit": self.sunlit,
-        }
+        return {name: getattr(self, name) for name in self.COLUMNS}
 
 
 def simulate_boom(
@@ -298,13 +292,7 @@ def simulate_boom(
         **run.run_record(raw, used),
         settings={**settings, "boom": boom.as_dict(), "solver": dict(raw["solver"])},
         length=boom.length,
-        T_mean=raw["T_mean"],
-        T_circ=raw["T_circ"],
-        theta=raw["theta"],
-        theta_dot=raw["theta_dot"],
-        thermal_moment=raw["thermal_moment"],
-        sunlit=raw["sunlit"],
-        y_end=raw["y_end"],
+        **{name: raw[name] for name in (*BoomSolution.COLUMNS, "y_end")},
         **run.limit_record(raw),
     )
     run.warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)

@@ -580,20 +580,21 @@ def simulate_tube(
     t_span: tuple[float, float],
     *,
     coupled: bool = True,
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
-    t_eval: ArrayLike | None = None,
     y0: ArrayLike | None = None,
-    method: str = "RK45",
-    max_step: float = np.inf,
+    **options: Any,
 ) -> ReferenceSolution:
     """The tube's transient, y = [T_mean, T_circ, theta, theta_dot], split at eclipses (from
-    the steady state at t_span[0]'s illumination unless ``y0`` is given)."""
+    the steady state at t_span[0]'s illumination unless ``y0`` is given). ``options``: ``rtol``
+    (1e-10), ``atol`` (1e-12), ``t_eval``, ``method`` ("RK45") and ``max_step`` as
+    :func:`simulate` takes them."""
+    o: dict[str, Any] = {"rtol": 1e-10, "atol": 1e-12, "t_eval": None, "method": "RK45"}
+    o["max_step"] = np.inf
+    o.update(options)
     parts = (tube_coefficients(boom), tube_hinge(boom))
     start = tube_steady_state(boom, coupled, illumination(orbit, float(t_span[0])))
     return _integrate_segments(
         lambda t, y, s: tube_rhs(y, boom, s, coupled, parts),
         start if y0 is None else y0,
-        t_span, orbit, rtol, atol, t_eval, method,
-        ("T_mean", "T_circ", "theta", "theta_dot"), max_step,
+        t_span, orbit, o["rtol"], o["atol"], o["t_eval"], o["method"],
+        ("T_mean", "T_circ", "theta", "theta_dot"), o["max_step"],
     )  # fmt: skip

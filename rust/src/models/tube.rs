@@ -193,19 +193,20 @@ impl TubeHinge {
 }
 
 impl StructuralModel for TubeHinge {
-    fn size(&self) -> usize {
-        2
-    }
-    fn names(&self) -> Vec<String> {
-        vec!["theta".into(), "theta_dot".into()]
-    }
-    fn inertia(&self) -> f64 {
-        self.inertia
-    }
     /// sin(ψ + θ) / sin ψ.
     #[inline(always)]
     fn area_factor(&self, q: &[f64]) -> f64 {
         (self.inclination + q[0]).sin() * self.inv_sin
+    }
+    fn inertia(&self) -> f64 {
+        self.inertia
+    }
+    /// θ (the tip deflection over the length) and θ̇, as the panel's hinge names them.
+    fn names(&self) -> Vec<String> {
+        vec!["theta".into(), "theta_dot".into()]
+    }
+    fn size(&self) -> usize {
+        2
     }
     #[inline(always)]
     fn rates(&self, load: f64, q: &[f64], out: &mut [f64]) -> f64 {
