@@ -19,6 +19,7 @@ from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_d
 from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.scenario import (
+    BOOM_KEYS,
     LAMINATE_KEYS,
     LAMINATE_PANEL_KEYS,
     LAYER_KEYS,
@@ -48,7 +49,7 @@ def series_units(names: Sequence[str]) -> dict[str, str]:
 
 
 def scenario_keys_help() -> str:
-    """Every key of the four tables of a scenario, for ``run --help`` (the names come from the
+    """Every key of the tables of a scenario, for ``run --help`` (the names come from the
     code, so none is missing)."""
     from dataclasses import fields
 
@@ -71,6 +72,12 @@ def scenario_keys_help() -> str:
                 + "); each [[laminate.layers]], front first, has "
                 + ", ".join(LAYER_KEYS)
                 + " (material = a tj.materials key, or every property)",
+            ),
+            table(
+                "boom",
+                list(BOOM_KEYS),
+                "a thin-walled tube in place of [panel] (length, radius, wall required; "
+                "material = a tj.materials key; SI units, angles in rad or _deg)",
             ),
             table(
                 "orbit",
