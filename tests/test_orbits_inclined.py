@@ -177,7 +177,7 @@ def test_inclination_zero_is_the_presets() -> None:
     date = "2026-03-01"
     year = tj.Orbit.geo_year(date)
     same = tj.Orbit.circular(GEO_ALTITUDE, 0.0, 1.3, date).replace(period=SIDEREAL_DAY)
-    assert same.replace(raan=0.0, j2=False) == year
+    assert same.replace(raan=0.0, j2=False, albedo=0.0, earth_ir=0.0) == year
     span = (0.0, 30.0 * DAY)
     np.testing.assert_array_equal(same.eclipses(*span), year.eclipses(*span))
     t = np.linspace(*span, 10_001)
@@ -194,7 +194,8 @@ def test_inclination_zero_is_the_presets() -> None:
 def test_the_hybrid_keeps_its_gate_on_an_inclined_low_orbit() -> None:
     from test_hybrid import assert_gate, both
 
-    orbit = tj.Orbit.circular(540e3, math.radians(51.6), 0.3, "2026-06-01")
+    # The geometry alone (the Earth's heat runs in full: tests/test_earth_heating.py).
+    orbit = tj.Orbit.circular(540e3, math.radians(51.6), 0.3, "2026-06-01", albedo=0, earth_ir=0)
     assert 0.1 < abs(orbit.beta(0.0)[0]) < 1.0  # an eclipse shorter than at β = 0
     full, hybrid = both(orbit, 6)
     assert_gate(full, hybrid)

@@ -8,6 +8,7 @@ coupled to a one-degree-of-freedom hinge model of its first bending mode, with a
 
 from thermojitter import _core, beam, materials, nastran
 from thermojitter._core import ConvergenceError, IntegrationError
+from thermojitter.attitude import Attitude
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
 from thermojitter.boom import (
     Boom,
@@ -28,6 +29,7 @@ from thermojitter.distributed import (
     simulate_distributed,
 )
 from thermojitter.errors import (
+    HybridFallbackWarning,
     InternalError,
     ParameterError,
     ParameterTypeError,
@@ -116,6 +118,8 @@ __all__ = [
     "LinearThermalResponse",
     "NastranBeam",
     "Orbit",
+    "Attitude",
+    "HybridFallbackWarning",
     "OrbitSummaries",
     "Panel",
     "ParameterError",

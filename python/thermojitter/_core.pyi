@@ -67,6 +67,8 @@ __all__ = [
     "beta",
     "nodal_rate",
     "J2",
+    "EARTH_ALBEDO",
+    "EARTH_IR",
     "OBLIQUITY",
     "YEAR_DAYS",
     "DAY",
@@ -78,6 +80,7 @@ __all__ = [
     "energy",
     "equivalent_panel",
     "flutter",
+    "flutter_at",
     "flux_scale",
     "hinge_points",
     "hinge_equivalent_damping_ratio",
@@ -132,6 +135,8 @@ MU_EARTH: float
 EQUINOX_DAY: float
 PERIHELION_DAY: float
 J2: float
+EARTH_ALBEDO: float
+EARTH_IR: float
 OBLIQUITY: float
 YEAR_DAYS: float
 DAY: float
@@ -224,6 +229,15 @@ def simulate_hinge(
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(
     panel: dict[str, float], model: str, coupled: bool, flux: float, with_critical: bool = True
+) -> dict[str, Any]: ...
+def flutter_at(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    *,
+    t: float,
+    model: str,
+    coupled: bool,
+    with_critical: bool = True,
 ) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------

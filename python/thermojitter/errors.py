@@ -21,6 +21,8 @@ test oracle ``reference.py`` aside): ``parameter`` is the argument's name as the
   studies because this module does not import the engine): every sample of a study failed.
 - :class:`ValidityLimitWarning` (a warning, not an error): a run's angle passed ``theta_limit``,
   beyond which the hinge model means nothing; the result says where (``limit_crossing``).
+- :class:`HybridFallbackWarning` (a warning): a run asked of the hybrid propagator was
+  integrated in full instead, its sunlit forcing varying (Earth heating, another attitude).
 
 This module imports nothing from the engine: the engine's binding layer builds its
 ``ParameterError`` from here.
@@ -103,6 +105,13 @@ class ValidityLimitWarning(UserWarning):
     model is not trusted beyond it (its rigid halves and cos θ coupling are meant for modest
     angles). Issued once per call; the result's ``limit_crossing`` says when and where. Silence
     it with ``on_limit="ignore"`` or :mod:`warnings` filters."""
+
+
+class HybridFallbackWarning(UserWarning):
+    """A run asked of the hybrid propagator was integrated in full (hinge resolved) instead: its
+    sunlit forcing varies (Earth heating, an attitude other than Sun-pointing), which the
+    hybrid's arcs take as constant. The result is the full integration's; its settings say so
+    under ``"hybrid_fallback"``."""
 
 
 def type_name(value: Any) -> str:

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
 from thermojitter.boom import Boom
 from thermojitter.boom import _equilibrium as _boom_equilibrium
 from thermojitter.orbit import Orbit
@@ -72,6 +73,7 @@ def flutter(
     orbit: Orbit | None = None,
     t: float = 0.0,
     layers: int | None = None,
+    attitude: Attitude | None = None,
 ) -> FlutterResult:
     """Linear stability of the sunlit equilibrium of ``panel``.
 
@@ -84,21 +86,45 @@ def flutter(
     ``layers=N`` analyses the N-node through-thickness model on the panel's layup (or one
     homogeneous layer for a plain panel); ``jacobian`` is then over (node temperatures…, θ, θ̇).
 
+    With an ``orbit`` that heats the panel from the Earth (``orbit.albedo``, ``orbit.earth_ir``)
+    or an ``attitude`` other than Sun-pointing, the equilibrium is the one in full sunlight under
+    every load at the point ``t`` of the orbit (the Earth's infrared and albedo and the
+    incidence there), and the critical damping is that equilibrium's (the N-node model takes the
+    front's sunlight only and refuses them).
+
     A :class:`thermojitter.Boom` in place of the panel: the tube's analysis, ``jacobian`` over
     (T_mean, T_circ, θ, θ̇), ``equilibrium`` a :class:`thermojitter.BoomEquilibrium`, and
     ``critical_damping`` the first mode's damping ratio ζ at which the growth rate crosses zero
     (not a c_d); ``model`` is ``"tube"``.
     """
     if isinstance(panel, Boom):
+        if attitude is not None:
+            raise checks.ParameterError(
+                "attitude",
+                attitude,
+                "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)",
+            )
         return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     flux = _flux(flux, orbit, t)
+    if attitude is not None and orbit is None:
+        raise checks.ParameterError("attitude", attitude, "needs an orbit (and t)")
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
+    loaded = orbit is not None and has_face_loads(orbit, attitude)
     if layers is not None:
+        if loaded:
+            raise checks.ParameterError(
+                "layers", layers, "takes the front's sunlight only: no Earth heating or attitude"
+            )
         result = _layered_flutter(panel, model, coupled, flux, layers)
     else:
-        raw = _core.flutter(panel.as_dict(), model, coupled, flux)
+        if loaded:
+            assert orbit is not None
+            at = engine_orbit(orbit, attitude)
+            raw = _core.flutter_at(panel.as_dict(), at, t=t, model=model, coupled=coupled)
+        else:
+            raw = _core.flutter(panel.as_dict(), model, coupled, flux)
         tf, tb, th = raw["equilibrium"]
         moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
         equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)

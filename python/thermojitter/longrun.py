@@ -21,7 +21,9 @@ from numpy.typing import NDArray
 from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
+from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
 from thermojitter.boom import Boom
+from thermojitter.errors import HybridFallbackWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.persist import Persistent
@@ -42,6 +44,13 @@ from thermojitter.simulate import (
     warn_crossing,
 )
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, HybridSettings, SolverSettings
+
+HYBRID_FALLBACK = (
+    "Earth heating or an attitude other than Sun-pointing vary the sunlit forcing, which the "
+    "hybrid propagator takes as constant between eclipses: every orbit was integrated in full "
+    "with rk45 (the hybrid's fallback)"
+)
+"""Why a hybrid run with the Earth's loads or another attitude is integrated in full."""
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -296,6 +305,7 @@ def simulate_orbits(
     hybrid: HybridSettings | dict[str, float] | None = None,
     layers: int | None = None,
     solver: SolverSettings | None = None,
+    attitude: Attitude | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -335,6 +345,14 @@ def simulate_orbits(
     - ``solver``: a :class:`thermojitter.SolverSettings` in place of ``rtol``, ``atol``, ``dt``
       and ``max_steps`` (with ``method="hybrid"``, those of its rk45 fallback);
       ``result.solver`` is what the engine ran with.
+    - ``attitude``: where the front face points (:class:`thermojitter.Attitude`, default
+      Sun-pointing); with it or with the orbit's Earth heating each face takes its own loads (see
+      :func:`thermojitter.simulate`), and each orbit's ``theta_eq`` is the sunlit equilibrium
+      under the loads at the orbit's start. The hybrid propagator takes the sunlit forcing as
+      constant between eclipses, which these loads are not: such a run is integrated in full
+      with rk45 (``result.propagation`` counts all of it as the fallback's), said in
+      ``result.settings["hybrid_fallback"]`` and by one
+      :class:`thermojitter.errors.HybridFallbackWarning`.
 
     A :class:`thermojitter.Boom` in place of the panel runs the tube: ``y0`` and ``y_end`` are
     (T_mean, T_circ, θ, θ̇), the summaries read θ (the tip deflection over the length) and its
@@ -347,8 +365,15 @@ def simulate_orbits(
         checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
         if layers is not None:
             raise checks.ParameterError("layers", layers, "a Boom has its own thermal model")
+        if attitude is not None:
+            raise checks.ParameterError(
+                "attitude",
+                attitude,
+                "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)",
+            )
     else:
         check_inputs(panel, orbit)
+    engine_orbit_args = engine_orbit(orbit, attitude)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
     orbits_per_call = checks.integer("orbits_per_call", orbits_per_call, 1)
     on_limit = checks.choice("on_limit", on_limit, ("stop", "flag", "ignore"))  # type: ignore[assignment]
@@ -387,12 +412,12 @@ def simulate_orbits(
         y0 = tuple(_core.boom_start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
     elif y0 is None and nodes is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
-        y0 = tuple(_core.start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
+        y0 = tuple(_core.start_state(panel.as_dict(), engine_orbit_args, t_start, coupled))
     elif y0 is None:
         assert nodes is not None and isinstance(panel, Panel)  # layers is refused for a boom
         y0 = tuple(
             _core.layered_start_state(
-                panel.as_dict(), grid_args(panel, nodes), orbit.as_dict(), t_start, coupled
+                panel.as_dict(), grid_args(panel, nodes), engine_orbit_args, t_start, coupled
             )
         )
     settings: dict[str, Any] = {
@@ -419,6 +444,11 @@ def simulate_orbits(
     hybrid_settings = HybridSettings.of(hybrid).as_dict()
     if method == "hybrid":
         settings["hybrid"] = hybrid_settings
+    if "attitude" in engine_orbit_args:
+        settings["attitude"] = engine_orbit_args["attitude"]
+    if method == "hybrid" and has_face_loads(orbit, attitude):
+        settings["hybrid_fallback"] = HYBRID_FALLBACK
+        warnings.warn(HYBRID_FALLBACK, HybridFallbackWarning, stacklevel=2)
     core_args: dict[str, Any] = {
         "model": model,
         "coupled": coupled,
@@ -480,7 +510,7 @@ def simulate_orbits(
                 raw = engine.call(
                     _boom_orbits if boom else _core.run_orbits,
                     panel.as_dict(),
-                    orbit.as_dict(),
+                    engine_orbit_args,
                     t_start=t0,
                     first_index=next_index,
                     n_orbits=count,

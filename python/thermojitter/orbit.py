@@ -72,6 +72,10 @@ MAX_LEO_ALTITUDE: float = _core.MAX_LEO_ALTITUDE
 """Highest altitude of :meth:`Orbit.leo`, m (beyond the Moon)."""
 J2: float = _core.J2
 """The Earth's second zonal harmonic, for the nodal drift."""
+EARTH_ALBEDO: float = _core.EARTH_ALBEDO
+"""The Earth's mean albedo, the default of :meth:`Orbit.circular`."""
+EARTH_IR: float = _core.EARTH_IR
+"""The Earth's mean infrared flux at its surface, W/m², the default of :meth:`Orbit.circular`."""
 OBLIQUITY: float = _core.OBLIQUITY
 """Obliquity of the ecliptic, rad."""
 YEAR_DAYS: float = _core.YEAR_DAYS
@@ -82,8 +86,11 @@ DAY: float = _core.DAY
 ShadowModel = Literal["none", "cylindrical", "conical", "penumbra"]
 _SHADOWS = ("none", "cylindrical", "conical", "penumbra")
 _BOOLS = ("season", "eccentric_sun", "j2")
-_EQUATORIAL: dict[str, Any] = {k: _GEO_EQUINOX[k] for k in ("inclination", "raan", "j2")}
-"""The orbit plane's fields at their defaults: an equatorial orbit's, as before they existed."""
+_EQUATORIAL: dict[str, Any] = {
+    k: _GEO_EQUINOX[k] for k in ("inclination", "raan", "j2", "albedo", "earth_ir")
+}
+"""The orbit plane's and the Earth's heat fields at their defaults: an equatorial orbit without
+Earth heating, as before they existed."""
 _UNSET = object()
 
 DateLike = str | _dt.date | float | int
@@ -182,6 +189,12 @@ class Orbit:
     """Right ascension of the ascending node at t = 0, rad (no effect at inclination 0)."""
     j2: bool = _GEO_EQUINOX["j2"]
     """The node drifts under the Earth's oblateness (no effect at inclination 0)."""
+    albedo: float = _GEO_EQUINOX["albedo"]
+    """The Earth's albedo, in [0, 1]: the fraction of sunlight it reflects onto the panel's faces
+    (0 on the presets, :data:`EARTH_ALBEDO` on :meth:`circular`)."""
+    earth_ir: float = _GEO_EQUINOX["earth_ir"]
+    """The Earth's infrared flux at its surface, W/m² (0 on the presets, :data:`EARTH_IR` on
+    :meth:`circular`)."""
 
     def __post_init__(self) -> None:
         checks.check_fields(self, flags=_BOOLS, choices={"shadow": _SHADOWS})
@@ -230,13 +243,20 @@ class Orbit:
         *,
         j2: bool = True,
         shadow: ShadowModel = "conical",
+        albedo: float = EARTH_ALBEDO,
+        earth_ir: float = EARTH_IR,
     ) -> Orbit:
         """Any circular Earth orbit: ``altitude`` (m), ``inclination`` and ``raan`` (rad; the node
         at ``epoch``), the Sun by date from ``epoch`` (as ``geo_year``'s ``start_date``; default
         the March equinox) with its distance, the node's J2 drift (``j2``), and ``shadow``
         ("conical" with penumbra, "cylindrical" or "none"). t = 0 at the orbit's noon (its
         point nearest the Sun). Keplerian period. At inclination 0 this is the presets'
-        equatorial orbit, where ``raan`` and ``j2`` do nothing."""
+        equatorial orbit, where ``raan`` and ``j2`` do nothing.
+
+        The Earth heats the panel: ``albedo`` (the fraction of sunlight it reflects) and
+        ``earth_ir`` (its infrared flux at the surface, W/m²) reach each face through its view
+        factor to the Earth (docs/howto/earth-heating.md); 0 for both leaves the Sun alone, as
+        on the presets."""
         leo = _core.leo_orbit(_altitude(altitude))
         return cls(
             radius=leo["radius"],
@@ -248,6 +268,8 @@ class Orbit:
             inclination=inclination,
             raan=raan,
             j2=j2,
+            albedo=albedo,
+            earth_ir=earth_ir,
         )
 
     @classmethod

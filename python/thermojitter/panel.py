@@ -105,8 +105,13 @@ class Panel:
     """C, solar flux at 1 au, W/m²."""
     moment_scale: float = _parameter("moment_scale", "-")
     """χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3)."""
+    absorptivity_back: float = dataclasses.field(default=None, metadata={"unit": "-"})  # type: ignore[assignment]
+    """α_b, solar absorptivity of the back side, in (0, 1]: what it absorbs of sunlight and of
+    the Earth's albedo when they reach it. Default: equal to ``absorptivity``."""
 
     def __post_init__(self) -> None:
+        if self.absorptivity_back is None:
+            object.__setattr__(self, "absorptivity_back", self.absorptivity)
         checks.check_fields(self)
         _core.validate_panel(self.as_dict())
 

@@ -147,6 +147,180 @@ def cylinder_sunlit(orbit: Any, t: ArrayLike) -> NDArray[np.bool_]:
     return np.asarray((along > 0.0) | (off_axis >= orbit.earth_radius))
 
 
+# --------------------------------------------------------------------------- Earth heating
+#
+# The loads of an attitude and of the Earth, in the angles of the Earth's disk seen from the panel
+# (the engine writes the view factor in H = r/R_E and the attitude through its basis vectors).
+
+
+def earth_view_factor(lam: ArrayLike, height_ratio: float) -> FloatArray:
+    """View factor of a flat face to the Earth, λ the angle of its normal to the Earth's centre
+    (rad), ``height_ratio`` = r/R_E. With ρ = asin(R_E/r) the Earth's angular radius: cos λ sin²ρ
+    while the whole disk is in front of the face (λ <= π/2 − ρ), 0 once all of it is behind
+    (λ >= π/2 + ρ), and in between
+    1/2 − asin(cos ρ / sin λ)/π + [sin²ρ cos λ acos(−cot ρ cot λ) − cos ρ sqrt(sin²ρ − cos²λ)]/π."""
+    lam = np.atleast_1d(np.asarray(lam, dtype=float))
+    rho = math.asin(1.0 / height_ratio)
+    out = np.zeros_like(lam)
+    full = lam <= 0.5 * math.pi - rho
+    out[full] = np.cos(lam[full]) * math.sin(rho) ** 2
+    part = (~full) & (lam < 0.5 * math.pi + rho)
+    lp = lam[part]
+    cl, sl = np.cos(lp), np.sin(lp)
+    cot_rho = math.cos(rho) / math.sin(rho)
+    first = 0.5 - np.arcsin(np.clip(math.cos(rho) / sl, -1.0, 1.0)) / math.pi
+    wedge = math.sin(rho) ** 2 * cl * np.arccos(np.clip(-cot_rho * cl / sl, -1.0, 1.0))
+    root = math.cos(rho) * np.sqrt(np.maximum(math.sin(rho) ** 2 - cl**2, 0.0))
+    out[part] = np.maximum(first + (wedge - root) / math.pi, 0.0)
+    return out
+
+
+def sun_distance_scale(orbit: Any, t: ArrayLike) -> FloatArray:
+    """The solar flux over its value at 1 au, 1/r² (1 without ``eccentric_sun``)."""
+    from thermojitter.orbit import DAY, PERIHELION_DAY, YEAR_DAYS
+
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    if not getattr(orbit, "eccentric_sun", False):
+        return np.ones_like(t)
+    anomaly = 2.0 * np.pi * (orbit.epoch_day + t / DAY - PERIHELION_DAY) / YEAR_DAYS
+    return np.asarray(1.0 / (1.0 - 0.0167 * np.cos(anomaly)) ** 2)
+
+
+def front_normals(orbit: Any, attitude: Any, t: ArrayLike) -> FloatArray:
+    """The front face's unit normal, shape (len(t), 3), for an inclined orbit: ``attitude.kind``
+    "sun_pointing" (on the Sun), "nadir" (on the Earth's centre), "inertial" (``attitude.normal``)
+    or "sun_tracking" (in the plane of the orbit normal h and the Sun, ``attitude.offset`` from the
+    orbit plane: the Sun's angle to it is β − offset)."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    kind = getattr(attitude, "kind", "sun_pointing")
+    sun = sun_vector(orbit, t)
+    if kind == "sun_pointing":
+        return sun
+    if kind == "nadir":
+        return -satellite_vector(orbit, t)
+    if kind == "inertial":
+        n = np.asarray(attitude.normal, dtype=float)
+        return np.tile(n / np.linalg.norm(n), (len(t), 1))
+    if kind == "sun_tracking":
+        h = orbit_normals(orbit, t)
+        b = beta(orbit, t)
+        in_plane = (sun - np.sin(b)[:, None] * h) / np.cos(b)[:, None]
+        return np.asarray(math.cos(attitude.offset) * in_plane + math.sin(attitude.offset) * h)
+    raise ValueError(f"unknown attitude {kind!r}")
+
+
+def face_fluxes(
+    orbit: Any, attitude: Any, t: ArrayLike, s: ArrayLike, solar_constant: float
+) -> dict[str, FloatArray]:
+    """Incident fluxes on each face, W/m², by source (``sun_``, ``albedo_``, ``ir_`` +
+    ``front``/``back``), for the illuminated fraction ``s`` of the Sun: sunlight on the face the
+    Sun is in front of, Earth infrared ``orbit.earth_ir`` times the view factor, and albedo
+    ``orbit.albedo`` times the sunlight at the sub-satellite point times the view factor."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    n = front_normals(orbit, attitude, t)
+    sun, sat = sun_vector(orbit, t), satellite_vector(orbit, t)
+    sunlight = solar_constant * sun_distance_scale(orbit, t)
+    incidence = np.einsum("ij,ij->i", n, sun)
+    if getattr(attitude, "kind", "sun_pointing") == "sun_pointing":
+        incidence = np.ones_like(t)
+    direct = sunlight * np.asarray(s, dtype=float)
+    # The angle of each face's normal to the direction of the Earth's centre, −sat.
+    to_earth = np.arccos(np.clip(-np.einsum("ij,ij->i", n, sat), -1.0, 1.0))
+    ratio = orbit.radius / orbit.earth_radius
+    view_front = earth_view_factor(to_earth, ratio)
+    view_back = earth_view_factor(np.pi - to_earth, ratio)
+    zenith = np.maximum(np.einsum("ij,ij->i", sat, sun), 0.0)
+    reflected = orbit.albedo * sunlight * zenith
+    return {
+        "sun_front": direct * np.maximum(incidence, 0.0),
+        "sun_back": direct * np.maximum(-incidence, 0.0),
+        "albedo_front": reflected * view_front,
+        "albedo_back": reflected * view_back,
+        "ir_front": orbit.earth_ir * view_front,
+        "ir_back": orbit.earth_ir * view_back,
+    }
+
+
+def absorbed_loads(
+    panel: Any, orbit: Any, attitude: Any, t: float, s: float
+) -> tuple[float, float]:
+    """(front, back) absorbed W/m² at time t, before the structure's area factor: sunlight and
+    albedo with each face's solar absorptivity, Earth infrared with its emissivity."""
+    f = {
+        k: float(v[0])
+        for k, v in face_fluxes(orbit, attitude, [t], [s], panel.solar_constant).items()
+    }
+    back_alpha = getattr(panel, "absorptivity_back", panel.absorptivity)
+    front = panel.absorptivity * (f["sun_front"] + f["albedo_front"])
+    front += panel.emissivity_front * f["ir_front"]
+    back = back_alpha * (f["sun_back"] + f["albedo_back"]) + panel.emissivity_back * f["ir_back"]
+    return front, back
+
+
+def rhs_loaded(
+    y: Sequence[float] | FloatArray,
+    panel: Any,
+    loads: tuple[float, float],
+    model: str = "nonlinear",
+    coupled: bool = True,
+) -> FloatArray:
+    """Eq. 2 with absorbed loads (front, back) W/m² on the two faces, both scaled by cos θ (the
+    two halves' mean projected area), on the hinge: y = [T_f, T_b, θ, θ̇]."""
+    T_f, T_b, theta, theta_dot = (float(v) for v in y)
+    area = math.cos(theta) if coupled else 1.0
+    half_cap = 0.5 * panel.mass_per_length * panel.specific_heat
+    conduction = panel.conductance * (T_f - T_b)
+    q_f = area * loads[0] - conduction - STEFAN_BOLTZMANN * panel.emissivity_front * T_f**4
+    q_b = area * loads[1] + conduction - STEFAN_BOLTZMANN * panel.emissivity_back * T_b**4
+    moment = float(thermal_moment(panel, T_f, T_b))
+    accel = _hinge_accel(panel, theta, theta_dot, moment, model)
+    return np.array([q_f / half_cap, q_b / half_cap, theta_dot, accel])
+
+
+def steady_state_loaded(
+    panel: Any, loads: tuple[float, float], coupled: bool = True
+) -> tuple[float, float, float]:
+    """The equilibrium (T_f, T_b, θ) under constant absorbed loads (front, back), W/m²."""
+    total = loads[0] + loads[1]
+    eps = panel.emissivity_front + panel.emissivity_back
+    T0 = (total / (STEFAN_BOLTZMANN * eps)) ** 0.25
+
+    def residual(x: FloatArray) -> FloatArray:
+        rates = rhs_loaded((x[0], x[1], x[2], 0.0), panel, loads, "linear", coupled)
+        half_cap = 0.5 * panel.mass_per_length * panel.specific_heat
+        static = float(thermal_moment(panel, x[0], x[1])) - panel.hinge_stiffness * x[2]
+        return np.array([rates[0] * half_cap, rates[1] * half_cap, static])
+
+    sol, _, ier, msg = fsolve(residual, [T0, T0, 0.0], xtol=1e-14, full_output=True)
+    if ier != 1 and np.max(np.abs(residual(sol))) > 1e-8:
+        raise RuntimeError(f"steady_state_loaded did not converge: {msg}")
+    return float(sol[0]), float(sol[1]), float(sol[2])
+
+
+def _simulate_loaded(
+    panel: Any, orbit: Any, attitude: Any, t_span: tuple[float, float], options: dict[str, Any]
+) -> ReferenceSolution:
+    """:func:`simulate` under the attitude's and the Earth's loads, in permanent sunlight (the
+    orbit's shadow is not modelled here: an orbit with ``shadow="none"``). Default start: the
+    equilibrium under the loads at t_span[0]."""
+    if getattr(orbit, "shadow", "none") != "none":
+        raise NotImplementedError("reference: Earth heating in permanent sunlight only")
+    model, coupled = options["model"], options["coupled"]
+    y0 = options["y0"]
+    if y0 is None:
+        start = absorbed_loads(panel, orbit, attitude, t_span[0], 1.0)
+        y0 = (*steady_state_loaded(panel, start, coupled), 0.0)
+
+    def fun(t: float, y: FloatArray, s: float) -> FloatArray:
+        return rhs_loaded(y, panel, absorbed_loads(panel, orbit, attitude, t, s), model, coupled)
+
+    names = ("T_front", "T_back", "theta", "theta_dot")
+    return _integrate_segments(
+        fun, y0, t_span, None, options["rtol"], options["atol"], options["t_eval"],
+        options["method"], names, options["max_step"],
+    )  # fmt: skip
+
+
 # --------------------------------------------------------------------------- model equations
 
 
@@ -398,12 +572,24 @@ def simulate(
     y0: ArrayLike | None = None,
     method: str = "RK45",
     max_step: float = np.inf,
+    attitude: Any = None,
 ) -> ReferenceSolution:
     """Coupled thermo-mechanical run, y = [T_f, T_b, theta, theta_dot], split at eclipses.
 
     ``max_step`` (s) caps solve_ivp's step; near an equilibrium its steps can otherwise span
     several hinge periods, and its interpolant between them does not resolve the oscillation.
+
+    With an ``attitude`` (``kind``, ``offset``, ``normal``) or an orbit heated by the Earth
+    (``albedo``, ``earth_ir``), each face takes its loads (:func:`absorbed_loads`), in permanent
+    sunlight only.
     """
+    earth = float(getattr(orbit, "albedo", 0.0)) + float(getattr(orbit, "earth_ir", 0.0))
+    if attitude is not None or earth > 0.0:
+        options = {
+            "model": model, "coupled": coupled, "rtol": rtol, "atol": atol, "t_eval": t_eval,
+            "y0": y0, "method": method, "max_step": max_step,
+        }  # fmt: skip
+        return _simulate_loaded(panel, orbit, attitude, t_span, options)
     if y0 is None:
         y0 = (*steady_state(panel, coupled), 0.0)
 

@@ -157,6 +157,12 @@ class Solution(_FaceDifference, _Run):
     ``y_end`` is the state there."""
     depth: Array | None = None
     """With ``layers=N``: each node's depth below the front face, m."""
+    flux_front: Array | None = None
+    """The flux reaching the front face at each sample, W/m²: sunlight, albedo and Earth
+    infrared on the flat panel in its attitude (the deflection's cos θ not applied); None with
+    ``layers=N``."""
+    flux_back: Array | None = None
+    """The flux reaching the back face at each sample, W/m² (as ``flux_front``)."""
     node_labels: tuple[str, ...] | None = None
     """With ``layers=N``: where each node sits: ``"front, L"``/``"back, L"`` on the faces of
     layers L, ``"L|M"`` on the interface of layers L and M, ``"L"`` inside layer L (a plain

@@ -22,6 +22,9 @@ A scenario has these tables, each optional::
     [orbit]        # preset = "geo_equinox" and/or any Orbit field
     preset = "geo_equinox"
 
+    [attitude]     # kind = "sun_pointing" | "sun_tracking" (offset, rad) | "nadir" |
+    kind = "sun_pointing"    # "inertial" (normal = [x, y, z])
+
     [simulation]   # t_start, t_end or orbits or years, model, coupled, method, rtol, atol, dt,
                    # dt_out, keep ("samples" | "orbits"), theta_limit_deg, on_limit,
                    # layers (nodes through the thickness: the N-node model)
@@ -45,6 +48,7 @@ from typing import Any
 
 from thermojitter import errors as checks
 from thermojitter import materials
+from thermojitter.attitude import Attitude
 from thermojitter.boom import Boom
 from thermojitter.errors import ParameterError
 from thermojitter.laminate import Laminate, Layer
@@ -164,6 +168,7 @@ class Scenario:
     panel: Panel | Boom = field(default_factory=Panel.paper)
     """The panel, or the boom of a scenario with a [boom] table."""
     orbit: Orbit = field(default_factory=Orbit.geo_equinox)
+    attitude: Attitude = field(default_factory=Attitude.sun_pointing)
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     output: OutputSettings = field(default_factory=OutputSettings)
     source: str = "<built-in>"
@@ -431,6 +436,33 @@ def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
     return _validated(path, "orbit", Orbit, base, values)  # type: ignore[no-any-return]
 
 
+ATTITUDE_KEYS = ("kind", "offset", "normal")
+"""The keys of a scenario's [attitude] table."""
+
+
+def _attitude(path: Path, table: dict[str, Any]) -> Attitude:
+    """[attitude]: kind (default Sun-pointing), with offset (rad) for Sun tracking and normal
+    (three numbers) for an inertial attitude."""
+    _reject_unknown(path, "attitude", table, set(ATTITUDE_KEYS))
+    kinds = ("sun_pointing", "sun_tracking", "nadir", "inertial")
+    kind = _choice(path, "attitude.kind", table.get("kind", "sun_pointing"), kinds)
+    values: dict[str, Any] = {"kind": kind}
+    if "offset" in table:
+        if kind != "sun_tracking":
+            raise ScenarioError(path, "attitude.offset", "goes with kind = 'sun_tracking'")
+        values["offset"] = _real(path, "attitude.offset", table["offset"])
+    if "normal" in table:
+        if kind != "inertial":
+            raise ScenarioError(path, "attitude.normal", "goes with kind = 'inertial'")
+        normal = table["normal"]
+        if not isinstance(normal, list) or len(normal) != 3:
+            raise ScenarioError(path, "attitude.normal", "must be three numbers [x, y, z]")
+        values["normal"] = tuple(
+            _real(path, f"attitude.normal[{i}]", v) for i, v in enumerate(normal)
+        )
+    return _validated(path, "attitude", Attitude, values, {})  # type: ignore[no-any-return]
+
+
 def _simulation(path: Path, table: dict[str, Any]) -> SimulationSettings:
     known = {f.name for f in fields(SimulationSettings)}
     _reject_unknown(path, "simulation", table, known)
@@ -497,7 +529,16 @@ def parse_scenario(
     ``extra_sections`` names further tables the caller accepts; they are returned unchecked in
     ``Scenario.extra`` (absent ones as empty tables)."""
     where = Path(path)
-    sections = {"panel", "laminate", "boom", "orbit", "simulation", "output", *extra_sections}
+    sections = {
+        "panel",
+        "laminate",
+        "boom",
+        "orbit",
+        "attitude",
+        "simulation",
+        "output",
+        *extra_sections,
+    }
     for key in data:
         if key not in sections:
             raise ScenarioError(
@@ -519,6 +560,7 @@ def parse_scenario(
     return Scenario(
         panel=panel,
         orbit=_orbit(where, _table(where, data, "orbit")),
+        attitude=_attitude(where, _table(where, data, "attitude")),
         simulation=_simulation(where, _table(where, data, "simulation")),
         output=_output(where, _table(where, data, "output")),
         source=str(path),

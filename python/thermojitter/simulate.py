@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.attitude import Attitude, engine_orbit
 from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
@@ -226,6 +227,7 @@ def simulate(
     solver: SolverSettings | None = None,
     theta_limit: float = DEFAULT_THETA_LIMIT,
     on_limit: OnLimit = "flag",
+    attitude: Attitude | None = None,
 ) -> Solution:
     """Integrates the coupled thermo-structural model over ``t_span`` (s).
 
@@ -261,6 +263,13 @@ def simulate(
     (``sol.stopped_at_limit``: no sample after the crossing, ``y_end`` the state at it);
     ``"ignore"`` checks nothing.
 
+    ``attitude``: where the front face points (:class:`thermojitter.Attitude`; default
+    Sun-pointing, the paper's plate). With it, and with the orbit's Earth heating
+    (``orbit.albedo``, ``orbit.earth_ir``), each face absorbs sunlight, albedo and Earth
+    infrared through its own incidence and view factor (docs/howto/earth-heating.md);
+    ``sol.flux_front`` and ``sol.flux_back`` are the fluxes reaching each face, W/m². The N-node
+    model (``layers=N``) takes the front's sunlight only and refuses them.
+
     Ctrl-C stops the run within one integration step (``KeyboardInterrupt``).
 
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
@@ -276,12 +285,19 @@ def simulate(
         checks.choice("model", model, _MODELS)
         if layers is not None:
             raise ParameterError("layers", layers, "a Boom has its own thermal model")
+        if attitude is not None:
+            raise ParameterError(
+                "attitude",
+                attitude,
+                "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)",
+            )
         return simulate_boom(  # type: ignore[return-value]
             panel, orbit, t_span, coupled=coupled, method=method, rtol=rtol, atol=atol, dt=dt,
             t_eval=t_eval, dt_out=dt_out, y0=y0, max_step=max_step, max_steps=max_steps,
             solver=solver, theta_limit=theta_limit, on_limit=on_limit,
         )  # fmt: skip
     check_inputs(panel, orbit)
+    engine_orbit_args = engine_orbit(orbit, attitude)
     used, run = run_settings(
         solver, time_span(t_span), t_eval, dt_out, method=method, rtol=rtol, atol=atol, dt=dt,
         max_step=max_step, max_steps=max_steps,
@@ -290,6 +306,8 @@ def simulate(
     settings: dict[str, Any] = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt}
     settings.update(model=model, coupled=coupled)
     settings.update(run["limit"])
+    if "attitude" in engine_orbit_args:
+        settings["attitude"] = engine_orbit_args["attitude"]
     nodes = None if layers is None else check_layers(layers)
     hinge = {
         "model": checks.choice("model", model, _MODELS),
@@ -301,7 +319,7 @@ def simulate(
             _core.simulate_layers,
             panel.as_dict(),
             grid_args(panel, nodes),
-            orbit.as_dict(),
+            engine_orbit_args,
             run,
             **hinge,
         )
@@ -320,7 +338,7 @@ def simulate(
         )
         warn_crossing(sol.limit_crossing, theta_limit, on_limit)
         return sol
-    raw = interruptible(_core.simulate, panel.as_dict(), orbit.as_dict(), run, **hinge)
+    raw = interruptible(_core.simulate, panel.as_dict(), engine_orbit_args, run, **hinge)
     sol = Solution(
         **run_record(raw, used),
         settings={**settings, "solver": dict(raw["solver"])},
@@ -329,6 +347,8 @@ def simulate(
         T_front=raw["T_front"],
         T_back=raw["T_back"],
         **_hinge_columns(raw),
+        flux_front=raw.get("flux_front"),
+        flux_back=raw.get("flux_back"),
     )
     warn_crossing(sol.limit_crossing, theta_limit, on_limit)
     return sol
@@ -350,9 +370,12 @@ def simulate_thermal(
     max_step: float = MAX_STEP,
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
+    attitude: Attitude | None = None,
 ) -> ThermalSolution:
     """The thermal models alone (paper Figs. 2–6): one isothermal node (eq. 1) or two layers
-    (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model."""
+    (eq. 2 with θ = 0). ``y0`` defaults to the sunlit equilibrium of that model. ``attitude``
+    and the orbit's Earth heating as in :func:`simulate` (the isothermal node absorbs both
+    faces' loads)."""
     check_inputs(panel, orbit)
     layers = checks.integer("layers", layers, 1, 2)  # type: ignore[assignment]
     used, run = run_settings(
@@ -361,7 +384,11 @@ def simulate_thermal(
     )  # fmt: skip
     run["y0"] = start_state(y0, int(layers))
     raw = interruptible(
-        _core.simulate_thermal, panel.as_dict(), orbit.as_dict(), run, layers=int(layers)
+        _core.simulate_thermal,
+        panel.as_dict(),
+        engine_orbit(orbit, attitude),
+        run,
+        layers=int(layers),
     )
     return ThermalSolution(
         **run_record(raw, used),

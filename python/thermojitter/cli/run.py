@@ -19,6 +19,7 @@ from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_d
 from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.scenario import (
+    ATTITUDE_KEYS,
     BOOM_KEYS,
     LAMINATE_KEYS,
     LAMINATE_PANEL_KEYS,
@@ -96,6 +97,12 @@ def scenario_keys_help() -> str:
                 "layers = nodes through "
                 "the thickness (the N-node model); max_steps = the run's step budget",
             ),
+            table(
+                "attitude",
+                list(ATTITUDE_KEYS),
+                'kind = "sun_pointing" | "sun_tracking" (offset, rad) | "nadir" | "inertial" '
+                "(normal = [x, y, z], the equatorial frame)",
+            ),
             table("output", ["format", "plots"], 'format = "csv" | "parquet"; plots = true'),
         ]
     )
@@ -162,6 +169,7 @@ def simulate_scenario(
                 t_eval=t_eval,
                 y0=y0,
                 layers=sim.layers,
+                attitude=scenario.attitude,
             )
             # the sample at b starts the next orbit's piece; only the last piece keeps its end
             keep = slice(None) if last else slice(0, len(inside))
@@ -277,6 +285,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
                 checkpoint=out / "checkpoint.json",
                 progress=not args.no_progress,
                 stop=STOP,
+                attitude=scenario.attitude,
             )
     except ParameterError as exc:
         if exc.parameter != "n_orbits":

@@ -7,6 +7,8 @@
 
 use crate::analysis::steady::{equilibrium, Equilibrium};
 use crate::error::{require_non_negative, Error, Result};
+use crate::inputs::heating::Loads;
+use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{jacobian_from_rows, Coupled, Coupling};
 use crate::models::hinge::{HingeModel, StructuralModel};
@@ -14,7 +16,7 @@ use crate::models::thermal::ThermalModel;
 use crate::models::thermal::STEFAN_BOLTZMANN;
 use crate::numerics::integrate::State;
 use nalgebra::allocator::Allocator;
-use nalgebra::{Complex, DMatrix, DVector, DefaultAllocator, Dim, Matrix4, U1};
+use nalgebra::{Complex, DMatrix, DVector, DefaultAllocator, Dim, Matrix4, U1, U4};
 
 /// Linear stability of the sunlit equilibrium.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -228,11 +230,32 @@ where
 {
     check_flux(flux)?;
     let eq = system.steady_state(flux)?;
+    spectrum_of(system, eq, Loads::sun(flux))
+}
+
+/// Linear stability of any coupled system at its sunlit equilibrium under every load of its
+/// orbit at time t (the Sun's distance, the Earth's infrared and albedo and the attitude's
+/// incidence there, s = 1), as [`analyse_system`] does under a flux factor.
+pub fn analyse_system_at(system: &Coupled, t: f64) -> Result<(State<U4>, DMatrix<f64>, Spectrum)> {
+    Orbit::check_time(t)?;
+    let eq = system.sunlit_steady_state(t)?;
+    spectrum_of(system, eq, system.sunlit_loads(t))
+}
+
+/// The Jacobian at the equilibrium `eq` under constant `loads`, and its spectrum.
+fn spectrum_of<T: ThermalModel, S: StructuralModel, D: Dim>(
+    system: &Coupled<T, S, D>,
+    eq: State<D>,
+    loads: Loads,
+) -> Result<(State<D>, DMatrix<f64>, Spectrum)>
+where
+    DefaultAllocator: Allocator<D>,
+{
     let y = DVector::from_column_slice(eq.as_slice());
     let dim = system.dim();
     let f = |x: &DVector<f64>| {
         let state = State::<D>::from_column_slice_generic(dim, U1, x.as_slice());
-        DVector::from_column_slice(system.rhs_at_flux(flux, &state).as_slice())
+        DVector::from_column_slice(system.rhs_at_loads(loads, &state).as_slice())
     };
     // Temperatures and shapes through zero: a kelvin, a milliradian (or its modal equivalent).
     let n_thermal = system.thermal().size();
@@ -318,6 +341,29 @@ pub fn critical_hinge_damping(
             damping: cd,
             ..*panel
         })
+    };
+    let start = panel
+        .damping
+        .max(1e-3 * (panel.hinge_stiffness * panel.hinge_inertia()).sqrt());
+    critical_value(growth, start, 1e-12)
+}
+
+/// [`critical_damping`] at the sunlit equilibrium under every load of `orbit` at time t
+/// ([`analyse_system_at`]).
+pub fn critical_damping_at(
+    panel: &Panel,
+    orbit: &Orbit,
+    t: f64,
+    model: HingeModel,
+    coupling: Coupling,
+) -> Result<f64> {
+    let growth = |cd: f64| -> Result<f64> {
+        let p = Panel {
+            damping: cd,
+            ..*panel
+        };
+        let system = Coupled::new(p, *orbit, model, coupling);
+        Ok(analyse_system_at(&system, t)?.2.growth_rate)
     };
     let start = panel
         .damping

@@ -3,6 +3,7 @@
 //! method with a finite-difference Jacobian.
 
 use crate::error::{Error, Result};
+use crate::inputs::heating::Loads;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{Coupled, Coupling};
 use crate::models::hinge::{Hinge, HingeModel, StructuralModel};
@@ -34,7 +35,7 @@ fn residual<T, S>(
     thermal: &T,
     structure: &S,
     coupling: Coupling,
-    flux: f64,
+    loads: Loads,
     x: &[f64],
 ) -> DVector<f64>
 where
@@ -50,7 +51,10 @@ where
     let mut r = DVector::zeros(x.len());
     let (flows, statics) = r.as_mut_slice().split_at_mut(n);
     // The rates dT/dt (heat flow over capacity), scaled back to W/m² by the capacity.
-    thermal.heat_flows(flux * area, temps, flows);
+    thermal.heat_flows(loads.sun * area, temps, flows);
+    if loads.has_face_loads() {
+        thermal.add_face_flows(loads.front * area, loads.back * area, flows);
+    }
     for (i, f) in flows.iter_mut().enumerate() {
         let capacity = thermal.capacity(i);
         *f = *f / capacity * capacity;
@@ -84,6 +88,22 @@ where
     T: ThermalModel + ?Sized,
     S: StructuralModel,
 {
+    steady_loaded(thermal, structure, coupling, Loads::sun(flux), flux)
+}
+
+/// [`steady`] under loads on both faces; `flux` is the front's solar flux factor that heats the
+/// plate as much (where Newton starts, and what is checked against [`FLUX_RANGE`]).
+pub fn steady_loaded<T, S>(
+    thermal: &T,
+    structure: &S,
+    coupling: Coupling,
+    loads: Loads,
+    flux: f64,
+) -> Result<DVector<f64>>
+where
+    T: ThermalModel + ?Sized,
+    S: StructuralModel,
+{
     let (low, high) = FLUX_RANGE;
     if !(low..=high).contains(&flux) {
         return Err(Error::invalid(
@@ -96,7 +116,7 @@ where
     let m = n + structure.positions();
     let mut x = DVector::zeros(m);
     thermal.initial_guess(flux, &mut x.as_mut_slice()[..n]);
-    let f_of = |x: &DVector<f64>| residual(thermal, structure, coupling, flux, x.as_slice());
+    let f_of = |x: &DVector<f64>| residual(thermal, structure, coupling, loads, x.as_slice());
     let residual_and_jacobian = |x: &DVector<f64>| {
         let f = f_of(x);
         let mut jac = DMatrix::zeros(m, m);
@@ -137,6 +157,19 @@ where
     /// of a run.
     pub fn steady_state(&self, flux: f64) -> Result<State<D>> {
         let x = steady(self.thermal(), self.structure(), self.coupling(), flux)?;
+        Ok(rest(&x, self.dim()))
+    }
+
+    /// The steady state under constant `loads` on both faces (`flux`: the front's solar flux
+    /// factor heating as much, see [`steady_loaded`]), velocities zero.
+    pub fn steady_state_loaded(&self, loads: Loads, flux: f64) -> Result<State<D>> {
+        let x = steady_loaded(
+            self.thermal(),
+            self.structure(),
+            self.coupling(),
+            loads,
+            flux,
+        )?;
         Ok(rest(&x, self.dim()))
     }
 }

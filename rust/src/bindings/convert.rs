@@ -1,6 +1,7 @@
 //! Python values to engine types, with errors that name the parameter.
 
 use super::error::invalid;
+use crate::inputs::heating::Attitude;
 use crate::inputs::orbit::Shadow;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
@@ -93,6 +94,14 @@ pub(super) fn required_item<'py, T: FromPyObjectOwned<'py>>(
     optional_item(d, key, kind)?.ok_or_else(|| invalid(key, "missing", "is required"))
 }
 
+/// An optional number of a mapping (checked as [`float_item`] checks it), or `default`.
+fn float_or(d: &Bound<'_, PyDict>, key: &str, default: f64) -> PyResult<f64> {
+    match d.get_item(key)? {
+        Some(_) => float_item(d, key),
+        None => Ok(default),
+    }
+}
+
 /// An orbit from a mapping: radius, earth_radius, period and phase0 are required; shadow
 /// ('none' | 'cylindrical' | 'conical' | 'penumbra'), season, eccentric_sun, epoch_day,
 /// inclination, raan and j2 are optional and default to the paper's equinox.
@@ -110,22 +119,55 @@ pub fn orbit_from(d: &Bound<'_, PyDict>) -> PyResult<Orbit> {
         shadow,
         season: optional_item(d, "season", "a bool")?.unwrap_or(base.season),
         eccentric_sun: optional_item(d, "eccentric_sun", "a bool")?.unwrap_or(base.eccentric_sun),
-        epoch_day: match d.get_item("epoch_day")? {
-            Some(_) => float_item(d, "epoch_day")?,
-            None => base.epoch_day,
-        },
-        inclination: match d.get_item("inclination")? {
-            Some(_) => float_item(d, "inclination")?,
-            None => base.inclination,
-        },
-        raan: match d.get_item("raan")? {
-            Some(_) => float_item(d, "raan")?,
-            None => base.raan,
-        },
+        epoch_day: float_or(d, "epoch_day", base.epoch_day)?,
+        inclination: float_or(d, "inclination", base.inclination)?,
+        raan: float_or(d, "raan", base.raan)?,
         j2: optional_item(d, "j2", "a bool")?.unwrap_or(base.j2),
+        albedo: float_or(d, "albedo", base.albedo)?,
+        earth_ir: float_or(d, "earth_ir", base.earth_ir)?,
+        attitude: match d.get_item("attitude")? {
+            Some(a) => attitude_from(&a)?,
+            None => base.attitude,
+        },
     };
     o.validate()?;
     Ok(o)
+}
+
+/// An attitude from a mapping: `kind` ('sun_pointing' | 'sun_tracking' | 'nadir' |
+/// 'inertial'), with `offset` (rad) for Sun tracking and `normal` (three numbers) for inertial.
+pub fn attitude_from(value: &Bound<'_, PyAny>) -> PyResult<Attitude> {
+    let d = value
+        .cast::<PyDict>()
+        .map_err(|_| type_error("attitude", "a mapping", value))?;
+    let kind: String = required_item(d, "kind", "a string")?;
+    let attitude = match kind.as_str() {
+        "sun_pointing" => Attitude::SunPointing,
+        "nadir" => Attitude::Nadir,
+        "sun_tracking" => Attitude::SunTracking {
+            offset: float_item(d, "offset")?,
+        },
+        "inertial" => {
+            let normal: Vec<f64> = required_item(d, "normal", "three numbers")?;
+            let normal: [f64; 3] = normal.try_into().map_err(|v: Vec<f64>| {
+                invalid(
+                    "attitude.normal",
+                    format!("{v:?}"),
+                    "must hold three numbers",
+                )
+            })?;
+            Attitude::inertial(normal)?
+        }
+        other => {
+            return Err(invalid(
+                "attitude",
+                format!("{other:?}"),
+                "must be 'sun_pointing', 'sun_tracking', 'nadir' or 'inertial'",
+            ))
+        }
+    };
+    attitude.validate()?;
+    Ok(attitude)
 }
 
 /// The coupling of a `coupled` flag: the projected area follows θ (two-way), or is frozen.

@@ -1,12 +1,15 @@
 //! Bindings of the flutter analysis.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{coupling, hinge_model, panel_from};
+use super::convert::{coupling, hinge_model, orbit_from, panel_from};
 use super::error::shield;
-use crate::analysis::flutter::{analyse, check_flux, critical_damping};
+use crate::analysis::flutter::{
+    analyse, analyse_system_at, check_flux, critical_damping, critical_damping_at,
+};
 use crate::analysis::linear::LinearThermal;
 use crate::analysis::stability::Axis;
 use crate::inputs::panel::Panel;
+use crate::models::coupled::Coupled;
 use crate::models::hinge::HingeModel;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -35,6 +38,44 @@ fn flutter<'py>(
         set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
         if with_critical {
             d.set_item("critical_damping", critical_damping(&p, m, c, flux)?)?;
+        }
+        Ok(d)
+    })
+}
+
+/// Linear stability of the paper's model at the sunlit equilibrium under every load of `orbit`
+/// at time `t` (its Earth heating and attitude there): the same mapping as [`flutter`].
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, *, t, model, coupled, with_critical=true))]
+fn flutter_at<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    t: f64,
+    model: &str,
+    coupled: bool,
+    with_critical: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let p = panel_from(panel)?;
+        p.validate()?;
+        let o = orbit_from(orbit)?;
+        let m = hinge_model(model)?;
+        let c = coupling(coupled);
+        let system = Coupled::new(p, o, m, c);
+        let (eq, jacobian, spectrum) = analyse_system_at(&system, t)?;
+        let d = PyDict::new(py);
+        d.set_item("equilibrium", (eq[0], eq[1], eq[2]))?;
+        let rows = (0..4).map(|i| (0..4).map(|j| jacobian[(i, j)]).collect());
+        set_spectrum(
+            &d,
+            rows,
+            &spectrum.eigenvalues,
+            spectrum.growth_rate,
+            spectrum.frequency_hz,
+        )?;
+        if with_critical {
+            d.set_item("critical_damping", critical_damping_at(&p, &o, t, m, c)?)?;
         }
         Ok(d)
     })
@@ -173,6 +214,7 @@ fn linear_delta_t<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LINEAR_FIELDS", LinearThermal::FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(flutter, m)?)?;
+    m.add_function(wrap_pyfunction!(flutter_at, m)?)?;
     m.add_function(wrap_pyfunction!(linear_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(linear_delta_t, m)?)?;
     m.add_function(wrap_pyfunction!(stability_map, m)?)?;

@@ -14,6 +14,7 @@ mod orbit;
 mod orbits;
 
 use crate::analysis::steady::equilibrium;
+use crate::inputs::heating::Optics;
 use crate::inputs::panel::{beam_first_angular_frequency, hinge_stiffness, StiffnessCriterion};
 use crate::models::coupled::{Coupled, DrivenHinge, MomentHistory};
 use crate::models::hinge::checked_hinge_energy;
@@ -102,6 +103,11 @@ fn start_state(
         let o = orbit_from(orbit)?;
         crate::Orbit::check_time(t0)?;
         let coupling = coupling(coupled);
+        if o.has_face_loads() {
+            p.validate()?;
+            let system = Coupled::new(p, o, crate::models::hinge::HingeModel::Nonlinear, coupling);
+            return Ok(system.sunlit_steady_state(t0)?.as_slice().to_vec());
+        }
         let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
         Ok(eq.state().as_slice().to_vec())
     })
@@ -285,6 +291,7 @@ pub(crate) fn transient_dict(py: Python<'_>, run: Transient) -> PyResult<Bound<'
                 names: vec!["theta".into(), "theta_dot".into()],
                 columns: vec![run.theta, run.theta_dot],
                 sunlit: run.sunlit,
+                fluxes: None,
                 moment: run.moment,
                 t: run.t,
                 stats: run.stats,
@@ -307,6 +314,10 @@ pub(crate) fn transient_dict(py: Python<'_>, run: Transient) -> PyResult<Bound<'
     }
     d.set_item(intern!(py, "thermal_moment"), array(py, run.moment))?;
     d.set_item(intern!(py, "sunlit"), array(py, run.sunlit))?;
+    if let Some((front, back)) = run.fluxes {
+        d.set_item(intern!(py, "flux_front"), array(py, front))?;
+        d.set_item(intern!(py, "flux_back"), array(py, back))?;
+    }
     Ok(d)
 }
 
@@ -326,7 +337,7 @@ fn simulate_thermal<'py>(
         let o = orbit_from(orbit)?;
         let (m, out) = run.integration()?;
         let thermal = crate::models::thermal_model(&p, layers)?;
-        let sys = Coupled::thermal_only(thermal, o);
+        let sys = Coupled::thermal_only(thermal, o).with_optics(Optics::of(&p));
         let (span, y0) = (run.span, run.y0);
         let run = py.detach(|| coupled_run(sys, &m, span, y0, &out, None, cancel))?;
         transient_dict(py, Transient::Coupled(run))

@@ -130,6 +130,8 @@ fn orbit_dict<'py>(py: Python<'py>, o: &Orbit) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("inclination", o.inclination)?;
     d.set_item("raan", o.raan)?;
     d.set_item("j2", o.j2)?;
+    d.set_item("albedo", o.albedo)?;
+    d.set_item("earth_ir", o.earth_ir)?;
     Ok(d)
 }
 
@@ -150,13 +152,14 @@ macro_rules! add_constants {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    use crate::inputs::heating::{EARTH_ALBEDO, EARTH_IR};
     use crate::inputs::orbit::{
         DAY, EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, J2, LEO_ALTITUDE, MAX_LEO_ALTITUDE,
         MIN_LEO_ALTITUDE, MU_EARTH, OBLIQUITY, PERIHELION_DAY, SIDEREAL_DAY, YEAR_DAYS,
     };
     add_constants!(m: GEO_RADIUS, LEO_ALTITUDE, MIN_LEO_ALTITUDE, MAX_LEO_ALTITUDE,
         EARTH_RADIUS, SIDEREAL_DAY, MU_EARTH, EQUINOX_DAY, PERIHELION_DAY, J2, OBLIQUITY,
-        YEAR_DAYS, DAY);
+        YEAR_DAYS, DAY, EARTH_ALBEDO, EARTH_IR);
     m.add(
         "GEO_EQUINOX_ORBIT",
         orbit_dict(m.py(), &Orbit::geo_equinox())?,

@@ -1,6 +1,7 @@
 //! The validated inputs of every run: the panel, its laminate, the orbit.
 
 pub mod boom;
+pub mod heating;
 pub mod laminate;
 pub mod orbit;
 pub mod panel;

@@ -35,6 +35,7 @@
 //! perihelion dates are mean values, good to about a day.
 
 use crate::error::{require_finite, require_positive, Error, Result};
+use crate::inputs::heating::{Attitude, MAX_EARTH_IR};
 use std::f64::consts::PI;
 
 /// Shortest orbit period accepted, s: a grazing orbit of a dense body takes tens of minutes; a
@@ -167,6 +168,12 @@ pub struct Orbit {
     pub raan: f64,
     /// The node drifts under J2 (no effect at inclination 0).
     pub j2: bool,
+    /// The Earth's albedo, the fraction of sunlight it reflects, in [0, 1] (0 on the presets).
+    pub albedo: f64,
+    /// The Earth's infrared flux at its surface, W/m² (0 on the presets).
+    pub earth_ir: f64,
+    /// Where the panel driven along this orbit points (the run's attitude).
+    pub attitude: Attitude,
 }
 
 impl Orbit {
@@ -184,6 +191,9 @@ impl Orbit {
             inclination: 0.0,
             raan: 0.0,
             j2: false,
+            albedo: 0.0,
+            earth_ir: 0.0,
+            attitude: Attitude::SunPointing,
         }
     }
 
@@ -236,6 +246,17 @@ impl Orbit {
             ));
         }
         require_angle("raan", self.raan)?;
+        if !(0.0..=1.0).contains(&self.albedo) {
+            return Err(Error::invalid("albedo", self.albedo, "must be in [0, 1]"));
+        }
+        if !(0.0..=MAX_EARTH_IR).contains(&self.earth_ir) {
+            return Err(Error::invalid(
+                "earth_ir",
+                self.earth_ir,
+                &format!("must be in [0, {MAX_EARTH_IR:e}] W/m²"),
+            ));
+        }
+        self.attitude.validate()?;
         if self.period < MIN_PERIOD {
             return Err(Error::invalid(
                 "period",
@@ -406,6 +427,41 @@ impl Orbit {
         ]
     }
 
+    /// Direction of the ascending node at time t (x for an equatorial orbit).
+    pub(crate) fn node_direction(&self, t: f64) -> [f64; 3] {
+        if self.equatorial() {
+            return [1.0, 0.0, 0.0];
+        }
+        self.plane(t)[0]
+    }
+
+    /// The orbit normal at time t (the north pole for an equatorial orbit).
+    pub fn normal(&self, t: f64) -> [f64; 3] {
+        if self.equatorial() {
+            return [0.0, 0.0, 1.0];
+        }
+        self.plane(t)[2]
+    }
+
+    /// Unit vector from the Earth's centre to the satellite at time t, in the frame of
+    /// [`Orbit::sun_direction`]. On the equatorial orbit the satellite is the orbit phase past
+    /// the Sun's meridian (its right ascension plus the phase), as the shadow sees it.
+    pub fn position(&self, t: f64) -> [f64; 3] {
+        if !self.equatorial() {
+            let [p, q, _] = self.plane(t);
+            let (su, cu) = self.latitude_argument(t).sin_cos();
+            return [0, 1, 2].map(|k| cu * p[k] + su * q[k]);
+        }
+        let phase = if self.season {
+            self.rate() * t + self.phase0
+        } else {
+            2.0 * PI * t / self.period + self.phase0
+        };
+        let s = self.sun_direction(t);
+        let (sa, ca) = (s[1].atan2(s[0]) + phase).sin_cos();
+        [ca, sa, 0.0]
+    }
+
     /// Argument of latitude of the orbit's noon (its point nearest the Sun) at time t, rad.
     fn noon(&self, t: f64) -> f64 {
         let s = self.sun_direction(t);
@@ -432,9 +488,7 @@ impl Orbit {
     /// Earth's centre, rad in [0, π].
     fn anti_sun_angle(&self, t: f64) -> f64 {
         if !self.equatorial() {
-            let [p, q, _] = self.plane(t);
-            let (su, cu) = self.latitude_argument(t).sin_cos();
-            let sat = [0, 1, 2].map(|k| cu * p[k] + su * q[k]);
+            let sat = self.position(t);
             let s = self.sun_direction(t);
             // atan2 of |sat × S| and −sat·S: accurate at both ends, unlike acos.
             return norm(cross(sat, s)).atan2(-dot(sat, s));
@@ -776,11 +830,11 @@ impl EclipseTable {
     }
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -788,7 +842,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-fn norm(a: [f64; 3]) -> f64 {
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 

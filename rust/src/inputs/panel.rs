@@ -114,6 +114,9 @@ panel_parameters! {
     solar_constant = 1361.0, in (0.0, 1e5, true);
     /// χ, scale of the flexural rigidity in the thermal moment (paper Sec. 4.3); 1 by default.
     moment_scale = 1.0, in (0.0, 100.0, true);
+    /// α_b, solar absorptivity of the back side, in (0, 1]: what it absorbs of sunlight and of
+    /// the Earth's albedo when they reach it (Table 1 has one absorptivity: the same value).
+    absorptivity_back = 0.8, in (0.0, 1.0, true);
 }
 
 impl Panel {

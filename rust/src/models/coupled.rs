@@ -2,6 +2,7 @@
 //! driven by a prescribed moment. Each implements [`OdeSystem`].
 
 use crate::error::{Error, Result};
+use crate::inputs::heating::{Loads, Optics};
 use crate::inputs::orbit::{Orbit, Shadow};
 use crate::inputs::panel::Panel;
 use crate::models::hinge::{hinge_acceleration, Hinge, HingeModel, Rigid, StructuralModel};
@@ -31,14 +32,72 @@ pub(crate) struct Sunlight {
     /// shadow, and the full-Sun and umbra segments of a penumbral one (the breakpoints include
     /// every contact). None inside a penumbra, where s(t) is evaluated at each call.
     constant_s: Option<f64>,
+    /// The panel's optics, which turn the Earth's heat and sunlight on the back into absorbed
+    /// loads; None for a system that takes the front's sunlight only.
+    optics: Option<Optics>,
+    /// The orbit heats more than the front's sunlight and the optics are known: the right-hand
+    /// side takes [`Sunlight::loads`] instead of [`Sunlight::flux`].
+    pub(crate) face_loads: bool,
 }
 
 impl Sunlight {
+    /// Sunlight on the front only: a system built on it refuses an orbit with more
+    /// ([`Sunlight::check`]).
     pub(crate) fn new(orbit: Orbit) -> Self {
         Sunlight {
             orbit,
             segment: (0.0, 0.0),
             constant_s: None,
+            optics: None,
+            face_loads: false,
+        }
+    }
+
+    /// Every load of the orbit, the Earth's and the attitude's included, absorbed with `optics`.
+    pub(crate) fn with_optics(orbit: Orbit, optics: Optics) -> Self {
+        Sunlight {
+            optics: Some(optics),
+            face_loads: orbit.has_face_loads(),
+            ..Sunlight::new(orbit)
+        }
+    }
+
+    /// Refuses an orbit whose loads this system cannot take: Earth heating or an attitude other
+    /// than Sun-pointing on a model that takes the front's sunlight only.
+    pub(crate) fn check(&self, what: &str) -> crate::error::Result<()> {
+        if self.orbit.has_face_loads() && self.optics.is_none() {
+            return Err(unsupported_face_loads(&self.orbit, what));
+        }
+        Ok(())
+    }
+
+    /// The illuminated fraction s at time t inside the current segment.
+    #[inline]
+    fn illumination(&self, t: f64) -> f64 {
+        match self.constant_s {
+            Some(s) => s,
+            None => {
+                let (a, b) = self.segment;
+                self.orbit.illumination_on(t, a, b)
+            }
+        }
+    }
+
+    /// Every absorbed load at time t inside the current segment (the front's sunlight alone
+    /// without optics).
+    pub(crate) fn loads(&self, t: f64) -> Loads {
+        match &self.optics {
+            Some(optics) if self.face_loads => self.orbit.loads(t, self.illumination(t), optics),
+            _ => Loads::sun(self.flux(t)),
+        }
+    }
+
+    /// The loads at time t in full sunlight (s = 1): what a run's default start is the steady
+    /// state of.
+    pub(crate) fn sunlit_loads(&self, t: f64) -> Loads {
+        match &self.optics {
+            Some(optics) if self.face_loads => self.orbit.loads(t, 1.0, optics),
+            _ => Loads::sun(self.orbit.flux_scale(t)),
         }
     }
 
@@ -60,13 +119,7 @@ impl Sunlight {
 
     #[inline]
     pub(crate) fn flux(&self, t: f64) -> f64 {
-        let s = match self.constant_s {
-            Some(s) => s,
-            None => {
-                let (a, b) = self.segment;
-                self.orbit.illumination_on(t, a, b)
-            }
-        };
+        let s = self.illumination(t);
         // At 1 au the scale is exactly 1: no multiplication, no division on the right-hand
         // side's path (with the multiplication the compiler merged both paths into a division).
         if self.orbit.eccentric_sun {
@@ -75,6 +128,27 @@ impl Sunlight {
             s
         }
     }
+}
+
+/// The refusal of an orbit's Earth heating or attitude by a model or path that cannot take them
+/// (`what`), naming the setting that asks for them.
+pub(crate) fn unsupported_face_loads(orbit: &Orbit, what: &str) -> Error {
+    let (name, value) = if orbit.albedo != 0.0 {
+        ("albedo", orbit.albedo.to_string())
+    } else if orbit.earth_ir != 0.0 {
+        ("earth_ir", orbit.earth_ir.to_string())
+    } else {
+        ("attitude", orbit.attitude.name().to_string())
+    };
+    Error::invalid(
+        name,
+        value,
+        &format!(
+            "is not modelled by {what}: Earth heating and attitudes other than Sun-pointing \
+             run on the hinge models (tj.simulate, tj.simulate_orbits); set albedo = earth_ir \
+             = 0 and a Sun-pointing attitude here"
+        ),
+    )
 }
 
 /// A thermal model and a structural model coupled through the thermal moment (thermal →
@@ -101,6 +175,7 @@ impl Coupled<TwoLayer, Hinge, U4> {
         let (thermal, structure) = (TwoLayer::new(&panel), Hinge::new(&panel, model));
         Self::compose(thermal, structure, orbit, coupling, U4::name())
             .expect("two temperatures and two hinge states make four")
+            .with_optics(Optics::of(&panel))
     }
 }
 
@@ -177,6 +252,48 @@ where
         })
     }
 
+    /// The same system absorbing every load of its orbit with the panel's `optics` (without
+    /// them, an orbit with Earth heating or an attitude other than Sun-pointing is refused).
+    pub fn with_optics(mut self, optics: Optics) -> Self {
+        self.sun = Sunlight::with_optics(self.sun.orbit, optics);
+        self
+    }
+
+    /// Whether the right-hand side takes loads on both faces (the orbit's Earth heating or
+    /// attitude), not only the front's sunlight.
+    pub fn has_face_loads(&self) -> bool {
+        self.sun.face_loads
+    }
+
+    /// The solar constant of the panel's optics, W/m² (None without them).
+    pub fn solar_constant(&self) -> Option<f64> {
+        self.sun.optics.map(|o| o.solar_constant)
+    }
+
+    /// The loads at time t in full sunlight (the front's sunlight alone, at the Sun's distance
+    /// there, when the orbit has no other).
+    pub fn sunlit_loads(&self, t: f64) -> Loads {
+        self.sun.sunlit_loads(t)
+    }
+
+    /// The absorbed loads at time t inside the current segment.
+    pub fn loads_at(&self, t: f64) -> Loads {
+        self.sun.loads(t)
+    }
+
+    /// The steady state in full sunlight at time t, velocities zero: the default start of a
+    /// run (under the Sun's distance at t, and the Earth's loads and the attitude's incidence
+    /// there when the orbit has them).
+    pub fn sunlit_steady_state(&self, t: f64) -> Result<State<D>> {
+        if self.sun.face_loads {
+            let loads = self.sun.sunlit_loads(t);
+            let optics = self.sun.optics.expect("face loads come with optics");
+            self.steady_state_loaded(loads, loads.equivalent_flux(&optics))
+        } else {
+            self.steady_state(self.sun.orbit.flux_scale(t))
+        }
+    }
+
     pub fn thermal(&self) -> &T {
         &self.thermal
     }
@@ -221,12 +338,18 @@ where
     /// The right-hand side at a given illumination factor (used by the equilibrium solver too).
     #[inline(always)]
     pub fn rhs_at_flux(&self, flux: f64, y: &State<D>) -> State<D> {
-        self.rhs_at_flux_as::<false>(flux, y)
+        self.rhs_at_loads_as::<false>(Loads::sun(flux), y)
     }
 
-    /// [`Coupled::rhs_at_flux`], with the models' fused rates when `FUSED`.
+    /// The right-hand side under loads on both faces.
     #[inline(always)]
-    fn rhs_at_flux_as<const FUSED: bool>(&self, flux: f64, y: &State<D>) -> State<D> {
+    pub fn rhs_at_loads(&self, loads: Loads, y: &State<D>) -> State<D> {
+        self.rhs_at_loads_as::<false>(loads, y)
+    }
+
+    /// [`Coupled::rhs_at_loads`], with the models' fused rates when `FUSED`.
+    #[inline(always)]
+    fn rhs_at_loads_as<const FUSED: bool>(&self, loads: Loads, y: &State<D>) -> State<D> {
         let mut out = State::<D>::zeros_generic(self.dim, U1);
         let n = self.thermal.size();
         let (temps, q) = y.as_slice().split_at(n);
@@ -240,9 +363,14 @@ where
             }
         };
         if FUSED {
-            self.thermal.rates_fused(flux * area, temps, temp_rates);
+            self.thermal
+                .rates_fused(loads.sun * area, temps, temp_rates);
         } else {
-            self.thermal.rates(flux * area, temps, temp_rates);
+            self.thermal.rates(loads.sun * area, temps, temp_rates);
+        }
+        if loads.has_face_loads() {
+            self.thermal
+                .add_face_rates(loads.front * area, loads.back * area, temp_rates);
         }
         out
     }
@@ -260,6 +388,18 @@ where
     pub fn flux_at(&self, t: f64) -> f64 {
         self.sun.flux(t)
     }
+
+    /// The right-hand side at time t: the front's sunlight alone (the paper's path, kept to the
+    /// bit) or every load of the orbit.
+    #[inline(always)]
+    fn rhs_as<const FUSED: bool>(&self, t: f64, y: &State<D>) -> State<D> {
+        let loads = if self.sun.face_loads {
+            self.sun.loads(t)
+        } else {
+            Loads::sun(self.sun.flux(t))
+        };
+        self.rhs_at_loads_as::<FUSED>(loads, y)
+    }
 }
 
 impl<T: ThermalModel, S: StructuralModel, D: Dim> OdeSystem<D> for Coupled<T, S, D>
@@ -268,16 +408,17 @@ where
 {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &State<D>) -> State<D> {
-        self.rhs_at_flux(self.sun.flux(t), y)
+        self.rhs_as::<false>(t, y)
     }
     #[inline(always)]
     fn rhs_fused(&self, t: f64, y: &State<D>) -> State<D> {
-        self.rhs_at_flux_as::<true>(self.sun.flux(t), y)
+        self.rhs_as::<true>(t, y)
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         self.sun.orbit.breakpoints(t0, t1)
     }
     fn check_span(&self, t0: f64, t1: f64) -> crate::error::Result<()> {
+        self.sun.check("a model without the panel's optics")?;
         self.sun.orbit.check_span(t0, t1)
     }
     fn enter_segment(&mut self, a: f64, b: f64) {

@@ -86,6 +86,29 @@ pub trait ThermalModel {
     fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
         crate::models::hinge::check_start_state(temps, temps.len(), None)
     }
+
+    /// The temperatures of the front and of the back face (the first and the last; the same
+    /// one for the isothermal plate).
+    #[inline]
+    fn faces(&self) -> (usize, usize) {
+        (0, self.size() - 1)
+    }
+
+    /// Adds loads absorbed on the front and on the back face, W/m², to the heat flows `out`.
+    #[inline]
+    fn add_face_flows(&self, front: f64, back: f64, out: &mut [f64]) {
+        let (f, b) = self.faces();
+        out[f] += front;
+        out[b] += back;
+    }
+
+    /// Adds loads absorbed on the front and on the back face, W/m², to the rates `out`, K/s.
+    #[inline]
+    fn add_face_rates(&self, front: f64, back: f64, out: &mut [f64]) {
+        let (f, b) = self.faces();
+        out[f] += front / self.capacity(f);
+        out[b] += back / self.capacity(b);
+    }
 }
 
 /// A boxed model is a model (what [`crate::models::thermal_model`] returns).
@@ -120,6 +143,9 @@ impl<M: ThermalModel + ?Sized> ThermalModel for Box<M> {
     fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
         (**self).check_start(temps)
     }
+    fn faces(&self) -> (usize, usize) {
+        (**self).faces()
+    }
 }
 
 /// A thermal model whose rates are computed as written, heat flows over capacities: the form of
@@ -151,6 +177,9 @@ impl<M: ThermalModel> ThermalModel for AsWritten<M> {
     }
     fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
         self.0.check_start(temps)
+    }
+    fn faces(&self) -> (usize, usize) {
+        self.0.faces()
     }
 }
 

@@ -241,6 +241,14 @@ pub type TubeSystem = Coupled<TubeThermal, TubeHinge, U4>;
 /// The boom in its orbit, validated.
 pub fn boom_system(boom: &Boom, orbit: Orbit, coupling: Coupling) -> Result<TubeSystem> {
     boom.validate()?;
+    if orbit.has_face_loads() {
+        return Err(Error::invalid(
+            "orbit",
+            "with Earth heating or an attitude",
+            "a boom takes the Sun alone on its lit side (albedo, earth_ir and the attitude are \
+             the plate's)",
+        ));
+    }
     Coupled::compose(
         TubeThermal::new(boom),
         TubeHinge::new(boom),

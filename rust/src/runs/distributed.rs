@@ -41,6 +41,10 @@ impl OdeSystem<Dyn> for DistributedSystem {
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
+    fn check_span(&self, t0: f64, t1: f64) -> crate::error::Result<()> {
+        self.sun.check("the distributed panel")?;
+        crate::numerics::integrate::check_span(t0, t1)
+    }
 }
 
 /// The sampled fields of a distributed run; per-sample rows.

@@ -531,8 +531,11 @@ pub fn run_batch_on(
     path: Path,
 ) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
+    // The lanes take the front's sunlight only: Earth heating and other attitudes run one
+    // sample at a time.
     let lockstep = path == Path::Lockstep
         && settings.hybrid.is_none()
+        && !settings.orbit.has_face_loads()
         && matches!(settings.method, Method::Dopri5(_));
     let scalar = |p: &Panel| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed);
     let out = pool.install(|| {

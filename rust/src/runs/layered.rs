@@ -43,6 +43,10 @@ impl OdeSystem<Dyn> for LayeredOrbit {
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.sun.enter(a, b);
     }
+    fn check_span(&self, t0: f64, t1: f64) -> Result<()> {
+        self.sun.check("the laminate's N-node model")?;
+        crate::numerics::integrate::check_span(t0, t1)
+    }
 }
 
 /// The N-node system on a state whose size S is known at compile time: the integrator's
@@ -64,6 +68,9 @@ impl<const S: usize> OdeSystem<Const<S>> for Fixed<S> {
     }
     fn enter_segment(&mut self, a: f64, b: f64) {
         self.0.enter_segment(a, b);
+    }
+    fn check_span(&self, t0: f64, t1: f64) -> Result<()> {
+        self.0.check_span(t0, t1)
     }
 }
 

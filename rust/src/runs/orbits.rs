@@ -25,6 +25,15 @@ use std::ops::ControlFlow;
 /// M_T/K_el at (t, y), and the sunlit equilibrium angle under a flux factor.
 pub trait SummaryView {
     fn theta_eq(&self, flux: f64) -> Result<f64>;
+    /// The sunlit equilibrium angle under every load of `orbit` at time t (its Earth heating
+    /// and attitude); by default refused: the model's summaries take the front's sunlight only.
+    fn theta_eq_loaded(&self, orbit: &Orbit, t: f64) -> Result<f64> {
+        let _ = t;
+        Err(crate::models::coupled::unsupported_face_loads(
+            orbit,
+            "this model's orbit summaries",
+        ))
+    }
     /// (θ, M_T/K_el) at time t in state y.
     fn angles(&self, t: f64, y: &[f64]) -> (f64, f64);
     /// θ̇ in state y, rad/s: where its sign changes within a step, θ has an extreme there and
@@ -64,6 +73,10 @@ pub(crate) struct TwoLayerView {
 impl SummaryView for TwoLayerView {
     fn theta_eq(&self, flux: f64) -> Result<f64> {
         Ok(equilibrium(&self.panel, self.coupling, flux)?.theta)
+    }
+    fn theta_eq_loaded(&self, orbit: &Orbit, t: f64) -> Result<f64> {
+        let system = Coupled::new(self.panel, *orbit, HingeModel::Nonlinear, self.coupling);
+        Ok(system.sunlit_steady_state(t)?[2])
     }
     #[inline]
     fn angles(&self, _t: f64, y: &[f64]) -> (f64, f64) {
@@ -303,7 +316,11 @@ impl<V: SummaryView> Collector<V> {
         let t0 = self.t_start + (index - self.first_index) as f64 * self.orbit.period;
         let t1 = t0 + self.orbit.period;
         let flux = self.orbit.flux_scale(0.5 * (t0 + t1));
-        let theta_eq = if flux > 0.0 {
+        let theta_eq = if self.orbit.has_face_loads() {
+            // Under the Earth's loads and the attitude's incidence at the orbit's start (its
+            // noon for `Orbit.circular`), in full sunlight.
+            self.view.theta_eq_loaded(&self.orbit, t0)?
+        } else if flux > 0.0 {
             self.view.theta_eq(flux)?
         } else {
             0.0

@@ -6,6 +6,7 @@
 
 use crate::cancel::Cancel;
 use crate::error::Result;
+use crate::inputs::heating::Optics;
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -56,6 +57,10 @@ pub struct CoupledRun {
     pub columns: Vec<Vec<f64>>,
     pub moment: Vec<f64>,
     pub sunlit: Vec<f64>,
+    /// The flux reaching the front and the back face at each sample, W/m² (sunlight, albedo
+    /// and Earth infrared on the flat panel in its attitude, the deflection's projected-area
+    /// factor not applied); None for a system without the panel's optics.
+    pub fluxes: Option<(Vec<f64>, Vec<f64>)>,
     pub stats: Stats,
     /// The state at `stats.t_end`.
     pub y_end: Vec<f64>,
@@ -116,7 +121,8 @@ pub fn simulate(req: RunRequest, cancel: &Cancel) -> Result<Transient> {
         let thermal = crate::models::thermal_model(&panel, layers)?;
         let n = thermal.size() + 2;
         let structure = Hinge::new(&panel, model);
-        let sys = Coupled::compose(thermal, structure, orbit, coupling, Dyn(n))?;
+        let sys = Coupled::compose(thermal, structure, orbit, coupling, Dyn(n))?
+            .with_optics(Optics::of(&panel));
         coupled_run(sys, &method, span, y0, &output, limit, cancel)?
     };
     Ok(Transient::Coupled(run))
@@ -146,7 +152,7 @@ where
             sys.check_start(&y)?;
             y
         }
-        None => sys.steady_state(orbit.flux_scale(span.0))?,
+        None => sys.sunlit_steady_state(span.0)?,
     };
     let names = sys.names();
     // The limit is on θ, the structure's first state (a thermal model alone has none).
@@ -162,6 +168,15 @@ where
         columns: (0..names.len()).map(|i| traj.column(i)).collect(),
         moment: traj.y.iter().map(|y| sys.moment(y)).collect(),
         sunlit: traj.t.iter().map(|&t| orbit.illumination(t)).collect(),
+        fluxes: sys.solar_constant().map(|c| {
+            traj.t
+                .iter()
+                .map(|&t| {
+                    let f = orbit.face_fluxes(t, orbit.illumination(t), c);
+                    (f.front(), f.back())
+                })
+                .unzip()
+        }),
         stopped: crossing.is_some() && watch.is_some_and(|l| l.stop),
         crossing,
         names,

@@ -188,6 +188,12 @@ pub fn run_orbits_hybrid(
         let run = out.run.clone().into();
         return Ok(LayeredHybrid { run, split: out });
     }
+    if req.spec.orbit.has_face_loads() {
+        return Err(crate::models::coupled::unsupported_face_loads(
+            &req.spec.orbit,
+            "the laminate's N-node model",
+        ));
+    }
     let (system, start) = req.system()?;
     let args = HybridArgs {
         spec,
