@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import boom as boom_module
 from thermojitter import errors as checks
 from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
 from thermojitter.boom import Boom
@@ -102,7 +103,7 @@ def flutter(
             raise checks.ParameterError(
                 "attitude",
                 attitude,
-                "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)",
+                boom_module.NO_ATTITUDE,
             )
         return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import _core
+from thermojitter import boom as boom_module
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
@@ -369,7 +370,7 @@ def simulate_orbits(
             raise checks.ParameterError(
                 "attitude",
                 attitude,
-                "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)",
+                boom_module.NO_ATTITUDE,
             )
     else:
         check_inputs(panel, orbit)

@@ -279,7 +279,7 @@ def simulate(
     (:func:`thermojitter.boom.simulate_boom`: a :class:`thermojitter.BoomSolution`, ``y0`` =
     (T_mean, T_circ, θ, θ̇); its rigid link has one equation of motion, whatever ``model``).
     """
-    from thermojitter.boom import Boom, simulate_boom  # noqa: F811 (the annotation's, at run time)
+    from thermojitter.boom import NO_ATTITUDE, Boom, simulate_boom  # noqa: F811 (the annotation's, at run time)
 
     if isinstance(panel, Boom):
         checks.choice("model", model, _MODELS)
@@ -289,7 +289,7 @@ def simulate(
             raise ParameterError(
                 "attitude",
                 attitude,
-                "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)",
+                NO_ATTITUDE,
             )
         return simulate_boom(  # type: ignore[return-value]
             panel, orbit, t_span, coupled=coupled, method=method, rtol=rtol, atol=atol, dt=dt,
