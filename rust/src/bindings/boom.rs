@@ -215,17 +215,11 @@ fn boom_flutter<'py>(
         let b = boom_from(boom)?;
         check_flux(flux)?;
         let c = coupling(coupled);
+        let (eq, jac, s) = crate::analysis::tube::spectrum(&b, c, flux)?;
         let d = PyDict::new(py);
-        let (eq, jac, spectrum) = crate::analysis::tube::spectrum(&b, c, flux)?;
         d.set_item("equilibrium", eq.to_vec())?;
-        let rows = (0..4).map(|i| (0..4).map(|j| jac[(i, j)]).collect());
-        set_spectrum(
-            &d,
-            rows,
-            &spectrum.eigenvalues,
-            spectrum.growth_rate,
-            spectrum.frequency_hz,
-        )?;
+        let rows = jac.row_iter().map(|row| row.iter().copied().collect());
+        set_spectrum(&d, rows, &s.eigenvalues, s.growth_rate, s.frequency_hz)?;
         if with_critical {
             let f = crate::analysis::tube::flutter(&b, c, flux)?;
             d.set_item("critical_damping", f.critical_damping_ratio)?;
