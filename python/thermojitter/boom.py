@@ -39,10 +39,17 @@ defaults of the optical and support parameters."""
 MATERIAL_FIELDS = ("density", "youngs_modulus", "expansion_coeff", "conductivity", "specific_heat")
 """The fields a boom takes from its ``material`` unless given."""
 
-NO_ATTITUDE = (
-    "a boom takes the Sun alone on its lit side (attitude and Earth heating are the plate's)"
-)
-"""Why a run of a boom refuses an attitude (the engine refuses an orbit with Earth heating)."""
+
+def check_attitude(attitude: Any) -> None:
+    """Refuses an attitude other than Sun-pointing for a boom, naming ``attitude``: its model
+    takes the Sun alone on its lit side (the engine refuses an orbit with Earth heating)."""
+    from thermojitter.attitude import Attitude
+
+    if attitude is not None and Attitude.of(attitude).kind != "sun_pointing":
+        raise checks.ParameterError(
+            "attitude", attitude, "a boom takes the Sun alone on its lit side (not an attitude)"
+        )
+
 
 DEFAULT_MATERIAL = "beryllium_copper"
 """The material of a boom given none: beryllium copper, the STEM booms' classical alloy."""

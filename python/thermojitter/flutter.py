@@ -99,12 +99,7 @@ def flutter(
     (not a c_d); ``model`` is ``"tube"``.
     """
     if isinstance(panel, Boom):
-        if attitude is not None:
-            raise checks.ParameterError(
-                "attitude",
-                attitude,
-                boom_module.NO_ATTITUDE,
-            )
+        boom_module.check_attitude(attitude)
         return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
     flux = _flux(flux, orbit, t)

@@ -366,12 +366,7 @@ def simulate_orbits(
         checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
         if layers is not None:
             raise checks.ParameterError("layers", layers, "a Boom has its own thermal model")
-        if attitude is not None:
-            raise checks.ParameterError(
-                "attitude",
-                attitude,
-                boom_module.NO_ATTITUDE,
-            )
+        boom_module.check_attitude(attitude)
     else:
         check_inputs(panel, orbit)
     engine_orbit_args = engine_orbit(orbit, attitude)

@@ -279,18 +279,13 @@ def simulate(
     (:func:`thermojitter.boom.simulate_boom`: a :class:`thermojitter.BoomSolution`, ``y0`` =
     (T_mean, T_circ, θ, θ̇); its rigid link has one equation of motion, whatever ``model``).
     """
-    from thermojitter.boom import NO_ATTITUDE, Boom, simulate_boom  # noqa: F811 (the annotation's, at run time)
+    from thermojitter.boom import Boom, check_attitude, simulate_boom  # noqa: F811 (the annotation's, at run time)
 
     if isinstance(panel, Boom):
         checks.choice("model", model, _MODELS)
         if layers is not None:
             raise ParameterError("layers", layers, "a Boom has its own thermal model")
-        if attitude is not None:
-            raise ParameterError(
-                "attitude",
-                attitude,
-                NO_ATTITUDE,
-            )
+        check_attitude(attitude)
         return simulate_boom(  # type: ignore[return-value]
             panel, orbit, t_span, coupled=coupled, method=method, rtol=rtol, atol=atol, dt=dt,
             t_eval=t_eval, dt_out=dt_out, y0=y0, max_step=max_step, max_steps=max_steps,
