@@ -10,6 +10,14 @@ from thermojitter import _core, beam, materials, nastran
 from thermojitter._core import ConvergenceError, IntegrationError
 from thermojitter.attitude import Attitude
 from thermojitter.beam import BeamComparison, FreeFreeBeam, compare_with_beam
+from thermojitter.boom import (
+    Boom,
+    BoomEquilibrium,
+    BoomSolution,
+    BoomStabilityMap,
+    boom_stability_map,
+    boom_steady_state,
+)
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
 from thermojitter.distributed import (
@@ -89,6 +97,10 @@ _check_kernel_variable()
 __all__ = [
     "AllSamplesFailedError",
     "BeamComparison",
+    "Boom",
+    "BoomEquilibrium",
+    "BoomSolution",
+    "BoomStabilityMap",
     "CalibrationResult",
     "CheckpointError",
     "ConvergenceError",
@@ -126,6 +138,8 @@ __all__ = [
     "ValidityLimitWarning",
     "beam",
     "beam_frequency",
+    "boom_stability_map",
+    "boom_steady_state",
     "flutter",
     "calibrate",
     "calibrate_from_csv",

@@ -36,6 +36,16 @@ __all__ = [
     "MAX_SAMPLES",
     "BEAM_MAX_ELEMENTS",
     "PANEL_FIELDS",
+    "BOOM_FIELDS",
+    "BOOM_RANGES",
+    "BOOM_EXAMPLE",
+    "boom_derived",
+    "boom_steady_state",
+    "boom_start_state",
+    "simulate_boom",
+    "run_boom_orbits",
+    "boom_flutter",
+    "boom_stability_map",
     "PANEL_RANGES",
     "PAPER_PANEL",
     "ENSEMBLE_LANES",
@@ -280,6 +290,48 @@ def run_orbits(
     theta_limit: float,
     stop_at_limit: bool,
     steps_per_period: float,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+
+# --- the boom (rust/src/bindings/boom.rs) --------------------------------------------------------
+BOOM_FIELDS: list[str]
+BOOM_RANGES: dict[str, tuple[float, float, bool]]  # name: (low, high, low end open); high closed
+BOOM_EXAMPLE: dict[str, float]
+
+def boom_derived(boom: dict[str, float]) -> dict[str, Any]: ...
+def boom_steady_state(
+    boom: dict[str, float], coupled: bool = True, flux: float = 1.0
+) -> list[float]: ...
+def boom_start_state(
+    boom: dict[str, float], orbit: dict[str, Any], t0: float, coupled: bool
+) -> list[float]: ...
+def simulate_boom(
+    boom: dict[str, float],
+    orbit: dict[str, Any],
+    run: _Run,
+    *,
+    coupled: bool,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+def run_boom_orbits(
+    boom: dict[str, float],
+    orbit: dict[str, Any],
+    spec: dict[str, Any],
+    y0: list[float],
+    *,
+    hybrid: dict[str, float] | None = None,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+def boom_flutter(
+    boom: dict[str, float], coupled: bool, flux: float, with_critical: bool = True
+) -> dict[str, Any]: ...
+def boom_stability_map(
+    boom: dict[str, float],
+    inclinations: list[float],
+    ratios: list[float],
+    coupled: bool,
+    flux: float,
+    *,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 

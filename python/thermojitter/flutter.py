@@ -11,8 +11,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter import boom as boom_module
 from thermojitter import errors as checks
 from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
+from thermojitter.boom import Boom
+from thermojitter.boom import _equilibrium as _boom_equilibrium
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.persist import Persistent
@@ -92,20 +95,19 @@ def flutter(
     every load at the point ``t`` of the orbit (the Earth's infrared and albedo and the
     incidence there), and the critical damping is that equilibrium's (the N-node model takes the
     front's sunlight only and refuses them).
+
+    A :class:`thermojitter.Boom` in place of the panel: the tube's analysis, ``jacobian`` over
+    (T_mean, T_circ, θ, θ̇), ``equilibrium`` a :class:`thermojitter.BoomEquilibrium`, and
+    ``critical_damping`` the first mode's damping ratio ζ at which the growth rate crosses zero
+    (not a c_d); ``model`` is ``"tube"``.
     """
+    if isinstance(panel, Boom):
+        boom_module.check_attitude(attitude)
+        return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
-    # t is checked even without an orbit: a t of the wrong type is a mistake either way.
-    t = checks.finite("t", t)
-    if orbit is not None:
-        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-        if flux is not None:
-            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
-        flux = float(orbit.flux_scale(t)[0])
-    elif flux is None:
-        flux = 1.0
+    flux = _flux(flux, orbit, t)
     if attitude is not None and orbit is None:
         raise checks.ParameterError("attitude", attitude, "needs an orbit (and t)")
-    flux = checks.real("flux", flux)
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
     point: _FlutterPoint = {"model": model, "coupled": coupled, "flux": flux}
@@ -128,6 +130,31 @@ def flutter(
         equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
         result = _result(raw, equilibrium, point)
     return dataclasses.replace(result, panel=panel, orbit=orbit)
+
+
+def _flux(flux: float | None, orbit: Orbit | None, t: float) -> float:
+    """The flux factor of an analysis: ``flux``, or ``orbit.flux_scale(t)``, or 1."""
+    # t is checked even without an orbit: a t of the wrong type is a mistake either way.
+    t = checks.finite("t", t)
+    if orbit is not None:
+        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
+        if flux is not None:
+            raise checks.ParameterError("flux", flux, "give flux or orbit (with t), not both")
+        flux = float(orbit.flux_scale(t)[0])
+    return checks.real("flux", 1.0 if flux is None else flux)
+
+
+def _boom_flutter(
+    boom: Boom, model: str, coupled: bool, flux: float | None, orbit: Orbit | None, t: float
+) -> FlutterResult:
+    """The tube's flutter analysis (see :func:`flutter`)."""
+    checks.choice("model", model, ("nonlinear", "linear"))
+    flux = _flux(flux, orbit, t)
+    coupled = checks.flag("coupled", coupled)
+    raw = _core.boom_flutter(boom.as_dict(), coupled, flux)
+    equilibrium = _boom_equilibrium(boom, raw["equilibrium"])
+    point: _FlutterPoint = {"model": "tube", "coupled": coupled, "flux": flux}  # type: ignore[typeddict-item]
+    return _result(raw, equilibrium, point)
 
 
 def _layered_flutter(panel: Panel, point: _FlutterPoint, layers: int) -> FlutterResult:

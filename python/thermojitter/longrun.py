@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Literal
@@ -19,9 +19,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import _core
+from thermojitter import boom as boom_module
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
+from thermojitter.boom import Boom
 from thermojitter.errors import HybridFallbackWarning
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
@@ -95,6 +97,9 @@ class OrbitSummaries(Persistent):
     (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
     full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``, and
     ``n_reread_steps``: exponential steps whose band of θ failed its check and were read again)."""
+    fallback: str | None = None
+    """Why a run asked for ``method="hybrid"`` ran the full integration instead (a boom), or
+    None."""
     solver: SolverSettings | None = None
     """The integrator settings the engine ran with, as it reports them (with ``method="hybrid"``,
     those of its rk45 fallback); rk45's step is further capped at T_n/``steps_per_period``.
@@ -262,8 +267,25 @@ def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
     return columns, y, next_index, counters, LimitCrossing.of(crossing)
 
 
+def _boom_orbits(
+    boom: dict[str, float],
+    orbit: dict[str, Any],
+    orbits: Mapping[str, Any],
+    *,
+    y0: list[float],
+    cancel: Any = None,
+    **watch: Any,
+) -> dict[str, Any]:
+    """``_core.run_boom_orbits`` called as ``_core.run_orbits`` is: the run's mapping and its
+    watch keys (start, index, limit) in the tube's one spec mapping."""
+    spec = {k: v for k, v in orbits.items() if k != "hybrid"} | watch
+    return _core.run_boom_orbits(
+        boom, orbit, spec, y0, hybrid=orbits.get("hybrid"), cancel=cancel
+    )
+
+
 def simulate_orbits(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     n_orbits: int,
     *,
@@ -336,8 +358,21 @@ def simulate_orbits(
       with rk45 (``result.propagation`` counts all of it as the fallback's), said in
       ``result.settings["hybrid_fallback"]`` and by one
       :class:`thermojitter.errors.HybridFallbackWarning`.
+
+    A :class:`thermojitter.Boom` in place of the panel runs the tube: ``y0`` and ``y_end`` are
+    (T_mean, T_circ, θ, θ̇), the summaries read θ (the tip deflection over the length) and its
+    quasi-static part as the panel's. ``method="hybrid"`` runs it with the full integration
+    (the hybrid's linear arcs are the plate's modal form) and says so: ``result.fallback`` gives
+    the reason and ``propagation`` puts all the time in ``t_fallback``.
     """
-    check_inputs(panel, orbit)
+    boom = isinstance(panel, Boom)
+    if isinstance(panel, Boom):
+        checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
+        if layers is not None:
+            raise checks.ParameterError("layers", layers, "a Boom has its own thermal model")
+        boom_module.check_attitude(attitude)
+    else:
+        check_inputs(panel, orbit)
     engine_orbit_args = engine_orbit(orbit, attitude)
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
     orbits_per_call = checks.integer("orbits_per_call", orbits_per_call, 1)
@@ -357,6 +392,8 @@ def simulate_orbits(
     n_orbits = orbit_count("n_orbits", n_orbits, orbit, t_start)
     method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
     nodes = None if layers is None else check_layers(layers)
+    # The N-node model's layup (layers is refused for a boom).
+    layup = None if isinstance(panel, Boom) or nodes is None else layup_dict(panel)
     used = SolverSettings.of(
         solver,
         method=None if method == "hybrid" else method,
@@ -371,8 +408,11 @@ def simulate_orbits(
     full = used.as_dict()
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None:
+    if y0 is None and boom:
+        y0 = tuple(_core.boom_start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
+    elif y0 is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
+        assert nodes is None or isinstance(panel, Panel)  # layers is refused for a boom
         grid = None if nodes is None else grid_args(panel, nodes)
         y0 = tuple(_core.start_state(panel.as_dict(), engine_orbit_args, t_start, coupled, grid))
     settings: dict[str, Any] = {
@@ -395,7 +435,7 @@ def simulate_orbits(
     }
     if nodes is not None:
         settings["layers"] = nodes
-        settings["layup"] = layup_dict(panel)
+        settings["layup"] = layup
     hybrid_settings = HybridSettings.of(hybrid).as_dict()
     if method == "hybrid":
         settings["hybrid"] = hybrid_settings
@@ -417,7 +457,9 @@ def simulate_orbits(
 
     budget = int(full["max_steps"])  # for the whole run, every orbit together
     if method != "hybrid":
-        row = np.array([[panel.as_dict()[f] for f in _core.PANEL_FIELDS]])
+        # A boom's step is capped by its equivalent hinge's period, the panel's of the same hinge.
+        hinge = panel.derived["hinge_panel"] if isinstance(panel, Boom) else panel.as_dict()
+        row = np.array([[hinge[f] for f in _core.PANEL_FIELDS]])
         least = float(_core.least_steps(row, full, orbit.period, steps_per_period)[0])
         cap = (
             "a fixed step dt" if method == "rk4" else f"the step capped at T_n/{steps_per_period:g}"
@@ -441,6 +483,7 @@ def simulate_orbits(
             _check_extension(path, saved, n_orbits, orbits_per_call, next_index)
 
     ran_with: dict[str, Any] | None = None  # the settings the engine reports it ran with
+    fallback: str | None = None
     bar = progress_bar(n_orbits, initial=next_index, unit="orbit", enabled=progress)
     interrupted = report = False
     stopped = crossing is not None and on_limit == "stop"
@@ -455,7 +498,7 @@ def simulate_orbits(
                 count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
                 t0 = float(t_start) + next_index * orbit.period
                 raw = engine.call(
-                    _core.run_orbits,
+                    _boom_orbits if boom else _core.run_orbits,
                     panel.as_dict(),
                     engine_orbit_args,
                     orbits_args(run, count),
@@ -469,6 +512,7 @@ def simulate_orbits(
                         columns[name].extend(np.asarray(raw[name]).tolist())
                     y = list(raw["y_end"])
                     ran_with = raw["solver"]
+                    fallback = raw.get("fallback", fallback)
                     counters["n_steps"] += int(raw["n_steps"])
                     counters["n_rhs"] += int(raw["n_rhs"])
                     for name in HYBRID_COUNTERS if method == "hybrid" else ():
@@ -532,9 +576,11 @@ def simulate_orbits(
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,
+        fallback=fallback,
         # A run all read from its checkpoint made no engine call: the engine's reading of the
         # same settings (the check every run makes of them) stands for it.
         solver=SolverSettings(**(_core.check_solver(full) if ran_with is None else ran_with)),
-        panel=panel,
+        # A boom's runs are not saved with their input (persist knows panels).
+        panel=panel if isinstance(panel, Panel) else None,
         orbit=orbit,
     )

@@ -241,8 +241,13 @@ def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Eq
     """The sunlit equilibrium of the coupled system (θ̇ = 0, all rates zero).
 
     ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
-    (1: nominal; e.g. 1.033 at perihelion).
+    (1: nominal; e.g. 1.033 at perihelion). A :class:`thermojitter.Boom` gives its
+    :class:`thermojitter.BoomEquilibrium` (:func:`thermojitter.boom_steady_state`).
     """
+    from thermojitter.boom import Boom, boom_steady_state
+
+    if isinstance(panel, Boom):
+        return boom_steady_state(panel, coupled=coupled, flux=flux)  # type: ignore[return-value]
     _check_panel(panel)
     pd = panel.as_dict()
     tf, tb, th = _core.steady_state(pd, checks.flag("coupled", coupled), checks.real("flux", flux))

@@ -651,3 +651,136 @@ def simulate_hinge(
 
     names = ("theta", "theta_dot")
     return _integrate_segments(fun, y0, t_span, None, rtol, atol, t_eval, method, names)
+
+
+# --------------------------------------------------------------------------- thin-walled tube
+
+
+def tube_cantilever_beta(mu: float) -> float:
+    """First root β of 1 + cos β cosh β + μ β (cos β sinh β − sin β cosh β) = 0: the clamped
+    beam with a point tip mass μ m L (moment-free tip, shear balanced by the mass's inertia)."""
+    from scipy.optimize import brentq
+
+    def f(b: float) -> float:
+        return (
+            1
+            + math.cos(b) * math.cosh(b)
+            + mu * b * (math.cos(b) * math.sinh(b) - math.sin(b) * math.cosh(b))
+        )
+
+    return float(brentq(f, 1e-4, 1.8751040687119611 + 1e-9, xtol=1e-15, rtol=1e-15))
+
+
+def tube_hinge(boom: Any) -> dict[str, float]:
+    """The cantilever's first mode as a hinge of angle θ = w(L)/L: I_B = L² (m ∫φ² + M_t) with
+    φ(L) = 1, K = ω₁² I_B, χ = K L/(2 E I) (static θ = the uniform curvature's tip deflection
+    over L), c = 2 ζ ω₁ I_B."""
+    from scipy.integrate import quad
+
+    r, h, L = boom.radius, boom.wall, boom.length
+    m = boom.density * 2 * math.pi * r * h
+    ei = boom.youngs_modulus * math.pi * r**3 * h
+    b = tube_cantilever_beta(boom.tip_mass / (m * L))
+    sigma = (math.cosh(b) + math.cos(b)) / (math.sinh(b) + math.sin(b))
+
+    def phi(x: float) -> float:
+        return math.cosh(b * x) - math.cos(b * x) - sigma * (math.sinh(b * x) - math.sin(b * x))
+
+    integral = quad(lambda x: phi(x) ** 2, 0.0, 1.0, epsabs=0, epsrel=1e-13)[0] / phi(1.0) ** 2
+    inertia = L**2 * (m * L * integral + boom.tip_mass)
+    omega = b**2 * math.sqrt(ei / (m * L**4))
+    stiffness = omega**2 * inertia
+    return {
+        "inertia": inertia,
+        "stiffness": stiffness,
+        "omega": omega,
+        "damping": 2 * boom.damping * omega * inertia,
+        "chi": boom.moment_scale * stiffness * L / (2 * ei),
+    }
+
+
+def tube_coefficients(boom: Any) -> dict[str, float]:
+    """The thin-walled tube's heat balance per unit area of wall (see ``tube_rhs``)."""
+    psi = boom.solar_inclination
+    q = boom.absorptivity * boom.solar_constant * math.sin(psi)
+    mean_t = (q / (math.pi * boom.emissivity * STEFAN_BOLTZMANN)) ** 0.25
+    ei = boom.emissivity_inner
+    eps = boom.emissivity + 4 * ei / (4 - ei)
+    conduction = boom.conduction_scale * boom.conductivity * boom.wall / boom.radius**2
+    return {
+        "mean": q / math.pi,
+        "harmonic": q / 2,
+        "capacity": boom.density * boom.specific_heat * boom.wall,
+        "radiation": boom.emissivity * STEFAN_BOLTZMANN,
+        "relaxation": conduction + 4 * STEFAN_BOLTZMANN * mean_t**3 * eps,
+        "moment": math.pi * boom.youngs_modulus * boom.expansion_coeff * boom.wall * boom.radius**2,
+    }
+
+
+def tube_rhs(
+    y: FloatArray,
+    boom: Any,
+    s: float,
+    coupled: bool,
+    parts: tuple[dict[str, float], dict[str, float]] | None = None,
+) -> FloatArray:
+    """(T̄, T_m, θ, θ̇)' of the tube lit on one side under illumination s: the absorbed flux
+    α C sin ψ max(cos φ, 0) has mean α C sin ψ/π and first harmonic α C sin ψ/2; incidence
+    sin(ψ + θ)/sin ψ; thermal moment χ π E a h r² T_m on the hinge. ``parts``: the
+    (``tube_coefficients``, ``tube_hinge``) of ``boom``, computed once by the caller."""
+    c, hinge = parts if parts is not None else (tube_coefficients(boom), tube_hinge(boom))
+    mean_t, circ, theta, rate = y
+    psi = boom.solar_inclination
+    f = s * (math.sin(psi + theta) / math.sin(psi) if coupled else 1.0)
+    return np.array(
+        [
+            (c["mean"] * f - c["radiation"] * mean_t**4) / c["capacity"],
+            (c["harmonic"] * f - c["relaxation"] * circ) / c["capacity"],
+            rate,
+            (
+                hinge["chi"] * c["moment"] * circ
+                - hinge["damping"] * rate
+                - hinge["stiffness"] * theta
+            )
+            / hinge["inertia"],
+        ]
+    )
+
+
+def tube_steady_state(boom: Any, coupled: bool = True, s: float = 1.0) -> FloatArray:
+    """(T̄, T_m, θ, 0) at rest under illumination s."""
+    c, hinge = tube_coefficients(boom), tube_hinge(boom)
+    mean_t = (c["mean"] * s / c["radiation"]) ** 0.25
+    circ = c["harmonic"] * s / c["relaxation"]
+    theta = hinge["chi"] * c["moment"] * circ / hinge["stiffness"]
+    guess = np.array([mean_t, circ, theta, 0.0])
+    if not coupled:
+        return guess
+    x = fsolve(lambda z: tube_rhs(z, boom, s, True, (c, hinge)), guess, xtol=1e-12)
+    return np.asarray(x, dtype=float)
+
+
+def simulate_tube(
+    boom: Any,
+    orbit: Any,
+    t_span: tuple[float, float],
+    *,
+    coupled: bool = True,
+    y0: ArrayLike | None = None,
+    **options: Any,
+) -> ReferenceSolution:
+    """The tube's transient, y = [T_mean, T_circ, theta, theta_dot], split at eclipses (from
+    the steady state at t_span[0]'s illumination unless ``y0`` is given). ``options``: ``rtol``
+    (1e-10), ``atol`` (1e-12), ``t_eval``, ``method`` ("RK45") and ``max_step`` as
+    :func:`simulate` takes them."""
+    o: dict[str, Any] = {"rtol": 1e-10, "atol": 1e-12, "t_eval": None, "method": "RK45"}
+    o["max_step"] = np.inf
+    o.update(options)
+    parts = (tube_coefficients(boom), tube_hinge(boom))
+    start = tube_steady_state(boom, coupled, illumination(orbit, float(t_span[0])))
+    return _integrate_segments(
+        lambda t, y, s: tube_rhs(y, boom, s, coupled, parts),
+        start if y0 is None else y0,
+        t_span, orbit, o["rtol"], o["atol"], o["t_eval"], o["method"],
+        ("T_mean", "T_circ", "theta", "theta_dot"), o["max_step"],
+    )  # fmt: skip

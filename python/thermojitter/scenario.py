@@ -14,6 +14,11 @@ A scenario has these tables, each optional::
     material = "kapton"      # properties of Layer (a material's values may be overridden)
     thickness = 50e-6
 
+    [boom]         # instead of [panel] and [laminate]: a thin-walled tube (thermojitter.Boom):
+    length = 30.0  # length, radius and wall required; material = a library key; any Boom
+    radius = 6.35e-3  # field (SI), and solar_inclination_deg in place of solar_inclination
+    wall = 5.1e-5
+
     [orbit]        # preset = "geo_equinox" and/or any Orbit field
     preset = "geo_equinox"
 
@@ -44,6 +49,7 @@ from typing import Any
 from thermojitter import errors as checks
 from thermojitter import materials
 from thermojitter.attitude import Attitude
+from thermojitter.boom import Boom
 from thermojitter.errors import ParameterError
 from thermojitter.laminate import Laminate, Layer
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
@@ -159,7 +165,8 @@ class OutputSettings:
 
 @dataclass(frozen=True)
 class Scenario:
-    panel: Panel = field(default_factory=Panel.paper)
+    panel: Panel | Boom = field(default_factory=Panel.paper)
+    """The panel, or the boom of a scenario with a [boom] table."""
     orbit: Orbit = field(default_factory=Orbit.geo_equinox)
     attitude: Attitude = field(default_factory=Attitude.sun_pointing)
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
@@ -258,6 +265,35 @@ def _panel(path: Path, table: dict[str, Any]) -> Panel:
     _reject_unknown(path, "panel", table, known)
     values = {key: _real(path, f"panel.{key}", value) for key, value in table.items()}
     return _validated(path, "panel", Panel, {}, values)  # type: ignore[no-any-return]
+
+
+BOOM_KEYS = (*Boom.field_names(), "material", "solar_inclination_deg")
+"""Keys of [boom]: the Boom's fields, its library material, and the inclination in degrees."""
+
+
+def _boom(path: Path, table: dict[str, Any]) -> Boom:
+    _reject_unknown(path, "boom", table, set(BOOM_KEYS))
+    values: dict[str, Any] = {}
+    for key, value in table.items():
+        if key == "material":
+            if not isinstance(value, str) or value not in materials.LIBRARY:
+                keys = ", ".join(materials.LIBRARY)
+                raise ScenarioError(path, "boom.material", f"must be one of {keys}")
+            values[key] = value
+        elif key == "solar_inclination_deg":
+            if "solar_inclination" in table:
+                raise ScenarioError(
+                    path, "boom.solar_inclination_deg", "give solar_inclination or _deg, not both"
+                )
+            values["solar_inclination"] = math.radians(_real(path, f"boom.{key}", value))
+        else:
+            values[key] = _real(path, f"boom.{key}", value)
+    required = {}
+    for key in ("length", "radius", "wall"):
+        if key not in values:
+            raise ScenarioError(path, f"boom.{key}", "is required")
+        required[key] = values.pop(key)
+    return _validated(path, "boom", Boom, required, values)  # type: ignore[no-any-return]
 
 
 LAYER_KEYS = ("material", "name", *(f.name for f in fields(Layer) if f.name != "name"))
@@ -493,13 +529,30 @@ def parse_scenario(
     ``extra_sections`` names further tables the caller accepts; they are returned unchecked in
     ``Scenario.extra`` (absent ones as empty tables)."""
     where = Path(path)
-    sections = {"panel", "laminate", "orbit", "attitude", "simulation", "output", *extra_sections}
+    sections = {
+        "panel",
+        "laminate",
+        "boom",
+        "orbit",
+        "attitude",
+        "simulation",
+        "output",
+        *extra_sections,
+    }
     for key in data:
         if key not in sections:
             raise ScenarioError(
                 where, key, f"unknown table (allowed: {', '.join(sorted(sections))})"
             )
-    if "laminate" in data:
+    panel: Panel | Boom
+    if "boom" in data:
+        for other in ("panel", "laminate"):
+            if other in data:
+                raise ScenarioError(
+                    where, other, "a scenario with [boom] has no [panel] or [laminate]"
+                )
+        panel = _boom(where, _table(where, data, "boom"))
+    elif "laminate" in data:
         layup = _laminate(where, _table(where, data, "laminate"))
         panel = _laminate_panel(where, _table(where, data, "panel"), layup)
     else:

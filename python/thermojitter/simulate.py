@@ -28,6 +28,7 @@ from thermojitter.solver import ATOL, MAX_STEP, MAX_STEPS, RTOL, SolverSettings
 
 if TYPE_CHECKING:
     from thermojitter._core import _Grid, _Orbits
+    from thermojitter.boom import Boom
 
 Model = Literal["nonlinear", "linear"]
 Method = Literal["rk45", "rk4"]
@@ -224,7 +225,7 @@ def orbits_args(options: Mapping[str, Any], n_orbits: int) -> _Orbits:
 
 
 def simulate(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     t_span: Sequence[float],
     *,
@@ -290,7 +291,23 @@ def simulate(
 
     Raises ``ValueError`` naming a bad input, ``IntegrationError`` if the integrator cannot
     finish.
+
+    A :class:`thermojitter.Boom` in place of the panel runs the tube
+    (:func:`thermojitter.boom.simulate_boom`: a :class:`thermojitter.BoomSolution`, ``y0`` =
+    (T_mean, T_circ, θ, θ̇); its rigid link has one equation of motion, whatever ``model``).
     """
+    from thermojitter.boom import Boom, check_attitude, simulate_boom  # noqa: F811 (the annotation's, at run time)
+
+    if isinstance(panel, Boom):
+        checks.choice("model", model, _MODELS)
+        if layers is not None:
+            raise ParameterError("layers", layers, "a Boom has its own thermal model")
+        check_attitude(attitude)
+        return simulate_boom(  # type: ignore[return-value]
+            panel, orbit, t_span, coupled=coupled, method=method, rtol=rtol, atol=atol, dt=dt,
+            t_eval=t_eval, dt_out=dt_out, y0=y0, max_step=max_step, max_steps=max_steps,
+            solver=solver, theta_limit=theta_limit, on_limit=on_limit,
+        )  # fmt: skip
     check_inputs(panel, orbit)
     engine_orbit_args = engine_orbit(orbit, attitude)
     used, run = run_settings(

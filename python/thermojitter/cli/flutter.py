@@ -106,6 +106,11 @@ def run(args: argparse.Namespace) -> int:
             scenario = load_scenario(path, extra_sections=("flutter",))
         except ScenarioError as e:
             raise UserError(str(e)) from None
+        if not isinstance(scenario.panel, Panel):
+            raise UserError(
+                f"{path}: boom: the flutter command maps a [panel]; a boom's analysis is "
+                "tj.flutter(boom) and tj.boom_stability_map"
+            )
         panel, orbit, options = scenario.panel, scenario.orbit, scenario.extra["flutter"]
         unknown = set(options) - set(FLUTTER_KEYS)
         if unknown:

@@ -20,6 +20,7 @@ from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.progress import progress_bar, report_interrupted
 from thermojitter.scenario import (
     ATTITUDE_KEYS,
+    BOOM_KEYS,
     LAMINATE_KEYS,
     LAMINATE_PANEL_KEYS,
     LAYER_KEYS,
@@ -49,7 +50,7 @@ def series_units(names: Sequence[str]) -> dict[str, str]:
 
 
 def scenario_keys_help() -> str:
-    """Every key of the four tables of a scenario, for ``run --help`` (the names come from the
+    """Every key of the tables of a scenario, for ``run --help`` (the names come from the
     code, so none is missing)."""
     from dataclasses import fields
 
@@ -72,6 +73,12 @@ def scenario_keys_help() -> str:
                 + "); each [[laminate.layers]], front first, has "
                 + ", ".join(LAYER_KEYS)
                 + " (material = a tj.materials key, or every property)",
+            ),
+            table(
+                "boom",
+                list(BOOM_KEYS),
+                "a thin-walled tube in place of [panel] (length, radius, wall required; "
+                "material = a tj.materials key; SI units, angles in rad or _deg)",
             ),
             table(
                 "orbit",
@@ -166,11 +173,14 @@ def simulate_scenario(
             )
             # the sample at b starts the next orbit's piece; only the last piece keeps its end
             keep = slice(None) if last else slice(0, len(inside))
-            piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in COLUMNS}}
+            # A boom's columns are its own (T_mean, T_circ in place of T_front, T_back).
+            names_of = sol._columns() if not hasattr(sol, "T_front") else COLUMNS
+            piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in names_of}}
             # With layers = N: a column per node, named as in Solution.to_pandas().
-            node_names = sol.node_columns
-            if sol.T_nodes is not None:
-                piece.update({n: sol.T_nodes[keep, k] for k, n in enumerate(node_names)})
+            node_names = getattr(sol, "node_columns", ())
+            nodes = getattr(sol, "T_nodes", None)
+            if nodes is not None:
+                piece.update({n: nodes[keep, k] for k, n in enumerate(node_names)})
             pieces.append(piece)
             for key in counters:
                 counters[key] += int(getattr(sol, key))
@@ -184,7 +194,7 @@ def simulate_scenario(
     finally:
         if bar is not None:
             bar.close()
-    names = ("t", *COLUMNS, *(node_names if pieces else ()))
+    names = tuple(pieces[0]) if pieces else ("t", *COLUMNS)
     columns = {
         name: np.concatenate([p[name] for p in pieces]) if pieces else np.empty(0) for name in names
     }

@@ -7,3 +7,4 @@ pub mod layered;
 pub mod linear;
 pub mod stability;
 pub mod steady;
+pub mod tube;

@@ -2,6 +2,7 @@
 //! releases the GIL around every integration. It holds no physics.
 
 mod beam;
+mod boom;
 mod cancel;
 mod convert;
 mod distributed;
@@ -482,6 +483,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flutter::register(m)?;
     orbits::register(m)?;
     beam::register(m)?;
+    boom::register(m)?;
     distributed::register(m)?;
     orbit::register(m)?;
     ensemble::register(m)?;

@@ -91,7 +91,7 @@ fn hybrid_counters<'py>(
 /// The summaries of a run (of either model: a two-layer `OrbitRun` converts) as columns, with
 /// its counters and the solver settings it ran with (`method`, as [`solver_dict`] reports them
 /// for every run).
-fn summary_dict<'py>(
+pub(super) fn summary_dict<'py>(
     py: Python<'py>,
     out: &crate::runs::layered::LayeredSummaries,
     method: &crate::numerics::integrate::Method,

@@ -333,7 +333,7 @@ impl Material {
 }
 
 /// The material library (room-temperature values).
-pub const MATERIALS: [Material; 5] = [
+pub const MATERIALS: [Material; 7] = [
     Material {
         key: "aluminium_6061",
         name: "aluminium 6061-T6",
@@ -400,6 +400,30 @@ pub const MATERIALS: [Material; 5] = [
         source: "DuPont, Kapton HN General Specifications (technical data sheet): k 0.12 W/(m K), \
                  ρ 1420 kg/m³, c 1.09 J/(g K), tensile modulus 2.5 GPa, a 20 ppm/°C \
                  (−14 to 38 °C), at 23 °C.",
+    },
+    Material {
+        key: "beryllium_copper",
+        name: "beryllium copper C17200, age hardened",
+        conductivity: 105.0,
+        density: 8250.0,
+        specific_heat: 420.0,
+        youngs_modulus: 128e9,
+        expansion_coeff: 17e-6,
+        source: "Materion, Alloy 25 (C17200) strip data sheet, typical values for the \
+                 precipitation-hardened temper: k 105 W/(m K), ρ 8.25 g/cm³, c 0.42 J/(g K), \
+                 E 128 GPa, a 17 ppm/K (20 to 200 °C).",
+    },
+    Material {
+        key: "stainless_301",
+        name: "stainless steel 301, full hard",
+        conductivity: 16.2,
+        density: 7880.0,
+        specific_heat: 500.0,
+        youngs_modulus: 193e9,
+        expansion_coeff: 17e-6,
+        source: "ASM Handbook vol. 1 (1990), wrought austenitic stainless steels, type 301, \
+                 room temperature: k 16.2 W/(m K), ρ 7.88 g/cm³, c 0.50 J/(g K), E 193 GPa, \
+                 a 17 ppm/K (0 to 100 °C).",
     },
 ];
 

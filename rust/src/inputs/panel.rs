@@ -58,6 +58,23 @@ macro_rules! panel_parameters {
     };
 }
 
+/// Refuses `v` outside `(low, high, low end open)` (the high end closed), naming `name`: the
+/// one range check of the panel's and the boom's parameter tables.
+pub(crate) fn check_in_range(name: &str, v: f64, range: (f64, f64, bool)) -> Result<()> {
+    let (low, high, open) = range;
+    let above_low = if open { v > low } else { v >= low };
+    if v.is_finite() && above_low && v <= high {
+        return Ok(());
+    }
+    let (low, high) = (short(low), short(high));
+    let range = if open {
+        format!("must be in ({low}, {high}]")
+    } else {
+        format!("must be in [{low}, {high}]")
+    };
+    Err(Error::invalid(name, v, &range))
+}
+
 fn not_a_parameter(name: &str) -> Error {
     Error::invalid("parameter", name, "is not a panel parameter")
 }
@@ -122,17 +139,7 @@ impl Panel {
     /// [`Panel::MAX_RATE`]; the first offending parameter is named in the error.
     pub fn validate(&self) -> Result<()> {
         for (name, low, high, open) in Self::RANGES {
-            let v = self.get(name)?;
-            let above_low = if open { v > low } else { v >= low };
-            if !(v.is_finite() && above_low && v <= high) {
-                let (low, high) = (short(low), short(high));
-                let range = if open {
-                    format!("must be in ({low}, {high}]")
-                } else {
-                    format!("must be in [{low}, {high}]")
-                };
-                return Err(Error::invalid(name, v, &range));
-            }
+            check_in_range(name, self.get(name)?, (low, high, open))?;
         }
         let rates = [
             (

@@ -324,7 +324,7 @@ where
     /// beyond ±π/2 or faster than it can move ([`crate::models::hinge::check_start_state`]).
     pub fn check_start(&self, y: &State<D>) -> Result<()> {
         let n = self.thermal.size();
-        crate::models::hinge::check_start_state(y.as_slice(), n, None)?;
+        self.thermal.check_start(&y.as_slice()[..n])?;
         self.structure.check_start(n, &y.as_slice()[n..])
     }
 

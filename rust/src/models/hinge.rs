@@ -88,6 +88,31 @@ pub fn check_moment(panel: &Panel, moment: f64) -> crate::error::Result<()> {
     ))
 }
 
+/// Refuses a start (θ, θ̇) = `states`, the components `offset` and `offset + 1` of the full
+/// state: θ within ±π/2 ([`check_hinge_angle`]), θ̇ within ±`most` rad/s, (π/2) max(ω_n, c_d/I_B)
+/// of a hinge, beyond which the start alone would swing it past its range.
+pub(crate) fn check_angle_and_rate(offset: usize, states: &[f64], most: f64) -> Result<()> {
+    let &[theta, rate, ..] = states else {
+        return Err(Error::invalid(
+            "y0",
+            format!("{} components", offset + states.len()),
+            &format!("must hold θ and θ̇ after its {offset} temperatures"),
+        ));
+    };
+    check_hinge_angle(&format!("y0[{offset}]"), theta)?;
+    if !(rate.is_finite() && rate.abs() <= most) {
+        return Err(Error::invalid(
+            &format!("y0[{}]", offset + 1),
+            rate,
+            &format!(
+                "θ̇ must be within ±{most:.4e} rad/s: (π/2) max(ω_n, c_d/I_B), beyond which \
+                 the start alone would swing the hinge past its range of ±π/2"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// A structural model of the plate: its states (positions, then velocities), their rates under
 /// the thermal moment, and the projected-area factor its shape imposes on the absorbed flux.
 ///
@@ -327,26 +352,7 @@ impl StructuralModel for Hinge {
         out[0] = (moment - self.hinge_stiffness * positions[0]) / self.hinge_stiffness;
     }
     fn check_start(&self, offset: usize, states: &[f64]) -> Result<()> {
-        let &[theta, rate, ..] = states else {
-            return Err(Error::invalid(
-                "y0",
-                format!("{} components", offset + states.len()),
-                &format!("must hold θ and θ̇ after its {offset} temperatures"),
-            ));
-        };
-        check_hinge_angle(&format!("y0[{offset}]"), theta)?;
-        let most = self.max_start_rate();
-        if !(rate.is_finite() && rate.abs() <= most) {
-            return Err(Error::invalid(
-                &format!("y0[{}]", offset + 1),
-                rate,
-                &format!(
-                    "θ̇ must be within ±{most:.4e} rad/s: (π/2) max(ω_n, c_d/I_B), beyond which \
-                     the start alone would swing the hinge past its range of ±π/2"
-                ),
-            ));
-        }
-        Ok(())
+        check_angle_and_rate(offset, states, self.max_start_rate())
     }
     fn check_static(&self, positions: &[f64]) -> Result<()> {
         let theta = positions[0];

@@ -9,6 +9,7 @@ pub mod hinge;
 pub mod layered;
 pub mod spacecraft;
 pub mod thermal;
+pub mod tube;
 
 use crate::error::{Error, Result};
 use crate::inputs::panel::Panel;

@@ -80,6 +80,13 @@ pub trait ThermalModel {
     /// plate's equilibrium.
     fn initial_guess(&self, flux: f64, out: &mut [f64]);
 
+    /// Refuses a start of the temperatures `temps` the model does not describe: by default each
+    /// an absolute temperature, finite and > 0 K (a model whose states include a perturbation
+    /// checks those as it must).
+    fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
+        crate::models::hinge::check_start_state(temps, temps.len(), None)
+    }
+
     /// The temperatures of the front and of the back face (the first and the last; the same
     /// one for the isothermal plate).
     #[inline]
@@ -133,6 +140,9 @@ impl<M: ThermalModel + ?Sized> ThermalModel for Box<M> {
     fn initial_guess(&self, flux: f64, out: &mut [f64]) {
         (**self).initial_guess(flux, out)
     }
+    fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
+        (**self).check_start(temps)
+    }
     fn faces(&self) -> (usize, usize) {
         (**self).faces()
     }
@@ -164,6 +174,9 @@ impl<M: ThermalModel> ThermalModel for AsWritten<M> {
     }
     fn initial_guess(&self, flux: f64, out: &mut [f64]) {
         self.0.initial_guess(flux, out)
+    }
+    fn check_start(&self, temps: &[f64]) -> crate::error::Result<()> {
+        self.0.check_start(temps)
     }
     fn faces(&self) -> (usize, usize) {
         self.0.faces()

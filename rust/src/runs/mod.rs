@@ -2,6 +2,7 @@
 //! hybrid exponential method, the lockstep SIMD lanes, ensembles, the distributed panel's runs.
 
 pub mod beam;
+pub mod boom;
 pub mod distributed;
 pub mod ensemble;
 pub mod hybrid;
