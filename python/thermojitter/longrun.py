@@ -279,9 +279,7 @@ def _boom_orbits(
     """``_core.run_boom_orbits`` called as ``_core.run_orbits`` is: the run's mapping and its
     watch keys (start, index, limit) in the tube's one spec mapping."""
     spec = {k: v for k, v in orbits.items() if k != "hybrid"} | watch
-    return _core.run_boom_orbits(
-        boom, orbit, spec, y0, hybrid=orbits.get("hybrid"), cancel=cancel
-    )
+    return _core.run_boom_orbits(boom, orbit, spec, y0, hybrid=orbits.get("hybrid"), cancel=cancel)
 
 
 def simulate_orbits(
