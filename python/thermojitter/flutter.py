@@ -154,7 +154,7 @@ def _boom_flutter(
     raw = _core.boom_flutter(boom.as_dict(), coupled, flux)
     equilibrium = _boom_equilibrium(boom, raw["equilibrium"])
     point: _FlutterPoint = {"model": "tube", "coupled": coupled, "flux": flux}  # type: ignore[typeddict-item]
-    return _result(raw, equilibrium, point)
+    return _result(raw, equilibrium, point)  # type: ignore[arg-type]
 
 
 def _layered_flutter(panel: Panel, point: _FlutterPoint, layers: int) -> FlutterResult:

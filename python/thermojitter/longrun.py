@@ -410,8 +410,8 @@ def simulate_orbits(
         y0 = tuple(_core.boom_start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
     elif y0 is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
-        assert nodes is None or isinstance(panel, Panel)  # layers is refused for a boom
-        grid = None if nodes is None else grid_args(panel, nodes)
+        # (layers is refused for a boom)
+        grid = grid_args(panel, nodes) if nodes is not None and isinstance(panel, Panel) else None
         y0 = tuple(_core.start_state(panel.as_dict(), engine_orbit_args, t_start, coupled, grid))
     settings: dict[str, Any] = {
         "panel": panel.as_dict(),
@@ -443,7 +443,7 @@ def simulate_orbits(
         settings["hybrid_fallback"] = HYBRID_FALLBACK
         warnings.warn(HYBRID_FALLBACK, HybridFallbackWarning, stacklevel=2)
     run: dict[str, Any] = {"model": model, "coupled": coupled, "solver": full, "window": window}
-    if nodes is not None:
+    if nodes is not None and isinstance(panel, Panel):
         run.update(layup=layup_dict(panel), nodes=nodes)
     if method == "hybrid":
         run["hybrid"] = hybrid_settings
