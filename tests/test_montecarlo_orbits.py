@@ -233,6 +233,7 @@ def test_mc_command_takes_orbit_inputs_an_attitude_and_a_boom(tmp_path: Path) ->
             epoch_day = {LEO.epoch_day!r}
             inclination = 0.5
             raan = 0.3
+            j2 = true
             albedo = 0.3
             earth_ir = 237.0
             [attitude]
