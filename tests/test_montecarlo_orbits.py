@@ -57,9 +57,7 @@ def assert_sample_is_its_single_run(row: Any, run: Any, flutter: Any) -> None:
     assert row["theta_eq"] == flutter.equilibrium.theta
 
 
-@settings(
-    max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow]
-)
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     attitude=st.sampled_from(ATTITUDES),
     seed=st.integers(0, 2**32 - 1),

@@ -3,10 +3,10 @@ parameters and orbit inputs.
 
 A study is a design — one row of panel parameters per sample, with the sample's orbit inputs
 (``ORBIT_INPUTS``: the study's orbit with its own albedo, Earth infrared, inclination, RAAN),
-drawn in Python from the seed up front (:mod:`.design`) — and a batch run of it in the Rust engine on a rayon pool with the GIL
-released (:mod:`.backends`). Each sample depends only on its own row, so the results are the
-same, bit for bit, whatever the number of threads, the chunking or the backend (local threads or
-Dask workers).
+drawn in Python from the seed up front (:mod:`.design`) — and a batch run of it in the Rust
+engine on a rayon pool with the GIL released (:mod:`.backends`). Each sample depends only on its
+own row, so the results are the same, bit for bit, whatever the number of threads, the chunking
+or the backend (local threads or Dask workers).
 
 The design is cut into chunks of rows (:mod:`.driver`). With ``checkpoint=DIR`` every finished
 chunk is written to ``DIR/chunk-NNNNN.parquet`` as soon as it completes, beside

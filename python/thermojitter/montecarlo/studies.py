@@ -317,8 +317,9 @@ def sensitivity(
 
     Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design (best with n
     a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
-    arguments (``layers``, ``attitude``, orbit inputs in ``vary`` and a boom too) these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``,
-    ``ST_conf`` per parameter (first-order and total indices, 95 % confidence half-widths).
+    arguments (``layers``, ``attitude``, orbit inputs in ``vary`` and a boom too) these are.
+    ``indices`` holds ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` per parameter (first-order and
+    total indices, 95 % confidence half-widths).
 
     The indices need the metric of every sample: a study in which some sample failed (or whose
     metric is NaN somewhere) is refused with a ValueError naming the first, after the warning

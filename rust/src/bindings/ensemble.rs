@@ -51,12 +51,24 @@ fn rows_from<T: Copy>(
 
 /// Rows of a (n, len(PANEL_FIELDS)) array, columns in PANEL_FIELDS order, as panels (unchecked).
 fn panels_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Panel>> {
-    rows_from(rows, Panel::paper(), &Panel::FIELDS, Panel::set, ("panels", "PANEL_FIELDS"))
+    rows_from(
+        rows,
+        Panel::paper(),
+        &Panel::FIELDS,
+        Panel::set,
+        ("panels", "PANEL_FIELDS"),
+    )
 }
 
 /// Rows of a (n, len(BOOM_FIELDS)) array, columns in BOOM_FIELDS order, as booms (unchecked).
 fn booms_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Boom>> {
-    rows_from(rows, Boom::example(), &Boom::FIELDS, Boom::set, ("booms", "BOOM_FIELDS"))
+    rows_from(
+        rows,
+        Boom::example(),
+        &Boom::FIELDS,
+        Boom::set,
+        ("booms", "BOOM_FIELDS"),
+    )
 }
 
 /// The rows of a design as panels, or as the booms' equivalent hinges (whose period caps a
@@ -71,11 +83,7 @@ fn hinges_from(rows: &PyReadonlyArray2<'_, f64>, boom: bool) -> PyResult<Vec<Pan
 
 /// Each sample's orbit: `base` with the sample's orbit inputs (a mapping of ORBIT_INPUTS names
 /// to arrays of `n` values; None: `base` for all), unchecked.
-fn orbits_from(
-    base: Orbit,
-    inputs: Option<&Bound<'_, PyDict>>,
-    n: usize,
-) -> PyResult<Vec<Orbit>> {
+fn orbits_from(base: Orbit, inputs: Option<&Bound<'_, PyDict>>, n: usize) -> PyResult<Vec<Orbit>> {
     let mut orbits = vec![base; n];
     let Some(inputs) = inputs else {
         return Ok(orbits);
@@ -266,7 +274,10 @@ impl MonteCarloPool {
                 return Err(invalid("grid", "given", "a boom has its own thermal model"));
             }
             let out = if boom {
-                let booms: Vec<(Boom, Orbit)> = booms_from(&panels)?.into_iter().zip(sample_orbits).collect();
+                let booms: Vec<(Boom, Orbit)> = booms_from(&panels)?
+                    .into_iter()
+                    .zip(sample_orbits)
+                    .collect();
                 py.detach(|| run_boom_batch(pool, &booms, &settings, cancel))?
             } else {
                 let samples: Vec<Sample> = panels_from(&panels)?

@@ -9,9 +9,9 @@
 //! batch is cut into chunks.
 
 use crate::analysis::flutter::{analyse, analyse_system_at, critical_damping, critical_damping_at};
-use crate::inputs::boom::Boom;
 use crate::cancel::Cancel;
 use crate::error::{require_positive, Error, Result};
+use crate::inputs::boom::Boom;
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{Coupled, Coupling};
@@ -454,14 +454,28 @@ pub fn run_batch_layered(
     layers: &Layers,
     cancel: &Cancel,
 ) -> Result<Vec<SampleMetrics>> {
+    let run = |x: &Sample, s: &EnsembleSettings| run_sample_layered(&x.panel, s, layers, cancel);
+    one_at_a_time(pool, samples, settings, cancel, run, |x| x.orbit)
+}
+
+/// Runs `items` on `pool`, one at a time per thread, each with the batch's settings on its orbit
+/// (`orbit_of`); results in input order, an item that fails keeping its error, as [`run_batch`].
+fn one_at_a_time<T: Sync>(
+    pool: &ThreadPool,
+    items: &[T],
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+    run: impl Fn(&T, &EnsembleSettings) -> Result<SampleMetrics> + Sync,
+    orbit_of: impl Fn(&T) -> Orbit + Sync,
+) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
     let out = pool.install(|| {
-        samples
+        items
             .par_iter()
             .with_max_len(1)
             .map(|x| {
-                checked_on(&x.orbit, settings)
-                    .and_then(|s| run_sample_layered(&x.panel, &s, layers, cancel))
+                checked_on(&orbit_of(x), settings)
+                    .and_then(|s| run(x, &s))
                     .unwrap_or_else(SampleMetrics::failed)
             })
             .collect()
@@ -522,20 +536,8 @@ pub fn run_boom_batch(
     settings: &EnsembleSettings,
     cancel: &Cancel,
 ) -> Result<Vec<SampleMetrics>> {
-    settings.validate()?;
-    let out = pool.install(|| {
-        booms
-            .par_iter()
-            .with_max_len(1)
-            .map(|(boom, orbit)| {
-                checked_on(orbit, settings)
-                    .and_then(|s| run_boom_sample(boom, &s, cancel))
-                    .unwrap_or_else(SampleMetrics::failed)
-            })
-            .collect()
-    });
-    cancel.check()?;
-    Ok(out)
+    let run = |x: &(Boom, Orbit), s: &EnsembleSettings| run_boom_sample(&x.0, s, cancel);
+    one_at_a_time(pool, booms, settings, cancel, run, |x| x.1)
 }
 
 /// A sample's metrics from its head and its run.
@@ -773,9 +775,9 @@ pub fn run_samples(
 mod tests {
     use super::*;
     use crate::analysis::steady::equilibrium;
-    use nalgebra::Vector4;
     use crate::numerics::integrate::Tolerances;
     use crate::runs::orbits::run_orbits;
+    use nalgebra::Vector4;
 
     fn settings() -> EnsembleSettings {
         EnsembleSettings {
@@ -997,11 +999,22 @@ mod tests {
         let p = pool(2).unwrap();
         let lanes = run_samples(&p, &samples, &s, &Cancel::new(), Path::Lockstep).unwrap();
         let scalar = run_samples(&p, &samples, &s, &Cancel::new(), Path::Scalar).unwrap();
-        let one = run_samples(&pool(1).unwrap(), &samples, &s, &Cancel::new(), Path::Lockstep);
+        let one = run_samples(
+            &pool(1).unwrap(),
+            &samples,
+            &s,
+            &Cancel::new(),
+            Path::Lockstep,
+        );
         assert_eq!(bits(&lanes), bits(&scalar));
         assert_eq!(bits(&lanes), bits(&one.unwrap()));
         for (x, row) in samples.iter().zip(&lanes) {
-            let alone = run_batch(&pool(1).unwrap(), &[x.panel], &s.on(x.orbit), &Cancel::new());
+            let alone = run_batch(
+                &pool(1).unwrap(),
+                &[x.panel],
+                &s.on(x.orbit),
+                &Cancel::new(),
+            );
             assert_eq!(bits(&alone.unwrap()), bits(std::slice::from_ref(row)));
         }
         // The Earth's loads move the equilibrium.
@@ -1010,7 +1023,10 @@ mod tests {
         bad[2].orbit.albedo = 1.5;
         let out = run_samples(&p, &bad, &s, &Cancel::new(), Path::Lockstep).unwrap();
         assert!(out[2].error.as_deref().unwrap().starts_with("albedo"));
-        assert!(out.iter().enumerate().all(|(i, m)| (i == 2) == m.error.is_some()));
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(i, m)| (i == 2) == m.error.is_some()));
     }
 
     #[test]
@@ -1053,7 +1069,10 @@ mod tests {
                     solar_inclination: 0.6 + 0.4 * k as f64,
                     ..Boom::example()
                 };
-                (boom, orbit_with(s.orbit, "inclination", 0.1 * k as f64).unwrap())
+                (
+                    boom,
+                    orbit_with(s.orbit, "inclination", 0.1 * k as f64).unwrap(),
+                )
             })
             .collect();
         let one = run_boom_batch(&pool(1).unwrap(), &booms, &s, &Cancel::new()).unwrap();
