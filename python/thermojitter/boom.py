@@ -14,7 +14,6 @@ A :class:`Boom` goes where a :class:`thermojitter.Panel` goes: :func:`thermojitt
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import InitVar, dataclass, fields
@@ -27,6 +26,17 @@ from numpy.typing import ArrayLike
 
 from thermojitter import _core, materials
 from thermojitter import errors as checks
+from thermojitter._runs import (
+    DEFAULT_THETA_LIMIT,
+    limit_args,
+    limit_record,
+    run_record,
+    run_settings,
+    start_state,
+    time_span,
+    warn_crossing,
+)
+from thermojitter.attitude import Attitude
 from thermojitter.orbit import Orbit
 from thermojitter.progress import interruptible
 from thermojitter.results import Array, LimitCrossing, _Run
@@ -43,8 +53,6 @@ MATERIAL_FIELDS = ("density", "youngs_modulus", "expansion_coeff", "conductivity
 def check_attitude(attitude: Any) -> None:
     """Refuses an attitude other than Sun-pointing for a boom, naming ``attitude``: its model
     takes the Sun alone on its lit side (the engine refuses an orbit with Earth heating)."""
-    from thermojitter.attitude import Attitude
-
     if attitude is not None and Attitude.of(attitude).kind != "sun_pointing":
         raise checks.ParameterError(
             "attitude", attitude, "a boom takes the Sun alone on its lit side (not an attitude)"
@@ -283,15 +291,12 @@ def simulate_boom(
     the steady state at the start's flux; ``coupled=False`` freezes the incidence;
     ``integrator``: ``method``, ``rtol``, ``atol``, ``dt``, ``max_step``, ``max_steps`` as
     :func:`thermojitter.simulate` takes them (or ``solver``)."""
-    # The module, not the function of the same name the package exports.
-    run = importlib.import_module("thermojitter.simulate")
-
     checks.instance("boom", boom, Boom, "a thermojitter.Boom")
     checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-    used, options = run.run_settings(solver, run.time_span(t_span), t_eval, dt_out, **integrator)
-    limit = run.DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
-    options["limit"] = run.limit_args(limit, on_limit)
-    options["y0"] = run.start_state(y0, 4)
+    used, options = run_settings(solver, time_span(t_span), t_eval, dt_out, **integrator)
+    limit = DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
+    options["limit"] = limit_args(limit, on_limit)
+    options["y0"] = start_state(y0, 4)
     raw = interruptible(
         _core.simulate_boom,
         boom.as_dict(),
@@ -301,13 +306,13 @@ def simulate_boom(
     )
     settings = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt, "coupled": coupled}
     sol = BoomSolution(
-        **run.run_record(raw, used),
+        **run_record(raw, used),
         settings={**settings, "boom": boom.as_dict(), "solver": dict(raw["solver"])},
         length=boom.length,
         **{name: raw[name] for name in (*BoomSolution.COLUMNS, "y_end")},
-        **run.limit_record(raw),
+        **limit_record(raw),
     )
-    run.warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)
+    warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)
     return sol
 
 
