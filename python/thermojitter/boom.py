@@ -24,18 +24,8 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
-from thermojitter import _core, materials
+from thermojitter import _core, _runs, materials
 from thermojitter import errors as checks
-from thermojitter._runs import (
-    DEFAULT_THETA_LIMIT,
-    limit_args,
-    limit_record,
-    run_record,
-    run_settings,
-    start_state,
-    time_span,
-    warn_crossing,
-)
 from thermojitter.attitude import Attitude
 from thermojitter.orbit import Orbit
 from thermojitter.progress import interruptible
@@ -293,10 +283,12 @@ def simulate_boom(
     :func:`thermojitter.simulate` takes them (or ``solver``)."""
     checks.instance("boom", boom, Boom, "a thermojitter.Boom")
     checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-    used, options = run_settings(solver, time_span(t_span), t_eval, dt_out, **integrator)
-    limit = DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
-    options["limit"] = limit_args(limit, on_limit)
-    options["y0"] = start_state(y0, 4)
+    used, options = _runs.run_settings(
+        solver, _runs.time_span(t_span), t_eval, dt_out, **integrator
+    )
+    limit = _runs.DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
+    options["limit"] = _runs.limit_args(limit, on_limit)
+    options["y0"] = _runs.start_state(y0, 4)
     raw = interruptible(
         _core.simulate_boom,
         boom.as_dict(),
@@ -306,13 +298,13 @@ def simulate_boom(
     )
     settings = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt, "coupled": coupled}
     sol = BoomSolution(
-        **run_record(raw, used),
+        **_runs.run_record(raw, used),
         settings={**settings, "boom": boom.as_dict(), "solver": dict(raw["solver"])},
         length=boom.length,
         **{name: raw[name] for name in (*BoomSolution.COLUMNS, "y_end")},
-        **limit_record(raw),
+        **_runs.limit_record(raw),
     )
-    warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)
+    _runs.warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)
     return sol
 
 

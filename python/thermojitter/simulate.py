@@ -10,19 +10,19 @@ from numpy.typing import ArrayLike
 
 from thermojitter import _core
 from thermojitter import errors as checks
+
+# What every run shares (its home before _runs.py), exported here as before.
 from thermojitter._runs import DEFAULT_DT_OUT as DEFAULT_DT_OUT
-from thermojitter._runs import (
-    DEFAULT_THETA_LIMIT,
-    limit_args,
-    limit_record,
-    run_record,
-    run_settings,
-    start_state,
-    time_span,
-    warn_crossing,
-)
+from thermojitter._runs import DEFAULT_THETA_LIMIT as DEFAULT_THETA_LIMIT
 from thermojitter._runs import ON_LIMIT as ON_LIMIT
+from thermojitter._runs import limit_args as limit_args
+from thermojitter._runs import limit_record as limit_record
+from thermojitter._runs import run_record as run_record
+from thermojitter._runs import run_settings as run_settings
 from thermojitter._runs import solver_args as solver_args
+from thermojitter._runs import start_state as start_state
+from thermojitter._runs import time_span as time_span
+from thermojitter._runs import warn_crossing as warn_crossing
 from thermojitter.attitude import Attitude, engine_orbit
 from thermojitter.boom import Boom, boom_steady_state, check_attitude, simulate_boom
 from thermojitter.errors import ParameterError
