@@ -280,3 +280,18 @@ def test_mc_command_refuses_a_bad_orbit_input_in_one_line(
     code = mc_command([str(scenario), "--n", "4", "--out", str(tmp_path / "x"), "--no-progress"])
     err = capsys.readouterr().err
     assert code == 2 and "albedo" in err and err.count("\n") == 1
+
+
+def test_sensitivity_takes_orbit_inputs_and_an_attitude() -> None:
+    pytest.importorskip("SALib")
+    vary = {"albedo": ("uniform", 0.0, 0.6), "raan": ("uniform", 0.0, 1.0)}
+    res = tj.sensitivity(
+        PAPER, LEO, vary, metric="theta_eq", n=4, attitude=tj.Attitude.nadir(), **FAST
+    )
+    assert list(res.indices.index) == ["albedo", "raan"]
+    assert len(res.samples) == 4 * 4 and res.samples["albedo"].between(0.0, 0.6).all()
+    # Each sample's equilibrium is its own orbit's at t = 0 (as the Monte Carlo's are).
+    row = res.samples.iloc[5]
+    orbit = LEO.replace(albedo=float(row["albedo"]), raan=float(row["raan"]))
+    eq = tj.flutter(PAPER, orbit=orbit, t=0.0, attitude=tj.Attitude.nadir()).equilibrium
+    assert row["theta_eq"] == eq.theta
