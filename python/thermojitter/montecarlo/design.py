@@ -316,8 +316,10 @@ def sampled(
     vary: Mapping[str, Any],
     u: NDArray[np.float64],
     truncate: bool,
-) -> tuple[list[str], NDArray[np.float64]]:
-    """(names, sampled values) of unit points ``u`` mapped through ``vary``."""
+) -> tuple[list[str], NDArray[np.float64], NDArray[np.float64]]:
+    """(names, sampled values, full panel rows) of unit points ``u`` mapped through ``vary``,
+    the rows checked by the engine's validation (the orbit inputs are checked by
+    :func:`checked_orbit_inputs`)."""
     names = list(vary)
     boom = isinstance(panel, Boom)
     dists = [distribution(name, vary[name]) for name in names]
@@ -327,23 +329,25 @@ def sampled(
             for j, (name, dist) in enumerate(zip(names, dists, strict=True))
         ]
     )
-    return names, values
-
-
-def refuse_design(
-    panel: Panel | Boom,
-    orbit: dict[str, Any],
-    names: Sequence[str],
-    values: NDArray[np.float64],
-    hint: str,
-) -> tuple[NDArray[np.float64], dict[str, Any]]:
-    """(full panel rows, orbit inputs) of a design, each sample's panel and orbit checked by the
-    engine's validation: a design with any sample outside a valid range is refused, naming it."""
     matrix = panel_matrix(panel, names, values)
-    refuse_invalid(matrix, hint, isinstance(panel, Boom))
+    refuse_invalid(matrix, truncation_hint(truncate), boom)
+    return names, values, matrix
+
+
+def truncation_hint(truncate: bool) -> str:
+    """What a refusal of a drawn design suggests."""
+    return "" if truncate else "; narrow the distribution or pass truncate=True"
+
+
+def checked_orbit_inputs(
+    orbit: dict[str, Any], names: Sequence[str], values: NDArray[np.float64], hint: str
+) -> dict[str, Any]:
+    """The orbit inputs of a design (name → one value a sample), each sample's orbit (``orbit``
+    with its inputs) checked by the engine's validation: a design with any sample outside a valid
+    range is refused, naming the input."""
     inputs = orbit_inputs(names, values)
     refuse_invalid_orbits(orbit, inputs, hint)
-    return matrix, inputs
+    return inputs
 
 
 def check_table(table: Any, what: str, of: str, boom: bool = False) -> Mapping[str, Any]:

@@ -25,9 +25,12 @@ from thermojitter.montecarlo.design import (
     check_seed,
     check_table,
     check_vary,
+    checked_orbit_inputs,
     describe,
-    refuse_design,
+    panel_matrix,
+    refuse_invalid,
     sampled,
+    truncation_hint,
     unit_design,
 )
 from thermojitter.montecarlo.driver import run_design, run_options, with_layers
@@ -196,9 +199,8 @@ def _run_drawn(
     (``monte_carlo`` and ``sensitivity``): the study's settings are its name, the panel, the
     distributions, ``n``, ``seed``, ``sampler`` (how ``u`` was drawn) and ``truncate``; ``run``
     goes to ``run_design``."""
-    names, values = sampled(panel, vary, u, truncate)
-    hint = "" if truncate else "; narrow the distribution or pass truncate=True"
-    matrix, inputs = refuse_design(panel, options["orbit"], names, values, hint)
+    names, values, matrix = sampled(panel, vary, u, truncate)
+    inputs = checked_orbit_inputs(options["orbit"], names, values, truncation_hint(truncate))
     settings = {
         **_settings(study, panel),
         "vary": {name: describe(vary[name]) for name in names},
@@ -262,7 +264,9 @@ def sweep(
         )
     options = with_layers(options, panel, layers, names)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
-    matrix, inputs = refuse_design(panel, options["orbit"], names, values, "")
+    matrix = panel_matrix(panel, names, values)
+    refuse_invalid(matrix, "", isinstance(panel, Boom))
+    inputs = checked_orbit_inputs(options["orbit"], names, values, "")
     settings = {**_settings("sweep", panel), "grid": dict(zip(names, axes, strict=True))}
     return run_design(
         names, values, matrix, options, settings, inputs, threads=threads, backend=backend,
