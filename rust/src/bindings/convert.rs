@@ -1,7 +1,7 @@
 //! Python values to engine types, with errors that name the parameter.
 
 use super::error::invalid;
-use crate::inputs::heating::Attitude;
+use crate::inputs::attitude::Attitude;
 use crate::inputs::orbit::Shadow;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
