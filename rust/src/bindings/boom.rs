@@ -166,7 +166,7 @@ fn run_boom_orbits<'py>(
         let method = solver_from(&solver)?;
         check_hinge_angle("theta_limit", theta_limit)?;
         if let Some(h) = hybrid {
-            super::orbits::hybrid_from(h)?;
+            super::convert::hybrid_from(h)?;
         }
         let options = SummaryOptions {
             window,
