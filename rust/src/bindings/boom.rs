@@ -104,13 +104,9 @@ fn simulate_boom<'py>(
     cancellable(cancel, |cancel| {
         let b = boom_from(boom)?;
         let o = orbit_from(orbit)?;
-        let (method, out) = run.integration()?;
-        let limit = run.watch()?;
+        let settings = run.transient(true)?;
         let c = coupling(coupled);
-        let (span, y0) = (run.span, run.y0);
-        let run = py.detach(|| {
-            crate::runs::boom::simulate(&b, o, c, &method, span, &out, y0, limit, cancel)
-        })?;
+        let run = py.detach(|| crate::runs::boom::simulate(&b, o, c, settings, cancel))?;
         transient_dict(py, Transient::Coupled(run))
     })
 }

@@ -9,7 +9,7 @@ use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
 use crate::numerics::integrate::{Method, Stats, Tolerances};
 use crate::runs::hybrid::HybridSettings;
-use crate::runs::simulate::Output;
+use crate::runs::simulate::{Output, TransientSettings};
 use crate::{Orbit, Panel};
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyTypeError;
@@ -525,6 +525,20 @@ impl RunOptions<'_> {
         };
         out.sample_times(t0, t1)?;
         Ok((method, out))
+    }
+
+    /// The transient's settings: [`RunOptions::integration`], then with `watch` the limit
+    /// ([`RunOptions::watch`]; without, none: a system with no θ), converted in that order.
+    pub fn transient(&self, watch: bool) -> PyResult<TransientSettings> {
+        let (method, output) = self.integration()?;
+        let limit = if watch { self.watch()? } else { None };
+        Ok(TransientSettings {
+            method,
+            span: self.span,
+            output,
+            y0: self.y0.clone(),
+            limit,
+        })
     }
 
     /// The validity limit the run watches (None without a `limit` entry, or with "ignore").
