@@ -114,7 +114,7 @@ mod runs {
         // the shadow exit, where its slope jumps.
         let ts = times(span, 0.1, &[b]);
         let run_settings = TransientSettings {
-            method: method.clone(),
+            method,
             span,
             output: Output::Times(ts.clone()),
             y0: None,
