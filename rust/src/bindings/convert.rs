@@ -383,11 +383,7 @@ pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
             "linear_tolerance" => s.linear_tolerance = v,
             "linear_amplitude" => s.linear_amplitude = v,
             "resolved_amplitude" => s.resolved_amplitude = v,
-            other => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "hybrid = {{{other:?}: ...}} is invalid: not a hybrid setting"
-                )))
-            }
+            other => return Err(invalid("hybrid", other, "not a hybrid setting")),
         }
     }
     s.validate()?;
