@@ -100,7 +100,7 @@ pub const ORBIT_INPUTS: [&str; 4] = ["albedo", "earth_ir", "inclination", "raan"
 /// low end open)`, both ends closed here.
 pub const ORBIT_INPUT_RANGES: [(f64, f64, bool); 4] = [
     (0.0, 1.0, false),
-    (0.0, crate::inputs::heating::MAX_EARTH_IR, false),
+    (0.0, crate::inputs::attitude::MAX_EARTH_IR, false),
     (0.0, std::f64::consts::PI, false),
     (
         -crate::inputs::orbit::MAX_PHASE0,
@@ -1034,7 +1034,7 @@ mod tests {
         let mut s = settings();
         s.orbit.albedo = 0.3;
         s.orbit.earth_ir = 237.0;
-        s.orbit.attitude = crate::inputs::heating::Attitude::Nadir;
+        s.orbit.attitude = crate::inputs::attitude::Attitude::Nadir;
         let p = panels()[3];
         let m = run_sample(&p, &s, &Cancel::new()).unwrap();
         let system = Coupled::new(p, s.orbit, s.model, s.coupling);
