@@ -1022,11 +1022,18 @@ mod tests {
         let mut bad = samples.clone();
         bad[2].orbit.albedo = 1.5;
         let out = run_samples(&p, &bad, &s, &Cancel::new(), Path::Lockstep).unwrap();
-        assert!(out[2].error.as_deref().unwrap().starts_with("albedo"));
+        assert_fails_alone(&out, 2, "albedo");
+    }
+
+    /// Sample `k` of `out`, alone, failed with an error naming `name`.
+    fn assert_fails_alone(out: &[SampleMetrics], k: usize, name: &str) {
+        let err = out[k].error.as_deref().unwrap();
+        assert!(err.starts_with(name), "{err}");
+        assert!(out[k].growth_rate.is_nan());
         assert!(out
             .iter()
             .enumerate()
-            .all(|(i, m)| (i == 2) == m.error.is_some()));
+            .all(|(i, m)| (i == k) == m.error.is_some()));
     }
 
     #[test]
@@ -1103,7 +1110,7 @@ mod tests {
         let mut loaded = booms.clone();
         loaded[1].1.albedo = 0.3;
         let out = run_boom_batch(&pool(2).unwrap(), &loaded, &s, &Cancel::new()).unwrap();
-        assert!(out[1].error.is_some() && out[0].error.is_none());
+        assert_fails_alone(&out, 1, "orbit");
     }
 
     #[test]
@@ -1111,13 +1118,7 @@ mod tests {
         let mut ps = panels();
         ps[2].emissivity_front = 1.5;
         let out = run_batch(&pool(2).unwrap(), &ps, &settings(), &Cancel::new()).unwrap();
-        let err = out[2].error.as_deref().unwrap();
-        assert!(err.starts_with("emissivity_front"), "{err}");
-        assert!(out[2].growth_rate.is_nan());
-        assert!(out
-            .iter()
-            .enumerate()
-            .all(|(i, m)| (i == 2) == m.error.is_some()));
+        assert_fails_alone(&out, 2, "emissivity_front");
     }
 
     #[test]
