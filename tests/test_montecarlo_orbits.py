@@ -214,6 +214,8 @@ def test_the_checkpoint_tells_attitudes_and_orbit_inputs_apart(tmp_path: Path) -
             tj.monte_carlo(PAPER, LEO, **changed, **args)
     # The design's digest covers the orbit inputs: the same panels on other orbits differ.
     s = first.attrs["settings"]
+    # Where the samples start on an orbit with the Earth's loads is part of the request.
+    assert s["run"]["start"] == "loaded_equilibrium"
     other = tj.monte_carlo(PAPER, LEO, vary={"raan": ("uniform", 0.0, 2.0)}, n=2, seed=3, **FAST)
     assert other.attrs["settings"]["design_sha256"] != s["design_sha256"]
 

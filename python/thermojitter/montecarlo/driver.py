@@ -98,6 +98,11 @@ def run_options(
     }
     if boom:
         options["boom"] = True
+    if face_loads(options, {}):
+        # The samples start at, and are analysed about, the equilibrium under every load of the
+        # orbit at t = 0 (before, at the Sun's alone): a checkpoint of a study on such an orbit
+        # written before that is not resumed with rows computed otherwise.
+        options["start"] = "loaded_equilibrium"
     return options
 
 
