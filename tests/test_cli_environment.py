@@ -17,7 +17,7 @@ import pytest
 import thermojitter as tj
 from thermojitter import cli
 from thermojitter.cli.flutter import BOOM_INCLINATIONS_DEG
-from thermojitter.reports.plots import face_flux_figure, orbit_year_figure
+from thermojitter.reports.plots import boom_stability_figure, face_flux_figure, orbit_year_figure
 
 INCLINATION = 0.4974  # rad, about 28.5 deg
 HUBBLE_ORBIT = f"""
@@ -47,7 +47,8 @@ def test_flutter_takes_earth_heating_the_attitude_and_the_point_of_the_orbit(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     text = "[panel]\ndamping = 1.5\n" + HUBBLE_ORBIT + TRACKING + "\n[flutter]\nt = 1500.0\n"
-    data = flutter_json(tmp_path, text, "--no-plot", "--x", "damping:0:3:4", "--y", "conductance:5:20:3")
+    axes = ("--x", "damping:0:3:4", "--y", "conductance:5:20:3")
+    data = flutter_json(tmp_path, text, "--no-plot", *axes)
     panel, orbit = tj.Panel.paper().replace(damping=1.5), hubble()
     attitude = tj.Attitude.sun_tracking(0.1)
     for model in ("nonlinear", "linear"):
@@ -123,7 +124,7 @@ def test_flutter_of_a_boom_is_the_tubes_analysis(tmp_path: Path) -> None:
         (BOOM + HUBBLE_ORBIT, [], "orbit.albedo"),
         (BOOM, ["--x", "damping:0:1:3"], "boom"),
         (HUBBLE_ORBIT, ["--flux", "1.0"], "give t, not flux"),
-        ("[flutter]\nt = \"noon\"\n", [], "flutter.t"),
+        ('[flutter]\nt = "noon"\n', [], "flutter.t"),
     ],
 )
 def test_flutter_refuses_what_it_cannot_analyse_in_one_line(
@@ -240,6 +241,22 @@ def test_the_flux_figure_plots_each_faces_flux() -> None:
         # Nadir: the front faces the Earth, so it keeps the Earth's infrared in the shadow.
         dark = sol.sunlit == 0.0
         assert dark.any() and np.all(sol.flux_front[dark] > 0.0)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+
+
+def test_the_boom_figure_plots_the_sweep() -> None:
+    boom = tj.Boom(15.0, 6.35e-3, 5.1e-5, absorptivity=0.5, emissivity=0.05, damping=0.0)
+    psi = np.radians([60.0, 90.0, 120.0])
+    sweep = tj.boom_stability_map(boom, psi, [boom.response_time_ratio])
+    fig = boom_stability_figure(sweep, boom)
+    try:
+        top, bottom = fig.axes[:2]
+        np.testing.assert_array_equal(top.lines[0].get_xdata(), np.degrees(psi))
+        np.testing.assert_array_equal(top.lines[0].get_ydata(), sweep.growth_rate[:, 0])
+        np.testing.assert_array_equal(bottom.lines[0].get_ydata(), sweep.critical_damping[:, 0])
     finally:
         import matplotlib.pyplot as plt
 

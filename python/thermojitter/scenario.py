@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from datetime import date
 from pathlib import Path
@@ -79,7 +79,7 @@ class ScenarioError(ValueError):
         super().__init__(message)
 
 
-ORBIT_PRESETS = {
+ORBIT_PRESETS: dict[str, Callable[..., Orbit]] = {
     "geo_equinox": Orbit.geo_equinox,
     "geo_year": Orbit.geo_year,
     "leo": Orbit.leo,
@@ -408,9 +408,7 @@ def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
     if "preset" in table:
         preset = _choice(path, "orbit.preset", table["preset"], tuple(ORBIT_PRESETS))
     if "start_date" in table and preset not in ("geo_year", "circular"):
-        raise ScenarioError(
-            path, "orbit.start_date", "goes with preset = 'geo_year' or 'circular'"
-        )
+        raise ScenarioError(path, "orbit.start_date", "goes with preset = 'geo_year' or 'circular'")
     if "altitude" in table and preset not in ("leo", "circular"):
         raise ScenarioError(path, "orbit.altitude", "goes with preset = 'leo' or 'circular'")
     if preset == "circular":

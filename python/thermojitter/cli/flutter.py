@@ -34,6 +34,8 @@ from typing import Any, Literal, cast
 import numpy as np
 
 from thermojitter import _core
+from thermojitter.attitude import Attitude, has_face_loads
+from thermojitter.boom import Boom, BoomEquilibrium, boom_stability_map
 from thermojitter.cli.common import Command, UserError, add_out, out_dir, write_output
 from thermojitter.flutter import (
     FlutterResult,
@@ -41,8 +43,6 @@ from thermojitter.flutter import (
     linear_thermal_response,
     stability_map,
 )
-from thermojitter.attitude import Attitude, has_face_loads
-from thermojitter.boom import Boom, BoomEquilibrium, boom_stability_map
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel
 from thermojitter.scenario import Scenario, ScenarioError, load_scenario
@@ -201,9 +201,7 @@ def _inputs(args: argparse.Namespace) -> Inputs:
             f"{source}: flux: the scenario's Earth heating or attitude sets the loads at the "
             "point t of the orbit; give t, not flux"
         )
-    return Inputs(
-        scenario.panel, orbit, attitude, options, source, t, flux, flux_given, coupled
-    )
+    return Inputs(scenario.panel, orbit, attitude, options, source, t, flux, flux_given, coupled)
 
 
 def _loads_line(inputs: Inputs) -> str:
@@ -406,9 +404,9 @@ def _boom_run(args: argparse.Namespace, inputs: Inputs, out: Path) -> int:
     )
     png = out / "boom_stability.png"
     if not args.no_plot:
-        from thermojitter.reports.plots import boom_stability_figure
+        from thermojitter.reports.plots import boom_stability_figure, save
 
-        boom_stability_figure(sweep, boom, png)
+        save(boom_stability_figure(sweep, boom), png)
     record = {
         **_point_record(inputs),
         "boom": boom.as_dict(),

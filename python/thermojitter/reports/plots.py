@@ -432,10 +432,11 @@ def stability_map_figure(m: Any, panel: Any, path: Path) -> Path:
     return save(fig, path)
 
 
-def boom_stability_figure(sweep: Any, boom: Any, path: Path) -> Path:
+def boom_stability_figure(sweep: Any, boom: Any) -> Any:
     """A boom's flutter over its solar inclination ψ at one response-time ratio B (a
     :class:`thermojitter.BoomStabilityMap` of one column): the growth rate at the boom's own
-    damping, and the damping ratio that suppresses flutter, with the scenario's ψ marked."""
+    damping (top axes), and the damping ratio that suppresses flutter (bottom), with the boom's
+    own ψ marked. Returns the figure."""
     psi = np.degrees(np.asarray(sweep.inclination, dtype=float))
     fig, (top, bottom) = figure(2, height=5.6)
     top.plot(psi, sweep.growth_rate[:, 0], "o-", ms=3, lw=1.0, color="C3", label="growth rate")
@@ -459,7 +460,7 @@ def boom_stability_figure(sweep: Any, boom: Any, path: Path) -> Path:
         f"{ratio:.3g}, $\\zeta$ = {boom.damping:g})"
     )
     legend(fig)
-    return save(fig, path)
+    return fig
 
 
 # --------------------------------------------------------------------------------------------
