@@ -261,3 +261,27 @@ def test_the_boom_figure_plots_the_sweep() -> None:
         import matplotlib.pyplot as plt
 
         plt.close(fig)
+
+
+def test_the_hubble_year_example_runs(tmp_path: Path) -> None:
+    """examples/hubble_year.py on one day (its default samples 24, about half a minute)."""
+    import subprocess
+    import sys
+
+    script = Path(__file__).resolve().parents[1] / "examples" / "hubble_year.py"
+    done = subprocess.run(
+        [sys.executable, str(script), "--days", "1", "--orbits", "2", "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "Warning" not in done.stderr
+    lines = done.stdout.splitlines()
+    day0 = next(line for line in lines if line.strip().startswith("0.0"))
+    beta = float(day0.split()[1])
+    orbit = tj.Orbit.circular(540e3, math.radians(28.5), 0.0, "2026-01-01")
+    deepest = orbit.eclipses(0.0, orbit.period)[0, 0]
+    assert beta == pytest.approx(math.degrees(orbit.beta(deepest + orbit.period / 2)[0]), abs=0.05)
+    assert any("c_d* at noon" in line for line in lines)
+    assert (tmp_path / "orbit_year.png").exists() and (tmp_path / "fluxes.png").exists()
