@@ -285,3 +285,22 @@ def test_the_hubble_year_example_runs(tmp_path: Path) -> None:
     assert beta == pytest.approx(math.degrees(orbit.beta(deepest + orbit.period / 2)[0]), abs=0.05)
     assert any("c_d* at noon" in line for line in lines)
     assert (tmp_path / "orbit_year.png").exists() and (tmp_path / "fluxes.png").exists()
+
+
+HISTORICAL = ("boom_1963_22a_bare", "boom_1963_22a_silver", "boom_hst_bistem", "boom_cfrp")
+
+
+@pytest.mark.parametrize("name", HISTORICAL)
+def test_each_historical_scenario_runs_through_the_command_in_under_a_minute(
+    name: str, tmp_path: Path
+) -> None:
+    """Issue 31's bound, through ``thermojitter run`` as a user runs it (plots included)."""
+    import time
+
+    scenario = Path(__file__).resolve().parents[1] / "examples" / f"{name}.toml"
+    started = time.perf_counter()
+    assert cli.main(["run", str(scenario), "--out", str(tmp_path), "--no-progress"]) == 0
+    elapsed = time.perf_counter() - started
+    assert elapsed < 60.0, elapsed
+    meta = json.loads((tmp_path / "run.json").read_text())
+    assert not meta["interrupted"] and "theta.png" in meta["files"]
