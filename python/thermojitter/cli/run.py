@@ -88,8 +88,8 @@ def scenario_keys_help() -> str:
                 "orbit",
                 ["preset", "start_date", "altitude", *(f.name for f in fields(Orbit))],
                 'preset = "geo_equinox" | "geo_year" (start_date = YYYY-MM-DD) | "leo" '
-                '(altitude, m) | "sunlit"; shadow = "none" | "cylindrical" | "penumbra" '
-                '(or "conical")',
+                '(altitude, m) | "circular" (altitude, start_date; Earth heating on) | '
+                '"sunlit"; shadow = "none" | "cylindrical" | "penumbra" (or "conical")',
             ),
             table(
                 "simulation",
