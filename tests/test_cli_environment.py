@@ -304,3 +304,30 @@ def test_each_historical_scenario_runs_through_the_command_in_under_a_minute(
     assert elapsed < 60.0, elapsed
     meta = json.loads((tmp_path / "run.json").read_text())
     assert not meta["interrupted"] and "theta.png" in meta["files"]
+
+
+@pytest.mark.parametrize(
+    ("text", "key"),
+    [
+        ('[orbit]\npreset = "circular"\naltitude = 540\n', "orbit.altitude"),
+        ('[orbit]\npreset = "circular"\nstart_date = "noon"\n', "orbit.start_date"),
+        ('[orbit]\npreset = "circular"\ninclination = 28.5\n', "orbit.inclination"),
+        ('[orbit]\npreset = "leo"\nstart_date = 2026-01-01\n', "orbit.start_date"),
+    ],
+)
+def test_the_circular_preset_names_a_bad_key(tmp_path: Path, text: str, key: str) -> None:
+    from thermojitter.scenario import ScenarioError, load_scenario
+
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(text)
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(scenario)
+    assert caught.value.key == key, caught.value
+
+
+def test_the_circular_preset_is_orbit_circular(tmp_path: Path) -> None:
+    from thermojitter.scenario import load_scenario
+
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(HUBBLE_ORBIT + "albedo = 0.0\n")
+    assert load_scenario(scenario).orbit == hubble().replace(albedo=0.0)
