@@ -293,7 +293,7 @@ def orbit_year_figure(
     [t0, t0 + span] (a year by default), against days from t0: β from ``orbit.beta`` at
     :data:`BETA_SAMPLES` evenly spaced times, each eclipse's length from first to last contact
     (``orbit.eclipse_durations``) at its deepest point (``orbit.eclipses``), and its umbra when
-    the orbit has a penumbra. Eclipses exist only while |β| is small enough; their seasons are
+    the orbit has a penumbra. Eclipses exist only while abs(β) is small enough; their seasons are
     the gaps. Returns the figure (top axes: β [deg]; bottom: eclipse length [min])."""
     t1 = t0 + span
     t = np.linspace(t0, t1, BETA_SAMPLES)
