@@ -92,9 +92,9 @@ solar_inclination_deg = 120.0
 """
 
 
-def test_flutter_of_a_boom_is_the_tubes_analysis(tmp_path: Path) -> None:
-    data = flutter_json(tmp_path, BOOM + '\n[orbit]\npreset = "geo_year"\n')
-    boom = tj.Boom(
+def the_boom() -> tj.Boom:
+    """The boom of BOOM, built through the API."""
+    return tj.Boom(
         15.0,
         6.35e-3,
         5.1e-5,
@@ -103,6 +103,11 @@ def test_flutter_of_a_boom_is_the_tubes_analysis(tmp_path: Path) -> None:
         damping=0.001,
         solar_inclination=math.radians(120.0),
     )
+
+
+def test_flutter_of_a_boom_is_the_tubes_analysis(tmp_path: Path) -> None:
+    data = flutter_json(tmp_path, BOOM + '\n[orbit]\npreset = "geo_year"\n')
+    boom = the_boom()
     orbit = tj.Orbit.geo_year()
     api = tj.flutter(boom, orbit=orbit, t=0.0)
     assert data["tube"]["growth_rate_per_s"] == api.growth_rate
@@ -161,15 +166,7 @@ def test_run_of_a_boom_writes_the_tubes_columns(tmp_path: Path) -> None:
     out = tmp_path / "out"
     assert cli.main(["run", str(scenario), "--out", str(out), "--no-progress", "--no-plots"]) == 0
     series = pd.read_csv(out / "timeseries.csv")
-    boom = tj.Boom(
-        15.0,
-        6.35e-3,
-        5.1e-5,
-        absorptivity=0.5,
-        emissivity=0.05,
-        damping=0.001,
-        solar_inclination=math.radians(120.0),
-    )
+    boom = the_boom()
     sol = tj.simulate(boom, tj.Orbit.leo(), (0.0, 600.0), dt_out=0.5)
     np.testing.assert_array_equal(series["T_circ [K]"], sol.T_circ)
     np.testing.assert_array_equal(series["theta [rad]"], sol.theta)
