@@ -19,8 +19,8 @@ A scenario has these tables, each optional::
     radius = 6.35e-3  # field (SI), and solar_inclination_deg in place of solar_inclination
     wall = 5.1e-5
 
-    [orbit]        # preset = "geo_equinox" and/or any Orbit field
-    preset = "geo_equinox"
+    [orbit]        # preset = "geo_equinox" | "geo_year" | "leo" | "circular" | "sunlit"
+    preset = "geo_equinox"   # and/or any Orbit field
 
     [attitude]     # kind = "sun_pointing" | "sun_tracking" (offset, rad) | "nadir" |
     kind = "sun_pointing"    # "inertial" (normal = [x, y, z])
@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from datetime import date
 from pathlib import Path
@@ -53,7 +53,7 @@ from thermojitter.boom import Boom
 from thermojitter.errors import ParameterError
 from thermojitter.laminate import Laminate, Layer
 from thermojitter.longrun import DEFAULT_THETA_LIMIT
-from thermojitter.orbit import LEO_ALTITUDE, Orbit
+from thermojitter.orbit import EQUINOX_DAY, LEO_ALTITUDE, Orbit, day_of_year
 from thermojitter.panel import LAYUP_FIELDS, Panel
 from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
@@ -79,10 +79,11 @@ class ScenarioError(ValueError):
         super().__init__(message)
 
 
-ORBIT_PRESETS = {
+ORBIT_PRESETS: dict[str, Callable[..., Orbit]] = {
     "geo_equinox": Orbit.geo_equinox,
     "geo_year": Orbit.geo_year,
     "leo": Orbit.leo,
+    "circular": Orbit.circular,
     "sunlit": Orbit.sunlit,
 }
 SHADOWS = ("none", "cylindrical", "penumbra", "conical")
@@ -406,11 +407,26 @@ def _orbit(path: Path, table: dict[str, Any]) -> Orbit:
     preset = None
     if "preset" in table:
         preset = _choice(path, "orbit.preset", table["preset"], tuple(ORBIT_PRESETS))
-    if "start_date" in table and preset != "geo_year":
-        raise ScenarioError(path, "orbit.start_date", "goes with preset = 'geo_year'")
-    if "altitude" in table and preset != "leo":
-        raise ScenarioError(path, "orbit.altitude", "goes with preset = 'leo'")
-    if preset == "geo_year":
+    if "start_date" in table and preset not in ("geo_year", "circular"):
+        raise ScenarioError(path, "orbit.start_date", "goes with preset = 'geo_year' or 'circular'")
+    if "altitude" in table and preset not in ("leo", "circular"):
+        raise ScenarioError(path, "orbit.altitude", "goes with preset = 'leo' or 'circular'")
+    if preset == "circular":
+        # Orbit.circular's own defaults (the March equinox, J2, a conical shadow, the Earth's
+        # mean albedo and infrared); its other fields below override them.
+        altitude = _positive(path, "orbit.altitude", table.get("altitude", LEO_ALTITUDE))
+        start = table.get("start_date", EQUINOX_DAY)
+        if not isinstance(start, (str, int, float, date)) or isinstance(start, bool):
+            raise ScenarioError(path, "orbit.start_date", "must be a date (2026-03-20) or a day")
+        try:
+            epoch = day_of_year(start, "start_date")
+        except (ValueError, TypeError) as exc:
+            raise ScenarioError(path, "orbit.start_date", str(exc)) from None
+        try:
+            base = Orbit.circular(altitude, epoch=epoch).as_dict()
+        except (ValueError, TypeError) as exc:
+            raise _engine_error(path, "orbit", exc, "altitude") from None
+    elif preset == "geo_year":
         start = table.get("start_date", "2026-01-01")
         if not isinstance(start, (str, int, date)) or isinstance(start, bool):
             raise ScenarioError(path, "orbit.start_date", "must be a date (2026-03-20) or a day")

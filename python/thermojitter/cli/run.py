@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from thermojitter.attitude import has_face_loads
 from thermojitter.cli.common import STOP, Interrupted, UserError, add_out, out_dir, write_output
 from thermojitter.errors import ParameterError, ValidityLimitWarning
 from thermojitter.progress import progress_bar, report_interrupted
@@ -38,10 +39,13 @@ MAX_ORBITS = 100_000
 COLUMNS = ("T_front", "T_back", "theta", "theta_dot", "thermal_moment", "sunlit")
 SERIES_UNITS = {
     "t": "s", "T_front": "K", "T_back": "K", "theta": "rad", "theta_dot": "rad/s",
-    "thermal_moment": "N m", "sunlit": "-",
+    "thermal_moment": "N m", "sunlit": "-", "flux_front": "W/m²", "flux_back": "W/m²",
 }  # fmt: skip
 """The unit of each column of the time series: in the CSV header (``t [s]``), and in the
-Parquet file's ``attrs["units"]``; a node's temperature (``T_node07 (core)``) is in K."""
+Parquet file's ``attrs["units"]``; a node's temperature (``T_node07 (core)``) is in K.
+``flux_front`` and ``flux_back`` (the flux reaching each face) are kept when the orbit heats the
+panel from the Earth or the attitude is not Sun-pointing."""
+FLUX_COLUMNS = ("flux_front", "flux_back")
 
 
 def series_units(names: Sequence[str]) -> dict[str, str]:
@@ -84,8 +88,8 @@ def scenario_keys_help() -> str:
                 "orbit",
                 ["preset", "start_date", "altitude", *(f.name for f in fields(Orbit))],
                 'preset = "geo_equinox" | "geo_year" (start_date = YYYY-MM-DD) | "leo" '
-                '(altitude, m) | "sunlit"; shadow = "none" | "cylindrical" | "penumbra" '
-                '(or "conical")',
+                '(altitude, m) | "circular" (altitude, start_date; Earth heating on) | '
+                '"sunlit"; shadow = "none" | "cylindrical" | "penumbra" (or "conical")',
             ),
             table(
                 "simulation",
@@ -148,6 +152,7 @@ def simulate_scenario(
     pieces: list[dict[str, np.ndarray]] = []
     counters = {"n_steps": 0, "n_rejected": 0, "n_rhs": 0}
     chunks = _chunks(t0, t1, scenario.orbit.period)
+    loaded = has_face_loads(scenario.orbit, scenario.attitude)
     node_names: tuple[str, ...] = ()
     y0: Any = None
     interrupted = False
@@ -177,6 +182,8 @@ def simulate_scenario(
             names_of = sol._columns() if not hasattr(sol, "T_front") else COLUMNS
             piece = {"t": sol.t[keep], **{c: getattr(sol, c)[keep] for c in names_of}}
             # With layers = N: a column per node, named as in Solution.to_pandas().
+            if loaded:
+                piece.update({c: getattr(sol, c)[keep] for c in FLUX_COLUMNS})
             node_names = getattr(sol, "node_columns", ())
             nodes = getattr(sol, "T_nodes", None)
             if nodes is not None:
@@ -242,6 +249,31 @@ def write_series(
     return write_output(target, lambda fh: fh.write(frame.to_csv(index=False).encode()))
 
 
+def orbit_figures(
+    out: Path,
+    scenario: Scenario,
+    t: np.ndarray | None = None,
+    columns: dict[str, np.ndarray] | None = None,
+) -> list[Path]:
+    """The figures of the orbit's environment: ``orbit_year.png`` (β and the eclipses over a
+    year from the run's start) when the Sun follows the year (``season``), and ``fluxes.png``
+    (the flux on each face over the time series) when the run keeps the fluxes."""
+    from thermojitter.reports.plots import face_flux_figure, orbit_year_figure, save
+
+    title = Path(scenario.source).stem
+    written = []
+    if scenario.orbit.season:
+        t0 = scenario.simulation.t_start
+        fig = orbit_year_figure(scenario.orbit, t0, title=title)
+        written.append(save(fig, out / "orbit_year.png"))
+    if t is not None and columns is not None and "flux_front" in columns:
+        fig = face_flux_figure(
+            t, columns["flux_front"], columns["flux_back"], scenario.orbit, title=title
+        )
+        written.append(save(fig, out / "fluxes.png"))
+    return written
+
+
 def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) -> int:
     """`run` with keep = "orbits": one summary row per orbit, resumable from out/checkpoint.json."""
     from thermojitter.longrun import simulate_orbits
@@ -297,6 +329,7 @@ def run_orbits_command(args: argparse.Namespace, scenario: Scenario, out: Path) 
         from thermojitter.reports.plots import orbit_summary_figure
 
         written.append(orbit_summary_figure(out, runs.columns, Path(scenario.source).stem).name)
+        written += [p.name for p in orbit_figures(out, scenario)]
     crossing = runs.limit_crossing
     files = [*written, "run.json", "checkpoint.json"]
     meta: dict[str, Any] = {
@@ -361,6 +394,7 @@ def run_command(args: argparse.Namespace) -> int:
 
         title = Path(scenario.source).stem
         written += [p.name for p in run_figures(out, t, columns, scenario.orbit, title=title)]
+        written += [p.name for p in orbit_figures(out, scenario, t, columns)]
     sim = scenario.simulation
     files = [*written, "run.json"]
     meta = {
@@ -381,15 +415,8 @@ def run_command(args: argparse.Namespace) -> int:
             **counters,
         },
         "shadow_intervals_s": [list(iv) for iv in intervals],
-        "columns": {
-            "t": "s",
-            "T_front": "K",
-            "T_back": "K",
-            "theta": "rad",
-            "theta_dot": "rad/s",
-            "thermal_moment": "N m",
-            "sunlit": "illuminated fraction",
-        },
+        # The unit of each column (a boom's are T_mean, T_circ in place of T_front, T_back).
+        "columns": {**series_units(list(columns)), "sunlit": "illuminated fraction"},
         "theta_min_deg": float(np.degrees(columns["theta"].min())) if len(t) else None,
         "theta_max_deg": float(np.degrees(columns["theta"].max())) if len(t) else None,
         "files": files,
@@ -421,7 +448,10 @@ def add_parser(sub: Any) -> None:
             "theta_dot [rad/s], thermal_moment [N m], sunlit [-]; the CSV header says the "
             "units, the Parquet file's attrs['units']), run.json (settings, step counts) "
             'and plots (temperatures.png, theta.png) into --out; with keep = "orbits", one '
-            "summary row per orbit (orbits.csv, orbits.png), resumable from checkpoint.json."
+            "summary row per orbit (orbits.csv, orbits.png), resumable from checkpoint.json. "
+            "With Earth heating or an [attitude], the flux reaching each face (flux_front, "
+            "flux_back [W/m2], fluxes.png); with the Sun following the year (season), "
+            "orbit_year.png (beta and every eclipse's length over a year from the start)."
         ),
         epilog="Scenario keys (every table and key optional):\n"
         + scenario_keys_help()

@@ -279,6 +279,70 @@ def run_figures(
     return written
 
 
+YEAR = 365.25 * 86400.0
+"""A Julian year, s: the default span of :func:`orbit_year_figure`."""
+
+BETA_SAMPLES = 2000
+"""Points of the β curve of :func:`orbit_year_figure`."""
+
+
+def orbit_year_figure(
+    orbit: Any, t0: float = 0.0, span: float = YEAR, *, title: str = "orbit"
+) -> Any:
+    """The Sun's angle β to the orbit plane and the length of every eclipse over
+    [t0, t0 + span] (a year by default), against days from t0: β from ``orbit.beta`` at
+    :data:`BETA_SAMPLES` evenly spaced times, each eclipse's length from first to last contact
+    (``orbit.eclipse_durations``) at its deepest point (``orbit.eclipses``), and its umbra when
+    the orbit has a penumbra. Eclipses exist only while abs(β) is small enough; their seasons are
+    the gaps. Returns the figure (top axes: β [deg]; bottom: eclipse length [min])."""
+    t1 = t0 + span
+    t = np.linspace(t0, t1, BETA_SAMPLES)
+    fig, (top, bottom) = figure(2, height=5.6)
+    top.plot((t - t0) / 86400.0, np.degrees(orbit.beta(t)), lw=1.0, color="C0", label=r"$\beta$")
+    top.axhline(0.0, color="k", lw=0.6)
+    top.set_ylabel(r"$\beta$, Sun to orbit plane [deg]")
+    top.set_title(f"{title}: the Sun's angle to the orbit plane and the eclipses")
+    rows = orbit.eclipses(t0, t1)
+    rows = rows[(rows[:, 0] >= t0) & (rows[:, 0] < t1)]
+    days = (rows[:, 0] - t0) / 86400.0
+    total = orbit.eclipse_durations(t0, t1) / 60.0
+    bottom.plot(days, total, ".", ms=2.5, color="C3", label="eclipse, first to last contact")
+    if orbit.shadow == "penumbra":
+        umbra = orbit.eclipse_durations(t0, t1, kind="umbra") / 60.0
+        bottom.plot(days, umbra, ".", ms=1.5, color="C1", label="umbra")
+    if not len(days):
+        bottom.text(0.5, 0.5, "no eclipse", transform=bottom.transAxes, ha="center")
+    bottom.set_ylim(bottom=0.0)
+    bottom.set_ylabel("eclipse length [min]")
+    bottom.set_xlabel(f"time from t = {t0:g} s [days]" if t0 else "time [days]")
+    for ax in (top, bottom):
+        ax.grid(alpha=0.3)
+    legend(fig)
+    return fig
+
+
+def face_flux_figure(
+    t: Array, flux_front: Array, flux_back: Array, orbit: Any, *, title: str = "run"
+) -> Any:
+    """The flux reaching each face over a run (``sol.flux_front``, ``sol.flux_back``, W/m²:
+    sunlight, albedo and Earth infrared on the flat panel in its attitude), with the Earth's
+    shadow shaded. Returns the figure (one axes: the front's line, then the back's)."""
+    t = np.asarray(t, dtype=float)
+    t0, t1 = float(t[0]), float(t[-1])
+    scale, unit = time_axis(t1 - t0 if len(t) > 1 else 1.0)
+    x = (t - t0) / scale
+    fig, (ax,) = figure(1, height=4.2)
+    line(ax, x, flux_front, lw=0.9, color="C3", label="front face")
+    line(ax, x, flux_back, lw=0.9, color="C0", label="back face")
+    shade_eclipses(ax, orbit, t0, t1, scale=scale, offset=t0)
+    ax.set_ylabel("flux reaching the face [W/m²]")
+    ax.set_xlabel(f"time from t = {t0:g} s [{unit}]" if t0 != 0.0 else f"time [{unit}]")
+    ax.set_title(f"{title}: sunlight, albedo and Earth infrared on each face")
+    ax.grid(alpha=0.3)
+    legend(fig)
+    return fig
+
+
 def orbit_summary_figure(out: Path, columns: dict[str, Array], title: str) -> Path:
     """Per-orbit summaries of a long run: amplitude, transient peaks and jitter RMS against time
     (days), on a log scale so that growth (flutter) shows as a straight line. Values below the
@@ -366,6 +430,37 @@ def stability_map_figure(m: Any, panel: Any, path: Path) -> Path:
         frameon=False,
     )
     return save(fig, path)
+
+
+def boom_stability_figure(sweep: Any, boom: Any) -> Any:
+    """A boom's flutter over its solar inclination ψ at one response-time ratio B (a
+    :class:`thermojitter.BoomStabilityMap` of one column): the growth rate at the boom's own
+    damping (top axes), and the damping ratio that suppresses flutter (bottom), with the boom's
+    own ψ marked. Returns the figure."""
+    psi = np.degrees(np.asarray(sweep.inclination, dtype=float))
+    fig, (top, bottom) = figure(2, height=5.6)
+    top.plot(psi, sweep.growth_rate[:, 0], "o-", ms=3, lw=1.0, color="C3", label="growth rate")
+    top.axhline(0.0, color="k", lw=0.8)
+    top.set_ylabel("growth rate [1/s]; > 0: flutter")
+    bottom.plot(
+        psi, sweep.critical_damping[:, 0], "o-", ms=3, lw=1.0, color="C0",
+        label="damping ratio that suppresses flutter",
+    )  # fmt: skip
+    bottom.set_ylabel(r"critical damping ratio $\zeta$ [-]")
+    bottom.set_xlabel(r"solar inclination $\psi$, Sun to the axis from root to tip [deg]")
+    for ax in (top, bottom):
+        ax.axvline(
+            np.degrees(boom.solar_inclination), color="0.4", ls="--", lw=0.9, label="scenario"
+        )
+        ax.grid(alpha=0.3)
+        tidy_ticks(ax)
+    ratio = float(np.asarray(sweep.ratio, dtype=float)[0])
+    top.set_title(
+        f"Thermal flutter of the boom over its solar inclination (B = $\\omega_1\\tau$ = "
+        f"{ratio:.3g}, $\\zeta$ = {boom.damping:g})"
+    )
+    legend(fig)
+    return fig
 
 
 # --------------------------------------------------------------------------------------------
