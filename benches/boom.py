@@ -7,6 +7,9 @@ frequency is the paper panel's (found by bisection on the length, the engine's f
 alternately; the median of the repeats is reported with the ratio of the wall times and of the
 time per right-hand side. Target: the boom's orbit costs no more than 1.5x the plate's.
 
+Then each historical scenario (``examples/boom_*.toml``) through the ``run`` command, as a user
+runs it, wall time from the command line to its written outputs. Target: under a minute each.
+
     python benches/boom.py [--repeats 7]
 """
 
@@ -14,7 +17,9 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -88,6 +93,16 @@ def main() -> None:
         f"boom / plate: {wb / wp:.2f}x per orbit (target <= 1.5x), "
         f"{(wb / rb) / (wp / rp):.2f}x per rhs"
     )
+    for path in sorted(EXAMPLES.glob("boom_*.toml")):
+        with tempfile.TemporaryDirectory() as out:
+            start = time.perf_counter()
+            subprocess.run(
+                [sys.executable, "-m", "thermojitter", "run", str(path), "--out", out,
+                 "--no-progress"],
+                check=True, capture_output=True,
+            )  # fmt: skip
+            wall = time.perf_counter() - start
+        print(f"{path.name}: {wall:5.1f} s through `thermojitter run` (target < 60 s)")
     print(f"load average at the end: {load()}")
 
 

@@ -150,6 +150,11 @@ def _boom_flutter(
     """The tube's flutter analysis (see :func:`flutter`)."""
     checks.choice("model", model, ("nonlinear", "linear"))
     flux = _flux(flux, orbit, t)
+    if orbit is not None and has_face_loads(orbit, None):
+        # As the boom's runs do: its analysis knows the Sun on its lit side only.
+        raise checks.ParameterError(
+            "orbit", orbit, "with Earth heating, a boom takes the Sun alone on its lit side"
+        )
     coupled = checks.flag("coupled", coupled)
     raw = _core.boom_flutter(boom.as_dict(), coupled, flux)
     equilibrium = _boom_equilibrium(boom, raw["equilibrium"])
