@@ -216,3 +216,54 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
         Ok(true)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{compare, spec};
+    use super::super::{run_orbits_hybrid, HybridSettings};
+    use crate::analysis::steady::equilibrium;
+    use crate::cancel::Cancel;
+    use crate::inputs::orbit::{Orbit, Shadow};
+    use crate::inputs::panel::Panel;
+    use crate::models::coupled::Coupling;
+    use crate::models::hinge::HingeModel;
+    use crate::numerics::integrate::{Method, Tolerances};
+    use crate::runs::orbits::{run_orbits, OrbitRunRequest};
+    use nalgebra::Vector4;
+
+    /// Table 1 with the linear hinge on a 540 km orbit, each shadow model: whole orbits by
+    /// exponential steps, every summary within the gate of a tight hinge-resolved run.
+    #[test]
+    fn a_low_orbit_of_a_linear_hinge_runs_whole_within_the_gate() {
+        let panel = Panel::paper();
+        for shadow in [Shadow::Cylindrical, Shadow::Penumbra] {
+            let orbit = Orbit {
+                shadow,
+                ..Orbit::leo(540e3)
+            };
+            let eq = equilibrium(&panel, Coupling::ProjectedArea, orbit.flux_scale(0.0)).unwrap();
+            let y0 = Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0);
+            let mut spec = spec(&panel, &orbit, 6);
+            spec.model = HingeModel::Linear;
+            let hybrid = run_orbits_hybrid(
+                &OrbitRunRequest { spec, y0 },
+                &HybridSettings::default(),
+                &Cancel::new(),
+            )
+            .unwrap();
+            spec.method = Method::Dopri5(Tolerances {
+                rtol: 1e-9,
+                atol: 1e-12,
+                ..Tolerances::default()
+            });
+            let full = run_orbits(&OrbitRunRequest { spec, y0 }).unwrap();
+            // The orbits asked for (a step ending on the run's end may open a stub of the next
+            // orbit, in both runs alike).
+            assert!(full.summaries.len() >= 6 && hybrid.run.summaries.len() >= 6);
+            compare(&full.summaries[..6], &hybrid.run.summaries[..6]);
+            assert_eq!(hybrid.t_linear, 0.0);
+            assert!(hybrid.t_exponential > 0.95 * 6.0 * orbit.period);
+            assert!(hybrid.run.stats.n_steps * 20 < full.stats.n_steps);
+        }
+    }
+}
