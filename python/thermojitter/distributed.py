@@ -37,7 +37,7 @@ from thermojitter import _core
 from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
-from thermojitter.persist import Persistent
+from thermojitter.persist import Persistent, field_type
 from thermojitter.progress import interruptible
 from thermojitter.results import LimitCrossing, Run, _dataframes_module, _FaceDifference
 from thermojitter.simulate import (
@@ -288,6 +288,7 @@ def simulate_distributed(
     )
 
 
+@field_type
 @dataclass(frozen=True)
 class OscillatoryMode:
     """One oscillatory eigen-pair of the linearised distributed panel: growth rate Re λ (1/s),
