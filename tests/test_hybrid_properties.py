@@ -98,9 +98,9 @@ def with_drawn_damping(draw: st.DrawFn, panel: tj.Panel) -> tj.Panel:
     return panel.replace(damping=draw(st.floats(0.002, 0.05)) * ref)
 
 
-@st.composite
-def cases(draw: st.DrawFn) -> Case:
-    kind = draw(st.sampled_from(["metal", "cfrp", "sandwich", "paper"]))
+def drawn_panel(draw: st.DrawFn, kind: str) -> tj.Panel:
+    """A panel of `kind` ("paper": Table 1 varied; "metal", "cfrp", "sandwich": a laminate),
+    its damping drawn about its critical damping."""
     if kind == "paper":
         panel = draw(panels(spread=0.2))
     else:
@@ -115,7 +115,13 @@ def cases(draw: st.DrawFn) -> Case:
             layers = [face, mat.ALUMINIUM_HONEYCOMB.layer(draw(st.floats(5e-3, 25e-3))), face]
             length = draw(st.floats(2.0, 8.0))
         panel = tj.Panel.from_laminate(tj.Laminate(layers, **optics(draw)), length=length)
-    panel = with_drawn_damping(draw, panel)
+    return with_drawn_damping(draw, panel)
+
+
+@st.composite
+def cases(draw: st.DrawFn) -> Case:
+    kind = draw(st.sampled_from(["metal", "cfrp", "sandwich", "paper"]))
+    panel = drawn_panel(draw, kind)
 
     orbits = ["geo_equinox", "geo_spring", "geo_no_eclipse", "leo"]
     # rk45 on a sandwich through GEO eclipses took up to 260 s for 2 orbits (measured on

@@ -19,18 +19,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, Phase, given, note, settings
 from test_hybrid import assert_gate
-from test_hybrid_properties import (
-    cfrp_layer,
-    compared_orbits,
-    gate_failures,
-    metal_layer,
-    optics,
-    with_drawn_damping,
-)
+from test_hybrid_properties import compared_orbits, drawn_panel, gate_failures
 
 import thermojitter as tj
-from conftest import PAPER, panels
-from thermojitter import materials as mat
+from conftest import PAPER
 
 SLOW = bool(os.environ.get("THERMOJITTER_SLOW"))
 
@@ -73,21 +65,7 @@ def low_orbits(draw: st.DrawFn) -> tuple[str, tj.Orbit]:
 @st.composite
 def cases(draw: st.DrawFn) -> Case:
     kind = draw(st.sampled_from(["paper", "paper", "metal", "cfrp", "sandwich"]))
-    if kind == "paper":
-        panel = draw(panels(spread=0.2))
-    else:
-        if kind == "metal":
-            layers = [metal_layer(draw)]
-            length = draw(st.floats(1.0, 5.0))
-        elif kind == "cfrp":
-            layers = [cfrp_layer(draw, draw(st.floats(0.5e-3, 3e-3)))]
-            length = draw(st.floats(1.0, 5.0))
-        else:
-            face = cfrp_layer(draw, draw(st.floats(0.1e-3, 0.5e-3)))
-            layers = [face, mat.ALUMINIUM_HONEYCOMB.layer(draw(st.floats(5e-3, 25e-3))), face]
-            length = draw(st.floats(2.0, 8.0))
-        panel = tj.Panel.from_laminate(tj.Laminate(layers, **optics(draw)), length=length)
-    panel = with_drawn_damping(draw, panel)
+    panel = drawn_panel(draw, kind)
     orbit_name, orbit = draw(low_orbits())
     # rk45 resolves the hinge: a stiff, light metal hinge costs ten times Table 1's.
     if SLOW:
