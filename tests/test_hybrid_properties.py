@@ -13,6 +13,7 @@ import datetime as dt
 import math
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import hypothesis.strategies as st
 import numpy as np
@@ -186,14 +187,31 @@ def compared_orbits(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries, n: int) 
     return min(m, len(full), len(hybrid))
 
 
-# Shrinking re-runs rk45 dozens of times (minutes for thin metal on GEO): the default tier
-# reports the drawn case as it failed (the message names every field), the slow tier shrinks.
-@settings(
-    max_examples=60 if SLOW else 8,
-    deadline=None,
-    phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
-    suppress_health_check=[HealthCheck.too_slow],
-)
+def assert_case_gate(
+    case: Case, full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries, m: int | None = None
+) -> None:
+    """Every orbit both runs finished (or the first m), every gated column, within the gate."""
+    if m is None:
+        m = compared_orbits(full, hybrid, case.n)
+    failures = gate_failures(full, hybrid, m)
+    assert not failures, (
+        f"{case.describe()}: {len(failures)} outside the gate in {m} compared orbits; "
+        + "; ".join(failures[:5])
+    )
+
+
+def case_settings(examples: int, slow_examples: int) -> Any:
+    """Shrinking re-runs rk45 dozens of times (minutes for thin metal on GEO): the default tier
+    reports the drawn case as it failed (the message names every field), the slow tier shrinks."""
+    return settings(
+        max_examples=slow_examples if SLOW else examples,
+        deadline=None,
+        phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
+        suppress_health_check=[HealthCheck.too_slow],
+    )
+
+
+@case_settings(8, 60)
 @given(case=cases())
 def test_hybrid_holds_the_gate_of_the_full_run(case: Case) -> None:
     note(case.describe())
@@ -206,9 +224,4 @@ def test_hybrid_holds_the_gate_of_the_full_run(case: Case) -> None:
         assert e.parameter == "n_orbits" and "max_steps" in str(e), e
         reject()
     hybrid = tj.simulate_orbits(case.panel, case.orbit, case.n, method="hybrid", **kw)  # type: ignore[arg-type]
-    m = compared_orbits(full, hybrid, case.n)
-    failures = gate_failures(full, hybrid, m)
-    assert not failures, (
-        f"{case.describe()}: {len(failures)} outside the gate in {m} compared orbits; "
-        + "; ".join(failures[:5])
-    )
+    assert_case_gate(case, full, hybrid)

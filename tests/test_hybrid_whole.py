@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
 
 import hypothesis.strategies as st
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, Phase, given, note, settings
+from hypothesis import given, note
 from test_hybrid import assert_gate
-from test_hybrid_properties import compared_orbits, drawn_panel, gate_failures
+from test_hybrid_properties import Case, assert_case_gate, case_settings, drawn_panel
 
 import thermojitter as tj
 from conftest import PAPER
@@ -28,19 +27,6 @@ SLOW = bool(os.environ.get("THERMOJITTER_SLOW"))
 
 REFERENCE = {"rtol": 1e-9, "atol": 1e-12}
 """rk45 well inside its default tolerances: the reference the gate is held to."""
-
-
-@dataclass(frozen=True)
-class Case:
-    kind: str
-    panel: tj.Panel
-    orbit_name: str
-    orbit: tj.Orbit
-    n: int
-
-    def describe(self) -> str:
-        fields = {k: v for k, v in self.panel.as_dict().items() if k != "layup"}
-        return f"{self.kind} panel {fields} on {self.orbit_name}, {self.n} orbits"
 
 
 @st.composite
@@ -75,24 +61,21 @@ def cases(draw: st.DrawFn) -> Case:
     return Case(kind, panel, orbit_name, orbit, n)
 
 
-@settings(
-    max_examples=40 if SLOW else 6,
-    deadline=None,
-    phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
-    suppress_health_check=[HealthCheck.too_slow],
-)
+@case_settings(6, 40)
 @given(case=cases())
 def test_whole_orbits_hold_the_gate_of_a_tight_rk45_run(case: Case) -> None:
     note(case.describe())
     kw = {"orbits_per_call": case.n, "progress": False, "model": "linear"}
     full = tj.simulate_orbits(case.panel, case.orbit, case.n, method="rk45", **REFERENCE, **kw)  # type: ignore[arg-type]
     hybrid = tj.simulate_orbits(case.panel, case.orbit, case.n, method="hybrid", **kw)  # type: ignore[arg-type]
-    m = compared_orbits(full, hybrid, case.n)
-    failures = gate_failures(full, hybrid, m)
-    assert not failures, (
-        f"{case.describe()}: {len(failures)} outside the gate in {m} compared orbits; "
-        + "; ".join(failures[:5])
-    )
+    m = None
+    if full.limit_crossing is None and hybrid.limit_crossing is None:
+        # A run whose end falls a rounding past an orbit's edge also returns a stub of the next
+        # orbit (rk45 as the hybrid; a defect of how a run ends, not of the propagator): the
+        # orbits asked for are compared.
+        assert len(full) == len(hybrid) in (case.n, case.n + 1), (len(full), len(hybrid))
+        m = case.n
+    assert_case_gate(case, full, hybrid, m)
 
 
 @pytest.mark.parametrize("shadow", ["cylindrical", "conical"])
