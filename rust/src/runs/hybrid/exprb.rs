@@ -117,7 +117,7 @@ fn oscillation_centre<const N: usize, M: HybridModel<N>>(
 }
 
 /// Where each step linearises the model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Linearise {
     /// At the step's start (the method as published).
     AtStart,
@@ -126,8 +126,10 @@ pub(crate) enum Linearise {
     /// phase at which the step began (the curvature of the hinge's moment times the swing), and
     /// the remainder holds a term at the hinge's own frequency, of the order of the swing
     /// squared, that shifts the frequency over the step; about the centre that term cancels and
-    /// the resonant remainder is of the order of the swing cubed.
-    AtCentre,
+    /// the resonant remainder is of the order of the swing cubed. The error of θ and θ̇ is held
+    /// to at most `theta` (rad) and `rate` (rad/s) as well: their tolerance relative to |θ|
+    /// measures a ringing small against the deflection too coarsely.
+    AtCentre { theta: f64, rate: f64 },
 }
 
 /// Integrates the segment [a, b] (no breakpoint inside; the system has entered it) from (t, y),
@@ -156,7 +158,9 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
         let y0 = *y;
         let jac = match linearise {
             Linearise::AtStart => system.jacobian(flux, &y0),
-            Linearise::AtCentre => system.jacobian(flux, &oscillation_centre(system, flux, &y0)),
+            Linearise::AtCentre { .. } => {
+                system.jacobian(flux, &oscillation_centre(system, flux, &y0))
+            }
         };
         let v = time_derivative(system, t0, flux, &y0, a, b);
         let mut rejected_here = false;
@@ -182,7 +186,17 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
                 } else {
                     tol.atol_angle
                 };
-                let r = corr[i] / (atol + tol.rtol * y0[i].abs().max(y1[i].abs()));
+                let mut scale = atol + tol.rtol * y0[i].abs().max(y1[i].abs());
+                if let Linearise::AtCentre { theta, rate } = linearise {
+                    scale = scale.min(if i == N - 2 {
+                        theta
+                    } else if i == N - 1 {
+                        rate
+                    } else {
+                        scale
+                    });
+                }
+                let r = corr[i] / scale;
                 acc += r * r;
             }
             let err = (acc / N as f64).sqrt();

@@ -41,6 +41,13 @@ use nalgebra::SVector;
 /// ringing time to decay into linear arcs).
 pub(crate) const WHOLE_ORBIT_PERIOD: f64 = 6.0 * 3600.0;
 
+/// The error of θ an exponential step may make, relative to the largest oscillation the
+/// summaries read: errors of every step add up over the ringing's life (three orbits on Table 1)
+/// and grow with a fluttering panel's ringing, against a gate of 2 % on every orbit.
+const RINGING_RTOL: f64 = 1e-3;
+/// Its floor, rad: a thousandth of the gate's absolute part (1e-6 rad).
+const RINGING_FLOOR: f64 = 1e-9;
+
 /// Whether a run on `orbit` of a model with this hinge goes whole by the exponential integrator.
 pub(crate) fn applies(orbit: &crate::inputs::orbit::Orbit, hinge: HingeModel) -> bool {
     orbit.period < WHOLE_ORBIT_PERIOD && hinge == HingeModel::Linear
@@ -109,6 +116,15 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
         self.system.enter_segment(a, b);
         let system = self.system.clone();
         let tolerances = self.settings.tolerances;
+        // The ringing's error held to a fraction of the largest oscillation the summaries read
+        // (the last orbit's jitter peak, this orbit's so far), with a floor for a panel at rest.
+        let peak = match self.obs.collector.done.last() {
+            Some(s) if s.jitter_peak.is_finite() => s.jitter_peak,
+            _ => 0.0,
+        }
+        .max(self.obs.collector.current.jitter_peak);
+        let theta = (RINGING_RTOL * peak).max(RINGING_FLOOR);
+        let rate = theta * self.judge.panel.natural_angular_frequency();
         let (mut t, mut y, mut h) = (self.t, self.y, self.h_exp);
         let start = self.t;
         let mut failed: Option<(f64, SVector<f64, N>)> = None;
@@ -121,7 +137,7 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             &mut y,
             &mut h,
             &tolerances,
-            Linearise::AtCentre,
+            Linearise::AtCentre { theta, rate },
             |st: &ExpStep<N>| -> Result<bool> {
                 this.obs.cancel.check()?;
                 if !this.read_closed_form(st)? {
