@@ -10,8 +10,8 @@
    ``--leo-models``: hybrid against rk45 over ``--leo-years`` side by side with the gate, then
    the hybrid alone over ``--leo-long-years`` on that orbit and on the same orbit inclined by
    28.5 deg (``Orbit.circular``, Earth heating off: with it on, the hybrid runs rk45 and says
-   so). A linear hinge runs whole orbits by the exponential integrator; the non-linear hinge
-   keeps the linear arcs and their fallback, whose LEO decade costs about what rk45's does
+   so). An eclipse every orbit leaves the hybrid no linear arcs: most of each orbit goes to its
+   hinge-resolved fallback, and a LEO decade costs about what rk45's does
    (``--leo-long-models`` picks the models of the long run; ``--leo-years 0`` skips part 4).
 
     python benches/longrun.py [--years 1] [--long-years 10] [--mc-samples 20] [--mc-years 10]

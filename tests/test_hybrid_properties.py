@@ -13,7 +13,6 @@ import datetime as dt
 import math
 import os
 from dataclasses import dataclass
-from typing import Any
 
 import hypothesis.strategies as st
 import numpy as np
@@ -99,9 +98,9 @@ def with_drawn_damping(draw: st.DrawFn, panel: tj.Panel) -> tj.Panel:
     return panel.replace(damping=draw(st.floats(0.002, 0.05)) * ref)
 
 
-def drawn_panel(draw: st.DrawFn, kind: str) -> tj.Panel:
-    """A panel of `kind` ("paper": Table 1 varied; "metal", "cfrp", "sandwich": a laminate),
-    its damping drawn about its critical damping."""
+@st.composite
+def cases(draw: st.DrawFn) -> Case:
+    kind = draw(st.sampled_from(["metal", "cfrp", "sandwich", "paper"]))
     if kind == "paper":
         panel = draw(panels(spread=0.2))
     else:
@@ -116,13 +115,7 @@ def drawn_panel(draw: st.DrawFn, kind: str) -> tj.Panel:
             layers = [face, mat.ALUMINIUM_HONEYCOMB.layer(draw(st.floats(5e-3, 25e-3))), face]
             length = draw(st.floats(2.0, 8.0))
         panel = tj.Panel.from_laminate(tj.Laminate(layers, **optics(draw)), length=length)
-    return with_drawn_damping(draw, panel)
-
-
-@st.composite
-def cases(draw: st.DrawFn) -> Case:
-    kind = draw(st.sampled_from(["metal", "cfrp", "sandwich", "paper"]))
-    panel = drawn_panel(draw, kind)
+    panel = with_drawn_damping(draw, panel)
 
     orbits = ["geo_equinox", "geo_spring", "geo_no_eclipse", "leo"]
     # rk45 on a sandwich through GEO eclipses took up to 260 s for 2 orbits (measured on
@@ -187,31 +180,14 @@ def compared_orbits(full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries, n: int) 
     return min(m, len(full), len(hybrid))
 
 
-def assert_case_gate(
-    case: Case, full: tj.OrbitSummaries, hybrid: tj.OrbitSummaries, m: int | None = None
-) -> None:
-    """Every orbit both runs finished (or the first m), every gated column, within the gate."""
-    if m is None:
-        m = compared_orbits(full, hybrid, case.n)
-    failures = gate_failures(full, hybrid, m)
-    assert not failures, (
-        f"{case.describe()}: {len(failures)} outside the gate in {m} compared orbits; "
-        + "; ".join(failures[:5])
-    )
-
-
-def case_settings(examples: int, slow_examples: int) -> Any:
-    """Shrinking re-runs rk45 dozens of times (minutes for thin metal on GEO): the default tier
-    reports the drawn case as it failed (the message names every field), the slow tier shrinks."""
-    return settings(
-        max_examples=slow_examples if SLOW else examples,
-        deadline=None,
-        phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
-        suppress_health_check=[HealthCheck.too_slow],
-    )
-
-
-@case_settings(8, 60)
+# Shrinking re-runs rk45 dozens of times (minutes for thin metal on GEO): the default tier
+# reports the drawn case as it failed (the message names every field), the slow tier shrinks.
+@settings(
+    max_examples=60 if SLOW else 8,
+    deadline=None,
+    phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
+    suppress_health_check=[HealthCheck.too_slow],
+)
 @given(case=cases())
 def test_hybrid_holds_the_gate_of_the_full_run(case: Case) -> None:
     note(case.describe())
@@ -224,4 +200,9 @@ def test_hybrid_holds_the_gate_of_the_full_run(case: Case) -> None:
         assert e.parameter == "n_orbits" and "max_steps" in str(e), e
         reject()
     hybrid = tj.simulate_orbits(case.panel, case.orbit, case.n, method="hybrid", **kw)  # type: ignore[arg-type]
-    assert_case_gate(case, full, hybrid)
+    m = compared_orbits(full, hybrid, case.n)
+    failures = gate_failures(full, hybrid, m)
+    assert not failures, (
+        f"{case.describe()}: {len(failures)} outside the gate in {m} compared orbits; "
+        + "; ".join(failures[:5])
+    )

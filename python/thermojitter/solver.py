@@ -112,12 +112,10 @@ class HybridSettings:
     one home of those numbers).
 
     - ``rtol``, ``atol_temperature`` (K), ``atol_angle`` (rad), ``max_step`` (s): error control
-      of the exponential integrator through the shadows (and through whole orbits on short
-      orbits of a linear hinge);
+      of the exponential integrator through the shadows;
     - ``linear_tolerance`` (rad): largest non-linear remainder, as a static angle error, at which
       the state is handed back to the exact linear arcs;
-    - ``linear_amplitude`` (rad): largest oscillation about the equilibrium propagated linearly
-      (on whole orbits: read in closed form);
+    - ``linear_amplitude`` (rad): largest oscillation about the equilibrium propagated linearly;
     - ``resolved_amplitude`` (rad): largest oscillation left to the exponential integrator.
 
     Immutable; the types are checked here (a real number or None), the values by the engine

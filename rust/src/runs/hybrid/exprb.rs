@@ -103,35 +103,6 @@ fn time_derivative<const N: usize, M: HybridModel<N>>(
     system.flux_sensitivity(flux, y) * dflux
 }
 
-/// The centre of the hinge's oscillation at state y: the same thermal state, θ at the
-/// quasi-static deflection M_T/K_el, at rest.
-fn oscillation_centre<const N: usize, M: HybridModel<N>>(
-    system: &M,
-    flux: f64,
-    y: &SVector<f64, N>,
-) -> SVector<f64, N> {
-    let mut c = *y;
-    c[N - 2] = system.quasi_static(flux, y);
-    c[N - 1] = 0.0;
-    c
-}
-
-/// Where each step linearises the model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Linearise {
-    /// At the step's start (the method as published).
-    AtStart,
-    /// At the centre of the hinge's oscillation ([`oscillation_centre`]): a step then spans many
-    /// periods of a ringing hinge. Linearised at the start, the Jacobian's hinge rows follow the
-    /// phase at which the step began (the curvature of the hinge's moment times the swing), and
-    /// the remainder holds a term at the hinge's own frequency, of the order of the swing
-    /// squared, that shifts the frequency over the step; about the centre that term cancels and
-    /// the resonant remainder is of the order of the swing cubed. The error of θ and θ̇ is held
-    /// to at most `theta` (rad) and `rate` (rad/s) as well: their tolerance relative to |θ|
-    /// measures a ringing small against the deflection too coarsely.
-    AtCentre { theta: f64, rate: f64 },
-}
-
 /// Integrates the segment [a, b] (no breakpoint inside; the system has entered it) from (t, y),
 /// t in [a, b), calling `on_step` after every accepted step; stops early when it returns true.
 /// `h` carries the step size from segment to segment. Returns the number of (accepted,
@@ -145,7 +116,6 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
     y: &mut SVector<f64, N>,
     h: &mut f64,
     tol: &ExpTolerances,
-    linearise: Linearise,
     mut on_step: impl FnMut(&ExpStep<N>) -> Result<bool>,
 ) -> Result<(u64, u64, bool)> {
     let (mut accepted, mut rejected) = (0u64, 0u64);
@@ -156,12 +126,7 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
     while *t < b {
         let t0 = *t;
         let y0 = *y;
-        let jac = match linearise {
-            Linearise::AtStart => system.jacobian(flux, &y0),
-            Linearise::AtCentre { .. } => {
-                system.jacobian(flux, &oscillation_centre(system, flux, &y0))
-            }
-        };
+        let jac = system.jacobian(flux, &y0);
         let v = time_derivative(system, t0, flux, &y0, a, b);
         let mut rejected_here = false;
         loop {
@@ -186,17 +151,7 @@ pub(crate) fn segment<const N: usize, M: HybridModel<N>>(
                 } else {
                     tol.atol_angle
                 };
-                let mut scale = atol + tol.rtol * y0[i].abs().max(y1[i].abs());
-                if let Linearise::AtCentre { theta, rate } = linearise {
-                    scale = scale.min(if i == N - 2 {
-                        theta
-                    } else if i == N - 1 {
-                        rate
-                    } else {
-                        scale
-                    });
-                }
-                let r = corr[i] / scale;
+                let r = corr[i] / (atol + tol.rtol * y0[i].abs().max(y1[i].abs()));
                 acc += r * r;
             }
             let err = (acc / N as f64).sqrt();

@@ -14,8 +14,6 @@
 //!   [`crate::runs::orbits::run_orbits`], for an orbit at a time, where the oscillation is too large for
 //!   the linearisation or the modal decomposition is ill-conditioned.
 //!
-//! Short orbits of a linear hinge run whole by the exponential integrator instead ([`whole`]).
-//!
 //! The switch back to linear arcs is guarded by a measured criterion: the non-linear remainder
 //! r = f(y) − A (y − y_eq), expressed as the static angle error it would cause (|A⁻¹|_θ·|r|), must
 //! be below `linear_tolerance`, the oscillation below `linear_amplitude`, the plate in full Sun and
@@ -29,7 +27,6 @@ mod laminate_tests;
 pub mod layered;
 pub mod linear;
 pub(crate) mod model;
-mod whole;
 
 use crate::cancel::Cancel;
 use crate::error::{require_positive, Error, Result};
@@ -711,9 +708,6 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
     }
 
     fn run(&mut self) -> Result<()> {
-        if whole::applies(&self.orbit, self.judge.model.hinge()) {
-            return self.whole_orbits();
-        }
         let mut fallback = false;
         while self.t < self.t_end && !self.stopped() {
             self.obs.cancel.check()?;
@@ -946,7 +940,6 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
                 &mut y,
                 &mut h,
                 &settings.tolerances,
-                exprb::Linearise::AtStart,
                 |st: &ExpStep<N>| -> Result<bool> {
                     this.obs.cancel.check()?;
                     this.read_step(st, period)?;
