@@ -170,7 +170,7 @@ def leo(panel: tj.Panel, args: argparse.Namespace) -> None:
                   f"{full.n_steps} steps; ratio rk45 / hybrid {ratio:.1f}x")  # fmt: skip
             gate(full, hybrid)
     n_long = int(round(args.leo_long_years * per_year))
-    for model in args.leo_long_models.split(","):
+    for model in args.leo_long_models.split(",") if n_long > 0 else []:
         for name, o in (("equatorial", orbit), ("inclined 28.5 deg", inclined)):
             t_long, long = timed_orbits(panel, o, n_long, model=model, method="hybrid")
             print(f"  {model} hinge, hybrid, {n_long} orbits ({args.leo_long_years:g} years), "
