@@ -5,10 +5,19 @@
    or 1e-6 rad where the value is below 5e-5 rad);
 2. the hybrid alone on ten years (``--long-years``), with peak memory;
 3. a multi-year Monte Carlo with the hybrid: samples per second (``--mc-samples`` samples of
-   ``--mc-years`` years, c_d varied).
+   ``--mc-years`` years, c_d varied);
+4. the low orbit ``Orbit.leo(540e3)`` (``--leo-altitude``), for each hinge model of
+   ``--leo-models``: hybrid against rk45 over ``--leo-years`` side by side with the gate, then
+   the hybrid alone over ``--leo-long-years`` on that orbit and on the same orbit inclined by
+   28.5 deg (``Orbit.circular``, Earth heating off: with it on, the hybrid runs rk45 and says
+   so). An eclipse every orbit leaves the hybrid no linear arcs: most of each orbit goes to its
+   hinge-resolved fallback, and a LEO decade costs about what rk45's does
+   (``--leo-long-models`` picks the models of the long run; ``--leo-years 0`` skips part 4).
 
     python benches/longrun.py [--years 1] [--long-years 10] [--mc-samples 20] [--mc-years 10]
                               [--skip-full] [--damping C_D] [--start 2026-01-01]
+                              [--leo-years 1] [--leo-long-years 10] [--leo-altitude 540e3]
+                              [--leo-models linear,nonlinear] [--leo-long-models linear]
 
 The machine may be shared: the load average is printed before and after.
 """
@@ -66,6 +75,11 @@ def main() -> None:
     parser.add_argument("--skip-full", action="store_true")
     parser.add_argument("--damping", type=float, default=None, help="override c_d, N m s/rad")
     parser.add_argument("--start", default="2026-01-01", help="start date of geo_year")
+    parser.add_argument("--leo-years", type=float, default=1.0)
+    parser.add_argument("--leo-long-years", type=float, default=10.0)
+    parser.add_argument("--leo-altitude", type=float, default=540e3, help="m")
+    parser.add_argument("--leo-models", default="linear,nonlinear")
+    parser.add_argument("--leo-long-models", default="linear")
     args = parser.parse_args()
     print(machine.describe())
 
@@ -120,7 +134,50 @@ def main() -> None:
         print(f"\n3. Monte Carlo, {args.mc_samples} samples x {horizon} orbits "
               f"({args.mc_years:g} years), hybrid: {t_mc:.1f} s, {rate:.2f} samples/s "
               f"({failed} failed); 1000 samples: about {1000 / rate / 60:.1f} min")  # fmt: skip
+    if args.leo_years > 0:
+        leo(panel, args)
     print(f"\nload average after: {machine.load()}")
+
+
+def timed_orbits(
+    panel: tj.Panel, orbit: tj.Orbit, n: int, **kw: object
+) -> tuple[float, tj.OrbitSummaries]:
+    start = time.perf_counter()
+    runs = tj.simulate_orbits(panel, orbit, n, on_limit="flag", progress=False,  # type: ignore[arg-type]
+                              orbits_per_call=n, **kw)  # fmt: skip
+    return time.perf_counter() - start, runs
+
+
+def leo(panel: tj.Panel, args: argparse.Namespace) -> None:
+    """Part 4: the low orbit, hybrid against rk45 over a span, then the hybrid's long run."""
+    orbit = tj.Orbit.leo(args.leo_altitude)
+    inclined = tj.Orbit.circular(args.leo_altitude, np.radians(28.5), albedo=0.0, earth_ir=0.0)
+    per_year = 365.25 * 86400.0 / orbit.period
+    n = int(round(args.leo_years * per_year))
+    print(f"\n4. Orbit.leo({args.leo_altitude:g}), period {orbit.period:.0f} s: {n} orbits "
+          f"({args.leo_years:g} years)")  # fmt: skip
+    for model in args.leo_models.split(","):
+        t_hybrid, hybrid = timed_orbits(panel, orbit, n, model=model, method="hybrid")
+        p = hybrid.propagation
+        print(f"  {model} hinge, hybrid: {t_hybrid:.2f} s ({1e3 * t_hybrid / n:.2f} ms/orbit); "
+              f"exponential steps {p['n_exp_steps']}, linear arcs {p['n_arcs']}, fallback "
+              f"steps {p['n_fallback_steps']} ({p['t_fallback']:.0f} s of "
+              f"{n * orbit.period:.0f} s)")  # fmt: skip
+        if not args.skip_full:
+            t_full, full = timed_orbits(panel, orbit, n, model=model, method="rk45")
+            ratio = t_full / t_hybrid
+            print(f"  {model} hinge, rk45:   {t_full:.2f} s ({1e3 * t_full / n:.2f} ms/orbit), "
+                  f"{full.n_steps} steps; ratio rk45 / hybrid {ratio:.1f}x")  # fmt: skip
+            gate(full, hybrid)
+    n_long = int(round(args.leo_long_years * per_year))
+    for model in args.leo_long_models.split(",") if n_long > 0 else []:
+        for name, o in (("equatorial", orbit), ("inclined 28.5 deg", inclined)):
+            t_long, long = timed_orbits(panel, o, n_long, model=model, method="hybrid")
+            print(f"  {model} hinge, hybrid, {n_long} orbits ({args.leo_long_years:g} years), "
+                  f"{name}: {t_long:.1f} s; non-linear model on "
+                  f"{100 * long.nonlinear_fraction:.1f} % of the time, fallback "
+                  f"{long.propagation['t_fallback']:.0f} s; "
+                  f"peak RSS {peak_rss_mb():.0f} MB")  # fmt: skip
 
 
 if __name__ == "__main__":
