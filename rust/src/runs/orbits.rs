@@ -245,6 +245,8 @@ pub(crate) struct Collector<V> {
     pub(crate) orbit: Orbit,
     pub(crate) options: SummaryOptions,
     pub(crate) first_index: u64,
+    /// The run's last orbit: the end of its final step may round past that orbit's end.
+    last_index: u64,
     pub(crate) t_start: f64,
     pub(crate) done: Vec<OrbitSummary>,
     pub(crate) current: OrbitSummary,
@@ -291,6 +293,7 @@ impl<V: SummaryView> Collector<V> {
             orbit: *orbit,
             options,
             first_index,
+            last_index: first_index + n_orbits.saturating_sub(1),
             t_start,
             done: Vec::with_capacity(n_orbits as usize),
             current: OrbitSummary::new(first_index, 0.0, 0.0, 0.0, None),
@@ -546,9 +549,10 @@ impl<V: SummaryView> Collector<V> {
         }
     }
 
-    /// Moves on to the orbit that holds t (closing the finished ones).
+    /// Moves on to the orbit that holds t (closing the finished ones). The run ends at
+    /// t_start + n P, which can round above the last orbit's t0 + P: no orbit opens past it.
     pub(crate) fn advance(&mut self, t: f64) -> Result<()> {
-        while t > self.current.t_end {
+        while t > self.current.t_end && self.current.index < self.last_index {
             self.close();
             let next = self.current.index + 1;
             self.current = self.open(next)?;
@@ -1030,6 +1034,42 @@ mod tests {
 
     fn paper_run(n: u64) -> OrbitRun {
         run(&Panel::paper(), 0.5, 0, n, None)
+    }
+
+    #[test]
+    fn the_run_end_rounding_past_the_last_orbit_opens_no_other() {
+        // A low orbit whose 5 P + P rounds below 6 P: the run ends (t_start + 6 P) after the
+        // last orbit's own end, and the collector must still close six orbits, not seven.
+        let o = (0..2000)
+            .map(|k| Orbit::leo(400e3 + 137.0 * k as f64))
+            .find(|o| 5.0 * o.period + o.period < 6.0 * o.period)
+            .expect("such a period exists");
+        let panel = Panel::paper();
+        let spec = OrbitRunSpec {
+            panel,
+            orbit: o,
+            model: HingeModel::Nonlinear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: 6,
+            options: SummaryOptions {
+                window: 600.0,
+                theta_limit: 0.5,
+                stop_at_limit: true,
+                steps_per_period: STEPS_PER_HINGE_PERIOD,
+            },
+        };
+        let view = TwoLayerView {
+            panel,
+            coupling: Coupling::ProjectedArea,
+        };
+        let mut c = Collector::new(view, &spec, 0.0).unwrap();
+        c.advance(spec.t_end()).unwrap();
+        assert_eq!(c.current.index, 5);
+        let done = c.finish(Stats::default(), Vector4::zeros());
+        assert_eq!(done.summaries.len(), 6);
     }
 
     #[test]
