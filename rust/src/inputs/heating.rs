@@ -305,6 +305,40 @@ impl Orbit {
         }
     }
 
+    /// Every load at time t in full sunlight (s = 1), absorbed with `optics`: the front's
+    /// sunlight alone, at the Sun's distance there, on an orbit without Earth heating or
+    /// attitude (the paper's arithmetic).
+    pub fn sunlit_loads(&self, t: f64, optics: &Optics) -> Loads {
+        if self.has_face_loads() {
+            self.loads(t, 1.0, optics)
+        } else {
+            Loads::sun(self.flux_scale(t))
+        }
+    }
+
+    /// Every load at time t in the Sun's illuminated fraction there, as a run's samples read
+    /// the state: on an orbit without Earth heating or attitude, the front's sunlight alone,
+    /// s × flux scale.
+    pub fn loads_at(&self, t: f64, optics: &Optics) -> Loads {
+        let s = self.illumination(t);
+        if self.has_face_loads() {
+            self.loads(t, s, optics)
+        } else {
+            Loads::sun(s * self.flux_scale(t))
+        }
+    }
+
+    /// The flux reaching the front and the back face at each of the times `t`, W/m² (in the
+    /// Sun's illuminated fraction there, the structure's area factor not applied).
+    pub fn face_flux_samples(&self, t: &[f64], solar_constant: f64) -> (Vec<f64>, Vec<f64>) {
+        t.iter()
+            .map(|&t| {
+                let f = self.face_fluxes(t, self.illumination(t), solar_constant);
+                (f.front(), f.back())
+            })
+            .unzip()
+    }
+
     /// The loads the thermal models absorb at time t for the illuminated fraction `s`: the
     /// front's sunlight as a flux factor (the paper's form) and the rest absorbed, W/m².
     pub fn loads(&self, t: f64, s: f64, optics: &Optics) -> Loads {
@@ -316,6 +350,65 @@ impl Orbit {
             back: optics.absorptivity_back * (f.sun_back + f.albedo_back)
                 + optics.emissivity_back * f.ir_back,
         }
+    }
+}
+
+/// Nodes and weights of the five-point Gauss–Legendre rule on [−1, 1].
+const GAUSS_5: [(f64, f64); 5] = [
+    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+    (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.0, 0.568_888_888_888_888_9),
+    (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+];
+
+/// Subintervals of the sunlit-arc average per orbit period: the loads are smooth on the arc
+/// but for the kinks of max(cos, 0) where the Sun or the Earth's edge crosses a face's plane,
+/// where each costs the rule O(h²) of that subinterval (h = period/2000: a relative ~1e-9 of the
+/// average).
+const AVERAGE_SUBINTERVALS: f64 = 2000.0;
+
+impl Orbit {
+    /// The loads averaged over the sunlit arc of the orbit that begins at `t0` (one period):
+    /// (1/τ) ∫ loads(t, s(t)) dt over the times with s(t) > 0 (the penumbra's partial Sun
+    /// included), τ their total length. On an orbit without Earth heating or attitude, the
+    /// front's sunlight alone: the mean of s × flux scale. Composite Gauss–Legendre between the
+    /// shadow's breakpoints.
+    pub fn sunlit_average_loads(&self, t0: f64, optics: &Optics) -> Result<Loads> {
+        Orbit::check_time(t0)?;
+        let t1 = t0 + self.period;
+        let mut edges = vec![t0];
+        edges.extend(self.breakpoints(t0, t1));
+        edges.push(t1);
+        let (mut sum, mut duration) = (Loads::sun(0.0), 0.0);
+        for w in edges.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if b <= a || self.illumination(0.5 * (a + b)) <= 0.0 {
+                continue;
+            }
+            let pieces = ((b - a) / self.period * AVERAGE_SUBINTERVALS).ceil().max(1.0);
+            let h = (b - a) / pieces;
+            for i in 0..pieces as usize {
+                let mid = a + (i as f64 + 0.5) * h;
+                for (x, weight) in GAUSS_5 {
+                    let l = self.loads_at(mid + 0.5 * h * x, optics).scaled(0.5 * h * weight);
+                    sum = Loads {
+                        sun: sum.sun + l.sun,
+                        front: sum.front + l.front,
+                        back: sum.back + l.back,
+                    };
+                }
+            }
+            duration += b - a;
+        }
+        if duration <= 0.0 {
+            return Err(Error::invalid(
+                "t",
+                t0,
+                "begins an orbit with no sunlit arc: there is no sunlit forcing to average",
+            ));
+        }
+        Ok(sum.scaled(1.0 / duration))
     }
 }
 

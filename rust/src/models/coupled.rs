@@ -286,11 +286,21 @@ where
     /// there when the orbit has them).
     pub fn sunlit_steady_state(&self, t: f64) -> Result<State<D>> {
         if self.sun.face_loads {
-            let loads = self.sun.sunlit_loads(t);
-            let optics = self.sun.optics.expect("face loads come with optics");
-            self.steady_state_loaded(loads, loads.equivalent_flux(&optics))
+            self.steady_state_under(self.sun.sunlit_loads(t))
         } else {
             self.steady_state(self.sun.orbit.flux_scale(t))
+        }
+    }
+
+    /// The steady state under constant `loads`, velocities zero (loads on the faces need the
+    /// panel's optics: the system must have them).
+    pub fn steady_state_under(&self, loads: Loads) -> Result<State<D>> {
+        if !loads.has_face_loads() {
+            return self.steady_state(loads.sun);
+        }
+        match self.sun.optics {
+            Some(optics) => self.steady_state_loaded(loads, loads.equivalent_flux(&optics)),
+            None => Err(unsupported_face_loads(&self.sun.orbit, "a model without optics")),
         }
     }
 
