@@ -143,7 +143,12 @@ pub fn start_state(
     t0: f64,
 ) -> Result<Vec<f64>> {
     Orbit::check_time(t0)?;
-    let eq = equilibrium_loaded(panel, c, coupling, orbit.sunlit_loads(t0, &Optics::of(panel)))?;
+    let eq = equilibrium_loaded(
+        panel,
+        c,
+        coupling,
+        orbit.sunlit_loads(t0, &Optics::of(panel)),
+    )?;
     let mut y = eq.temperatures;
     y.push(eq.theta);
     y.push(0.0);

@@ -5,13 +5,15 @@ use super::convert::{
     coupling, dict_of, hinge_model, orbit_from, panel_from, set_named, FlutterPoint,
 };
 use super::error::shield;
-use crate::analysis::flutter::{analyse, analyse_system_under, critical_damping, critical_damping_under};
+use crate::analysis::flutter::{
+    analyse, analyse_system_under, critical_damping, critical_damping_under,
+};
+use crate::analysis::linear::LinearThermal;
+use crate::analysis::stability::Axis;
 use crate::error::Result;
 use crate::inputs::heating::{Loads, Optics};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
-use crate::analysis::linear::LinearThermal;
-use crate::analysis::stability::Axis;
 use crate::models::coupled::Coupled;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -75,7 +77,10 @@ fn flutter_at<'py>(
             spectrum.frequency_hz,
         )?;
         if with_critical {
-            d.set_item("critical_damping", critical_damping_under(&p, &o, loads, m, c)?)?;
+            d.set_item(
+                "critical_damping",
+                critical_damping_under(&p, &o, loads, m, c)?,
+            )?;
         }
         d.set_item("loads", (loads.sun, loads.front, loads.back))?;
         Ok(d)

@@ -259,10 +259,7 @@ fn layered_flutter_at<'py>(
 }
 
 /// The flutter analysis of `point` as a mapping: equilibrium, spectrum, critical damping.
-fn layered_analysis<'py>(
-    py: Python<'py>,
-    point: LayeredPoint<'_>,
-) -> PyResult<Bound<'py, PyDict>> {
+fn layered_analysis<'py>(py: Python<'py>, point: LayeredPoint<'_>) -> PyResult<Bound<'py, PyDict>> {
     let a = py.detach(|| point.analyse())?;
     let d = equilibrium_dict(py, &a.equilibrium)?;
     let size = a.jacobian.nrows();

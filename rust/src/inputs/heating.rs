@@ -227,6 +227,63 @@ impl FaceFluxes {
     }
 }
 
+impl FaceFluxes {
+    /// What the faces absorb of these fluxes with `optics`: the front's sunlight as a flux factor
+    /// (the paper's form), the rest in W/m².
+    pub fn absorbed(&self, optics: &Optics) -> Loads {
+        Loads {
+            sun: self.sun_front / optics.solar_constant,
+            front: optics.absorptivity_front * self.albedo_front
+                + optics.emissivity_front * self.ir_front,
+            back: optics.absorptivity_back * (self.sun_back + self.albedo_back)
+                + optics.emissivity_back * self.ir_back,
+        }
+    }
+}
+
+/// What heats a flat face at one time, before its orientation (see [`Orbit::sources`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sources {
+    /// Unit vectors to the Sun and to the satellite from the Earth's centre.
+    pub sun: [f64; 3],
+    pub position: [f64; 3],
+    /// C · scale · s, W/m².
+    pub direct: f64,
+    /// a · C · scale · max(cos Z, 0), W/m² (times a face's view factor: its albedo).
+    pub albedo: f64,
+    /// E_IR, W/m².
+    pub earth_ir: f64,
+    /// H = r/R_E.
+    pub height_ratio: f64,
+}
+
+impl Sources {
+    /// The incident fluxes on the faces of a plate whose front normal is `normal` (unit); the
+    /// front exactly on the Sun when `on_sun` (the paper's plate, its incidence exactly 0).
+    pub fn fluxes(&self, normal: [f64; 3], on_sun: bool) -> FaceFluxes {
+        let cos_sun = if on_sun {
+            1.0
+        } else {
+            dot(normal, self.sun).clamp(-1.0, 1.0)
+        };
+        let h = self.height_ratio;
+        // The direction to the Earth's centre is −position.
+        let cos_front = -dot(normal, self.position);
+        let (view_front, view_back) = (
+            earth_view_factor(cos_front, h),
+            earth_view_factor(-cos_front, h),
+        );
+        FaceFluxes {
+            sun_front: self.direct * cos_sun.max(0.0),
+            sun_back: self.direct * (-cos_sun).max(0.0),
+            albedo_front: self.albedo * view_front,
+            albedo_back: self.albedo * view_back,
+            ir_front: self.earth_ir * view_front,
+            ir_back: self.earth_ir * view_back,
+        }
+    }
+}
+
 /// The geometry of one time: the unit vectors to the Sun and to the satellite (from the Earth's
 /// centre) and the front normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -280,29 +337,47 @@ impl Orbit {
     /// solar constant C (W/m²), before the structure's area factor.
     pub fn face_fluxes(&self, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
         let g = self.geometry(t);
-        let cos_sun = match self.attitude {
-            // Exactly 1: the paper's plate.
-            Attitude::SunPointing => 1.0,
-            _ => dot(g.normal, g.sun).clamp(-1.0, 1.0),
-        };
+        self.sources(&g, t, s, solar_constant)
+            .fluxes(g.normal, self.attitude == Attitude::SunPointing)
+    }
+
+    /// What heats a flat face at time t, whatever its normal: the Sun's and the satellite's
+    /// directions, the direct sunlight C · scale · s, the albedo's sunlit-Earth factor
+    /// a · C · scale · max(cos Z, 0), the Earth's infrared and H = r/R_E.
+    pub fn sources(&self, g: &Geometry, t: f64, s: f64, solar_constant: f64) -> Sources {
         let sunlight = solar_constant * self.flux_scale(t);
-        let direct = sunlight * s;
-        let h = self.radius / self.earth_radius;
-        // The direction to the Earth's centre is −position.
-        let cos_front = -dot(g.normal, g.position);
-        let (view_front, view_back) = (
-            earth_view_factor(cos_front, h),
-            earth_view_factor(-cos_front, h),
-        );
-        let lit = self.albedo * sunlight * dot(g.position, g.sun).max(0.0);
-        FaceFluxes {
-            sun_front: direct * cos_sun.max(0.0),
-            sun_back: direct * (-cos_sun).max(0.0),
-            albedo_front: lit * view_front,
-            albedo_back: lit * view_back,
-            ir_front: self.earth_ir * view_front,
-            ir_back: self.earth_ir * view_back,
+        Sources {
+            sun: g.sun,
+            position: g.position,
+            direct: sunlight * s,
+            albedo: self.albedo * sunlight * dot(g.position, g.sun).max(0.0),
+            earth_ir: self.earth_ir,
+            height_ratio: self.radius / self.earth_radius,
         }
+    }
+
+    /// The loads the thermal models absorb at time t for the illuminated fraction `s`: the
+    /// front's sunlight as a flux factor (the paper's form) and the rest absorbed, W/m².
+    pub fn loads(&self, t: f64, s: f64, optics: &Optics) -> Loads {
+        self.face_fluxes(t, s, optics.solar_constant)
+            .absorbed(optics)
+    }
+
+    /// The direction of the panel's length at time t (unit, in the plane of its faces): about
+    /// which a bent panel's elements turn. Taken in the plane of the front normal and the orbit
+    /// normal h, as the wing of an array that tracks the Sun about h lies along its drive axis
+    /// (there the Sun stays in the plane of the normal and the length); with the normal on h,
+    /// the direction a quarter orbit past the node.
+    pub fn length_direction(&self, t: f64, normal: [f64; 3]) -> [f64; 3] {
+        let along_plane = |d: [f64; 3]| {
+            let c = dot(d, normal);
+            let p = [0, 1, 2].map(|k| d[k] - c * normal[k]);
+            let l = norm(p);
+            (l > 1e-9).then(|| p.map(|x| x / l))
+        };
+        let h = self.normal(t);
+        // With the normal on h, h × (the node) is a unit vector in the faces' plane.
+        along_plane(h).unwrap_or_else(|| cross(h, self.node_direction(t)))
     }
 
     /// Every load at time t in full sunlight (s = 1), absorbed with `optics`: the front's
@@ -337,19 +412,6 @@ impl Orbit {
                 (f.front(), f.back())
             })
             .unzip()
-    }
-
-    /// The loads the thermal models absorb at time t for the illuminated fraction `s`: the
-    /// front's sunlight as a flux factor (the paper's form) and the rest absorbed, W/m².
-    pub fn loads(&self, t: f64, s: f64, optics: &Optics) -> Loads {
-        let f = self.face_fluxes(t, s, optics.solar_constant);
-        Loads {
-            sun: f.sun_front / optics.solar_constant,
-            front: optics.absorptivity_front * f.albedo_front
-                + optics.emissivity_front * f.ir_front,
-            back: optics.absorptivity_back * (f.sun_back + f.albedo_back)
-                + optics.emissivity_back * f.ir_back,
-        }
     }
 }
 
@@ -386,12 +448,16 @@ impl Orbit {
             if b <= a || self.illumination(0.5 * (a + b)) <= 0.0 {
                 continue;
             }
-            let pieces = ((b - a) / self.period * AVERAGE_SUBINTERVALS).ceil().max(1.0);
+            let pieces = ((b - a) / self.period * AVERAGE_SUBINTERVALS)
+                .ceil()
+                .max(1.0);
             let h = (b - a) / pieces;
             for i in 0..pieces as usize {
                 let mid = a + (i as f64 + 0.5) * h;
                 for (x, weight) in GAUSS_5 {
-                    let l = self.loads_at(mid + 0.5 * h * x, optics).scaled(0.5 * h * weight);
+                    let l = self
+                        .loads_at(mid + 0.5 * h * x, optics)
+                        .scaled(0.5 * h * weight);
                     sum = Loads {
                         sun: sum.sun + l.sun,
                         front: sum.front + l.front,
@@ -457,6 +523,46 @@ mod tests {
             );
             assert!((a - b).abs() < 1e-9, "{a} {b}");
         }
+    }
+
+    /// The sunlit-arc average against a plain midpoint sum over a fine grid (the sunlit samples
+    /// only), on an inclined orbit with its eclipse, Earth heating and a tracking attitude; and
+    /// the full Sun alone (the mean of 1) on the paper's orbit with its eclipse.
+    #[test]
+    fn the_sunlit_average_is_the_mean_over_the_lit_samples() {
+        let optics = Optics::of(&Panel::paper());
+        let o = Orbit {
+            albedo: 0.3,
+            earth_ir: 237.0,
+            attitude: Attitude::SunTracking { offset: 0.2 },
+            shadow: Shadow::Cylindrical,
+            ..Orbit::leo(540e3)
+        };
+        let t0 = 123.0;
+        let avg = o.sunlit_average_loads(t0, &optics).unwrap();
+        let n = 2_000_000;
+        let h = o.period / n as f64;
+        let (mut sum, mut lit) = ([0.0; 3], 0usize);
+        for i in 0..n {
+            let t = t0 + (i as f64 + 0.5) * h;
+            if o.illumination(t) > 0.0 {
+                let l = o.loads_at(t, &optics);
+                sum = [sum[0] + l.sun, sum[1] + l.front, sum[2] + l.back];
+                lit += 1;
+            }
+        }
+        let want = sum.map(|x| x / lit as f64);
+        // The midpoint sum's error at the two shadow edges: about h/τ.
+        for (got, want) in [avg.sun, avg.front, avg.back].iter().zip(want) {
+            assert!((got / want - 1.0).abs() < 2e-6, "{got} vs {want}");
+        }
+        let bare = Orbit {
+            shadow: Shadow::Cylindrical,
+            ..Orbit::geo_equinox()
+        };
+        let mean = bare.sunlit_average_loads(0.0, &optics).unwrap();
+        assert_eq!((mean.front, mean.back), (0.0, 0.0));
+        assert!((mean.sun - 1.0).abs() < 1e-12, "{}", mean.sun);
     }
 
     #[test]
