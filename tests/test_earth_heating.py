@@ -242,7 +242,7 @@ def test_models_that_take_the_front_sunlight_only_refuse_the_earths_heat() -> No
     boom = tj.Boom(length=30.0, radius=6.35e-3, wall=5.1e-5)
     with pytest.raises(tj.ParameterError) as err:
         tj.simulate(boom, orbit, (0.0, 100.0))
-    assert err.value.parameter == "earth_ir"
+    assert err.value.parameter == "orbit"
     with pytest.raises(tj.ParameterError) as err:
         tj.simulate(boom, tj.Orbit.leo(540e3), (0.0, 100.0), attitude=tj.Attitude.nadir())
     assert err.value.parameter == "attitude"

@@ -67,7 +67,13 @@ def test_two_nodes_analyse_the_same_flutter_under_the_earths_heat(
     # The two-layer Jacobian is by differences, the nodal one analytic.
     scale = float(np.max(np.abs(two.eigenvalues)))
     assert nodes.growth_rate == pytest.approx(two.growth_rate, rel=1e-5, abs=1e-8 * scale)
-    assert nodes.critical_damping == pytest.approx(two.critical_damping, rel=1e-4, abs=1e-9)
+    # A growth rate off by ε moves c_d* by 2 I_B ε: the differences' 1e-8 of the spectrum is
+    # 2e-8 of the hinge's critical damping sqrt(K_el I_B) (frozen, undamped: growth 0 exactly).
+    inertia = panel.mass_per_length * (panel.length / 4) ** 3 * 2 / 3
+    hinge_scale = math.sqrt(panel.hinge_stiffness * inertia)
+    assert nodes.critical_damping == pytest.approx(
+        two.critical_damping, rel=1e-4, abs=2e-8 * hinge_scale
+    )
 
 
 @settings(max_examples=6)
@@ -288,20 +294,21 @@ def sunlit_arcs(orbit: tj.Orbit, t0: float) -> list[tuple[float, float]]:
 def averaged_loads(
     panel: tj.Panel, orbit: tj.Orbit, attitude: tj.Attitude, t0: float
 ) -> tuple[float, float]:
-    """The reference's absorbed loads (front, back) averaged over the sunlit arcs by quadrature."""
-    from scipy.integrate import quad
-
+    """The reference's absorbed loads (front, back) averaged over the sunlit arcs: the trapezoid
+    rule on 200,001 points an arc (its error, h² f''/12 and at a kink of the loads h² |Δf'|, is
+    below 1e-10 of the mean)."""
+    total = np.zeros(2)
     arcs = sunlit_arcs(orbit, t0)
-    total = [0.0, 0.0]
+    back_alpha = panel.absorptivity_back
     for a, b in arcs:
-        for face in (0, 1):
-            value, _ = quad(
-                lambda t: ref.absorbed_loads(panel, orbit, attitude, t, 1.0)[face],
-                a, b, epsabs=1e-10, epsrel=1e-12, limit=400,
-            )  # fmt: skip
-            total[face] += value
+        t = np.linspace(a, b, 200_001)
+        f = ref.face_fluxes(orbit, attitude, t, np.ones_like(t), panel.solar_constant)
+        front = panel.absorptivity * (f["sun_front"] + f["albedo_front"])
+        front += panel.emissivity_front * f["ir_front"]
+        back = back_alpha * (f["sun_back"] + f["albedo_back"]) + panel.emissivity_back * f["ir_back"]
+        total += [np.trapezoid(front, t), np.trapezoid(back, t)]
     duration = sum(b - a for a, b in arcs)
-    return total[0] / duration, total[1] / duration
+    return float(total[0] / duration), float(total[1] / duration)
 
 
 @settings(max_examples=5)
@@ -326,16 +333,19 @@ def test_the_orbit_averaged_flutter_is_about_the_quasi_steady_balance_of_the_mea
     assert math.isfinite(point.growth_rate) and math.isfinite(fl.critical_damping)
 
 
-def test_the_orbit_average_on_the_papers_orbit_is_its_mean_sunlight() -> None:
-    """Without the Earth's heat: the mean of the Sun's distance scale over the sunlit arc, and
-    the analysis at that flux; over a GEO orbit it moves by less than 2e-4 (its 1/r² changes by
-    that much a day)."""
+def test_the_orbit_average_without_the_earths_heat_is_the_mean_sunlight() -> None:
+    """A Sun-pointing plate in LEO without the Earth's heat: the mean of the Sun's distance
+    scale over the sunlit arc, and the analysis at that flux; over one orbit it moves by less
+    than 2e-4 (its 1/r² changes by that much a day)."""
     panel = tj.Panel.paper()
-    orbit = tj.Orbit.geo_year("2026-03-10").replace(shadow="cylindrical")
+    orbit = tj.Orbit.circular(
+        540e3, math.radians(28.5), 0.0, "2026-03-10", shadow="cylindrical", albedo=0.0,
+        earth_ir=0.0,
+    )  # fmt: skip
     t = 3.0 * orbit.period
     fl = tj.flutter(panel, orbit=orbit, t=t, orbit_average=True)
     arcs = sunlit_arcs(orbit, t)
-    assert sum(b - a for a, b in arcs) < 0.97 * orbit.period  # in the eclipse season
+    assert sum(b - a for a, b in arcs) < 0.7 * orbit.period
     mean = sum(
         float(np.trapezoid(ref.sun_distance_scale(orbit, g := np.linspace(a, b, 20001)), g))
         for a, b in arcs

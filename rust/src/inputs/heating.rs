@@ -415,6 +415,27 @@ impl Orbit {
     }
 }
 
+/// Where `f` changes sign in (a, b), when its ends differ in sign: bisection to the rounding of t.
+fn sign_change(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Option<f64> {
+    let (mut lo, mut hi) = (a, b);
+    let low_sign = f(lo) > 0.0;
+    if low_sign == (f(hi) > 0.0) {
+        return None;
+    }
+    while hi - lo > 1e-12 * hi.abs().max(1.0) {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if (f(mid) > 0.0) == low_sign {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
 /// Nodes and weights of the five-point Gauss–Legendre rule on [−1, 1].
 const GAUSS_5: [(f64, f64); 5] = [
     (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
@@ -424,18 +445,40 @@ const GAUSS_5: [(f64, f64); 5] = [
     (0.906_179_845_938_664, 0.236_926_885_056_189_1),
 ];
 
-/// Subintervals of the sunlit-arc average per orbit period: the loads are smooth on the arc
-/// but for the kinks of max(cos, 0) where the Sun or the Earth's edge crosses a face's plane,
-/// where each costs the rule O(h²) of that subinterval (h = period/2000: a relative ~1e-9 of the
-/// average).
+/// Subintervals of the sunlit-arc average per orbit period. The loads are smooth on each piece
+/// between their kinks — where the Sun crosses a face's plane (max(±n·Ŝ, 0)) and where the
+/// sub-satellite point crosses the terminator (the albedo's max(cos Z, 0)), which are found and
+/// split at — but for the view factor's edges of full view, where its second derivative jumps
+/// (an O(h³) error of the subinterval there: a relative ~1e-10 of the average).
 const AVERAGE_SUBINTERVALS: f64 = 2000.0;
 
 impl Orbit {
+    /// The times in (x0, x1) where a load has a kink — the Sun crossing the faces' plane, the
+    /// sub-satellite point crossing the terminator — each where its cosine changes sign between
+    /// the ends (the interval is short against the orbit: at most one crossing of each), found
+    /// by bisection; sorted.
+    fn kinks(&self, x0: f64, x1: f64) -> Vec<f64> {
+        let incidence = |t: f64| {
+            let g = self.geometry(t);
+            dot(g.normal, g.sun)
+        };
+        let zenith = |t: f64| dot(self.position(t), self.sun_direction(t));
+        let mut out = Vec::new();
+        if self.attitude != Attitude::SunPointing {
+            out.extend(sign_change(incidence, x0, x1));
+        }
+        if self.albedo != 0.0 {
+            out.extend(sign_change(zenith, x0, x1));
+        }
+        out.sort_by(f64::total_cmp);
+        out
+    }
+
     /// The loads averaged over the sunlit arc of the orbit that begins at `t0` (one period):
     /// (1/τ) ∫ loads(t, s(t)) dt over the times with s(t) > 0 (the penumbra's partial Sun
     /// included), τ their total length. On an orbit without Earth heating or attitude, the
     /// front's sunlight alone: the mean of s × flux scale. Composite Gauss–Legendre between the
-    /// shadow's breakpoints.
+    /// shadow's breakpoints, split at the loads' kinks ([`AVERAGE_SUBINTERVALS`]).
     pub fn sunlit_average_loads(&self, t0: f64, optics: &Optics) -> Result<Loads> {
         Orbit::check_time(t0)?;
         let t1 = t0 + self.period;
@@ -453,16 +496,20 @@ impl Orbit {
                 .max(1.0);
             let h = (b - a) / pieces;
             for i in 0..pieces as usize {
-                let mid = a + (i as f64 + 0.5) * h;
-                for (x, weight) in GAUSS_5 {
-                    let l = self
-                        .loads_at(mid + 0.5 * h * x, optics)
-                        .scaled(0.5 * h * weight);
-                    sum = Loads {
-                        sun: sum.sun + l.sun,
-                        front: sum.front + l.front,
-                        back: sum.back + l.back,
-                    };
+                let (x0, x1) = (a + i as f64 * h, a + (i + 1) as f64 * h);
+                let mut cuts = vec![x0];
+                cuts.extend(self.kinks(x0, x1));
+                cuts.push(x1);
+                for piece in cuts.windows(2) {
+                    let (mid, half) = (0.5 * (piece[0] + piece[1]), 0.5 * (piece[1] - piece[0]));
+                    for (x, weight) in GAUSS_5 {
+                        let l = self.loads_at(mid + half * x, optics).scaled(half * weight);
+                        sum = Loads {
+                            sun: sum.sun + l.sun,
+                            front: sum.front + l.front,
+                            back: sum.back + l.back,
+                        };
+                    }
                 }
             }
             duration += b - a;
