@@ -11,10 +11,10 @@ import hypothesis.strategies as st
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from conftest import wing_layup
 from test_earth_heating import ATTITUDES, PANELS, orbits
 
 import thermojitter as tj
+from conftest import wing_layup
 from thermojitter import reference as ref
 
 SIGMA = ref.STEFAN_BOLTZMANN
@@ -31,7 +31,14 @@ def test_two_nodes_under_the_earths_heat_are_the_two_layer_model(
     orbit = data.draw(orbits())
     span = (0.0, 300.0)
     t_eval = np.linspace(*span, 31)
-    run = {"attitude": attitude, "coupled": coupled, "t_eval": t_eval, **TIGHT}
+    # Drawn panels may bend beyond the hinge model's range: the two runs are compared all the same.
+    run = {
+        "attitude": attitude,
+        "coupled": coupled,
+        "t_eval": t_eval,
+        "on_limit": "ignore",
+        **TIGHT,
+    }
     two = tj.simulate(panel, orbit, span, **run)  # type: ignore[arg-type]
     nodes = tj.simulate(panel, orbit, span, layers=2, **run)  # type: ignore[arg-type]
     # The same start (the two-layer model's steady state under the loads at t = 0) to the bit.
@@ -92,7 +99,7 @@ def test_n_nodes_under_the_earths_heat_are_the_references(
     t_eval = np.linspace(*span, 31)
     sol = tj.simulate(
         panel, orbit, span, layers=nodes, attitude=attitude, coupled=coupled, t_eval=t_eval,
-        **TIGHT,  # type: ignore[arg-type]
+        on_limit="ignore", **TIGHT,  # type: ignore[arg-type]
     )  # fmt: skip
     want = ref.simulate_nodes(
         panel, orbit, span, nodes=nodes, attitude=attitude, coupled=coupled, t_eval=t_eval,
@@ -133,11 +140,14 @@ def test_n_nodes_flutter_at_a_point_of_the_orbit_is_the_references() -> None:
         up[j] += h
         down[j] -= h
         jac[:, j] = (
-            ref.rhs_nodes_loaded(up, panel, nodes, loads) - ref.rhs_nodes_loaded(down, panel, nodes, loads)
+            ref.rhs_nodes_loaded(up, panel, nodes, loads)
+            - ref.rhs_nodes_loaded(down, panel, nodes, loads)
         ) / (2 * h)
     eigenvalues = np.linalg.eigvals(jac)
     scale = float(np.max(np.abs(eigenvalues)))
-    assert fl.growth_rate == pytest.approx(float(np.max(eigenvalues.real)), rel=1e-5, abs=1e-8 * scale)
+    assert fl.growth_rate == pytest.approx(
+        float(np.max(eigenvalues.real)), rel=1e-5, abs=1e-8 * scale
+    )
 
 
 def test_the_laminate_takes_the_earths_heat_on_its_outer_nodes() -> None:
@@ -156,7 +166,9 @@ def test_the_laminate_takes_the_earths_heat_on_its_outer_nodes() -> None:
     # At rest in the steady state: the first samples barely move.
     assert np.max(np.abs(heated.T_nodes[1] - heated.T_nodes[0])) < 0.05
     assert heated.flux_front is not None and heated.flux_front[0] > 200.0
-    runs = tj.simulate_orbits(panel, orbit, 1, layers=20, method="rk45", attitude=nadir, progress=False)
+    runs = tj.simulate_orbits(
+        panel, orbit, 1, layers=20, method="rk45", attitude=nadir, progress=False
+    )
     assert np.isfinite(runs.theta_eq).all()
 
 
@@ -208,7 +220,9 @@ def test_every_element_of_the_distributed_panel_takes_the_loads_at_its_own_slope
     orbit = data.draw(orbits(shadow="none"))
     # Soft enough for the slopes to matter (a few degrees), within the model's range.
     panel = panel.replace(youngs_modulus=2e10)
-    sol = tj.simulate_distributed(panel, orbit, (0.0, 1.0), attitude=attitude, elements=12, t_eval=[0.0])  # type: ignore[arg-type]
+    sol = tj.simulate_distributed(
+        panel, orbit, (0.0, 1.0), attitude=attitude, elements=12, t_eval=[0.0]
+    )  # type: ignore[arg-type]
     w, x = sol.deflection[0], sol.x_node
     slopes = np.diff(w) / np.diff(x)
     assert np.ptp(slopes) > 1e-3
@@ -305,7 +319,9 @@ def averaged_loads(
         f = ref.face_fluxes(orbit, attitude, t, np.ones_like(t), panel.solar_constant)
         front = panel.absorptivity * (f["sun_front"] + f["albedo_front"])
         front += panel.emissivity_front * f["ir_front"]
-        back = back_alpha * (f["sun_back"] + f["albedo_back"]) + panel.emissivity_back * f["ir_back"]
+        back = (
+            back_alpha * (f["sun_back"] + f["albedo_back"]) + panel.emissivity_back * f["ir_back"]
+        )
         total += [np.trapezoid(front, t), np.trapezoid(back, t)]
     duration = sum(b - a for a, b in arcs)
     return float(total[0] / duration), float(total[1] / duration)

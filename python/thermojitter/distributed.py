@@ -272,7 +272,9 @@ def simulate_distributed(
     )  # fmt: skip
     run["limit"] = limit_args(theta_limit, on_limit)
     run["y0"] = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
-    raw = interruptible(_core.simulate_distributed, panel.as_dict(), engine_orbit_args, settings, run)
+    raw = interruptible(
+        _core.simulate_distributed, panel.as_dict(), engine_orbit_args, settings, run
+    )
     limit = limit_record(raw)
     warn_crossing(limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(
@@ -285,7 +287,11 @@ def simulate_distributed(
             "dt": used.dt,
             "solver": used.as_dict(),
             **run["limit"],
-            **({"attitude": engine_orbit_args["attitude"]} if "attitude" in engine_orbit_args else {}),
+            **(
+                {"attitude": engine_orbit_args["attitude"]}
+                if "attitude" in engine_orbit_args
+                else {}
+            ),
         },
         x=raw["x"],
         x_node=raw["x_node"],

@@ -321,7 +321,7 @@ def _simulate_loaded(
     )  # fmt: skip
 
 
-# --------------------------------------------------------------------------- N nodes through the thickness
+# ------------------------------------------------------------- N nodes through the thickness
 
 
 def node_model(panel: Any, nodes: int) -> tuple[FloatArray, float, FloatArray]:
@@ -420,9 +420,7 @@ def simulate_nodes(
         return rhs_nodes_loaded(y, panel, nodes, loads, model, coupled)
 
     names = (*(f"T_{i}" for i in range(nodes)), "theta", "theta_dot")
-    return _integrate_segments(
-        fun, y0, t_span, None, rtol, atol, t_eval, "RK45", names, max_step
-    )
+    return _integrate_segments(fun, y0, t_span, None, rtol, atol, t_eval, "RK45", names, max_step)
 
 
 # --------------------------------------------------------------------------- model equations
