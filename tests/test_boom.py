@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import minimize_scalar
 
@@ -188,6 +188,14 @@ boom_params = st.fixed_dictionaries(
 
 @settings(max_examples=10, deadline=None)
 @given(params=boom_params, coupled=st.booleans())
+@example(  # a 2 m CFRP tube: rings at nano-radians, where the absolute tolerance rules
+    params={
+        "length": 2.0, "radius": 0.0234375, "wall_ratio": 0.03125, "material": "cfrp_m55j_qi",
+        "absorptivity": 0.5, "emissivity": 0.5, "emissivity_inner": 0.0, "damping": 0.0,
+        "tip_mass": 0.0, "solar_inclination": 1.0, "conduction_scale": 1.0,
+    },
+    coupled=False,
+)  # fmt: skip
 def test_engine_transient_matches_the_reference(params: dict[str, object], coupled: bool) -> None:
     p = dict(params)
     p["wall"] = float(p.pop("wall_ratio")) * float(p["radius"])  # type: ignore[arg-type]
@@ -205,9 +213,11 @@ def test_engine_transient_matches_the_reference(params: dict[str, object], coupl
         b, GEO, span, coupled=coupled, t_eval=t, y0=y0, rtol=1e-11, atol=1e-13,
         max_step=0.05 / b.first_frequency,
     )  # fmt: skip
+    # Relative to each row's scale, plus the absolute tolerance both runs were given (atol per step,
+    # over about a hundred steps): a stiff short tube rings at nano-radians, where atol dominates.
     for name, row in zip(want.names, want.y, strict=True):
-        scale = max(float(np.max(np.abs(row))), 1e-12)
-        assert np.max(np.abs(getattr(got, name) - row)) <= 1e-6 * scale, name
+        scale = float(np.max(np.abs(row)))
+        assert np.max(np.abs(getattr(got, name) - row)) <= 1e-6 * scale + 100 * 1e-13, name
 
 
 def test_reference_steady_state_agrees_with_the_engine() -> None:

@@ -108,7 +108,8 @@ def test_the_default_kernel_stays_near_the_records(default: dict, name: str) -> 
     # once: other bits, and other rejected steps here and there, so the runs part by about the
     # integration's own error (θ within 1e-5 of its range over the orbit; 1.6e-6 measured).
     got, want = default[name], RECORDED[name]
-    assert default["kernel"] == tj._core.cpu_info()["scalar_kernel"]
+    if tj._core.KERNEL_VARIABLE not in os.environ:  # else this process runs the chosen kernel
+        assert default["kernel"] == tj._core.cpu_info()["scalar_kernel"]
     if default["kernel"] == "portable":
         assert got == want
         return

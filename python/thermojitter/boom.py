@@ -14,7 +14,6 @@ A :class:`Boom` goes where a :class:`thermojitter.Panel` goes: :func:`thermojitt
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import InitVar, dataclass, fields
@@ -25,8 +24,9 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
-from thermojitter import _core, materials
+from thermojitter import _core, _runs, materials
 from thermojitter import errors as checks
+from thermojitter.attitude import Attitude
 from thermojitter.orbit import Orbit
 from thermojitter.progress import interruptible
 from thermojitter.results import Array, LimitCrossing, _Run
@@ -43,8 +43,6 @@ MATERIAL_FIELDS = ("density", "youngs_modulus", "expansion_coeff", "conductivity
 def check_attitude(attitude: Any) -> None:
     """Refuses an attitude other than Sun-pointing for a boom, naming ``attitude``: its model
     takes the Sun alone on its lit side (the engine refuses an orbit with Earth heating)."""
-    from thermojitter.attitude import Attitude
-
     if attitude is not None and Attitude.of(attitude).kind != "sun_pointing":
         raise checks.ParameterError(
             "attitude", attitude, "a boom takes the Sun alone on its lit side (not an attitude)"
@@ -283,15 +281,14 @@ def simulate_boom(
     the steady state at the start's flux; ``coupled=False`` freezes the incidence;
     ``integrator``: ``method``, ``rtol``, ``atol``, ``dt``, ``max_step``, ``max_steps`` as
     :func:`thermojitter.simulate` takes them (or ``solver``)."""
-    # The module, not the function of the same name the package exports.
-    run = importlib.import_module("thermojitter.simulate")
-
     checks.instance("boom", boom, Boom, "a thermojitter.Boom")
     checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
-    used, options = run.run_settings(solver, run.time_span(t_span), t_eval, dt_out, **integrator)
-    limit = run.DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
-    options["limit"] = run.limit_args(limit, on_limit)
-    options["y0"] = run.start_state(y0, 4)
+    used, options = _runs.run_settings(
+        solver, _runs.time_span(t_span), t_eval, dt_out, **integrator
+    )
+    limit = _runs.DEFAULT_THETA_LIMIT if theta_limit is None else theta_limit
+    options["limit"] = _runs.limit_args(limit, on_limit)
+    options["y0"] = _runs.start_state(y0, 4)
     raw = interruptible(
         _core.simulate_boom,
         boom.as_dict(),
@@ -301,13 +298,13 @@ def simulate_boom(
     )
     settings = {"rtol": used.rtol, "atol": used.atol, "dt": used.dt, "coupled": coupled}
     sol = BoomSolution(
-        **run.run_record(raw, used),
+        **_runs.run_record(raw, used),
         settings={**settings, "boom": boom.as_dict(), "solver": dict(raw["solver"])},
         length=boom.length,
         **{name: raw[name] for name in (*BoomSolution.COLUMNS, "y_end")},
-        **run.limit_record(raw),
+        **_runs.limit_record(raw),
     )
-    run.warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)
+    _runs.warn_crossing(sol.limit_crossing, limit, on_limit, stacklevel=4)
     return sol
 
 

@@ -197,24 +197,17 @@ def calibrate(
         [0.0 if n == "damping" else 1e-9 * s for n, s in zip(names, scale, strict=True)]
     )
 
+    # The forward runs' settings, written once: the result records them.
+    trial_settings: dict[str, Any] = {"model": model, "coupled": coupled, "rtol": rtol}
+    trial_settings.update(atol=atol, theta_limit=limits["theta_limit"])
+    span = (ts[0], ts[-1])
+
     def run(x: Array, on_limit: OnLimit) -> Any:
         trial = trial0.replace(**dict(zip(names, (float(v) for v in x), strict=True)))
         with warnings.catch_warnings():
             # The fit warns once, itself, of a crossing of the fitted run.
             warnings.simplefilter("ignore", ValidityLimitWarning)
-            return simulate(
-                trial,
-                orb,
-                (ts[0], ts[-1]),
-                model=model,
-                coupled=coupled,
-                rtol=rtol,
-                atol=atol,
-                t_eval=ts,
-                y0=y0,
-                theta_limit=limits["theta_limit"],
-                on_limit=on_limit,
-            )
+            return simulate(trial, orb, span, t_eval=ts, y0=y0, on_limit=on_limit, **trial_settings)
 
     def forward(x: Array) -> Array:
         return np.asarray(run(x, "ignore").theta)
@@ -262,15 +255,7 @@ def calibrate(
         success=bool(res.success),
         message=str(res.message),
         nfev=int(res.nfev),
-        settings={
-            "model": model,
-            "coupled": coupled,
-            "fit": names,
-            "rtol": rtol,
-            "atol": atol,
-            "theta_limit": limits["theta_limit"],
-            "on_limit": on_limit,
-        },
+        settings={**trial_settings, "fit": names, "on_limit": on_limit},
         limit_crossing=crossing,
     )
 

@@ -38,7 +38,7 @@ from thermojitter.attitude import Attitude, engine_orbit
 from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
-from thermojitter.persist import Persistent
+from thermojitter.persist import Persistent, field_type
 from thermojitter.progress import interruptible
 from thermojitter.results import LimitCrossing, Run, _dataframes_module, _FaceDifference
 from thermojitter.simulate import (
@@ -313,6 +313,7 @@ def simulate_distributed(
     )
 
 
+@field_type
 @dataclass(frozen=True)
 class OscillatoryMode:
     """One oscillatory eigen-pair of the linearised distributed panel: growth rate Re λ (1/s),

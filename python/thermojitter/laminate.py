@@ -13,8 +13,10 @@ from typing import Any
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.persist import field_type
 
 
+@field_type
 @dataclass(frozen=True)
 class Layer:
     """One layer of a laminate, isotropic in its plane; every value SI.
@@ -52,6 +54,7 @@ class Layer:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
+@field_type
 @dataclass(frozen=True)
 class Laminate:
     """A stack of layers (front first) with its surface properties.

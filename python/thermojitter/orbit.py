@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.persist import field_type
 
 # The constants live in the engine (rust/src/orbit.rs); these are their Python names.
 GEO_RADIUS: float = _core.GEO_RADIUS
@@ -155,6 +156,7 @@ def _altitude(altitude: Any) -> float:
     return height
 
 
+@field_type
 @dataclass(frozen=True)
 class Orbit:
     """A circular orbit, its Earth shadow and the Sun over the year.

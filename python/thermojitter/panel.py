@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from functools import cached_property
@@ -14,7 +15,7 @@ import numpy as np
 from thermojitter import _core
 from thermojitter import errors as checks
 from thermojitter.laminate import Laminate
-from thermojitter.results import Equilibrium
+from thermojitter.persist import Persistent, field_type
 
 StiffnessCriterion = Literal["deflection", "deflection_small_angle", "frequency"]
 
@@ -61,6 +62,7 @@ def _parameter(name: str, unit: str) -> Any:
     return dataclasses.field(default=_TABLE_1[name], metadata={"unit": unit})
 
 
+@field_type
 @dataclass(frozen=True)
 class Panel:
     """A long, thin, Sun-pointing plate of unit width; every value SI.
@@ -229,6 +231,26 @@ class Panel:
         return float(_core.derived(self.as_dict())["hinge_inertia"])
 
 
+@field_type
+@dataclass(frozen=True)
+class Equilibrium(Persistent):
+    """The sunlit steady state: temperatures (K), hinge angle (rad) and thermal moment (N m)."""
+
+    T_front: float
+    T_back: float
+    theta: float
+    thermal_moment: float
+
+    @property
+    def delta_T(self) -> float:
+        """T_front − T_back, K."""
+        return self.T_front - self.T_back
+
+    @property
+    def theta_deg(self) -> float:
+        return math.degrees(self.theta)
+
+
 PANEL_UNITS: dict[str, str] = {f.name: f.metadata["unit"] for f in fields(Panel)}
 """SI unit of each Panel field, for axis labels and tables."""
 
@@ -238,16 +260,9 @@ def _check_panel(panel: Any) -> None:
 
 
 def steady_state(panel: Panel, *, coupled: bool = True, flux: float = 1.0) -> Equilibrium:
-    """The sunlit equilibrium of the coupled system (θ̇ = 0, all rates zero).
-
-    ``coupled=False`` freezes the projected area (cos θ → 1). ``flux`` scales the solar constant
-    (1: nominal; e.g. 1.033 at perihelion). A :class:`thermojitter.Boom` gives its
-    :class:`thermojitter.BoomEquilibrium` (:func:`thermojitter.boom_steady_state`).
-    """
-    from thermojitter.boom import Boom, boom_steady_state
-
-    if isinstance(panel, Boom):
-        return boom_steady_state(panel, coupled=coupled, flux=flux)  # type: ignore[return-value]
+    """The panel's sunlit equilibrium (θ̇ = 0, all rates zero): ``coupled`` and ``flux`` as
+    :func:`thermojitter.steady_state` takes them (which takes a :class:`thermojitter.Boom`
+    too)."""
     _check_panel(panel)
     pd = panel.as_dict()
     tf, tb, th = _core.steady_state(pd, checks.flag("coupled", coupled), checks.real("flux", flux))

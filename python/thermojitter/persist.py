@@ -25,7 +25,7 @@ import json
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
@@ -119,20 +119,23 @@ def _xarray() -> Any:
 # ------------------------------------------------------------------------------ JSON fields
 
 
-def _types() -> dict[str, type]:
-    """The classes a result's JSON fields may hold, by name (nothing else is made on load)."""
-    from thermojitter.distributed import OscillatoryMode
-    from thermojitter.laminate import Laminate, Layer
-    from thermojitter.orbit import Orbit
-    from thermojitter.panel import Panel
-    from thermojitter.results import Equilibrium, LimitCrossing
-    from thermojitter.solver import HybridSettings, SolverSettings
+_FIELD_TYPES: dict[str, type] = {}
+"""The classes a result's JSON fields may hold, by name (nothing else is made on load)."""
 
-    classes: list[type] = [
-        OscillatoryMode, Laminate, Layer, Orbit, Panel, Equilibrium, LimitCrossing,
-        HybridSettings, SolverSettings,
-    ]  # fmt: skip
-    return {c.__name__: c for c in classes}
+_T = TypeVar("_T", bound=type)
+
+
+def field_type(cls: _T) -> _T:
+    """Class decorator: instances of ``cls`` may be held in a result's fields (written as JSON,
+    made again on load). Each class registers itself where it is defined, so ``persist`` imports
+    none of them."""
+    _FIELD_TYPES[cls.__name__] = cls
+    return cls
+
+
+def _types() -> dict[str, type]:
+    """The classes a result's JSON fields may hold, by name (those marked :func:`field_type`)."""
+    return _FIELD_TYPES
 
 
 def encode(value: Any) -> Any:

@@ -5,21 +5,21 @@ from __future__ import annotations
 import importlib
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from thermojitter.persist import Persistent
+from thermojitter.orbit import Orbit
+from thermojitter.panel import Equilibrium as Equilibrium  # the panel's steady state
+from thermojitter.panel import Panel
+from thermojitter.persist import Persistent, field_type
 from thermojitter.solver import SolverSettings
-
-if TYPE_CHECKING:
-    from thermojitter.orbit import Orbit
-    from thermojitter.panel import Panel
 
 Array = NDArray[np.float64]
 
 
+@field_type
 class LimitCrossing(NamedTuple):
     """Where a run's angle first passed its ``theta_limit``: the time ``t`` (s), the ``orbit``
     it falls in (whole orbits since the run's start, as :func:`thermojitter.simulate_orbits`
@@ -62,25 +62,6 @@ class _FaceDifference:
     def delta_T(self: _Faces) -> Array:
         """T_front − T_back, K (over time; over time × element for the distributed panel)."""
         return self.T_front - self.T_back
-
-
-@dataclass(frozen=True)
-class Equilibrium(Persistent):
-    """The sunlit steady state: temperatures (K), hinge angle (rad) and thermal moment (N m)."""
-
-    T_front: float
-    T_back: float
-    theta: float
-    thermal_moment: float
-
-    @property
-    def delta_T(self) -> float:
-        """T_front − T_back, K."""
-        return self.T_front - self.T_back
-
-    @property
-    def theta_deg(self) -> float:
-        return math.degrees(self.theta)
 
 
 @dataclass(frozen=True)

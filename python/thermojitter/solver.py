@@ -17,6 +17,7 @@ from typing import Any, Literal
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.persist import field_type
 
 DEFAULTS: dict[str, Any] = dict(_core.SOLVER_DEFAULTS)
 """method "rk45", rtol, atol, max_step (s), max_steps."""
@@ -27,6 +28,7 @@ MAX_STEPS: int = DEFAULTS["max_steps"]
 METHODS = ("rk45", "rk4")
 
 
+@field_type
 @dataclasses.dataclass(frozen=True)
 class SolverSettings:
     """How a run integrates: ``method`` ``"rk45"`` (Dormand–Prince 5(4), error control by
@@ -102,6 +104,7 @@ def _checked(key: tuple[tuple[str, type, Any], ...]) -> SolverSettings:
     return SolverSettings(**{name: value for name, _, value in key})
 
 
+@field_type
 @dataclasses.dataclass(frozen=True)
 class HybridSettings:
     """How ``method="hybrid"`` propagates (see :func:`thermojitter.simulate_orbits`): every

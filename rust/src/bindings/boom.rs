@@ -104,13 +104,9 @@ fn simulate_boom<'py>(
     cancellable(cancel, |cancel| {
         let b = boom_from(boom)?;
         let o = orbit_from(orbit)?;
-        let (method, out) = run.integration()?;
-        let limit = run.watch()?;
+        let settings = run.transient(true)?;
         let c = coupling(coupled);
-        let (span, y0) = (run.span, run.y0);
-        let run = py.detach(|| {
-            crate::runs::boom::simulate(&b, o, c, &method, span, &out, y0, limit, cancel)
-        })?;
+        let run = py.detach(|| crate::runs::boom::simulate(&b, o, c, settings, cancel))?;
         transient_dict(py, Transient::Coupled(run))
     })
 }
@@ -166,7 +162,7 @@ fn run_boom_orbits<'py>(
         let method = solver_from(&solver)?;
         check_hinge_angle("theta_limit", theta_limit)?;
         if let Some(h) = hybrid {
-            super::orbits::hybrid_from(h)?;
+            super::convert::hybrid_from(h)?;
         }
         let options = SummaryOptions {
             window,

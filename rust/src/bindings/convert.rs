@@ -1,19 +1,22 @@
 //! Python values to engine types, with errors that name the parameter.
 
 use super::error::invalid;
-use crate::inputs::heating::Attitude;
+use crate::inputs::attitude::Attitude;
+use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS};
 use crate::inputs::orbit::Shadow;
+use crate::models::conduction::Conduction;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
 use crate::numerics::integrate::{Method, Stats, Tolerances};
-use crate::runs::simulate::Output;
+use crate::runs::hybrid::HybridSettings;
+use crate::runs::simulate::{Output, TransientSettings};
 use crate::{Orbit, Panel};
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyBool, PyDict, PyString};
+use pyo3::types::{PyBool, PyDict, PyList, PyString};
 
 /// A float entry of a mapping, named in any error. The key may be an interned Python string, so
 /// that the lookup neither builds nor hashes a new string.
@@ -292,6 +295,101 @@ pub fn solver_from(d: &Bound<'_, PyDict>) -> PyResult<Method> {
     }
 }
 
+/// A layer from a mapping of its fields and a name.
+pub(super) fn layer_from(d: &Bound<'_, PyAny>, index: usize) -> PyResult<Layer> {
+    let d = d
+        .cast::<PyDict>()
+        .map_err(|_| type_error(&format!("layers[{index}]"), "a mapping", d))?;
+    let name: String = match d.get_item("name")? {
+        Some(v) => v
+            .extract()
+            .map_err(|_| type_error(&format!("layers[{index}].name"), "a string", &v))?,
+        None => format!("layer {index}"),
+    };
+    // Errors name the layer and the field: "layer 'core': density".
+    let value = |field: &str| -> PyResult<f64> {
+        let label = format!("layer '{name}': {field}");
+        let v = d
+            .get_item(field)?
+            .ok_or_else(|| invalid(&label, "missing", "is required"))?;
+        if v.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(type_error(&label, "a number", &v));
+        }
+        v.extract::<f64>()
+            .map_err(|_| type_error(&label, "a number", &v))
+    };
+    let [thickness, conductivity, density, specific_heat, youngs_modulus, expansion_coeff] =
+        LAYER_FIELDS;
+    Ok(Layer {
+        thickness: value(thickness)?,
+        conductivity: value(conductivity)?,
+        density: value(density)?,
+        specific_heat: value(specific_heat)?,
+        youngs_modulus: value(youngs_modulus)?,
+        expansion_coeff: value(expansion_coeff)?,
+        name,
+    })
+}
+
+/// A laminate from a mapping {layers: [mapping…], emissivity_front, emissivity_back,
+/// absorptivity, reference_temperature}, validated.
+pub(super) fn laminate_from(d: &Bound<'_, PyDict>) -> PyResult<Laminate> {
+    let items = d
+        .get_item("layers")?
+        .ok_or_else(|| invalid("layers", "missing", "is required"))?;
+    let list = items
+        .cast::<PyList>()
+        .map_err(|_| type_error("layers", "a list of layers", &items))?;
+    let layers = list
+        .iter()
+        .enumerate()
+        .map(|(i, item)| layer_from(&item, i))
+        .collect::<PyResult<Vec<_>>>()?;
+    let lam = Laminate {
+        layers,
+        emissivity_front: float_item(d, "emissivity_front")?,
+        emissivity_back: float_item(d, "emissivity_back")?,
+        absorptivity: float_item(d, "absorptivity")?,
+        reference_temperature: float_item(d, "reference_temperature")?,
+    };
+    lam.validate()?;
+    Ok(lam)
+}
+
+/// The conduction model of `panel` with `nodes` nodes through its layup, or through one
+/// homogeneous layer for a plain panel.
+pub(super) fn conduction_from(
+    panel: &Panel,
+    layup: Option<&Bound<'_, PyDict>>,
+    nodes: usize,
+) -> PyResult<Conduction> {
+    Ok(match layup {
+        Some(d) => Conduction::new(panel, &laminate_from(d)?, nodes)?,
+        None => Conduction::homogeneous(panel, nodes)?,
+    })
+}
+
+/// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
+pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
+    let mut s = HybridSettings::default();
+    for (key, value) in d.iter() {
+        let key: String = key.extract()?;
+        let v: f64 = value.extract()?;
+        match key.as_str() {
+            "rtol" => s.tolerances.rtol = v,
+            "atol_temperature" => s.tolerances.atol_temperature = v,
+            "atol_angle" => s.tolerances.atol_angle = v,
+            "max_step" => s.tolerances.max_step = v,
+            "linear_tolerance" => s.linear_tolerance = v,
+            "linear_amplitude" => s.linear_amplitude = v,
+            "resolved_amplitude" => s.resolved_amplitude = v,
+            other => return Err(invalid("hybrid", other, "not a hybrid setting")),
+        }
+    }
+    s.validate()?;
+    Ok(s)
+}
+
 // The groups of parameters that several pyfunctions take: each group is ONE struct read from ONE
 // Python mapping (pyo3's `FromPyObject`, `from_item_all`: a key per field), converted here, once,
 // with the errors every function gives. The Python side builds each mapping in one place too
@@ -310,9 +408,9 @@ pub struct Grid<'py> {
 }
 
 impl Grid<'_> {
-    /// The conduction model of `panel` on this grid ([`super::laminate::conduction_from`]).
-    pub fn conduction(&self, panel: &Panel) -> PyResult<crate::models::conduction::Conduction> {
-        super::laminate::conduction_from(panel, self.layup.as_ref(), self.nodes)
+    /// The conduction model of `panel` on this grid ([`conduction_from`]).
+    pub fn conduction(&self, panel: &Panel) -> PyResult<Conduction> {
+        conduction_from(panel, self.layup.as_ref(), self.nodes)
     }
 }
 
@@ -365,11 +463,8 @@ impl OrbitsRun<'_> {
     }
 
     /// The hybrid propagator's settings (None: the solver alone).
-    pub fn hybrid(&self) -> PyResult<Option<crate::runs::hybrid::HybridSettings>> {
-        self.hybrid
-            .as_ref()
-            .map(super::orbits::hybrid_from)
-            .transpose()
+    pub fn hybrid(&self) -> PyResult<Option<HybridSettings>> {
+        self.hybrid.as_ref().map(hybrid_from).transpose()
     }
 }
 
@@ -426,6 +521,20 @@ impl RunOptions<'_> {
         };
         out.sample_times(t0, t1)?;
         Ok((method, out))
+    }
+
+    /// The transient's settings: [`RunOptions::integration`], then with `watch` the limit
+    /// ([`RunOptions::watch`]; without, none: a system with no θ), converted in that order.
+    pub fn transient(&self, watch: bool) -> PyResult<TransientSettings> {
+        let (method, output) = self.integration()?;
+        let limit = if watch { self.watch()? } else { None };
+        Ok(TransientSettings {
+            method,
+            span: self.span,
+            output,
+            y0: self.y0.clone(),
+            limit,
+        })
     }
 
     /// The validity limit the run watches (None without a `limit` entry, or with "ignore").

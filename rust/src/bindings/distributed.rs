@@ -172,17 +172,13 @@ fn simulate_distributed<'py>(
     cancellable(cancel, |cancel| {
         let m = model_from(panel, settings)?;
         let o = orbit_from(orbit)?;
-        let (method, out) = run.integration()?;
-        let limit = run.watch()?;
-        let span = run.span;
-        let start = run.y0;
-        if let Some(x) = start.iter().flatten().find(|x| !x.is_finite()) {
+        let settings = run.transient(true)?;
+        if let Some(x) = settings.y0.iter().flatten().find(|x| !x.is_finite()) {
             return Err(invalid("y0", x, "every component must be finite"));
         }
+        let limit = settings.limit;
         let r = py
-            .detach(|| {
-                crate::runs::distributed::simulate(&m, o, &method, span, start, &out, limit, cancel)
-            })
+            .detach(|| crate::runs::distributed::simulate(&m, o, settings, cancel))
             .map_err(PyErr::from)?;
         let mesh = &m.reduction.mesh;
         let (n, nodes) = (m.n(), m.n() + 1);

@@ -4,10 +4,9 @@
 //! front.
 
 use super::cancel::{cancellable, CancelToken};
-use super::convert::{orbit_from, solver_dict, solver_from, OrbitsRun};
+use super::convert::{laminate_from, orbit_from, solver_dict, solver_from, OrbitsRun};
 use super::error::invalid;
 use super::error::shield;
-use super::laminate::laminate_from;
 use crate::runs::ensemble::{
     pool, run_batch_layered, run_batch_on, EnsembleSettings, Layers, Path, SampleMetrics,
 };

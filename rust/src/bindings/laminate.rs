@@ -2,95 +2,19 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, dict_of, float_item, hinge_model, orbit_from, panel_dict, panel_from, set_named,
-    type_error, FlutterPoint, Grid, RunOptions,
+    coupling, dict_of, hinge_model, laminate_from, layer_from, orbit_from, panel_dict, panel_from,
+    set_named, FlutterPoint, Grid, RunOptions,
 };
-use super::error::{invalid, shield};
+use super::error::shield;
 use super::flutter::set_spectrum;
 use crate::analysis::flutter::check_flux;
 use crate::analysis::layered::{LayeredEquilibrium, LayeredPoint};
 use crate::inputs::heating::Loads;
-use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS, MATERIALS};
-use crate::inputs::panel::Panel;
-use crate::models::conduction::Conduction;
+use crate::inputs::laminate::{LAYER_FIELDS, MATERIALS};
 use crate::runs::request::ThermalChoice;
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
-
-/// A layer from a mapping of its fields and a name.
-fn layer_from(d: &Bound<'_, PyAny>, index: usize) -> PyResult<Layer> {
-    let d = d
-        .cast::<PyDict>()
-        .map_err(|_| type_error(&format!("layers[{index}]"), "a mapping", d))?;
-    let name: String = match d.get_item("name")? {
-        Some(v) => v
-            .extract()
-            .map_err(|_| type_error(&format!("layers[{index}].name"), "a string", &v))?,
-        None => format!("layer {index}"),
-    };
-    // Errors name the layer and the field: "layer 'core': density".
-    let value = |field: &str| -> PyResult<f64> {
-        let label = format!("layer '{name}': {field}");
-        let v = d
-            .get_item(field)?
-            .ok_or_else(|| invalid(&label, "missing", "is required"))?;
-        if v.is_instance_of::<pyo3::types::PyBool>() {
-            return Err(type_error(&label, "a number", &v));
-        }
-        v.extract::<f64>()
-            .map_err(|_| type_error(&label, "a number", &v))
-    };
-    let [thickness, conductivity, density, specific_heat, youngs_modulus, expansion_coeff] =
-        LAYER_FIELDS;
-    Ok(Layer {
-        thickness: value(thickness)?,
-        conductivity: value(conductivity)?,
-        density: value(density)?,
-        specific_heat: value(specific_heat)?,
-        youngs_modulus: value(youngs_modulus)?,
-        expansion_coeff: value(expansion_coeff)?,
-        name,
-    })
-}
-
-/// A laminate from a mapping {layers: [mapping…], emissivity_front, emissivity_back,
-/// absorptivity, reference_temperature}, validated.
-pub fn laminate_from(d: &Bound<'_, PyDict>) -> PyResult<Laminate> {
-    let items = d
-        .get_item("layers")?
-        .ok_or_else(|| invalid("layers", "missing", "is required"))?;
-    let list = items
-        .cast::<PyList>()
-        .map_err(|_| type_error("layers", "a list of layers", &items))?;
-    let layers = list
-        .iter()
-        .enumerate()
-        .map(|(i, item)| layer_from(&item, i))
-        .collect::<PyResult<Vec<_>>>()?;
-    let lam = Laminate {
-        layers,
-        emissivity_front: float_item(d, "emissivity_front")?,
-        emissivity_back: float_item(d, "emissivity_back")?,
-        absorptivity: float_item(d, "absorptivity")?,
-        reference_temperature: float_item(d, "reference_temperature")?,
-    };
-    lam.validate()?;
-    Ok(lam)
-}
-
-/// The conduction model of `panel` with `nodes` nodes through its layup, or through one
-/// homogeneous layer for a plain panel.
-pub fn conduction_from(
-    panel: &Panel,
-    layup: Option<&Bound<'_, PyDict>>,
-    nodes: usize,
-) -> PyResult<Conduction> {
-    Ok(match layup {
-        Some(d) => Conduction::new(panel, &laminate_from(d)?, nodes)?,
-        None => Conduction::homogeneous(panel, nodes)?,
-    })
-}
+use pyo3::types::PyDict;
 
 /// Checks one layer mapping (errors name the layer and field).
 #[pyfunction]

@@ -262,19 +262,14 @@ pub(crate) fn coupled_transient<'py>(
     thermal: impl FnOnce(&crate::Panel) -> PyResult<ThermalChoice>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (p, o, hinge) = (panel_from(panel)?, orbit_from(orbit)?, hinge_model(model)?);
-    let (method, output) = run.integration()?;
-    let limit = run.watch()?;
+    let settings = run.transient(true)?;
     let req = RunRequest {
         panel: p,
         orbit: o,
         thermal: thermal(&p)?,
         model: hinge,
         coupling: coupling(coupled),
-        method,
-        span: run.span,
-        output,
-        y0: run.y0,
-        limit,
+        settings,
     };
     let run = py.detach(|| crate::runs::request::simulate(req, cancel))?;
     transient_dict(py, run)
@@ -337,11 +332,10 @@ fn simulate_thermal<'py>(
     cancellable(cancel, |cancel| {
         let p = panel_from(panel)?;
         let o = orbit_from(orbit)?;
-        let (m, out) = run.integration()?;
+        let settings = run.transient(false)?;
         let thermal = crate::models::thermal_model(&p, layers)?;
         let sys = Coupled::thermal_only(thermal, o).with_optics(Optics::of(&p));
-        let (span, y0) = (run.span, run.y0);
-        let run = py.detach(|| coupled_run(sys, &m, span, y0, &out, None, cancel))?;
+        let run = py.detach(|| coupled_run(sys, settings, cancel))?;
         transient_dict(py, Transient::Coupled(run))
     })
 }

@@ -143,7 +143,7 @@ macro_rules! add_constants {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    use crate::inputs::heating::{EARTH_ALBEDO, EARTH_IR};
+    use crate::inputs::attitude::{EARTH_ALBEDO, EARTH_IR};
     use crate::inputs::orbit::{
         DAY, EARTH_RADIUS, EQUINOX_DAY, GEO_RADIUS, J2, LEO_ALTITUDE, MAX_LEO_ALTITUDE,
         MIN_LEO_ALTITUDE, MU_EARTH, OBLIQUITY, PERIHELION_DAY, SIDEREAL_DAY, YEAR_DAYS,

@@ -4,7 +4,6 @@ use super::cancel::{cancellable, CancelToken};
 use super::convert::{
     crossing_tuple, orbit_from, panel_from, set_counters, set_named, solver_dict, OrbitsRun,
 };
-use crate::runs::hybrid::HybridSettings;
 use crate::runs::layered::LayeredRunRequest;
 use crate::runs::orbits::{OrbitRunRequest, OrbitRunSpec, SummaryOptions};
 use crate::runs::request::{OrbitsModel, OrbitsRequest};
@@ -129,31 +128,6 @@ pub(super) fn summary_dict<'py>(
     d.set_item("crossing", crossing_tuple(out.crossing))?;
     d.set_item("solver", solver_dict(py, method)?)?;
     Ok(d)
-}
-
-/// Hybrid settings from a mapping of optional keys (missing ones keep the engine's defaults).
-pub(super) fn hybrid_from(d: &Bound<'_, PyDict>) -> PyResult<HybridSettings> {
-    let mut s = HybridSettings::default();
-    for (key, value) in d.iter() {
-        let key: String = key.extract()?;
-        let v: f64 = value.extract()?;
-        match key.as_str() {
-            "rtol" => s.tolerances.rtol = v,
-            "atol_temperature" => s.tolerances.atol_temperature = v,
-            "atol_angle" => s.tolerances.atol_angle = v,
-            "max_step" => s.tolerances.max_step = v,
-            "linear_tolerance" => s.linear_tolerance = v,
-            "linear_amplitude" => s.linear_amplitude = v,
-            "resolved_amplitude" => s.resolved_amplitude = v,
-            other => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "hybrid = {{{other:?}: ...}} is invalid: not a hybrid setting"
-                )))
-            }
-        }
-    }
-    s.validate()?;
-    Ok(s)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,5 +1,6 @@
 //! The validated inputs of every run: the panel, its laminate, the orbit.
 
+pub mod attitude;
 pub mod boom;
 pub mod heating;
 pub mod laminate;

@@ -35,7 +35,8 @@
 //! perihelion dates are mean values, good to about a day.
 
 use crate::error::{require_finite, require_positive, Error, Result};
-use crate::inputs::heating::{Attitude, MAX_EARTH_IR};
+use crate::inputs::attitude::{Attitude, MAX_EARTH_IR};
+use crate::numerics::vector::{cross, dot, norm};
 use std::f64::consts::PI;
 
 /// Shortest orbit period accepted, s: a grazing orbit of a dense body takes tens of minutes; a
@@ -828,22 +829,6 @@ impl EclipseTable {
         let last = self.list.partition_point(|e| e.outer.0 < t1);
         &self.list[first..last.max(first)]
     }
-}
-
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// Visible fraction of a disk of angular radius `rho_s` whose centre is `sep` away from the

@@ -7,3 +7,4 @@ pub mod newton;
 pub(crate) mod simd;
 #[cfg(test)]
 pub(crate) mod testing;
+pub(crate) mod vector;

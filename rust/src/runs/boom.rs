@@ -13,25 +13,21 @@ use crate::numerics::integrate::Method;
 use crate::runs::layered::LayeredSummaries;
 use crate::runs::orbits::{run_summarised, OrbitRunSpec, SummaryOptions, SummaryView};
 use crate::runs::request::{coupled_run, CoupledRun};
-use crate::runs::simulate::{state_from, OnLimit, Output};
+use crate::runs::simulate::{state_from, TransientSettings};
 use nalgebra::U4;
 
-/// One transient of the boom from `y0` (default: its steady state at the start's flux):
-/// columns T_mean, T_circ, theta, theta_dot, the thermal moment and the illumination.
-#[allow(clippy::too_many_arguments)]
+/// One transient of the boom as `settings` say, from their `y0` (default: its steady state at the
+/// start's flux): columns T_mean, T_circ, theta, theta_dot, the thermal moment and the
+/// illumination.
 pub fn simulate(
     boom: &Boom,
     orbit: Orbit,
     coupling: Coupling,
-    method: &Method,
-    span: (f64, f64),
-    output: &Output,
-    y0: Option<Vec<f64>>,
-    limit: Option<OnLimit>,
+    settings: TransientSettings,
     cancel: &Cancel,
 ) -> Result<CoupledRun> {
     let sys = boom_system(boom, orbit, coupling)?;
-    coupled_run(sys, method, span, y0, output, limit, cancel)
+    coupled_run(sys, settings, cancel)
 }
 
 /// How the orbit summaries read the boom's state (T̄, T_m, θ, θ̇).

@@ -8,9 +8,9 @@ use crate::inputs::orbit::Orbit;
 use crate::models::coupled::Sunlight;
 use crate::models::distributed::{DistributedPanel, ElementHeat};
 use crate::numerics::integrate::Stats;
-use crate::numerics::integrate::{Dyn, Method, OdeSystem, State};
+use crate::numerics::integrate::{Dyn, OdeSystem, State};
 use crate::runs::orbits::LimitCrossing;
-use crate::runs::simulate::{run_watched, Limit, OnLimit, Output};
+use crate::runs::simulate::{run_watched, Limit, OnLimit, TransientSettings};
 use nalgebra::DVector;
 
 /// The distributed panel driven by an orbit's sunlight, and by its Earth heating and attitude
@@ -90,25 +90,22 @@ pub struct DistributedRun {
     pub crossing: Option<LimitCrossing>,
 }
 
-/// Integrates `model` on `orbit` over `t_span` from `y0` (default: the sunlit equilibrium at the
-/// start's flux scale) and samples it as `output` asks, watching θ_f against `limit` (see
+/// Integrates `model` on `orbit` as `settings` say: over their span from their `y0` (default: the
+/// sunlit equilibrium at the start's flux scale), sampled as their `output` asks, watching θ_f
+/// against their `limit` (see
 /// [`crate::runs::simulate::run_watched`]) and stopping within a step of `cancel`.
-#[allow(clippy::too_many_arguments)]
 pub fn simulate(
     model: &DistributedPanel,
     orbit: Orbit,
-    method: &Method,
-    t_span: (f64, f64),
-    y0: Option<Vec<f64>>,
-    output: &Output,
-    limit: Option<OnLimit>,
+    settings: TransientSettings,
     cancel: &Cancel,
 ) -> Result<DistributedRun> {
+    let t_span = settings.span;
     orbit.validate()?;
     model.check_orbit(&orbit)?;
     let (t0, _) = t_span;
     crate::numerics::integrate::check_span(t_span.0, t_span.1)?;
-    let start = match y0 {
+    let start = match settings.y0 {
         Some(v) => {
             if v.len() != model.state_size() {
                 return Err(Error::invalid(
@@ -134,13 +131,13 @@ pub fn simulate(
         None => model.equilibrium(orbit.flux_scale(t0))?,
     };
     let mut system = DistributedSystem::new(model.clone(), orbit);
-    let watch = limit.map(|on| model.limit(on));
+    let watch = settings.limit.map(|on| model.limit(on));
     let traj = run_watched(
         &mut system,
-        method,
+        &settings.method,
         t_span,
         DVector::from_vec(start),
-        output,
+        &settings.output,
         watch.as_ref(),
         cancel,
     )?;

@@ -17,7 +17,7 @@ use crate::numerics::integrate::{Dyn, Method, Stats};
 use crate::runs::hybrid::{HybridRun, HybridSettings};
 use crate::runs::layered::{LayeredRun, LayeredRunRequest, LayeredSummaries};
 use crate::runs::orbits::{LimitCrossing, OrbitRunRequest};
-use crate::runs::simulate::{run_watched, state_from, OnLimit, Output};
+use crate::runs::simulate::{run_watched, state_from, TransientSettings};
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim};
 
@@ -40,11 +40,7 @@ pub struct RunRequest {
     pub thermal: ThermalChoice,
     pub model: HingeModel,
     pub coupling: Coupling,
-    pub method: Method,
-    pub span: (f64, f64),
-    pub output: Output,
-    pub y0: Option<Vec<f64>>,
-    pub limit: Option<OnLimit>,
+    pub settings: TransientSettings,
 }
 
 /// A sampled run of a coupled system (or of a thermal model alone): every state component by
@@ -88,11 +84,7 @@ pub fn simulate(req: RunRequest, cancel: &Cancel) -> Result<Transient> {
         thermal,
         model,
         coupling,
-        method,
-        span,
-        output,
-        y0,
-        limit,
+        settings,
     } = req;
     let layers = match thermal {
         ThermalChoice::Layers(n) => n,
@@ -103,11 +95,11 @@ pub fn simulate(req: RunRequest, cancel: &Cancel) -> Result<Transient> {
                 &orbit,
                 model,
                 coupling,
-                &method,
-                span,
-                y0.as_deref(),
-                &output,
-                limit,
+                &settings.method,
+                settings.span,
+                settings.y0.as_deref(),
+                &settings.output,
+                settings.limit,
                 cancel,
             )?;
             return Ok(Transient::Layered(run));
@@ -116,27 +108,24 @@ pub fn simulate(req: RunRequest, cancel: &Cancel) -> Result<Transient> {
     let run = if layers == 2 {
         // The paper's model, its state size known at compile time.
         let sys = Coupled::new(panel, orbit, model, coupling);
-        coupled_run(sys, &method, span, y0, &output, limit, cancel)?
+        coupled_run(sys, settings, cancel)?
     } else {
         let thermal = crate::models::thermal_model(&panel, layers)?;
         let n = thermal.size() + 2;
         let structure = Hinge::new(&panel, model);
         let sys = Coupled::compose(thermal, structure, orbit, coupling, Dyn(n))?
             .with_optics(Optics::of(&panel));
-        coupled_run(sys, &method, span, y0, &output, limit, cancel)?
+        coupled_run(sys, settings, cancel)?
     };
     Ok(Transient::Coupled(run))
 }
 
-/// Runs a coupled system (or a thermal model alone) from `y0` (default: its steady state at the
-/// start's flux), watching θ against `limit` when the system has a θ.
+/// Runs a coupled system (or a thermal model alone) as `settings` say, from their `y0` (default:
+/// its steady state at the start's flux), watching θ against their `limit` when the system has a
+/// θ.
 pub fn coupled_run<T, S, D>(
     mut sys: Coupled<T, S, D>,
-    method: &Method,
-    span: (f64, f64),
-    y0: Option<Vec<f64>>,
-    out: &Output,
-    limit: Option<OnLimit>,
+    settings: TransientSettings,
     cancel: &Cancel,
 ) -> Result<CoupledRun>
 where
@@ -145,8 +134,9 @@ where
     D: Dim,
     DefaultAllocator: Allocator<D>,
 {
+    let span = settings.span;
     let orbit = *sys.orbit();
-    let y_start = match y0 {
+    let y_start = match settings.y0 {
         Some(v) => {
             let y = state_from(&v, sys.dim())?;
             sys.check_start(&y)?;
@@ -157,8 +147,17 @@ where
     let names = sys.names();
     // The limit is on θ, the structure's first state (a thermal model alone has none).
     let theta = names.iter().position(|n| n == "theta");
-    let watch = limit.zip(theta).map(|(l, i)| l.on_component(i));
-    let traj = run_watched(&mut sys, method, span, y_start, out, watch.as_ref(), cancel)?;
+    let watch = settings.limit.zip(theta).map(|(l, i)| l.on_component(i));
+    let (method, output) = (&settings.method, &settings.output);
+    let traj = run_watched(
+        &mut sys,
+        method,
+        span,
+        y_start,
+        output,
+        watch.as_ref(),
+        cancel,
+    )?;
     let crossing = traj
         .crossing
         .as_ref()
@@ -242,7 +241,7 @@ pub fn run_orbits(req: &OrbitsRequest, cancel: &Cancel) -> Result<OrbitsRun> {
 mod tests {
     use super::*;
     use crate::numerics::integrate::Tolerances;
-    use crate::runs::simulate::run;
+    use crate::runs::simulate::{run, Output};
 
     fn request(thermal: ThermalChoice) -> RunRequest {
         RunRequest {
@@ -251,11 +250,13 @@ mod tests {
             thermal,
             model: HingeModel::Nonlinear,
             coupling: Coupling::ProjectedArea,
-            method: Method::Dopri5(Tolerances::default()),
-            span: (0.0, 3000.0),
-            output: Output::Every(100.0),
-            y0: None,
-            limit: None,
+            settings: TransientSettings {
+                method: Method::Dopri5(Tolerances::default()),
+                span: (0.0, 3000.0),
+                output: Output::Every(100.0),
+                y0: None,
+                limit: None,
+            },
         }
     }
 
@@ -267,7 +268,8 @@ mod tests {
         };
         let mut sys = Coupled::new(req.panel, req.orbit, req.model, req.coupling);
         let y0 = sys.steady_state(req.orbit.flux_scale(0.0)).unwrap();
-        let want = run(&mut sys, &req.method, req.span, y0, &req.output).unwrap();
+        let s = &req.settings;
+        let want = run(&mut sys, &s.method, s.span, y0, &s.output).unwrap();
         assert_eq!(got.t, want.t);
         assert_eq!(got.names, ["T_front", "T_back", "theta", "theta_dot"]);
         for (i, column) in got.columns.iter().enumerate() {
@@ -290,10 +292,10 @@ mod tests {
             &req.orbit,
             req.model,
             req.coupling,
-            &req.method,
-            req.span,
+            &req.settings.method,
+            req.settings.span,
             None,
-            &req.output,
+            &req.settings.output,
             None,
             &Cancel::new(),
         )
@@ -305,7 +307,7 @@ mod tests {
     #[test]
     fn a_start_of_the_wrong_size_is_refused_by_name() {
         let mut req = request(ThermalChoice::Layers(3));
-        req.y0 = Some(vec![300.0; 4]);
+        req.settings.y0 = Some(vec![300.0; 4]);
         let e = simulate(req, &Cancel::new()).unwrap_err();
         assert!(
             matches!(e, crate::error::Error::InvalidParameter { ref name, .. } if name == "y0"),

@@ -246,6 +246,18 @@ impl OnLimit {
     }
 }
 
+/// How one transient runs, whatever its system: the integrator, the span (t0, t1), where to
+/// report, the start (None: the system's steady state at t0's flux) and the validity limit to
+/// watch.
+#[derive(Debug, Clone)]
+pub struct TransientSettings {
+    pub method: Method,
+    pub span: (f64, f64),
+    pub output: Output,
+    pub y0: Option<Vec<f64>>,
+    pub limit: Option<OnLimit>,
+}
+
 /// Checks a validity limit on the hinge angle: > 0 and within the hinge model's range ±π/2.
 pub fn check_theta_limit(theta_limit: f64) -> Result<()> {
     crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;

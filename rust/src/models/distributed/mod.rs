@@ -33,7 +33,8 @@
 pub mod structure;
 
 use crate::error::{require_finite, require_non_negative, Error, Result};
-use crate::inputs::heating::{Attitude, Loads, Optics, Sources};
+use crate::inputs::attitude::Attitude;
+use crate::inputs::heating::{Loads, Optics, Sources};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;

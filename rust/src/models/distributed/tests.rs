@@ -70,7 +70,7 @@ mod runs {
     use crate::numerics::integrate::{Method, Tolerances};
     use crate::runs::beam::respond;
     use crate::runs::distributed::simulate;
-    use crate::runs::simulate::Output;
+    use crate::runs::simulate::{Output, TransientSettings};
 
     fn tight(rtol: f64) -> Method {
         Method::Dopri5(Tolerances {
@@ -113,17 +113,14 @@ mod runs {
         // The moment is sampled finely (it is interpolated linearly by the comparator) and at
         // the shadow exit, where its slope jumps.
         let ts = times(span, 0.1, &[b]);
-        let run = simulate(
-            &m,
-            orbit,
-            &method,
+        let run_settings = TransientSettings {
+            method,
             span,
-            None,
-            &Output::Times(ts.clone()),
-            None,
-            &crate::cancel::Cancel::new(),
-        )
-        .unwrap();
+            output: Output::Times(ts.clone()),
+            y0: None,
+            limit: None,
+        };
+        let run = simulate(&m, orbit, run_settings, &crate::cancel::Cancel::new()).unwrap();
         for sample in &run.temperatures {
             for row in sample {
                 assert!(row.iter().all(|v| *v == row[0]), "temperatures differ");
@@ -182,17 +179,14 @@ mod runs {
         y0[nt] += 1e-4 / m.reduction.rise_modal[0].abs() * m.reduction.mesh.arm();
         let span = (0.0, 8000.0);
         let ts = times(span, 0.05, &[]);
-        let run = simulate(
-            &m,
-            orbit,
-            &tight(1e-11),
+        let settings = TransientSettings {
+            method: tight(1e-11),
             span,
-            Some(y0),
-            &Output::Times(ts),
-            None,
-            &crate::cancel::Cancel::new(),
-        )
-        .unwrap();
+            output: Output::Times(ts),
+            y0: Some(y0),
+            limit: None,
+        };
+        let run = simulate(&m, orbit, settings, &crate::cancel::Cancel::new()).unwrap();
         let x: Vec<f64> = run.theta_f.iter().map(|v| v - theta_eq).collect();
         let (mut tp, mut lp) = (Vec::new(), Vec::new());
         for i in 1..x.len() - 1 {

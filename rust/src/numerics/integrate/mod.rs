@@ -104,15 +104,7 @@ where
         f0: State<D>,
         f1: State<D>,
     ) -> Self {
-        DenseStep {
-            t0,
-            t1,
-            y0,
-            y1,
-            slopes: Slopes::Hermite([f0, f1]),
-            r: OnceCell::new(),
-            mid: None,
-        }
+        Self::from_slopes(t0, t1, y0, y1, Slopes::Hermite([f0, f1]))
     }
 
     /// Dormand–Prince's continuous extension from the slopes k1, k3, k4, k5, k6, k7.
@@ -123,15 +115,7 @@ where
         y1: State<D>,
         slopes: [State<D>; 6],
     ) -> Self {
-        DenseStep {
-            t0,
-            t1,
-            y0,
-            y1,
-            slopes: Slopes::Dopri5(slopes),
-            r: OnceCell::new(),
-            mid: None,
-        }
+        Self::from_slopes(t0, t1, y0, y1, Slopes::Dopri5(slopes))
     }
 
     /// A step whose interpolant's coefficients r1..r5 and value `mid` at [`DenseStep::midpoint`]
@@ -145,14 +129,23 @@ where
         r: [State<D>; 5],
         mid: State<D>,
     ) -> Self {
+        let mut step = Self::from_slopes(t0, t1, y0, y1, Slopes::Given);
+        step.r = OnceCell::from(r);
+        step.mid = Some(mid);
+        step
+    }
+
+    /// A step over [t0, t1] from y0 to y1 whose interpolant `slopes` gives, its coefficients
+    /// and midpoint not built yet.
+    fn from_slopes(t0: f64, t1: f64, y0: State<D>, y1: State<D>, slopes: Slopes<D>) -> Self {
         DenseStep {
             t0,
             t1,
             y0,
             y1,
-            slopes: Slopes::Given,
-            r: OnceCell::from(r),
-            mid: Some(mid),
+            slopes,
+            r: OnceCell::new(),
+            mid: None,
         }
     }
 
