@@ -89,6 +89,7 @@ __all__ = [
     "linear_delta_t",
     "linear_thermal",
     "layered_flutter",
+    "layered_flutter_at",
     "layered_steady_state",
     "materials",
     "moment",

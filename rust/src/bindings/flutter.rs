@@ -10,7 +10,6 @@ use crate::analysis::flutter::{
 };
 use crate::analysis::linear::LinearThermal;
 use crate::analysis::stability::Axis;
-use crate::error::Result;
 use crate::inputs::heating::{Loads, Optics};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
@@ -58,13 +57,9 @@ fn flutter_at<'py>(
     average: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let p = panel_from(panel)?;
-        p.validate()?;
-        let o = orbit_from(orbit)?;
-        let m = hinge_model(model)?;
-        let c = coupling(coupled);
+        let (p, o, loads) = on_orbit(panel, orbit, t, average)?;
+        let (m, c) = (hinge_model(model)?, coupling(coupled));
         let system = Coupled::new(p, o, m, c);
-        let loads = forcing(&p, &o, t, average)?;
         let (eq, jacobian, spectrum) = analyse_system_under(&system, loads)?;
         let d = PyDict::new(py);
         d.set_item("equilibrium", (eq[0], eq[1], eq[2]))?;
@@ -87,15 +82,26 @@ fn flutter_at<'py>(
     })
 }
 
-/// The constant loads a flutter analysis on an orbit is about: every load of `orbit` at time t
-/// in full sunlight, or (`average`) their mean over the sunlit arc of the orbit beginning at t.
-pub(super) fn forcing(p: &Panel, o: &Orbit, t: f64, average: bool) -> Result<Loads> {
-    if average {
-        o.sunlit_average_loads(t, &Optics::of(p))
+/// The panel and the orbit of a flutter analysis on an orbit, and the constant loads it is
+/// about: every load of the orbit at time t in full sunlight, or (`average`) their mean over the
+/// sunlit arc of the orbit beginning at t.
+pub(super) fn on_orbit(
+    panel: &Bound<'_, PyDict>,
+    orbit: &Bound<'_, PyDict>,
+    t: f64,
+    average: bool,
+) -> PyResult<(Panel, Orbit, Loads)> {
+    let p = panel_from(panel)?;
+    p.validate()?;
+    let o = orbit_from(orbit)?;
+    let optics = Optics::of(&p);
+    let loads = if average {
+        o.sunlit_average_loads(t, &optics)?
     } else {
         Orbit::check_time(t)?;
-        Ok(o.sunlit_loads(t, &Optics::of(p)))
-    }
+        o.sunlit_loads(t, &optics)
+    };
+    Ok((p, o, loads))
 }
 
 /// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as

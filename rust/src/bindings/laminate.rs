@@ -2,8 +2,8 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, dict_of, hinge_model, laminate_from, layer_from, orbit_from, panel_dict, panel_from,
-    set_named, FlutterPoint, Grid, RunOptions,
+    coupling, dict_of, hinge_model, laminate_from, layer_from, panel_dict, panel_from, set_named,
+    FlutterPoint, Grid, RunOptions,
 };
 use super::error::shield;
 use super::flutter::set_spectrum;
@@ -11,6 +11,9 @@ use crate::analysis::flutter::check_flux;
 use crate::analysis::layered::{LayeredEquilibrium, LayeredPoint};
 use crate::inputs::heating::Loads;
 use crate::inputs::laminate::{LAYER_FIELDS, MATERIALS};
+use crate::inputs::panel::Panel;
+use crate::models::coupled::Coupling;
+use crate::models::hinge::HingeModel;
 use crate::runs::request::ThermalChoice;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -131,17 +134,7 @@ fn layered_flutter<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let (p, m, k) = point.inputs(panel)?;
-        let c = grid.conduction(&p)?;
-        layered_analysis(
-            py,
-            LayeredPoint {
-                panel: &p,
-                conduction: &c,
-                model: m,
-                coupling: k,
-                loads: Loads::sun(point.flux),
-            },
-        )
+        layered_analysis(py, &p, &grid, (m, k), Loads::sun(point.flux))
     })
 }
 
@@ -162,28 +155,32 @@ fn layered_flutter_at<'py>(
     average: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let p = panel_from(panel)?;
-        p.validate()?;
-        let o = orbit_from(orbit)?;
-        let c = grid.conduction(&p)?;
-        let loads = super::flutter::forcing(&p, &o, t, average)?;
-        let d = layered_analysis(
-            py,
-            LayeredPoint {
-                panel: &p,
-                conduction: &c,
-                model: hinge_model(model)?,
-                coupling: coupling(coupled),
-                loads,
-            },
-        )?;
+        let (p, _, loads) = super::flutter::on_orbit(panel, orbit, t, average)?;
+        let hinge = (hinge_model(model)?, coupling(coupled));
+        let d = layered_analysis(py, &p, &grid, hinge, loads)?;
         d.set_item("loads", (loads.sun, loads.front, loads.back))?;
         Ok(d)
     })
 }
 
-/// The flutter analysis of `point` as a mapping: equilibrium, spectrum, critical damping.
-fn layered_analysis<'py>(py: Python<'py>, point: LayeredPoint<'_>) -> PyResult<Bound<'py, PyDict>> {
+/// The flutter analysis of the N-node system of `panel` on `grid` with the hinge model and
+/// coupling `hinge` under constant `loads`, as a mapping: equilibrium, spectrum, critical
+/// damping.
+fn layered_analysis<'py>(
+    py: Python<'py>,
+    panel: &Panel,
+    grid: &Grid<'py>,
+    hinge: (HingeModel, Coupling),
+    loads: Loads,
+) -> PyResult<Bound<'py, PyDict>> {
+    let conduction = grid.conduction(panel)?;
+    let point = LayeredPoint {
+        panel,
+        conduction: &conduction,
+        model: hinge.0,
+        coupling: hinge.1,
+        loads,
+    };
     let a = py.detach(|| point.analyse())?;
     let d = equilibrium_dict(py, &a.equilibrium)?;
     let size = a.jacobian.nrows();

@@ -384,6 +384,17 @@ impl DistributedPanel {
             }
             (f, jac)
         };
+        self.settle(x, residual_and_jacobian)
+    }
+
+    /// Newton on every element's heat balance from the temperatures `x`, then the state at rest
+    /// in static equilibrium with them, refused when its tip rise exceeds the arm.
+    fn settle(
+        &self,
+        x: DVector<f64>,
+        residual_and_jacobian: impl FnMut(&DVector<f64>) -> (DVector<f64>, DMatrix<f64>),
+    ) -> Result<Vec<f64>> {
+        let nt = self.temps();
         let settled =
             |x: &DVector<f64>, dx: &DVector<f64>| (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]);
         let x = newton(
@@ -393,13 +404,7 @@ impl DistributedPanel {
             residual_and_jacobian,
             settled,
         )?;
-        self.rest_in(x.as_slice())
-    }
-
-    /// The state at rest in static equilibrium with the temperatures `temps`, refused when its
-    /// tip rise exceeds the arm.
-    fn rest_in(&self, temps: &[f64]) -> Result<Vec<f64>> {
-        let y = self.static_state(temps);
+        let y = self.static_state(x.as_slice());
         self.theta_f(&y, 0.0).map_err(|_| Error::NoConvergence {
             what: "distributed steady state".into(),
             reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
@@ -558,16 +563,7 @@ impl DistributedPanel {
             }
             (f, jac)
         };
-        let settled =
-            |x: &DVector<f64>, dx: &DVector<f64>| (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]);
-        let x = newton(
-            "distributed steady state",
-            x,
-            nt,
-            residual_and_jacobian,
-            settled,
-        )?;
-        self.rest_in(x.as_slice())
+        self.settle(x, residual_and_jacobian)
     }
 
     /// ∂f/∂y of the right-hand side at state `y` under illumination factor `flux`.
