@@ -292,31 +292,27 @@ impl DistributedPanel {
 
     /// The right-hand side under illumination factor `flux` (s × flux scale).
     pub fn rhs_at_flux(&self, flux: f64, y: &[f64], dy: &mut [f64]) {
-        let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
-        let r = &self.reduction;
-        let moments = self.moments(y);
-        let q = self.modal(y);
-        let v = &y[nt + k..];
-        let gm = self.modal_forces(&moments);
-        let areas = match self.settings.coupling {
-            Coupling::ProjectedArea => self.areas(&self.slopes_with(q, &moments, &gm)),
-            Coupling::Frozen => self.areas(&vec![0.0; n]),
-        };
-        for (e, area) in areas.iter().enumerate() {
-            let temps = self.element(y, e);
-            self.thermal
-                .rates(flux * area, temps, &mut dy[e * s..(e + 1) * s]);
-        }
-        let zeta = self.settings.damping_ratio;
-        for i in 0..k {
-            let w = r.omega[i];
-            dy[nt + i] = v[i];
-            dy[nt + k + i] = gm[i] - 2.0 * zeta * w * v[i] - w * w * q[i];
-        }
+        let sun = self.settings.sun_angle.sin_cos();
+        let frozen = self.settings.coupling == Coupling::Frozen;
+        self.rhs_with(y, dy, |slope, temps, out| {
+            let area = if frozen { sun.1 } else { incidence(sun, slope) };
+            self.thermal.rates(flux * area, temps, out);
+        });
     }
 
     /// The right-hand side under the orbit's `heat` (each element at its own orientation).
     pub fn rhs_loaded(&self, heat: &ElementHeat, y: &[f64], dy: &mut [f64]) {
+        self.rhs_with(y, dy, |slope, temps, out| {
+            let loads = heat.loads(slope);
+            self.thermal.rates(loads.sun, temps, out);
+            self.thermal.add_face_rates(loads.front, loads.back, out);
+        });
+    }
+
+    /// The right-hand side, each element's temperature rates written by `heat(ρ, temps, out)`
+    /// from its chord slope ρ (0 with the coupling frozen) and its temperatures.
+    #[inline]
+    fn rhs_with(&self, y: &[f64], dy: &mut [f64], heat: impl Fn(f64, &[f64], &mut [f64])) {
         let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
         let r = &self.reduction;
         let moments = self.moments(y);
@@ -328,10 +324,7 @@ impl DistributedPanel {
             Coupling::Frozen => vec![0.0; n],
         };
         for (e, &slope) in slopes.iter().enumerate() {
-            let loads = heat.loads(slope);
-            let out = &mut dy[e * s..(e + 1) * s];
-            self.thermal.rates(loads.sun, self.element(y, e), out);
-            self.thermal.add_face_rates(loads.front, loads.back, out);
+            heat(slope, self.element(y, e), &mut dy[e * s..(e + 1) * s]);
         }
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
