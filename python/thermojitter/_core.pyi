@@ -61,6 +61,9 @@ __all__ = [
     "beam_response",
     "beam_static",
     "check_panels",
+    "check_orbits",
+    "ORBIT_INPUTS",
+    "ORBIT_INPUT_RANGES",
     "check_solver",
     "conduction_grid",
     "cpu_info",
@@ -406,10 +409,21 @@ def stability_map(
 ) -> dict[str, Any]: ...
 
 # --- ensembles (Monte Carlo, sweeps) -----------------------------------------------------------
-def check_panels(panels: _F) -> list[tuple[int, str, str]]: ...
+def check_panels(panels: _F, *, boom: bool = False) -> list[tuple[int, str, str]]: ...
+def check_orbits(
+    orbit: dict[str, Any], orbit_inputs: dict[str, Any], n: int
+) -> list[tuple[int, str, str]]: ...
 def least_steps(
-    panels: _F, solver: dict[str, Any], span: float, steps_per_period: float | None = None
+    panels: _F,
+    solver: dict[str, Any],
+    span: float,
+    steps_per_period: float | None = None,
+    *,
+    boom: bool = False,
 ) -> _F: ...
+
+ORBIT_INPUTS: list[str]
+ORBIT_INPUT_RANGES: dict[str, tuple[float, float, bool]]
 
 @final
 class MonteCarloPool:
@@ -427,6 +441,8 @@ class MonteCarloPool:
         validity_limit: float = ...,
         cancel: CancelToken | None = None,
         lockstep: bool = True,
+        orbit_inputs: dict[str, Any] | None = None,
+        boom: bool = False,
     ) -> dict[str, Any]: ...
 
 EnsemblePool = MonteCarloPool

@@ -2,12 +2,15 @@
 
 The scenario format of ``thermojitter run`` with two more tables:
 
-    [panel]            # Panel fields overriding Table 1 (optional)
+    [panel]            # Panel fields overriding Table 1 (optional; or a [boom] table)
     damping = 3.0
     [orbit]            # a preset and/or Orbit fields (optional; default GEO at equinox)
     radius = 7.0e6
     period = 5828.5
-    [vary]             # parameter = [distribution, numbers...] (see tj.monte_carlo)
+    [attitude]         # optional: where the front face points (as for ``run``)
+    [vary]             # parameter = [distribution, numbers...] (see tj.monte_carlo): panel
+                       # (or boom) parameters and the orbit inputs albedo, earth_ir,
+                       # inclination, raan
     damping = ["uniform", 1.0, 4.0]
     emissivity_back = ["normal", 0.3, 0.03]
     [montecarlo]       # optional defaults: n, seed, sampler, horizon, threshold, truncate,
@@ -60,8 +63,9 @@ RUN_KEYS = (
 
 
 def read_scenario(path: str | Path) -> dict[str, Any]:
-    """The panel, orbit, vary and montecarlo tables of a scenario file, checked (the panel and
-    orbit by the shared scenario parser, so every scenario file of ``run`` works here)."""
+    """The panel (or boom), orbit, attitude, vary and montecarlo tables of a scenario file,
+    checked (the panel, orbit and attitude by the shared scenario parser, so every scenario file
+    of ``run`` works here)."""
     scenario = load_scenario(path, extra_sections=("vary", "montecarlo"))
     vary = scenario.extra["vary"]
     if not vary:
@@ -80,11 +84,19 @@ def read_scenario(path: str | Path) -> dict[str, Any]:
             "montecarlo.layers",
             f"must be an integer >= 2 (nodes through the thickness), not {layers!r}",
         )
-    return {"panel": scenario.panel, "orbit": scenario.orbit, "vary": vary, "settings": settings}
+    return {
+        "panel": scenario.panel,
+        "orbit": scenario.orbit,
+        "attitude": scenario.attitude,
+        "vary": vary,
+        "settings": settings,
+    }
 
 
 def options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("scenario", help="scenario TOML with [panel], [orbit], [vary] tables")
+    p.add_argument(
+        "scenario", help="scenario TOML with [panel] or [boom], [orbit], [attitude], [vary] tables"
+    )
     add_out(p, required=True, help="output folder (created)")
     p.add_argument("--n", type=int, help="number of samples (default 1000)")
     p.add_argument("--seed", type=int, help="seed of the design (default 0)")
@@ -127,6 +139,7 @@ def run(args: argparse.Namespace) -> int:
             frame = monte_carlo(
                 scenario["panel"],
                 scenario["orbit"],
+                attitude=scenario["attitude"],
                 vary={
                     k: tuple(v) if isinstance(v, list) else v for k, v in scenario["vary"].items()
                 },

@@ -22,8 +22,14 @@ _LOCKSTEP = True
 
 
 def run_chunk(
-    pool: Any, panels: NDArray[np.float64], options: dict[str, Any], cancel: Any = None
+    pool: Any,
+    panels: NDArray[np.float64],
+    options: dict[str, Any],
+    cancel: Any = None,
+    inputs: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
+    """Runs the rows of ``panels`` (booms with ``options["boom"]``), each sample's orbit the
+    study's with its ``inputs`` (orbit input name → one value a row)."""
     raw = pool.run(
         panels,
         options["orbit"],
@@ -33,6 +39,8 @@ def run_chunk(
         validity_limit=options["validity_limit"],
         cancel=cancel,
         lockstep=_LOCKSTEP,
+        orbit_inputs=inputs or None,
+        boom=bool(options.get("boom", False)),
     )
     out: dict[str, Any] = {m: np.asarray(raw[m], dtype=float) for m in FLOAT_METRICS}
     out["stable"] = np.asarray(raw["stable"], dtype=bool)
@@ -46,7 +54,9 @@ _WORKER_POOLS: dict[tuple[str, int], Any] = {}
 _WORKER_POOLS_LOCK = threading.Lock()
 
 
-def dask_chunk(panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str, Any]:
+def dask_chunk(
+    panels: NDArray[np.float64], options: dict[str, Any], inputs: dict[str, Any] | None = None
+) -> dict[str, Any]:
     """Runs one chunk on a Dask worker, on a rayon pool of as many threads as the worker has.
 
     Tasks that run at once on one worker share its pool, so the worker's cores are not
@@ -64,11 +74,17 @@ def dask_chunk(panels: NDArray[np.float64], options: dict[str, Any]) -> dict[str
         if pool is None:
             pool = _core.MonteCarloPool(key[1] or None)
             _WORKER_POOLS[key] = pool
-    return run_chunk(pool, panels, options)
+    return run_chunk(pool, panels, options, inputs=inputs)
+
+
+def rows(inputs: dict[str, Any], a: int, b: int) -> dict[str, Any]:
+    """The orbit inputs of samples a..b."""
+    return {name: values[a:b] for name, values in inputs.items()}
 
 
 def local_chunks(
     matrix: NDArray[np.float64],
+    inputs: dict[str, Any],
     todo: list[tuple[int, int, int]],
     options: dict[str, Any],
     threads: int | None,
@@ -80,7 +96,10 @@ def local_chunks(
     pool = _core.MonteCarloPool(threads)
     token = _core.CancelToken()
     with cf.ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermojitter") as ex:
-        futures = {ex.submit(run_chunk, pool, matrix[a:b], options, token): k for k, a, b in todo}
+        futures = {
+            ex.submit(run_chunk, pool, matrix[a:b], options, token, rows(inputs, a, b)): k
+            for k, a, b in todo
+        }
         try:
             for fut in cf.as_completed(futures):
                 yield futures[fut], fut.result()
@@ -115,12 +134,16 @@ def dask_client(backend: Any) -> tuple[Any, bool]:
 def dask_chunks(
     client: Any,
     matrix: NDArray[np.float64],
+    inputs: dict[str, Any],
     todo: list[tuple[int, int, int]],
     options: dict[str, Any],
 ) -> Generator[tuple[int, dict[str, Any]], None, None]:
     from distributed import as_completed
 
-    futures = {client.submit(dask_chunk, matrix[a:b], options, pure=False): k for k, a, b in todo}
+    futures = {
+        client.submit(dask_chunk, matrix[a:b], options, rows(inputs, a, b), pure=False): k
+        for k, a, b in todo
+    }
     try:
         for fut in as_completed(list(futures)):
             yield futures[fut], fut.result()

@@ -1,5 +1,6 @@
-"""The design of a study: distributions of panel parameters, unit-cube samplers, and the rows of
-panels they map to, each checked against the engine's ranges before anything runs."""
+"""The design of a study: distributions of panel (or boom) parameters and orbit inputs,
+unit-cube samplers, and the rows of panels and the orbit inputs they map to, each checked
+against the engine's ranges before anything runs."""
 
 from __future__ import annotations
 
@@ -15,10 +16,24 @@ from scipy.stats import qmc
 
 from thermojitter import _core
 from thermojitter import errors as checks
+from thermojitter.boom import Boom
 from thermojitter.errors import ParameterError, ParameterTypeError
 from thermojitter.panel import Panel
 
 Sampler = Literal["random", "lhs", "sobol"]
+
+ORBIT_INPUTS: tuple[str, ...] = tuple(_core.ORBIT_INPUTS)
+"""The orbit inputs a study may vary beside the panel's parameters, named as the parameters of
+:meth:`thermojitter.Orbit.circular`: each sample runs on the study's orbit with its own values."""
+
+ORBIT_INPUT_RANGES: Mapping[str, tuple[float, float, bool]] = {
+    name: (float(lo), float(hi), bool(open_))
+    for name, (lo, hi, open_) in _core.ORBIT_INPUT_RANGES.items()
+}
+"""The valid range of each orbit input, as the engine checks it: (low, high, low end open)."""
+
+BOOM_REFUSED_INPUTS = ("albedo", "earth_ir")
+"""Orbit inputs a boom cannot vary: its model takes the Sun alone on its lit side."""
 
 
 def _numbers(name: str, spec: Sequence[Any], count: int, usage: str) -> list[float]:
@@ -129,16 +144,33 @@ def describe(spec: Any) -> Any:
     }
 
 
-def check_names(names: Sequence[Any], what: str) -> None:
-    fields = Panel.field_names()
+def check_names(names: Sequence[Any], what: str, boom: bool = False) -> None:
+    """Each name a parameter of the panel (of the boom with ``boom``) or an orbit input."""
+    kind = "boom" if boom else "panel"
+    fields = (*(Boom if boom else Panel).field_names(), *ORBIT_INPUTS)
     for name in names:
         if not isinstance(name, str) or name not in fields:
             raise ParameterError(
                 what,
                 name,
-                message=f"{what}: {name!r} is not a panel parameter; "
+                message=f"{what}: {name!r} is not a {kind} parameter or an orbit input; "
                 f"choose from {', '.join(fields)}",
             )
+        if boom and name in BOOM_REFUSED_INPUTS:
+            raise ParameterError(
+                f"{what}.{name}",
+                name,
+                message=f"{what}: {name!r} cannot be varied for a boom: its model takes the Sun "
+                "alone on its lit side (no Earth heating)",
+            )
+
+
+def value_range(name: str, boom: bool = False) -> tuple[float, float, bool]:
+    """The valid range of a varied parameter or orbit input: (low, high, low end open)."""
+    if name in ORBIT_INPUT_RANGES:
+        return ORBIT_INPUT_RANGES[name]
+    lo, hi, lo_open = (Boom if boom else Panel).RANGES[name]
+    return float(lo), float(hi), bool(lo_open)
 
 
 def unit_design(sampler: str, n: int, d: int, seed: int) -> NDArray[np.float64]:
@@ -170,14 +202,16 @@ def _open_unit(u: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.clip(u, np.finfo(float).tiny, np.nextafter(1.0, 0.0))
 
 
-def quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> NDArray[np.float64]:
+def quantiles(
+    name: str, dist: Any, u: NDArray[np.float64], truncate: bool, boom: bool = False
+) -> NDArray[np.float64]:
     """Maps unit points through the distribution's ppf; with ``truncate``, through the ppf
     restricted to the parameter's valid range."""
     u = _open_unit(u)
     if not truncate:
         with np.errstate(all="ignore"):
             return np.asarray(dist.ppf(u), dtype=float)
-    lo, hi, lo_open = Panel.RANGES[name]  # the engine's range, high end closed
+    lo, hi, lo_open = value_range(name, boom)  # the engine's range, high end closed
     with np.errstate(all="ignore"):
         a, b = float(dist.cdf(lo)), float(dist.cdf(hi))
     if not b - a > 0:
@@ -194,19 +228,35 @@ def quantiles(name: str, dist: Any, u: NDArray[np.float64], truncate: bool) -> N
     return np.clip(x, low, hi)
 
 
-def panel_matrix(panel: Panel, names: Sequence[str], values: NDArray[np.float64]) -> Any:
-    """Rows of every panel field (PANEL_FIELDS order): the base panel with ``names`` replaced."""
-    fields = list(_core.PANEL_FIELDS)
+def structure_fields(panel: Panel | Boom) -> list[str]:
+    """The columns of a design's rows: PANEL_FIELDS, or BOOM_FIELDS for a boom."""
+    return list(_core.BOOM_FIELDS if isinstance(panel, Boom) else _core.PANEL_FIELDS)
+
+
+def panel_matrix(panel: Panel | Boom, names: Sequence[str], values: NDArray[np.float64]) -> Any:
+    """Rows of every panel field (PANEL_FIELDS order; BOOM_FIELDS for a boom): the base panel
+    with its parameters among ``names`` replaced (the orbit inputs are the orbit's)."""
+    fields = structure_fields(panel)
     base = panel.as_dict()
     rows = np.tile(np.array([base[f] for f in fields], dtype=float), (len(values), 1))
     for j, name in enumerate(names):
-        rows[:, fields.index(name)] = values[:, j]
+        if name not in ORBIT_INPUTS:
+            rows[:, fields.index(name)] = values[:, j]
     return np.ascontiguousarray(rows)
 
 
-def refuse_invalid(matrix: NDArray[np.float64], hint: str) -> None:
-    """Runs the panel validation on every row; refuses the design naming the parameter."""
-    bad = _core.check_panels(matrix)
+def orbit_inputs(names: Sequence[str], values: NDArray[np.float64]) -> dict[str, Any]:
+    """The varied orbit inputs among ``names``: name → one value a sample (empty: none)."""
+    return {
+        name: np.ascontiguousarray(values[:, j], dtype=float)
+        for j, name in enumerate(names)
+        if name in ORBIT_INPUTS
+    }
+
+
+def _refuse(bad: Sequence[tuple[int, str, str]], n: int, value: Any, hint: str) -> None:
+    """Refuses a design with rows the engine's validation refused, naming the first parameter;
+    ``value(row, name)`` is that parameter's value in the row."""
     if not bad:
         return
     by_name: dict[str, list[tuple[int, str]]] = {}
@@ -214,13 +264,30 @@ def refuse_invalid(matrix: NDArray[np.float64], hint: str) -> None:
         by_name.setdefault(name, []).append((row, message))
     name, rows = next(iter(by_name.items()))
     row, message = rows[0]
-    value = matrix[row, list(_core.PANEL_FIELDS).index(name)]
     raise ParameterError(
         name,
-        float(value),
-        message=f"{name}: {len(rows)} of {len(matrix)} samples are outside its valid range "
+        float(value(row, name)),
+        message=f"{name}: {len(rows)} of {n} samples are outside its valid range "
         f"(sample {row}: {message}){hint}",
     )
+
+
+def refuse_invalid(matrix: NDArray[np.float64], hint: str, boom: bool = False) -> None:
+    """Runs the panel (or boom) validation on every row; refuses the design naming the
+    parameter."""
+    fields = list(_core.BOOM_FIELDS if boom else _core.PANEL_FIELDS)
+    bad = _core.check_panels(matrix, boom=boom)
+    _refuse(bad, len(matrix), lambda row, name: matrix[row, fields.index(name)], hint)
+
+
+def refuse_invalid_orbits(orbit: dict[str, Any], inputs: dict[str, Any], hint: str) -> None:
+    """Runs the orbit validation on every sample's orbit (``orbit`` with the sample's
+    ``inputs``); refuses the design naming the input."""
+    if not inputs:
+        return
+    n = len(next(iter(inputs.values())))
+    bad = _core.check_orbits(orbit, inputs, n)
+    _refuse(bad, n, lambda row, name: inputs[name][row] if name in inputs else math.nan, hint)
 
 
 def check_seed(seed: Any, checkpoint: Any) -> int:
@@ -245,38 +312,56 @@ def check_n(n: Any, least: int = 1) -> int:
 
 
 def sampled(
-    panel: Panel,
+    panel: Panel | Boom,
     vary: Mapping[str, Any],
     u: NDArray[np.float64],
     truncate: bool,
 ) -> tuple[list[str], NDArray[np.float64], NDArray[np.float64]]:
-    """(names, sampled values, full panel rows) of unit points ``u`` mapped through ``vary``."""
+    """(names, sampled values, full panel rows) of unit points ``u`` mapped through ``vary``,
+    the rows checked by the engine's validation (the orbit inputs are checked by
+    :func:`checked_orbit_inputs`)."""
     names = list(vary)
+    boom = isinstance(panel, Boom)
     dists = [distribution(name, vary[name]) for name in names]
     values = np.column_stack(
         [
-            quantiles(name, dist, u[:, j], truncate)
+            quantiles(name, dist, u[:, j], truncate, boom)
             for j, (name, dist) in enumerate(zip(names, dists, strict=True))
         ]
     )
     matrix = panel_matrix(panel, names, values)
-    hint = "" if truncate else "; narrow the distribution or pass truncate=True"
-    refuse_invalid(matrix, hint)
+    refuse_invalid(matrix, truncation_hint(truncate), boom)
     return names, values, matrix
 
 
-def check_table(table: Any, what: str, of: str) -> Mapping[str, Any]:
+def truncation_hint(truncate: bool) -> str:
+    """What a refusal of a drawn design suggests."""
+    return "" if truncate else "; narrow the distribution or pass truncate=True"
+
+
+def checked_orbit_inputs(
+    orbit: dict[str, Any], names: Sequence[str], values: NDArray[np.float64], hint: str
+) -> dict[str, Any]:
+    """The orbit inputs of a design (name → one value a sample), each sample's orbit (``orbit``
+    with its inputs) checked by the engine's validation: a design with any sample outside a valid
+    range is refused, naming the input."""
+    inputs = orbit_inputs(names, values)
+    refuse_invalid_orbits(orbit, inputs, hint)
+    return inputs
+
+
+def check_table(table: Any, what: str, of: str, boom: bool = False) -> Mapping[str, Any]:
     """``table`` (the argument ``what``: ``vary``, ``grid``) as a non-empty mapping of panel
-    parameter names to ``of``."""
+    (or boom) parameter names and orbit inputs to ``of``."""
     if not isinstance(table, Mapping) or not table:
         raise ParameterError(
             what,
             table,
             message=f"{what} must be a non-empty mapping of panel parameter names to {of}",
         )
-    check_names(list(table), what)
+    check_names(list(table), what, boom)
     return table
 
 
-def check_vary(vary: Any) -> Mapping[str, Any]:
-    return check_table(vary, "vary", "distributions")
+def check_vary(vary: Any, boom: bool = False) -> Mapping[str, Any]:
+    return check_table(vary, "vary", "distributions", boom)

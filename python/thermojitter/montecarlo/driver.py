@@ -7,7 +7,8 @@ import contextlib
 import hashlib
 import math
 import os
-from collections.abc import Generator, Sequence
+import warnings
+from collections.abc import Generator, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -16,8 +17,15 @@ from numpy.typing import NDArray
 from thermojitter import _core
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
-from thermojitter.errors import ParameterError
-from thermojitter.longrun import DEFAULT_THETA_LIMIT, orbit_count, refuse_beyond_budget
+from thermojitter.attitude import Attitude, engine_orbit
+from thermojitter.boom import Boom, check_attitude
+from thermojitter.errors import HybridFallbackWarning, ParameterError
+from thermojitter.longrun import (
+    DEFAULT_THETA_LIMIT,
+    HYBRID_FALLBACK,
+    orbit_count,
+    refuse_beyond_budget,
+)
 from thermojitter.montecarlo.backends import dask_chunks, dask_client, local_chunks
 from thermojitter.montecarlo.metrics import (
     report_failures,
@@ -50,9 +58,16 @@ def run_options(
     window: float,
     threshold: float | None,
     stop_at_threshold: bool,
+    attitude: Attitude | None = None,
+    panel: Panel | Boom | None = None,
 ) -> dict[str, Any]:
     """The keyword arguments of MonteCarloPool.run shared by every chunk (plain data), from the
-    study's own arguments (those monte_carlo, sweep and sensitivity share)."""
+    study's own arguments (those monte_carlo, sweep and sensitivity share). The orbit carries
+    the study's ``attitude`` (as single runs take it); a ``panel`` that is a boom runs the
+    tube's model (``"boom"``)."""
+    boom = isinstance(panel, Boom)
+    if boom:
+        check_attitude(attitude)
     chosen = default_method(method, orbit, horizon)
     # The method as given (None: the solver's or the default); "hybrid" is no solver method.
     full = SolverSettings.of(
@@ -63,8 +78,13 @@ def run_options(
     threshold = checks.optional_positive("threshold", threshold)
     window = checks.positive("window", window)
     hybrid = chosen == "hybrid"
-    return {
-        "orbit": orbit.as_record(),
+    record = orbit.as_record()
+    # The attitude is kept only when not Sun-pointing, so that a study without it keeps its
+    # settings (and its checkpoint's fingerprint).
+    if "attitude" in (with_attitude := engine_orbit(orbit, attitude)):
+        record["attitude"] = with_attitude["attitude"]
+    options: dict[str, Any] = {
+        "orbit": record,
         "model": checks.choice("model", model, ("nonlinear", "linear")),
         "coupled": checks.flag("coupled", coupled),
         # The hybrid propagator falls back on the hinge-resolved rk45 where it must.
@@ -76,10 +96,42 @@ def run_options(
         "validity_limit": DEFAULT_THETA_LIMIT,
         "hybrid": {} if hybrid else None,
     }
+    if boom:
+        options["boom"] = True
+    if face_loads(options, {}):
+        # The samples start at, and are analysed about, the equilibrium under every load of the
+        # orbit at t = 0 (before, at the Sun's alone): a checkpoint of a study on such an orbit
+        # written before that is not resumed with rows computed otherwise.
+        options["start"] = "loaded_equilibrium"
+    return options
+
+
+def face_loads(options: Mapping[str, Any], inputs: Mapping[str, Any]) -> bool:
+    """Whether some sample of a study heats more than the front's sunlight: the Earth's loads on
+    the study's orbit or drawn for a sample, or an attitude other than Sun-pointing."""
+    orbit = options["orbit"]
+    drawn = [np.asarray(inputs[k]) for k in ("albedo", "earth_ir") if k in inputs]
+    return bool(
+        orbit.get("albedo", 0.0) != 0.0
+        or orbit.get("earth_ir", 0.0) != 0.0
+        or "attitude" in orbit
+        or any((v != 0.0).any() for v in drawn)
+    )
+
+
+def warn_hybrid_fallback(options: Mapping[str, Any], inputs: Mapping[str, Any]) -> None:
+    """Says, once, that the hybrid propagator integrates in full the samples with the Earth's
+    loads or another attitude (each then has ``t_nonlinear`` equal to ``t_reached``)."""
+    if options["hybrid"] is not None and not options.get("boom") and face_loads(options, inputs):
+        warnings.warn(
+            f"{HYBRID_FALLBACK} for the samples with them (their t_nonlinear is the whole run)",
+            HybridFallbackWarning,
+            stacklevel=4,
+        )
 
 
 def with_layers(
-    options: dict[str, Any], panel: Panel, layers: Any, names: Sequence[str]
+    options: dict[str, Any], panel: Panel | Boom, layers: Any, names: Sequence[str]
 ) -> dict[str, Any]:
     """The run options with the N-node through-thickness model (``layers`` nodes) on the
     panel's layup, or on each sample's panel as one homogeneous layer for a plain panel.
@@ -88,7 +140,16 @@ def with_layers(
     its layup decides cannot be varied (the N-node model takes them from the layers)."""
     if layers is None:
         return options
+    if isinstance(panel, Boom):
+        raise ParameterError("layers", layers, "a Boom has its own thermal model")
     nodes = check_layers(layers)
+    if face_loads(options, {}) or any(name in ("albedo", "earth_ir") for name in names):
+        raise ParameterError(
+            "layers",
+            layers,
+            "takes the front's sunlight only: no Earth heating (albedo, earth_ir, drawn or on "
+            "the orbit) or attitude",
+        )
     # Run-wide: a node count the layup cannot take is refused here, not by every sample.
     _core.conduction_grid(panel.as_dict(), grid_args(panel, nodes))
     if panel.layup is not None:
@@ -139,7 +200,8 @@ def _refuse_beyond_budget(
         return
     solver = options["solver"]
     period = float(options["orbit"]["period"])
-    least = _core.least_steps(matrix, solver, options["n_orbits"] * period)
+    span = options["n_orbits"] * period
+    least = _core.least_steps(matrix, solver, span, boom=bool(options.get("boom")))
     budget = int(solver["max_steps"])
     horizon = options["n_orbits"]
     per = f"{least.max() / horizon:.3g} per orbit of the slowest sample"
@@ -156,6 +218,7 @@ def run_design(
     matrix: NDArray[np.float64],
     options: dict[str, Any],
     settings: dict[str, Any],
+    inputs: dict[str, Any],
     *,
     threads: int | None,
     backend: Any,
@@ -168,15 +231,19 @@ def run_design(
     if threads is not None:
         threads = checks.integer("threads", threads, 1, _core.MAX_THREADS)
     _refuse_beyond_budget(matrix, options, settings)
+    warn_hybrid_fallback(options, inputs)
     if chunk_size is None:
         chunk_size = default_chunk_size(n)
     else:
         chunk_size = checks.integer("chunk_size", chunk_size, 1)
+    design = hashlib.sha256(np.ascontiguousarray(matrix).tobytes())
+    for name in sorted(inputs):  # each sample's orbit inputs (none: the digest of the panels)
+        design.update(name.encode() + b"\0" + np.ascontiguousarray(inputs[name]).tobytes())
     settings = {
         **settings,
         "format": FORMAT_VERSION,
         "run": options,
-        "design_sha256": hashlib.sha256(np.ascontiguousarray(matrix).tobytes()).hexdigest(),
+        "design_sha256": design.hexdigest(),
     }
     directory = checks.path("checkpoint", checkpoint) if checkpoint is not None else None
     request = checkpoints.digest(settings)
@@ -199,9 +266,9 @@ def run_design(
     try:
         if todo:
             stream: Generator[tuple[int, dict[str, Any]], None, None] = (
-                local_chunks(matrix, todo, options, threads)
+                local_chunks(matrix, inputs, todo, options, threads)
                 if client is None
-                else dask_chunks(client, matrix, todo, options)
+                else dask_chunks(client, matrix, inputs, todo, options)
             )
             written = set(done)
             failed_write = False  # after one failed write, the rest are kept in memory only

@@ -21,11 +21,15 @@ METRICS = (
 )  # fmt: skip
 """Columns of the metrics, after the sampled parameters (angles rad, times s, rates 1/s):
 
-- ``theta_eq``: sunlit equilibrium angle at full Sun;
+- ``theta_eq``: sunlit equilibrium angle at full Sun (for a boom, its tip deflection over its
+  length);
 - ``growth_rate``, ``frequency_hz``, ``stable``: linear stability of that equilibrium
   (``tj.flutter``); ``stable`` is a nullable boolean (pandas ``"boolean"``), missing (NA) for a
   sample that failed, so that ``(~frame.stable).mean()`` is the share of the finished samples
-  that flutter; ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad;
+  that flutter; ``critical_damping``: c_d at which the growth rate crosses zero, N m s/rad (for
+  a boom, the first mode's damping ratio ζ at which it does); with the Earth's loads or an
+  attitude other than Sun-pointing, these four are of the equilibrium in full sunlight under
+  every load at t = 0;
 - ``theta_abs_max``: max abs(θ) over the horizon; ``amplitude``: max abs(θ − θ_eq);
 - ``entry_peak``/``exit_peak``: max abs(θ − θ_eq) within ``window`` s after a shadow entry / exit;
 - ``jitter_rms``/``jitter_peak``: of θ − M_T/K_el (the oscillation about the quasi-static

@@ -1,5 +1,5 @@
-"""The three studies over panel parameters: Monte Carlo, full-factorial sweeps and Sobol
-sensitivity."""
+"""The three studies over panel (or boom) parameters and orbit inputs: Monte Carlo,
+full-factorial sweeps and Sobol sensitivity."""
 
 from __future__ import annotations
 
@@ -15,6 +15,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from thermojitter import errors as checks
+from thermojitter.attitude import Attitude
+from thermojitter.boom import Boom
 from thermojitter.errors import ParameterError
 from thermojitter.montecarlo.design import (
     MAX_SAMPLES,
@@ -23,10 +25,12 @@ from thermojitter.montecarlo.design import (
     check_seed,
     check_table,
     check_vary,
+    checked_orbit_inputs,
     describe,
     panel_matrix,
     refuse_invalid,
     sampled,
+    truncation_hint,
     unit_design,
 )
 from thermojitter.montecarlo.driver import run_design, run_options, with_layers
@@ -40,7 +44,7 @@ from thermojitter.solver import ATOL, MAX_STEPS, RTOL, SolverSettings
 
 
 def monte_carlo(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     *,
     vary: Mapping[str, Any],
@@ -66,11 +70,14 @@ def monte_carlo(
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
     layers: int | None = None,
+    attitude: Attitude | None = None,
 ) -> Any:
     """Runs ``n`` panels drawn around ``panel`` and returns a pandas DataFrame, one row a sample:
     the sampled parameters, then the metrics (see ``METRICS``).
 
-    - ``vary``: panel parameter name → frozen scipy.stats distribution or shorthand
+    - ``vary``: panel parameter name (or orbit input: ``albedo``, ``earth_ir``,
+      ``inclination``, ``raan``, named as the parameters of :meth:`Orbit.circular`; each sample
+      then runs on ``orbit`` with its own values) → frozen scipy.stats distribution or shorthand
       (``("uniform", lo, hi)``, ``("normal", mean, sd)``, ``("lognormal", median, sigma)``,
       ``("loguniform", lo, hi)``, ``("truncnorm", mean, sd, lo, hi)``,
       ``("triangular", lo, mode, hi)``). A design with a sample outside a parameter's valid range
@@ -115,17 +122,31 @@ def monte_carlo(
     raises :class:`AllSamplesFailedError` (an ``IntegrationError``; the frame is its
     ``.samples``).
 
+    - ``attitude``: where the front face points (:class:`thermojitter.Attitude`, default
+      Sun-pointing), as in ``simulate_orbits``. With it, or with the Earth's loads on the orbit or
+      drawn (``albedo``, ``earth_ir``), a sample's ``theta_eq``, ``growth_rate``,
+      ``frequency_hz`` and ``critical_damping`` are those of its equilibrium in full sunlight
+      under every load at t = 0 (``tj.flutter(panel, orbit=..., t=0, attitude=...)``), and its run
+      starts there, as ``simulate_orbits`` does; the hybrid propagator integrates such samples in
+      full with its rk45 fallback (one :class:`thermojitter.errors.HybridFallbackWarning` says
+      so). Each sample equals the single ``simulate_orbits`` run of its panel on its orbit.
+    - A :class:`thermojitter.Boom` in place of the panel: ``vary`` names boom parameters (and
+      ``inclination``, ``raan``; a boom takes no Earth heating nor attitude); each sample is the
+      tube's flutter analysis at full Sun (``critical_damping`` is then the first mode's
+      critical damping ratio ζ, as ``tj.flutter(boom)``'s) and its ``simulate_orbits`` run,
+      integrated in full (the tube has no hybrid form).
+
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
     """
-    check_inputs(panel, orbit)
-    vary = check_vary(vary)
+    check_structure(panel, orbit)
+    vary = check_vary(vary, isinstance(panel, Boom))
     n = check_n(n)
     seed = check_seed(seed, checkpoint)
     sampler = checks.choice("sampler", sampler, ("random", "lhs", "sobol"))  # type: ignore[assignment]
     truncate = checks.flag("truncate", truncate)
     options = run_options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
-        threshold, stop_at_threshold,
+        threshold, stop_at_threshold, attitude, panel,
     )  # fmt: skip
     options = with_layers(options, panel, layers, list(vary))
     u = unit_design(sampler, n, len(vary), seed)
@@ -138,9 +159,33 @@ def monte_carlo(
     return frame
 
 
+def check_structure(panel: Any, orbit: Any) -> None:
+    """TypeError unless ``panel`` is a Panel or a Boom and ``orbit`` an Orbit; a boom refuses an
+    orbit with the Earth's loads (its model takes the Sun alone), naming ``orbit``."""
+    if not isinstance(panel, Boom):
+        check_inputs(panel, orbit)
+        return
+    checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
+    if orbit.albedo != 0.0 or orbit.earth_ir != 0.0:
+        raise ParameterError(
+            "orbit",
+            orbit,
+            message="orbit: a boom takes the Sun alone on its lit side: give an orbit with "
+            "albedo = earth_ir = 0",
+        )
+
+
+def _settings(study: str, panel: Panel | Boom) -> dict[str, Any]:
+    """The settings every study records first: its name and the base panel (or boom)."""
+    out: dict[str, Any] = {"study": study, "panel": panel.as_dict()}
+    if isinstance(panel, Boom):
+        out["structure"] = "boom"
+    return out
+
+
 def _run_drawn(
     study: str,
-    panel: Panel,
+    panel: Panel | Boom,
     vary: Mapping[str, Any],
     u: NDArray[np.float64],
     n: int,
@@ -155,20 +200,20 @@ def _run_drawn(
     distributions, ``n``, ``seed``, ``sampler`` (how ``u`` was drawn) and ``truncate``; ``run``
     goes to ``run_design``."""
     names, values, matrix = sampled(panel, vary, u, truncate)
+    inputs = checked_orbit_inputs(options["orbit"], names, values, truncation_hint(truncate))
     settings = {
-        "study": study,
-        "panel": panel.as_dict(),
+        **_settings(study, panel),
         "vary": {name: describe(vary[name]) for name in names},
         "n": n,
         "seed": seed,
         **sampler,
         "truncate": truncate,
     }
-    return run_design(names, values, matrix, options, settings, **run)
+    return run_design(names, values, matrix, options, settings, inputs, **run)
 
 
 def sweep(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     grid: Mapping[str, Sequence[float]],
     *,
@@ -190,13 +235,15 @@ def sweep(
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
     layers: int | None = None,
+    attitude: Attitude | None = None,
 ) -> Any:
     """Full-factorial study: every combination of the ``grid`` values (parameter name → values),
     the first parameter varying slowest. Returns a DataFrame like ``monte_carlo``'s; the other
-    arguments (``layers`` too) are the same, and so is the handling of failed samples (a
-    warning and ``frame.attrs["n_failed"]``; :class:`AllSamplesFailedError` when all failed)."""
-    check_inputs(panel, orbit)
-    check_table(grid, "grid", "values")
+    arguments (``layers``, ``attitude`` and a boom too; the grid may name orbit inputs) are the
+    same, and so is the handling of failed samples (a warning and ``frame.attrs["n_failed"]``;
+    :class:`AllSamplesFailedError` when all failed)."""
+    check_structure(panel, orbit)
+    check_table(grid, "grid", "values", isinstance(panel, Boom))
     axes: list[list[float]] = []
     for name, vals in grid.items():
         arr = checks.real_array(f"grid.{name}", vals)  # numbers: not bools, not strings
@@ -205,7 +252,7 @@ def sweep(
         axes.append(arr.tolist())
     options = run_options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
-        threshold, stop_at_threshold,
+        threshold, stop_at_threshold, attitude, panel,
     )  # fmt: skip
     names = list(grid)
     size = math.prod(len(a) for a in axes)
@@ -218,14 +265,11 @@ def sweep(
     options = with_layers(options, panel, layers, names)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
     matrix = panel_matrix(panel, names, values)
-    refuse_invalid(matrix, "")
-    settings = {
-        "study": "sweep",
-        "panel": panel.as_dict(),
-        "grid": dict(zip(names, axes, strict=True)),
-    }
+    refuse_invalid(matrix, "", isinstance(panel, Boom))
+    inputs = checked_orbit_inputs(options["orbit"], names, values, "")
+    settings = {**_settings("sweep", panel), "grid": dict(zip(names, axes, strict=True))}
     return run_design(
-        names, values, matrix, options, settings, threads=threads, backend=backend,
+        names, values, matrix, options, settings, inputs, threads=threads, backend=backend,
         checkpoint=checkpoint, chunk_size=chunk_size, progress=progress,
     )  # fmt: skip
 
@@ -243,7 +287,7 @@ class SensitivityResult:
 
 
 def sensitivity(
-    panel: Panel,
+    panel: Panel | Boom,
     orbit: Orbit,
     vary: Mapping[str, Any],
     *,
@@ -270,14 +314,16 @@ def sensitivity(
     max_steps: int = MAX_STEPS,
     solver: SolverSettings | None = None,
     layers: int | None = None,
+    attitude: Attitude | None = None,
 ) -> SensitivityResult:
     """Sobol sensitivity indices of one metric to the parameters in ``vary`` (needs SALib:
     ``pip install 'thermojitter[sensitivity]'``).
 
     Runs n·(d + 2) samples (n·(2d + 2) with ``second_order``) of Saltelli's design (best with n
     a power of 2), mapped through the distributions of ``vary`` like ``monte_carlo``, whose other
-    arguments (``layers`` too) these are. ``indices`` holds ``S1``, ``S1_conf``, ``ST``,
-    ``ST_conf`` per parameter (first-order and total indices, 95 % confidence half-widths).
+    arguments (``layers``, ``attitude``, orbit inputs in ``vary`` and a boom too) these are.
+    ``indices`` holds ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` per parameter (first-order and
+    total indices, 95 % confidence half-widths).
 
     The indices need the metric of every sample: a study in which some sample failed (or whose
     metric is NaN somewhere) is refused with a ValueError naming the first, after the warning
@@ -294,8 +340,8 @@ def sensitivity(
         ) from exc
     import pandas as pd
 
-    check_inputs(panel, orbit)
-    vary = check_vary(vary)
+    check_structure(panel, orbit)
+    vary = check_vary(vary, isinstance(panel, Boom))
     n = check_n(n, 2)
     seed = check_seed(seed, None)
     second_order = checks.flag("second_order", second_order)
@@ -306,7 +352,7 @@ def sensitivity(
         raise ParameterError("metric", metric, f"choose from {choices}")
     options = run_options(
         orbit, horizon, model, coupled, method, solver, rtol, atol, dt, max_steps, window,
-        threshold, stop_at_threshold,
+        threshold, stop_at_threshold, attitude, panel,
     )  # fmt: skip
     names = list(vary)
     options = with_layers(options, panel, layers, names)

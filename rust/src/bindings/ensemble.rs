@@ -7,54 +7,138 @@ use super::cancel::{cancellable, CancelToken};
 use super::convert::{laminate_from, orbit_from, solver_dict, solver_from, OrbitsRun};
 use super::error::invalid;
 use super::error::shield;
+use crate::inputs::boom::Boom;
 use crate::runs::ensemble::{
-    pool, run_batch_layered, run_batch_on, EnsembleSettings, Layers, Path, SampleMetrics,
+    orbit_with, pool, run_batch_layered, run_boom_batch, run_samples, EnsembleSettings, Layers,
+    Path, Sample, SampleMetrics, ORBIT_INPUTS, ORBIT_INPUT_RANGES,
 };
 use crate::runs::orbits::{resolve_hinge, STEPS_PER_HINGE_PERIOD};
-use crate::Panel;
-use numpy::{PyArray1, PyReadonlyArray2};
+use crate::{Orbit, Panel};
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::ThreadPool;
 
-/// Rows of a (n, len(PANEL_FIELDS)) array, columns in PANEL_FIELDS order, as panels (unchecked).
-fn panels_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Panel>> {
+/// Rows of a (n, len(fields)) array, columns in `fields` order, each set on a copy of `base`
+/// with `set` (unchecked); `what` names the array and its columns in an error.
+fn rows_from<T: Copy>(
+    rows: &PyReadonlyArray2<'_, f64>,
+    base: T,
+    fields: &[&str],
+    set: fn(&mut T, &str, f64) -> crate::Result<()>,
+    what: (&str, &str),
+) -> PyResult<Vec<T>> {
     let a = rows.as_array();
-    if a.ncols() != Panel::FIELDS.len() {
+    if a.ncols() != fields.len() {
         return Err(invalid(
-            "panels",
+            what.0,
             format!("{} columns", a.ncols()),
-            &format!("must have {} columns (PANEL_FIELDS)", Panel::FIELDS.len()),
+            &format!("must have {} columns ({})", fields.len(), what.1),
         ));
     }
     a.rows()
         .into_iter()
         .map(|row| {
-            let mut p = Panel::paper();
-            for (name, &v) in Panel::FIELDS.iter().zip(row.iter()) {
-                p.set(name, v)?;
+            let mut x = base;
+            for (name, &v) in fields.iter().zip(row.iter()) {
+                set(&mut x, name, v)?;
             }
-            Ok(p)
+            Ok(x)
         })
         .collect()
+}
+
+/// Rows of a (n, len(PANEL_FIELDS)) array, columns in PANEL_FIELDS order, as panels (unchecked).
+fn panels_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Panel>> {
+    rows_from(
+        rows,
+        Panel::paper(),
+        &Panel::FIELDS,
+        Panel::set,
+        ("panels", "PANEL_FIELDS"),
+    )
+}
+
+/// Rows of a (n, len(BOOM_FIELDS)) array, columns in BOOM_FIELDS order, as booms (unchecked).
+fn booms_from(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Boom>> {
+    rows_from(
+        rows,
+        Boom::example(),
+        &Boom::FIELDS,
+        Boom::set,
+        ("booms", "BOOM_FIELDS"),
+    )
+}
+
+/// The rows of a design as panels, or as the booms' equivalent hinges (whose period caps a
+/// boom's step as a panel's does).
+fn hinges_from(rows: &PyReadonlyArray2<'_, f64>, boom: bool) -> PyResult<Vec<Panel>> {
+    if boom {
+        Ok(booms_from(rows)?.iter().map(Boom::hinge_panel).collect())
+    } else {
+        panels_from(rows)
+    }
+}
+
+/// Each sample's orbit: `base` with the sample's orbit inputs (a mapping of ORBIT_INPUTS names
+/// to arrays of `n` values; None: `base` for all), unchecked.
+fn orbits_from(base: Orbit, inputs: Option<&Bound<'_, PyDict>>, n: usize) -> PyResult<Vec<Orbit>> {
+    let mut orbits = vec![base; n];
+    let Some(inputs) = inputs else {
+        return Ok(orbits);
+    };
+    for (key, values) in inputs.iter() {
+        let name: String = key.extract()?;
+        if !ORBIT_INPUTS.contains(&name.as_str()) {
+            return Err(invalid(
+                "orbit_inputs",
+                format!("{name:?}"),
+                &format!("must name orbit inputs: {}", ORBIT_INPUTS.join(", ")),
+            ));
+        }
+        let values: PyReadonlyArray1<'_, f64> = values.extract()?;
+        let values = values.as_array();
+        if values.len() != n {
+            return Err(invalid(
+                "orbit_inputs",
+                format!("{} values of {name}", values.len()),
+                &format!("must hold one value a sample ({n})"),
+            ));
+        }
+        for (o, &v) in orbits.iter_mut().zip(values.iter()) {
+            *o = orbit_with(*o, &name, v)?;
+        }
+    }
+    Ok(orbits)
+}
+
+/// The (row, parameter, message) of an error of row `i`.
+fn refusal(i: usize, e: crate::Error) -> (usize, String, String) {
+    let name = match &e {
+        crate::Error::InvalidParameter { name, .. } => name.clone(),
+        _ => String::new(),
+    };
+    (i, name, e.to_string())
 }
 
 /// The fewest integrator steps a run of `span` s of each row of `panels` takes, with the step
 /// capped at T_n / `steps_per_period` as long runs do (0: no cap; None: the ensembles' cap):
 /// known before any work, so that a request beyond its step budget is refused up front.
+/// With `boom`, the rows are booms (BOOM_FIELDS), each capped by its equivalent hinge.
 #[pyfunction]
-#[pyo3(signature = (panels, solver, span, steps_per_period=None))]
+#[pyo3(signature = (panels, solver, span, steps_per_period=None, *, boom=false))]
 fn least_steps<'py>(
     py: Python<'py>,
     panels: PyReadonlyArray2<'py, f64>,
     solver: &Bound<'py, PyDict>,
     span: f64,
     steps_per_period: Option<f64>,
+    boom: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     shield(|| {
         let method = solver_from(solver)?;
         let cap = steps_per_period.unwrap_or(STEPS_PER_HINGE_PERIOD);
-        let least = panels_from(&panels)?
+        let least = hinges_from(&panels, boom)?
             .iter()
             .map(|p| resolve_hinge(&method, p, cap).least_steps(span))
             .collect();
@@ -62,22 +146,42 @@ fn least_steps<'py>(
     })
 }
 
-/// Every row that the panel validation refuses, as (row, parameter, message).
+/// Every row that the panel validation (with `boom`, the boom's: rows of BOOM_FIELDS) refuses,
+/// as (row, parameter, message).
 #[pyfunction]
-fn check_panels(panels: PyReadonlyArray2<'_, f64>) -> PyResult<Vec<(usize, String, String)>> {
+#[pyo3(signature = (panels, *, boom=false))]
+fn check_panels(
+    panels: PyReadonlyArray2<'_, f64>,
+    boom: bool,
+) -> PyResult<Vec<(usize, String, String)>> {
     shield(|| {
-        Ok(panels_from(&panels)?
+        let checks: Vec<crate::Result<()>> = if boom {
+            booms_from(&panels)?.iter().map(Boom::validate).collect()
+        } else {
+            panels_from(&panels)?.iter().map(Panel::validate).collect()
+        };
+        Ok(checks
+            .into_iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.err().map(|e| refusal(i, e)))
+            .collect())
+    })
+}
+
+/// Every sample whose orbit (`orbit` with the sample's `orbit_inputs`, as `MonteCarloPool.run`
+/// builds it) the orbit validation refuses, as (row, parameter, message).
+#[pyfunction]
+fn check_orbits(
+    orbit: &Bound<'_, PyDict>,
+    orbit_inputs: &Bound<'_, PyDict>,
+    n: usize,
+) -> PyResult<Vec<(usize, String, String)>> {
+    shield(|| {
+        let base = orbit_from(orbit)?;
+        Ok(orbits_from(base, Some(orbit_inputs), n)?
             .iter()
             .enumerate()
-            .filter_map(|(i, p)| {
-                p.validate().err().map(|e| {
-                    let name = match &e {
-                        crate::Error::InvalidParameter { name, .. } => name.clone(),
-                        _ => String::new(),
-                    };
-                    (i, name, e.to_string())
-                })
-            })
+            .filter_map(|(i, o)| o.validate().err().map(|e| refusal(i, e)))
             .collect())
     })
 }
@@ -115,8 +219,10 @@ impl MonteCarloPool {
     /// columns. `lockstep`: several samples per thread in SIMD lanes (the same rows, bit for
     /// bit, as one at a time). The `orbits` run's `grid`: the N-node through-thickness model with
     /// that many nodes, on its `layup` (a laminate mapping) or, without one, on each sample's
-    /// panel as one homogeneous layer.
-    #[pyo3(signature = (panels, orbit, orbits, *, threshold, stop_at_threshold, validity_limit=crate::models::hinge::VALIDITY_LIMIT, cancel=None, lockstep=true))]
+    /// panel as one homogeneous layer. `orbit_inputs`: each sample's orbit inputs (a mapping of
+    /// ORBIT_INPUTS names to one value a sample) set on `orbit`. `boom`: the rows are booms
+    /// (BOOM_FIELDS), one at a time per thread.
+    #[pyo3(signature = (panels, orbit, orbits, *, threshold, stop_at_threshold, validity_limit=crate::models::hinge::VALIDITY_LIMIT, cancel=None, lockstep=true, orbit_inputs=None, boom=false))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -129,6 +235,8 @@ impl MonteCarloPool {
         validity_limit: f64,
         cancel: Option<&Bound<'py, CancelToken>>,
         lockstep: bool,
+        orbit_inputs: Option<&Bound<'py, PyDict>>,
+        boom: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let path = if lockstep {
             Path::Lockstep
@@ -136,8 +244,9 @@ impl MonteCarloPool {
             Path::Scalar
         };
         cancellable(cancel, |cancel| {
-            let ps = panels_from(&panels)?;
             let orbit = orbit_from(orbit)?;
+            let n = panels.as_array().nrows();
+            let sample_orbits = orbits_from(orbit, orbit_inputs, n)?;
             let (model, coupling, method) = orbits.hinge()?;
             let settings = EnsembleSettings {
                 orbit,
@@ -160,10 +269,26 @@ impl MonteCarloPool {
                 }),
                 None => None,
             };
-            let out = py.detach(|| match &layers {
-                Some(l) => run_batch_layered(pool, &ps, &settings, l, cancel),
-                None => run_batch_on(pool, &ps, &settings, cancel, path),
-            })?;
+            if boom && layers.is_some() {
+                return Err(invalid("grid", "given", "a boom has its own thermal model"));
+            }
+            let out = if boom {
+                let booms: Vec<(Boom, Orbit)> = booms_from(&panels)?
+                    .into_iter()
+                    .zip(sample_orbits)
+                    .collect();
+                py.detach(|| run_boom_batch(pool, &booms, &settings, cancel))?
+            } else {
+                let samples: Vec<Sample> = panels_from(&panels)?
+                    .into_iter()
+                    .zip(sample_orbits)
+                    .map(|(panel, orbit)| Sample { panel, orbit })
+                    .collect();
+                py.detach(|| match &layers {
+                    Some(l) => run_batch_layered(pool, &samples, &settings, l, cancel),
+                    None => run_samples(pool, &samples, &settings, cancel, path),
+                })?
+            };
             let d = PyDict::new(py);
             let col = |f: fn(&SampleMetrics) -> f64| -> Vec<f64> { out.iter().map(f).collect() };
             for (name, values) in [
@@ -226,6 +351,13 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("EnsemblePool", m.getattr("MonteCarloPool")?)?;
     m.add_function(wrap_pyfunction!(cpu_info, m)?)?;
     m.add_function(wrap_pyfunction!(check_panels, m)?)?;
+    m.add_function(wrap_pyfunction!(check_orbits, m)?)?;
+    m.add("ORBIT_INPUTS", ORBIT_INPUTS.to_vec())?;
+    let ranges = PyDict::new(m.py());
+    for (name, range) in ORBIT_INPUTS.iter().zip(ORBIT_INPUT_RANGES) {
+        ranges.set_item(name, range)?;
+    }
+    m.add("ORBIT_INPUT_RANGES", ranges)?;
     m.add_function(wrap_pyfunction!(least_steps, m)?)?;
     Ok(())
 }

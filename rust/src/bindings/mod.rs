@@ -112,14 +112,8 @@ fn start_state(
                 &p, &c, coupling, &o, t0,
             )?);
         }
-        crate::Orbit::check_time(t0)?;
-        if o.has_face_loads() {
-            p.validate()?;
-            let system = Coupled::new(p, o, crate::models::hinge::HingeModel::Nonlinear, coupling);
-            return Ok(system.sunlit_steady_state(t0)?.as_slice().to_vec());
-        }
-        let eq = equilibrium(&p, coupling, o.flux_scale(t0))?;
-        Ok(eq.state().as_slice().to_vec())
+        let y0 = crate::runs::orbits::start_state(&p, &o, coupling, t0)?;
+        Ok(y0.as_slice().to_vec())
     })
 }
 

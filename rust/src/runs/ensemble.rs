@@ -1,28 +1,30 @@
 //! Monte Carlo (`tj.monte_carlo`, `sweep`, `sensitivity`; `python/thermojitter/montecarlo.py`):
 //! batches of independent panels (samples, sweep points) run in parallel on rayon.
 //!
-//! Each sample is one panel integrated over a whole number of orbits from its sunlit equilibrium,
-//! plus the flutter analysis of that equilibrium, reduced to a few numbers. A sample is computed
-//! by one thread from its own inputs only, so the results do not depend on the number of threads
-//! or on how a batch is cut into chunks.
+//! Each sample is one panel (or one boom) on its orbit, integrated over a whole number of orbits
+//! from its sunlit equilibrium, plus the flutter analysis of that equilibrium, reduced to a few
+//! numbers. A sample's orbit is the batch's, or the batch's with the sample's own orbit inputs
+//! ([`ORBIT_INPUTS`]: the Earth's heat and the orbit plane). A sample is computed by one thread
+//! from its own inputs only, so the results do not depend on the number of threads or on how a
+//! batch is cut into chunks.
 
-use crate::analysis::flutter::{analyse, critical_damping};
-use crate::analysis::steady::equilibrium;
+use crate::analysis::flutter::{analyse, analyse_system_at, critical_damping, critical_damping_at};
 use crate::cancel::Cancel;
 use crate::error::{require_positive, Error, Result};
+use crate::inputs::boom::Boom;
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
-use crate::models::coupled::Coupling;
+use crate::models::coupled::{Coupled, Coupling};
 use crate::models::hinge::HingeModel;
 use crate::numerics::cpu::Kernel;
 use crate::numerics::integrate::{DenseStep, Method, Observer};
 use crate::runs::hybrid::{run_orbits_hybrid, HybridSettings};
 use crate::runs::lockstep::{solve_lockstep, Job, LaneObserver, StepReads, RUNS_PER_CORE};
 use crate::runs::orbits::{
-    finish_orbits, prepare_orbits, run_orbits_cancellable, OrbitRun, OrbitRunRequest, OrbitRunSpec,
-    SummaryObserver, SummaryOptions, TwoLayerView,
+    finish_orbits, prepare_orbits, run_orbits_cancellable, start_state, LimitCrossing, OrbitRun,
+    OrbitRunRequest, OrbitRunSpec, OrbitSummary, SummaryObserver, SummaryOptions, TwoLayerView,
 };
-use nalgebra::{Vector4, U4};
+use nalgebra::U4;
 use rayon::prelude::*;
 use rayon::ThreadPool;
 use std::cell::RefCell;
@@ -53,6 +55,11 @@ pub struct EnsembleSettings {
 }
 
 impl EnsembleSettings {
+    /// The settings of a sample run on `orbit` (the batch's with the sample's orbit inputs).
+    pub fn on(&self, orbit: Orbit) -> EnsembleSettings {
+        EnsembleSettings { orbit, ..*self }
+    }
+
     pub fn validate(&self) -> Result<()> {
         self.orbit.validate()?;
         self.method.validate()?;
@@ -83,6 +90,52 @@ impl EnsembleSettings {
     }
 }
 
+/// The orbit inputs a batch may vary sample by sample, named as the parameters of
+/// `Orbit.circular`: the Earth's albedo and infrared flux, the orbit plane's inclination and its
+/// node's right ascension. Neither changes the period, so every sample of a batch runs the same
+/// span of time.
+pub const ORBIT_INPUTS: [&str; 4] = ["albedo", "earth_ir", "inclination", "raan"];
+
+/// The valid range of each of [`ORBIT_INPUTS`] as [`Orbit::validate`] checks it, `(low, high,
+/// low end open)`, both ends closed here.
+pub const ORBIT_INPUT_RANGES: [(f64, f64, bool); 4] = [
+    (0.0, 1.0, false),
+    (0.0, crate::inputs::attitude::MAX_EARTH_IR, false),
+    (0.0, std::f64::consts::PI, false),
+    (
+        -crate::inputs::orbit::MAX_PHASE0,
+        crate::inputs::orbit::MAX_PHASE0,
+        false,
+    ),
+];
+
+/// `orbit` with the orbit input `name` ([`ORBIT_INPUTS`]) set to `value`, unchecked (a sample's
+/// run validates its orbit).
+pub fn orbit_with(orbit: Orbit, name: &str, value: f64) -> Result<Orbit> {
+    let mut o = orbit;
+    match name {
+        "albedo" => o.albedo = value,
+        "earth_ir" => o.earth_ir = value,
+        "inclination" => o.inclination = value,
+        "raan" => o.raan = value,
+        _ => {
+            return Err(Error::invalid(
+                "orbit input",
+                name,
+                &format!("must be one of {}", ORBIT_INPUTS.join(", ")),
+            ))
+        }
+    }
+    Ok(o)
+}
+
+/// One sample of a batch: its panel and the orbit it runs on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    pub panel: Panel,
+    pub orbit: Orbit,
+}
+
 /// The numbers kept from one sample. Angles rad, times s; NaN where not defined.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleMetrics {
@@ -91,7 +144,8 @@ pub struct SampleMetrics {
     /// Largest real part of the Jacobian's eigenvalues at that equilibrium, 1/s.
     pub growth_rate: f64,
     pub frequency_hz: f64,
-    /// Damping at which the growth rate crosses zero, N m s/rad.
+    /// Damping at which the growth rate crosses zero, N m s/rad (a boom's: the critical damping
+    /// ratio of its first mode).
     pub critical_damping: f64,
     /// max |θ| over the horizon.
     pub theta_abs_max: f64,
@@ -154,8 +208,38 @@ fn max_defined(values: impl Iterator<Item = f64>) -> f64 {
     values.fold(f64::NAN, |acc, v| if v.is_nan() { acc } else { acc.max(v) })
 }
 
-fn reduce(run: &OrbitRun) -> (f64, f64, f64, f64, f64, f64) {
-    let s = &run.summaries;
+/// What a sample's metrics read of its run over orbits, whatever its model.
+struct Ran<'a> {
+    summaries: &'a [OrbitSummary],
+    t_end: f64,
+    n_steps: u64,
+    crossing: Option<LimitCrossing>,
+}
+
+impl<'a> From<&'a OrbitRun> for Ran<'a> {
+    fn from(run: &'a OrbitRun) -> Self {
+        Ran {
+            summaries: &run.summaries,
+            t_end: run.stats.t_end,
+            n_steps: run.stats.n_steps,
+            crossing: run.crossing,
+        }
+    }
+}
+
+impl<'a> From<&'a crate::runs::layered::LayeredSummaries> for Ran<'a> {
+    fn from(run: &'a crate::runs::layered::LayeredSummaries) -> Self {
+        Ran {
+            summaries: &run.summaries,
+            t_end: run.stats.t_end,
+            n_steps: run.stats.n_steps,
+            crossing: run.crossing,
+        }
+    }
+}
+
+fn reduce(run: &Ran<'_>) -> (f64, f64, f64, f64, f64, f64) {
+    let s = run.summaries;
     let theta_abs_max = max_defined(s.iter().map(|o| o.theta_max.abs().max(o.theta_min.abs())));
     let amplitude = max_defined(s.iter().map(|o| o.amplitude));
     let entry = max_defined(s.iter().map(|o| o.entry_peak));
@@ -164,7 +248,7 @@ fn reduce(run: &OrbitRun) -> (f64, f64, f64, f64, f64, f64) {
     // Each orbit's RMS weighted by the time integrated in it (the last may be cut short).
     let (mut sq, mut total) = (0.0, 0.0);
     for o in s {
-        let span = (o.t_end.min(run.stats.t_end) - o.t_start).max(0.0);
+        let span = (o.t_end.min(run.t_end) - o.t_start).max(0.0);
         sq += o.jitter_rms * o.jitter_rms * span;
         total += span;
     }
@@ -177,7 +261,7 @@ fn reduce(run: &OrbitRun) -> (f64, f64, f64, f64, f64, f64) {
 }
 
 /// First orbit whose largest |θ| passed `limit`, as a float (NaN: none).
-fn first_orbit_beyond(run: &OrbitRun, limit: f64) -> f64 {
+fn first_orbit_beyond(run: &Ran<'_>, limit: f64) -> f64 {
     run.summaries
         .iter()
         .find(|o| o.theta_max.abs().max(o.theta_min.abs()) > limit)
@@ -185,7 +269,7 @@ fn first_orbit_beyond(run: &OrbitRun, limit: f64) -> f64 {
 }
 
 /// Least-squares slope of ln(amplitude) against the orbit index (orbits with amplitude > 0).
-fn log_slope(run: &OrbitRun) -> f64 {
+fn log_slope(run: &Ran<'_>) -> f64 {
     let points: Vec<(f64, f64)> = run
         .summaries
         .iter()
@@ -203,8 +287,8 @@ fn log_slope(run: &OrbitRun) -> f64 {
     sxy / sxx
 }
 
-/// One sample: the flutter analysis and the summarised run of `panel` (stops with
-/// `Error::Cancelled` within one step of `cancel` being cancelled).
+/// One sample: the flutter analysis and the summarised run of `panel` on the batch's orbit
+/// (stops with `Error::Cancelled` within one step of `cancel` being cancelled).
 pub fn run_sample(
     panel: &Panel,
     settings: &EnsembleSettings,
@@ -218,11 +302,13 @@ pub fn run_sample(
             (run, t)
         }
         Some(h) => {
+            // The Earth's loads and attitudes other than Sun-pointing are integrated in full
+            // (their time counted in t_nonlinear), as a single hybrid run does.
             let out = run_orbits_hybrid(&req, h, cancel)?;
             (out.run, out.t_exponential + out.t_fallback)
         }
     };
-    Ok(sample_metrics(&head, settings, &run, t_nonlinear))
+    Ok(sample_metrics(&head, settings, &(&run).into(), t_nonlinear))
 }
 
 /// What a sample knows before its run: the flutter analysis of its equilibrium.
@@ -233,7 +319,11 @@ struct SampleHead {
     critical_damping: f64,
 }
 
-/// The flutter analysis of a sample, its initial state and its summary options.
+/// The flutter analysis of a sample, its initial state and its summary options: at full Sun
+/// (the flux factor 1) on an orbit of the Sun alone, as `tj.flutter(panel)`; under every load
+/// of its orbit at t = 0 (the Earth's, the attitude's incidence) when it has them, as
+/// `tj.flutter(panel, orbit=..., t=0)`. The run starts where a single run does
+/// ([`start_state`]).
 fn sample_head(
     panel: &Panel,
     settings: &EnsembleSettings,
@@ -242,20 +332,40 @@ fn sample_head(
     cancel.check()?;
     panel.validate()?;
     let s = settings;
-    let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
-    let critical = critical_damping(panel, s.model, s.coupling, 1.0)?;
-    let eq = equilibrium(panel, s.coupling, s.orbit.flux_scale(0.0))?;
+    let head = if s.orbit.has_face_loads() {
+        let system = Coupled::new(*panel, s.orbit, s.model, s.coupling);
+        let (eq, _, spectrum) = analyse_system_at(&system, 0.0)?;
+        SampleHead {
+            theta_eq: eq[2],
+            growth_rate: spectrum.growth_rate,
+            frequency_hz: spectrum.frequency_hz,
+            critical_damping: critical_damping_at(panel, &s.orbit, 0.0, s.model, s.coupling)?,
+        }
+    } else {
+        let flutter = analyse(panel, s.model, s.coupling, 1.0)?;
+        SampleHead {
+            theta_eq: flutter.equilibrium.theta,
+            growth_rate: flutter.growth_rate,
+            frequency_hz: flutter.frequency_hz,
+            critical_damping: critical_damping(panel, s.model, s.coupling, 1.0)?,
+        }
+    };
     let req = OrbitRunRequest {
         spec: orbit_spec(panel, s),
-        y0: Vector4::new(eq.t_front, eq.t_back, eq.theta, 0.0),
-    };
-    let head = SampleHead {
-        theta_eq: flutter.equilibrium.theta,
-        growth_rate: flutter.growth_rate,
-        frequency_hz: flutter.frequency_hz,
-        critical_damping: critical,
+        y0: start_state(panel, &s.orbit, s.coupling, 0.0)?,
     };
     Ok((head, req))
+}
+
+/// The summary options of every sample of a batch.
+fn summary_options(s: &EnsembleSettings) -> SummaryOptions {
+    SummaryOptions {
+        window: s.window,
+        // Without a threshold nothing is timed: a limit no angle reaches.
+        theta_limit: s.threshold.unwrap_or(f64::MAX),
+        stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
+        steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+    }
 }
 
 /// The run over orbits every sample of a batch takes (`panel` being the sample's), from t = 0,
@@ -270,13 +380,7 @@ fn orbit_spec(panel: &Panel, s: &EnsembleSettings) -> OrbitRunSpec {
         t_start: 0.0,
         first_index: 0,
         n_orbits: s.n_orbits,
-        options: SummaryOptions {
-            window: s.window,
-            // Without a threshold nothing is timed: a limit no angle reaches.
-            theta_limit: s.threshold.unwrap_or(f64::MAX),
-            stop_at_limit: s.stop_at_threshold && s.threshold.is_some(),
-            steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
-        },
+        options: summary_options(s),
     }
 }
 
@@ -339,37 +443,39 @@ pub fn run_sample_layered(
             (out.run, out.split.t_exponential + out.split.t_fallback)
         }
     };
-    let n = out.y_end.len();
-    let run = OrbitRun {
-        summaries: out.summaries,
-        stats: out.stats,
-        // The metrics read the summaries only; the faces stand for the thermal state.
-        y_end: Vector4::new(
-            out.y_end[0],
-            out.y_end[n - 3],
-            out.y_end[n - 2],
-            out.y_end[n - 1],
-        ),
-        crossing: out.crossing,
-    };
-    Ok(sample_metrics(&head, settings, &run, t_nonlinear))
+    Ok(sample_metrics(&head, settings, &(&out).into(), t_nonlinear))
 }
 
 /// [`run_batch`] with the N-node model (one sample at a time per thread).
 pub fn run_batch_layered(
     pool: &ThreadPool,
-    panels: &[Panel],
+    samples: &[Sample],
     settings: &EnsembleSettings,
     layers: &Layers,
     cancel: &Cancel,
 ) -> Result<Vec<SampleMetrics>> {
+    let run = |x: &Sample, s: &EnsembleSettings| run_sample_layered(&x.panel, s, layers, cancel);
+    one_at_a_time(pool, samples, settings, cancel, run, |x| x.orbit)
+}
+
+/// Runs `items` on `pool`, one at a time per thread, each with the batch's settings on its orbit
+/// (`orbit_of`); results in input order, an item that fails keeping its error, as [`run_batch`].
+fn one_at_a_time<T: Sync>(
+    pool: &ThreadPool,
+    items: &[T],
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+    run: impl Fn(&T, &EnsembleSettings) -> Result<SampleMetrics> + Sync,
+    orbit_of: impl Fn(&T) -> Orbit + Sync,
+) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
     let out = pool.install(|| {
-        panels
+        items
             .par_iter()
             .with_max_len(1)
-            .map(|p| {
-                run_sample_layered(p, settings, layers, cancel)
+            .map(|x| {
+                checked_on(&orbit_of(x), settings)
+                    .and_then(|s| run(x, &s))
                     .unwrap_or_else(SampleMetrics::failed)
             })
             .collect()
@@ -378,11 +484,67 @@ pub fn run_batch_layered(
     Ok(out)
 }
 
+/// The settings of a sample on `orbit` (the batch's on it), the orbit checked as the batch's is.
+fn checked_on(orbit: &Orbit, settings: &EnsembleSettings) -> Result<EnsembleSettings> {
+    if *orbit == settings.orbit {
+        return Ok(*settings);
+    }
+    let s = settings.on(*orbit);
+    s.validate()?;
+    Ok(s)
+}
+
+/// One boom: the tube's flutter analysis at full Sun (its growth rate, frequency and critical
+/// damping ratio, as `tj.flutter(boom)`) and its summarised run over the orbits from its steady
+/// state at t = 0, as a single run of it (`runs::boom::run_orbits`). The tube has no hybrid
+/// form: a hybrid batch integrates it in full.
+pub fn run_boom_sample(
+    boom: &Boom,
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+) -> Result<SampleMetrics> {
+    cancel.check()?;
+    let s = settings;
+    let flutter = crate::analysis::tube::flutter(boom, s.coupling, 1.0)?;
+    let head = SampleHead {
+        theta_eq: flutter.equilibrium[2],
+        growth_rate: flutter.spectrum.growth_rate,
+        frequency_hz: flutter.spectrum.frequency_hz,
+        critical_damping: flutter.critical_damping_ratio,
+    };
+    let system = crate::models::tube::boom_system(boom, s.orbit, s.coupling)?;
+    let y0 = system.steady_state(s.orbit.flux_scale(0.0))?;
+    let out = crate::runs::boom::run_orbits(
+        boom,
+        s.orbit,
+        s.coupling,
+        &s.method,
+        (0.0, 0, s.n_orbits),
+        y0.as_slice(),
+        summary_options(s),
+        cancel,
+    )?;
+    let t_nonlinear = out.stats.t_end;
+    Ok(sample_metrics(&head, settings, &(&out).into(), t_nonlinear))
+}
+
+/// Runs every boom on `pool` (one at a time per thread), each on its orbit; results in input
+/// order, a failed boom keeping its error, as [`run_batch`].
+pub fn run_boom_batch(
+    pool: &ThreadPool,
+    booms: &[(Boom, Orbit)],
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+) -> Result<Vec<SampleMetrics>> {
+    let run = |x: &(Boom, Orbit), s: &EnsembleSettings| run_boom_sample(&x.0, s, cancel);
+    one_at_a_time(pool, booms, settings, cancel, run, |x| x.1)
+}
+
 /// A sample's metrics from its head and its run.
 fn sample_metrics(
     head: &SampleHead,
     settings: &EnsembleSettings,
-    run: &OrbitRun,
+    run: &Ran<'_>,
     t_nonlinear: f64,
 ) -> SampleMetrics {
     let (theta_abs_max, amplitude, entry_peak, exit_peak, jitter_rms, jitter_peak) = reduce(run);
@@ -402,8 +564,8 @@ fn sample_metrics(
         orbit_limit: first_orbit_beyond(run, settings.validity_limit),
         amplitude_slope: log_slope(run),
         t_nonlinear,
-        t_reached: run.stats.t_end,
-        n_steps: run.stats.n_steps,
+        t_reached: run.t_end,
+        n_steps: run.n_steps,
         error: None,
     }
 }
@@ -412,6 +574,7 @@ fn sample_metrics(
 struct LaneSample<'c> {
     index: usize,
     head: SampleHead,
+    settings: EnsembleSettings,
     observer: SummaryObserver<'c, TwoLayerView>,
 }
 
@@ -432,20 +595,36 @@ impl LaneObserver for LaneSample<'_> {
     }
 }
 
-/// Runs `panels` (hinge-resolved Dormand–Prince samples) on this thread, up to
-/// [`RUNS_PER_CORE`] at a time in lockstep; results in input order, each the same, bit for bit,
-/// as [`run_sample`]'s.
-fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> Vec<SampleMetrics> {
-    // Rows are written by `next` (a sample that fails before its run) and by `done`.
-    let out = RefCell::new(vec![None; panels.len()]);
-    let mut queue = panels.iter().enumerate();
-    let s = settings;
+/// Whether a sample on `orbit` can run in a lane: the lanes take the front's sunlight only, so a
+/// sample with the Earth's loads or another attitude runs alone (on the scalar path, whose rows
+/// the lanes reproduce bit for bit).
+fn fits_a_lane(orbit: &Orbit) -> bool {
+    !orbit.has_face_loads()
+}
+
+/// Runs `samples` (hinge-resolved Dormand–Prince samples) on this thread, up to
+/// [`RUNS_PER_CORE`] at a time in lockstep, those that do not fit a lane one at a time; results
+/// in input order, each the same, bit for bit, as [`run_sample`]'s.
+fn run_group(
+    samples: &[Sample],
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+) -> Vec<SampleMetrics> {
+    // Rows are written by `next` (a sample that fails before its run, or runs alone) and by
+    // `done`.
+    let out = RefCell::new(vec![None; samples.len()]);
+    let mut queue = samples.iter().enumerate();
     let next = || {
-        for (index, panel) in queue.by_ref() {
-            let prepared = sample_head(panel, s, cancel)
-                .and_then(|(head, req)| Ok((head, prepare_orbits(&req, cancel)?)));
+        for (index, sample) in queue.by_ref() {
+            let prepared = checked_on(&sample.orbit, settings).and_then(|s| {
+                if !fits_a_lane(&s.orbit) {
+                    return Ok(Err(run_sample(&sample.panel, &s, cancel)?));
+                }
+                let (head, req) = sample_head(&sample.panel, &s, cancel)?;
+                Ok(Ok((head, s, prepare_orbits(&req, cancel)?)))
+            });
             match prepared {
-                Ok((head, run)) => {
+                Ok(Ok((head, settings, run))) => {
                     let Method::Dopri5(tol) = run.method else {
                         unreachable!("only Dormand–Prince batches run in lockstep")
                     };
@@ -458,10 +637,12 @@ fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> 
                         observer: LaneSample {
                             index,
                             head,
+                            settings,
                             observer: run.observer,
                         },
                     });
                 }
+                Ok(Err(row)) => out.borrow_mut()[index] = Some(row),
                 Err(e) => out.borrow_mut()[index] = Some(SampleMetrics::failed(e)),
             }
         }
@@ -469,7 +650,10 @@ fn run_group(panels: &[Panel], settings: &EnsembleSettings, cancel: &Cancel) -> 
     };
     let done = |sample: LaneSample<'_>, outcome| {
         let row = finish_orbits(sample.observer, outcome)
-            .map(|run| sample_metrics(&sample.head, s, &run, run.stats.t_end))
+            .map(|run| {
+                let t = run.stats.t_end;
+                sample_metrics(&sample.head, &sample.settings, &(&run).into(), t)
+            })
             .unwrap_or_else(SampleMetrics::failed);
         out.borrow_mut()[sample.index] = Some(row);
     };
@@ -529,7 +713,7 @@ fn group_size(samples: usize, threads: usize) -> usize {
     RUNS_PER_CORE.min(samples.div_ceil(threads.max(1))).max(1)
 }
 
-/// [`run_batch`] along `path`.
+/// [`run_batch`] along `path`, every panel on the batch's orbit.
 pub fn run_batch_on(
     pool: &ThreadPool,
     panels: &[Panel],
@@ -537,28 +721,50 @@ pub fn run_batch_on(
     cancel: &Cancel,
     path: Path,
 ) -> Result<Vec<SampleMetrics>> {
+    let samples: Vec<Sample> = panels
+        .iter()
+        .map(|&panel| Sample {
+            panel,
+            orbit: settings.orbit,
+        })
+        .collect();
+    run_samples(pool, &samples, settings, cancel, path)
+}
+
+/// [`run_batch_on`] with each sample on its own orbit (the batch's with the sample's orbit
+/// inputs); a sample whose orbit is invalid fails alone, naming the input.
+pub fn run_samples(
+    pool: &ThreadPool,
+    samples: &[Sample],
+    settings: &EnsembleSettings,
+    cancel: &Cancel,
+    path: Path,
+) -> Result<Vec<SampleMetrics>> {
     settings.validate()?;
-    // The lanes take the front's sunlight only: Earth heating and other attitudes run one
-    // sample at a time.
+    // The lanes take hinge-resolved Dormand–Prince runs; each group runs those of its samples
+    // that do not fit a lane (the Earth's loads, other attitudes) one at a time.
     let lockstep = path == Path::Lockstep
         && settings.hybrid.is_none()
-        && !settings.orbit.has_face_loads()
         && matches!(settings.method, Method::Dopri5(_));
-    let scalar = |p: &Panel| run_sample(p, settings, cancel).unwrap_or_else(SampleMetrics::failed);
+    let scalar = |x: &Sample| {
+        checked_on(&x.orbit, settings)
+            .and_then(|s| run_sample(&x.panel, &s, cancel))
+            .unwrap_or_else(SampleMetrics::failed)
+    };
     let out = pool.install(|| {
         if lockstep {
-            let group = group_size(panels.len(), rayon::current_num_threads());
-            let groups: Vec<Vec<SampleMetrics>> = panels
+            let group = group_size(samples.len(), rayon::current_num_threads());
+            let groups: Vec<Vec<SampleMetrics>> = samples
                 .par_chunks(group)
                 .with_max_len(1)
                 .map(|group| match group {
-                    [p] => vec![scalar(p)],
+                    [x] => vec![scalar(x)],
                     _ => run_group(group, settings, cancel),
                 })
                 .collect();
             groups.into_iter().flatten().collect()
         } else {
-            panels.par_iter().with_max_len(1).map(scalar).collect()
+            samples.par_iter().with_max_len(1).map(scalar).collect()
         }
     });
     cancel.check()?;
@@ -568,8 +774,10 @@ pub fn run_batch_on(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::steady::equilibrium;
     use crate::numerics::integrate::Tolerances;
     use crate::runs::orbits::run_orbits;
+    use nalgebra::Vector4;
 
     fn settings() -> EnsembleSettings {
         EnsembleSettings {
@@ -766,18 +974,151 @@ mod tests {
         assert!(m.amplitude_slope.is_finite());
     }
 
+    /// Samples of `panels()` on orbits that vary their inputs: some with the Earth's loads, one
+    /// with an albedo out of range.
+    fn samples_on_orbits(s: &EnsembleSettings) -> Vec<Sample> {
+        panels()
+            .into_iter()
+            .enumerate()
+            .map(|(k, panel)| {
+                let mut orbit = orbit_with(s.orbit, "inclination", 0.2 * k as f64).unwrap();
+                orbit = orbit_with(orbit, "raan", 0.5 * k as f64).unwrap();
+                if k % 2 == 1 {
+                    orbit = orbit_with(orbit, "albedo", 0.1 * k as f64).unwrap();
+                    orbit = orbit_with(orbit, "earth_ir", 40.0 * k as f64).unwrap();
+                }
+                Sample { panel, orbit }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_sample_on_its_own_orbit_equals_a_batch_on_that_orbit() {
+        let s = settings();
+        let samples = samples_on_orbits(&s);
+        let p = pool(2).unwrap();
+        let lanes = run_samples(&p, &samples, &s, &Cancel::new(), Path::Lockstep).unwrap();
+        let scalar = run_samples(&p, &samples, &s, &Cancel::new(), Path::Scalar).unwrap();
+        let one = run_samples(
+            &pool(1).unwrap(),
+            &samples,
+            &s,
+            &Cancel::new(),
+            Path::Lockstep,
+        );
+        assert_eq!(bits(&lanes), bits(&scalar));
+        assert_eq!(bits(&lanes), bits(&one.unwrap()));
+        for (x, row) in samples.iter().zip(&lanes) {
+            let alone = run_batch(
+                &pool(1).unwrap(),
+                &[x.panel],
+                &s.on(x.orbit),
+                &Cancel::new(),
+            );
+            assert_eq!(bits(&alone.unwrap()), bits(std::slice::from_ref(row)));
+        }
+        // The Earth's loads move the equilibrium.
+        assert_ne!(lanes[1].theta_eq, lanes[0].theta_eq);
+        let mut bad = samples.clone();
+        bad[2].orbit.albedo = 1.5;
+        let out = run_samples(&p, &bad, &s, &Cancel::new(), Path::Lockstep).unwrap();
+        assert_fails_alone(&out, 2, "albedo");
+    }
+
+    /// Sample `k` of `out`, alone, failed with an error naming `name`.
+    fn assert_fails_alone(out: &[SampleMetrics], k: usize, name: &str) {
+        let err = out[k].error.as_deref().unwrap();
+        assert!(err.starts_with(name), "{err}");
+        assert!(out[k].growth_rate.is_nan());
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(i, m)| (i == k) == m.error.is_some()));
+    }
+
+    #[test]
+    fn a_loaded_sample_starts_and_is_analysed_where_a_single_run_is() {
+        let mut s = settings();
+        s.orbit.albedo = 0.3;
+        s.orbit.earth_ir = 237.0;
+        s.orbit.attitude = crate::inputs::attitude::Attitude::Nadir;
+        let p = panels()[3];
+        let m = run_sample(&p, &s, &Cancel::new()).unwrap();
+        let system = Coupled::new(p, s.orbit, s.model, s.coupling);
+        let (eq, _, spectrum) = analyse_system_at(&system, 0.0).unwrap();
+        assert_eq!(m.theta_eq, eq[2]);
+        assert_eq!(m.growth_rate, spectrum.growth_rate);
+        let y0 = Coupled::new(p, s.orbit, HingeModel::Nonlinear, s.coupling)
+            .sunlit_steady_state(0.0)
+            .unwrap();
+        let req = OrbitRunRequest {
+            spec: OrbitRunSpec {
+                options: SummaryOptions {
+                    theta_limit: 0.2,
+                    ..summary_options(&s)
+                },
+                ..orbit_spec(&p, &s)
+            },
+            y0,
+        };
+        let run = run_orbits(&req).unwrap();
+        assert_eq!(m.exit_peak, run.summaries[0].exit_peak);
+        assert_eq!(m.n_steps, run.stats.n_steps);
+    }
+
+    #[test]
+    fn booms_do_not_depend_on_threads_and_equal_their_single_run() {
+        let s = settings();
+        let booms: Vec<(Boom, Orbit)> = (0..5)
+            .map(|k| {
+                let boom = Boom {
+                    damping: 0.002 * k as f64,
+                    solar_inclination: 0.6 + 0.4 * k as f64,
+                    ..Boom::example()
+                };
+                (
+                    boom,
+                    orbit_with(s.orbit, "inclination", 0.1 * k as f64).unwrap(),
+                )
+            })
+            .collect();
+        let one = run_boom_batch(&pool(1).unwrap(), &booms, &s, &Cancel::new()).unwrap();
+        let two = run_boom_batch(&pool(2).unwrap(), &booms, &s, &Cancel::new()).unwrap();
+        assert_eq!(bits(&one), bits(&two));
+        let (boom, orbit) = booms[3];
+        let system = crate::models::tube::boom_system(&boom, orbit, s.coupling).unwrap();
+        let y0 = system.steady_state(orbit.flux_scale(0.0)).unwrap();
+        let single = crate::runs::boom::run_orbits(
+            &boom,
+            orbit,
+            s.coupling,
+            &s.method,
+            (0.0, 0, 1),
+            y0.as_slice(),
+            summary_options(&s),
+            &Cancel::new(),
+        )
+        .unwrap();
+        let o = single.summaries[0];
+        assert_eq!(one[3].exit_peak, o.exit_peak);
+        assert_eq!(one[3].amplitude, o.amplitude);
+        assert_eq!(one[3].n_steps, single.stats.n_steps);
+        let f = crate::analysis::tube::flutter(&boom, s.coupling, 1.0).unwrap();
+        assert_eq!(one[3].critical_damping, f.critical_damping_ratio);
+        assert_eq!(one[3].theta_eq, f.equilibrium[2]);
+        // A boom refuses the Earth's loads: that sample fails alone.
+        let mut loaded = booms.clone();
+        loaded[1].1.albedo = 0.3;
+        let out = run_boom_batch(&pool(2).unwrap(), &loaded, &s, &Cancel::new()).unwrap();
+        assert_fails_alone(&out, 1, "orbit");
+    }
+
     #[test]
     fn a_bad_panel_fails_alone() {
         let mut ps = panels();
         ps[2].emissivity_front = 1.5;
         let out = run_batch(&pool(2).unwrap(), &ps, &settings(), &Cancel::new()).unwrap();
-        let err = out[2].error.as_deref().unwrap();
-        assert!(err.starts_with("emissivity_front"), "{err}");
-        assert!(out[2].growth_rate.is_nan());
-        assert!(out
-            .iter()
-            .enumerate()
-            .all(|(i, m)| (i == 2) == m.error.is_some()));
+        assert_fails_alone(&out, 2, "emissivity_front");
     }
 
     #[test]

@@ -824,6 +824,25 @@ pub struct OrbitRunRequest {
     pub y0: Vector4<f64>,
 }
 
+/// The default start of a run of `panel` on `orbit` at `t0`: the sunlit steady state at rest,
+/// (T_f, T_b, θ, 0), under the Sun's distance at `t0`, and under the Earth's loads and the
+/// attitude's incidence there when the orbit has them. Every run over orbits (single or in a
+/// Monte Carlo batch) starts here unless given a state.
+pub fn start_state(
+    panel: &Panel,
+    orbit: &Orbit,
+    coupling: Coupling,
+    t0: f64,
+) -> Result<Vector4<f64>> {
+    Orbit::check_time(t0)?;
+    if orbit.has_face_loads() {
+        panel.validate()?;
+        let system = Coupled::new(*panel, *orbit, HingeModel::Nonlinear, coupling);
+        return system.sunlit_steady_state(t0);
+    }
+    Ok(equilibrium(panel, coupling, orbit.flux_scale(t0))?.state())
+}
+
 /// Integrates the coupled system over the orbits of `req` and summarises each orbit.
 pub fn run_orbits(req: &OrbitRunRequest) -> Result<OrbitRun> {
     run_orbits_cancellable(req, &Cancel::new())
