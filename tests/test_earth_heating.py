@@ -239,15 +239,18 @@ def test_the_hybrid_runs_earth_heating_in_full_and_says_so(orbit: tj.Orbit) -> N
 
 def test_models_that_take_the_front_sunlight_only_refuse_the_earths_heat() -> None:
     orbit = tj.Orbit.leo(540e3).replace(earth_ir=237.0)
+    boom = tj.Boom(length=30.0, radius=6.35e-3, wall=5.1e-5)
     with pytest.raises(tj.ParameterError) as err:
-        tj.simulate(tj.Panel.paper(), orbit, (0.0, 100.0), layers=4)
-    assert err.value.parameter == "earth_ir"
+        tj.simulate(boom, orbit, (0.0, 100.0))
+    assert err.value.parameter == "orbit"
     with pytest.raises(tj.ParameterError) as err:
-        tj.simulate(
-            tj.Panel.paper(), tj.Orbit.leo(540e3), (0.0, 100.0), layers=4,
-            attitude=tj.Attitude.nadir(),
-        )  # fmt: skip
+        tj.simulate(boom, tj.Orbit.leo(540e3), (0.0, 100.0), attitude=tj.Attitude.nadir())
     assert err.value.parameter == "attitude"
+    # The N-node model's hybrid propagator takes the sunlit forcing as constant between
+    # eclipses: it refuses them (method="rk45" runs them).
+    with pytest.raises(tj.ParameterError) as err, pytest.warns(tj.HybridFallbackWarning):
+        tj.simulate_orbits(tj.Panel.paper(), orbit, 1, layers=4, method="hybrid", progress=False)
+    assert err.value.parameter == "earth_ir"
 
 
 def test_attitudes_and_heat_loads_are_checked() -> None:

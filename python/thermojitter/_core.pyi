@@ -92,6 +92,7 @@ __all__ = [
     "linear_delta_t",
     "linear_thermal",
     "layered_flutter",
+    "layered_flutter_at",
     "layered_steady_state",
     "materials",
     "moment",
@@ -279,6 +280,7 @@ def flutter_at(
     model: str,
     coupled: bool,
     with_critical: bool = True,
+    average: bool = False,
 ) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------
@@ -465,6 +467,16 @@ def layered_steady_state(
 ) -> dict[str, Any]: ...
 def layered_flutter(
     panel: dict[str, float], grid: _Grid, point: _FlutterPoint
+) -> dict[str, Any]: ...
+def layered_flutter_at(
+    panel: dict[str, float],
+    grid: _Grid,
+    orbit: dict[str, Any],
+    *,
+    t: float,
+    model: str,
+    coupled: bool,
+    average: bool = False,
 ) -> dict[str, Any]: ...
 def simulate_layers(
     panel: dict[str, float],

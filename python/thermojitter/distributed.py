@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter.attitude import Attitude, engine_orbit
 from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
 from thermojitter.panel import Panel
@@ -151,6 +152,11 @@ class DistributedSolution(_FaceTemperatures, _FaceDifference, Run):
     """Where abs(θ_f) first passed ``theta_limit`` (its ``theta`` is θ_f, rad), or None."""
     stopped_at_limit: bool = False
     """True when ``on_limit="stop"`` ended the run at the crossing."""
+    flux_front: Array | None = None
+    """The flux reaching the flat panel's front face at each sample, W/m²: sunlight, albedo and
+    Earth infrared in its attitude (each element's own orientation not applied)."""
+    flux_back: Array | None = None
+    """The flux reaching the flat panel's back face at each sample, W/m² (as ``flux_front``)."""
 
     @property
     def theta_f_deg(self) -> Array:
@@ -216,6 +222,7 @@ def simulate_distributed(
     solver: SolverSettings | None = None,
     theta_limit: float = DEFAULT_THETA_LIMIT,
     on_limit: OnLimit = "flag",
+    attitude: Attitude | None = None,
 ) -> DistributedSolution:
     """Integrates the distributed panel over ``t_span`` (s) on ``orbit``, through its eclipses
     and penumbrae.
@@ -235,10 +242,19 @@ def simulate_distributed(
       :func:`thermojitter.simulate` watches θ (checked on every step; ``"flag"`` records the
       first crossing in ``sol.limit_crossing`` and warns, ``"stop"`` also ends the run there,
       ``"ignore"`` checks nothing).
+    - ``attitude`` (:class:`thermojitter.Attitude`; default Sun-pointing) and the orbit's Earth
+      heating (``orbit.albedo``, ``orbit.earth_ir``): every element absorbs sunlight on either
+      face, albedo and Earth infrared (docs/howto/earth-heating.md) at its own orientation — the
+      attitude's front normal turned by the element's slope about the panel's width, the panel's
+      length lying in the plane of the normal and the orbit normal (a Sun-tracking wing along its
+      drive axis) — so the deflection still feeds back on every load; ``sun_angle`` must then be
+      0 (the attitude sets the incidence). ``sol.flux_front`` and ``sol.flux_back`` are the fluxes
+      reaching the flat panel's faces, W/m².
 
     Ctrl-C stops the run within one integration step (``KeyboardInterrupt``).
     """
     check_inputs(panel, orbit)
+    engine_orbit_args = engine_orbit(orbit, attitude)
     t0, t1 = time_span(t_span)
     settings = distributed_settings(
         panel,
@@ -256,7 +272,9 @@ def simulate_distributed(
     )  # fmt: skip
     run["limit"] = limit_args(theta_limit, on_limit)
     run["y0"] = start_state(y0, None)  # numbers (the engine checks the size and the temperatures)
-    raw = interruptible(_core.simulate_distributed, panel.as_dict(), orbit.as_dict(), settings, run)
+    raw = interruptible(
+        _core.simulate_distributed, panel.as_dict(), engine_orbit_args, settings, run
+    )
     limit = limit_record(raw)
     warn_crossing(limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, "θ_f")
     return DistributedSolution(
@@ -269,6 +287,11 @@ def simulate_distributed(
             "dt": used.dt,
             "solver": used.as_dict(),
             **run["limit"],
+            **(
+                {"attitude": engine_orbit_args["attitude"]}
+                if "attitude" in engine_orbit_args
+                else {}
+            ),
         },
         x=raw["x"],
         x_node=raw["x_node"],
@@ -284,6 +307,8 @@ def simulate_distributed(
         support=support,
         frequencies_hz=raw["frequencies_hz"],
         damping_ratio=float(raw["damping_ratio"]),
+        flux_front=raw["flux_front"],
+        flux_back=raw["flux_back"],
         **limit,
     )
 

@@ -78,6 +78,7 @@ def flutter(
     t: float = 0.0,
     layers: int | None = None,
     attitude: Attitude | None = None,
+    orbit_average: bool = False,
 ) -> FlutterResult:
     """Linear stability of the sunlit equilibrium of ``panel``.
 
@@ -93,15 +94,32 @@ def flutter(
     With an ``orbit`` that heats the panel from the Earth (``orbit.albedo``, ``orbit.earth_ir``)
     or an ``attitude`` other than Sun-pointing, the equilibrium is the one in full sunlight under
     every load at the point ``t`` of the orbit (the Earth's infrared and albedo and the
-    incidence there), and the critical damping is that equilibrium's (the N-node model takes the
-    front's sunlight only and refuses them).
+    incidence there), and the critical damping is that equilibrium's; the N-node model
+    (``layers=N``) takes them on its outer nodes.
+
+    ``orbit_average=True`` (with ``orbit``) analyses instead the equilibrium under the forcing
+    averaged over the sunlit arc of the orbit that begins at ``t``: every load (the front's
+    sunlight at the Sun's distance and the attitude's incidence, the Earth's infrared and albedo,
+    sunlight on the back) is averaged over the times the Sun is at least partly visible (the
+    penumbra's partial Sun included), and the panel's quasi-steady state under that constant mean
+    is the equilibrium the Jacobian, the growth rate and the critical damping are about. ``flux``
+    is then the mean of the front's solar flux factor over the arc. Along an inclined LEO orbit the
+    incidence and the Earth's loads change over the arc; this is the operating point about which
+    the panel oscillates on average, where ``t`` alone gives one point of the arc.
 
     A :class:`thermojitter.Boom` in place of the panel: the tube's analysis, ``jacobian`` over
     (T_mean, T_circ, θ, θ̇), ``equilibrium`` a :class:`thermojitter.BoomEquilibrium`, and
     ``critical_damping`` the first mode's damping ratio ζ at which the growth rate crosses zero
     (not a c_d); ``model`` is ``"tube"``.
     """
+    average = checks.flag("orbit_average", orbit_average)
+    if average and orbit is None:
+        raise checks.ParameterError("orbit_average", orbit_average, "needs an orbit (and t)")
     if isinstance(panel, Boom):
+        if average:
+            raise checks.ParameterError(
+                "orbit_average", orbit_average, "is for a panel: a Boom takes the flux at t"
+            )
         boom_module.check_attitude(attitude)
         return _boom_flutter(panel, model, coupled, flux, orbit, t)
     checks.instance("panel", panel, Panel, "a thermojitter.Panel")
@@ -111,18 +129,31 @@ def flutter(
     coupled = checks.flag("coupled", coupled)
     checks.choice("model", model, ("nonlinear", "linear"))
     point: _FlutterPoint = {"model": model, "coupled": coupled, "flux": flux}
-    loaded = orbit is not None and has_face_loads(orbit, attitude)
+    # On an orbit with more than the front's sunlight, or averaged over its sunlit arc: the
+    # engine takes the orbit's loads itself.
+    on_orbit = orbit is not None and (average or has_face_loads(orbit, attitude))
     if layers is not None:
-        if loaded:
-            raise checks.ParameterError(
-                "layers", layers, "takes the front's sunlight only: no Earth heating or attitude"
-            )
-        result = _layered_flutter(panel, point, layers)
+        nodes = check_layers(layers)
+        if on_orbit:
+            assert orbit is not None
+            raw = _core.layered_flutter_at(
+                panel.as_dict(), grid_args(panel, nodes), engine_orbit(orbit, attitude), t=t,
+                model=model, coupled=coupled, average=average,
+            )  # fmt: skip
+            if average:
+                point["flux"] = float(raw["loads"][0])
+        else:
+            raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), point)
+        result = _layered_result(raw, point)
     else:
-        if loaded:
+        if on_orbit:
             assert orbit is not None
             at = engine_orbit(orbit, attitude)
-            raw = _core.flutter_at(panel.as_dict(), at, t=t, model=model, coupled=coupled)
+            raw = _core.flutter_at(
+                panel.as_dict(), at, t=t, model=model, coupled=coupled, average=average
+            )
+            if average:
+                point["flux"] = float(raw["loads"][0])
         else:
             raw = _core.flutter(panel.as_dict(), point)
         tf, tb, th = raw["equilibrium"]
@@ -162,10 +193,8 @@ def _boom_flutter(
     return _result(raw, equilibrium, point)  # type: ignore[arg-type]
 
 
-def _layered_flutter(panel: Panel, point: _FlutterPoint, layers: int) -> FlutterResult:
+def _layered_result(raw: dict[str, Any], point: _FlutterPoint) -> FlutterResult:
     """The N-node model's flutter analysis: the Jacobian over (node temperatures…, θ, θ̇)."""
-    nodes = check_layers(layers)
-    raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), point)
     temps = raw["temperatures"]
     equilibrium = Equilibrium(
         T_front=float(temps[0]),

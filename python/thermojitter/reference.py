@@ -321,6 +321,108 @@ def _simulate_loaded(
     )  # fmt: skip
 
 
+# ------------------------------------------------------------- N nodes through the thickness
+
+
+def node_model(panel: Any, nodes: int) -> tuple[FloatArray, float, FloatArray]:
+    """A plain panel's one homogeneous layer on ``nodes`` equally spaced nodes, front (ξ = 0) to
+    back (ξ = 1), the temperature linear between them: (heat capacity lumped at each node,
+    J/(m² K): the node's share of the layer, half a spacing at the faces; conductance of each
+    spacing, W/(m² K), the panel's K over the spacing's fraction of the thickness; thermal moment
+    per kelvin at each node, N m/K: M_T = χ a E b ∫ z T dz with z = d (1/2 − ξ) from the middle
+    plane, b = 12 I/d³, integrated exactly over the node's hat function)."""
+    if nodes < 2:
+        raise ValueError("nodes must be >= 2")
+    h = 1.0 / (nodes - 1)
+    heat_capacity = panel.mass_per_length * panel.specific_heat
+    capacity = np.full(nodes, heat_capacity * h)
+    capacity[[0, -1]] *= 0.5
+    xi = np.linspace(0.0, 1.0, nodes)
+    # ∫ φ_i(ξ) (1/2 − ξ) dξ over the hat of node i: the interior's two halves, the faces' one.
+    weight = h * (0.5 - xi)
+    weight[0] = h / 4.0 - h * h / 6.0
+    weight[-1] = -weight[0]
+    chi = getattr(panel, "moment_scale", 1.0)
+    # χ a E b d² ∫ ... dξ with b d³ = 12 I.
+    gain = chi * panel.expansion_coeff * panel.youngs_modulus * 12.0 * panel.bending_inertia
+    return capacity, panel.conductance / h, gain / panel.thickness * weight
+
+
+def rhs_nodes_loaded(
+    y: Sequence[float] | FloatArray,
+    panel: Any,
+    nodes: int,
+    loads: tuple[float, float],
+    model: str = "nonlinear",
+    coupled: bool = True,
+) -> FloatArray:
+    """The N-node plate with absorbed loads (front, back) W/m² on its face nodes, both scaled by
+    cos θ, on the hinge: y = [T_0 … T_{N−1}, θ, θ̇]."""
+    y = np.asarray(y, dtype=float)
+    temps, theta, theta_dot = y[:nodes], float(y[nodes]), float(y[nodes + 1])
+    capacity, conductance, weight = node_model(panel, nodes)
+    area = math.cos(theta) if coupled else 1.0
+    flow = np.zeros(nodes)
+    through = conductance * np.diff(temps)  # into node i from node i + 1
+    flow[:-1] += through
+    flow[1:] -= through
+    flow[0] += area * loads[0] - STEFAN_BOLTZMANN * panel.emissivity_front * temps[0] ** 4
+    flow[-1] += area * loads[1] - STEFAN_BOLTZMANN * panel.emissivity_back * temps[-1] ** 4
+    moment = float(weight @ temps)
+    accel = _hinge_accel(panel, theta, theta_dot, moment, model)
+    return np.concatenate([flow / capacity, [theta_dot, accel]])
+
+
+def steady_state_nodes_loaded(
+    panel: Any, nodes: int, loads: tuple[float, float], coupled: bool = True
+) -> FloatArray:
+    """The N-node plate's equilibrium (T_0 … T_{N−1}, θ) under constant loads (front, back)."""
+    capacity, _, weight = node_model(panel, nodes)
+    two = steady_state_loaded(panel, loads, coupled)
+    # From the two-node balance's faces, linear between them.
+    x0 = np.concatenate([np.linspace(two[0], two[1], nodes), [two[2]]])
+
+    def residual(x: FloatArray) -> FloatArray:
+        rates = rhs_nodes_loaded(np.append(x, 0.0), panel, nodes, loads, "linear", coupled)
+        static = float(weight @ x[:nodes]) - panel.hinge_stiffness * x[nodes]
+        return np.append(rates[:nodes] * capacity, static)
+
+    sol, _, ier, msg = fsolve(residual, x0, xtol=1e-14, full_output=True)
+    if ier != 1 and np.max(np.abs(residual(sol))) > 1e-8:
+        raise RuntimeError(f"steady_state_nodes_loaded did not converge: {msg}")
+    return np.asarray(sol, dtype=float)
+
+
+def simulate_nodes(
+    panel: Any,
+    orbit: Any,
+    t_span: tuple[float, float],
+    *,
+    nodes: int,
+    attitude: Any = None,
+    model: str = "nonlinear",
+    coupled: bool = True,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    t_eval: ArrayLike | None = None,
+    max_step: float = np.inf,
+) -> ReferenceSolution:
+    """The N-node plate on the hinge under every load of the orbit and attitude
+    (:func:`absorbed_loads`), in permanent sunlight (an orbit with ``shadow="none"``), from the
+    equilibrium under the loads at t_span[0]; rows T_0 … T_{N−1}, θ, θ̇."""
+    if getattr(orbit, "shadow", "none") != "none":
+        raise NotImplementedError("reference: the N-node plate in permanent sunlight only")
+    start = absorbed_loads(panel, orbit, attitude, t_span[0], 1.0)
+    y0 = np.append(steady_state_nodes_loaded(panel, nodes, start, coupled), 0.0)
+
+    def fun(t: float, y: FloatArray, s: float) -> FloatArray:
+        loads = absorbed_loads(panel, orbit, attitude, t, s)
+        return rhs_nodes_loaded(y, panel, nodes, loads, model, coupled)
+
+    names = (*(f"T_{i}" for i in range(nodes)), "theta", "theta_dot")
+    return _integrate_segments(fun, y0, t_span, None, rtol, atol, t_eval, "RK45", names, max_step)
+
+
 # --------------------------------------------------------------------------- model equations
 
 

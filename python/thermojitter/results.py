@@ -140,8 +140,7 @@ class Solution(_FaceDifference, _Run):
     """With ``layers=N``: each node's depth below the front face, m."""
     flux_front: Array | None = None
     """The flux reaching the front face at each sample, W/m²: sunlight, albedo and Earth
-    infrared on the flat panel in its attitude (the deflection's cos θ not applied); None with
-    ``layers=N``."""
+    infrared on the flat panel in its attitude (the deflection's cos θ not applied)."""
     flux_back: Array | None = None
     """The flux reaching the back face at each sample, W/m² (as ``flux_front``)."""
     node_labels: tuple[str, ...] | None = None

@@ -177,7 +177,8 @@ def simulate(
     (``orbit.albedo``, ``orbit.earth_ir``), each face absorbs sunlight, albedo and Earth
     infrared through its own incidence and view factor (docs/howto/earth-heating.md);
     ``sol.flux_front`` and ``sol.flux_back`` are the fluxes reaching each face, W/m². The N-node
-    model (``layers=N``) takes the front's sunlight only and refuses them.
+    model (``layers=N``) takes them on its outer nodes, the front's loads on the front node and the
+    back's on the back node.
 
     Ctrl-C stops the run within one integration step (``KeyboardInterrupt``).
 
@@ -237,6 +238,8 @@ def simulate(
             T_nodes=temps,
             depth=raw["depth"],
             node_labels=tuple(raw["node_labels"]),
+            flux_front=raw.get("flux_front"),
+            flux_back=raw.get("flux_back"),
         )
         warn_crossing(sol.limit_crossing, theta_limit, on_limit)
         return sol

@@ -238,8 +238,17 @@ where
 /// incidence there, s = 1), as [`analyse_system`] does under a flux factor.
 pub fn analyse_system_at(system: &Coupled, t: f64) -> Result<(State<U4>, DMatrix<f64>, Spectrum)> {
     Orbit::check_time(t)?;
-    let eq = system.sunlit_steady_state(t)?;
-    spectrum_of(system, eq, system.sunlit_loads(t))
+    analyse_system_under(system, system.sunlit_loads(t))
+}
+
+/// Linear stability of any coupled system at its equilibrium under constant `loads` (e.g. the
+/// sunlit-arc average of [`Orbit::sunlit_average_loads`]), as [`analyse_system_at`].
+pub fn analyse_system_under(
+    system: &Coupled,
+    loads: Loads,
+) -> Result<(State<U4>, DMatrix<f64>, Spectrum)> {
+    let eq = system.steady_state_under(loads)?;
+    spectrum_of(system, eq, loads)
 }
 
 /// The Jacobian at the equilibrium `eq` under constant `loads`, and its spectrum.
@@ -357,13 +366,26 @@ pub fn critical_damping_at(
     model: HingeModel,
     coupling: Coupling,
 ) -> Result<f64> {
+    Orbit::check_time(t)?;
+    let loads = Coupled::new(*panel, *orbit, model, coupling).sunlit_loads(t);
+    critical_damping_under(panel, orbit, loads, model, coupling)
+}
+
+/// [`critical_damping_at`] about the equilibrium under constant `loads`.
+pub fn critical_damping_under(
+    panel: &Panel,
+    orbit: &Orbit,
+    loads: Loads,
+    model: HingeModel,
+    coupling: Coupling,
+) -> Result<f64> {
     let growth = |cd: f64| -> Result<f64> {
         let p = Panel {
             damping: cd,
             ..*panel
         };
         let system = Coupled::new(p, *orbit, model, coupling);
-        Ok(analyse_system_at(&system, t)?.2.growth_rate)
+        Ok(analyse_system_under(&system, loads)?.2.growth_rate)
     };
     let start = panel
         .damping

@@ -2,6 +2,7 @@
 //! run, the Jacobian there, flutter growth and critical damping.
 
 use crate::error::{Error, Result};
+use crate::inputs::heating::{Loads, Optics};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -26,19 +27,51 @@ pub fn equilibrium(
     coupling: Coupling,
     flux: f64,
 ) -> Result<LayeredEquilibrium> {
+    equilibrium_loaded(panel, c, coupling, Loads::sun(flux))
+}
+
+/// [`equilibrium`] under constant `loads`: the front's sunlight as a flux factor and the further
+/// loads absorbed on each face (W/m², the Earth's and sunlight on the back), all scaled by the
+/// projected area with the two-way coupling.
+pub fn equilibrium_loaded(
+    panel: &Panel,
+    c: &Conduction,
+    coupling: Coupling,
+    loads: Loads,
+) -> Result<LayeredEquilibrium> {
     let n = c.nodes();
+    let flux = loads.sun;
+    // The front's sunlight that heats the plate as much: where Newton starts.
+    let start_flux = if loads.has_face_loads() {
+        loads.equivalent_flux(&Optics::of(panel))
+    } else {
+        flux
+    };
     if c.two_layer {
         // Two nodes on a plain panel are eq. 2: the same steady state to the bit, so that a run
         // from it is the two-layer run.
-        let eq = crate::analysis::steady::equilibrium(panel, coupling, flux)?;
-        let temperatures = vec![eq.t_front, eq.t_back];
+        let (t_front, t_back, theta) = if loads.has_face_loads() {
+            panel.validate()?;
+            let x = crate::analysis::steady::steady_loaded(
+                &crate::models::thermal::TwoLayer::new(panel),
+                &crate::models::hinge::Hinge::new(panel, HingeModel::Nonlinear),
+                coupling,
+                loads,
+                start_flux,
+            )?;
+            (x[0], x[1], x[2])
+        } else {
+            let eq = crate::analysis::steady::equilibrium(panel, coupling, flux)?;
+            (eq.t_front, eq.t_back, eq.theta)
+        };
+        let temperatures = vec![t_front, t_back];
         return Ok(LayeredEquilibrium {
             moment: c.moment(&temperatures),
             temperatures,
-            theta: eq.theta,
+            theta,
         });
     }
-    let profile = c.steady_profile(flux)?;
+    let profile = c.steady_profile(start_flux)?;
     let k_el = panel.hinge_stiffness;
     let mut x = DVector::zeros(n + 1);
     for i in 0..n {
@@ -61,12 +94,17 @@ pub fn equilibrium(
         }
         f[0] += qf;
         f[n - 1] += qb;
+        if loads.has_face_loads() {
+            f[0] += loads.front * area;
+            f[n - 1] += loads.back * area;
+        }
         f[n] = (c.moment(&t) - k_el * th) / k_el;
         let mut jac = DMatrix::zeros(n + 1, n + 1);
         jac.view_mut((0, 0), (n, n)).copy_from(&(-&k));
         jac[(0, 0)] -= 4.0 * c.radiation_front * t[0].powi(3);
         jac[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3);
-        jac[(0, n)] = c.absorbed * flux * d_area;
+        jac[(0, n)] = (c.absorbed * flux + loads.front) * d_area;
+        jac[(n - 1, n)] += loads.back * d_area;
         for i in 0..n {
             jac[(n, i)] = c.moment_weight[i] / k_el;
         }
@@ -105,7 +143,12 @@ pub fn start_state(
     t0: f64,
 ) -> Result<Vec<f64>> {
     Orbit::check_time(t0)?;
-    let eq = equilibrium(panel, c, coupling, orbit.flux_scale(t0))?;
+    let eq = equilibrium_loaded(
+        panel,
+        c,
+        coupling,
+        orbit.sunlit_loads(t0, &Optics::of(panel)),
+    )?;
     let mut y = eq.temperatures;
     y.push(eq.theta);
     y.push(0.0);
@@ -135,14 +178,15 @@ pub struct LayeredPoint<'a> {
     pub conduction: &'a Conduction,
     pub model: HingeModel,
     pub coupling: Coupling,
-    /// The illumination factor (flux scale) held constant.
-    pub flux: f64,
+    /// The loads held constant: the front's sunlight as a flux factor (the flux scale), and
+    /// the Earth's and the back's sunlight when the orbit has them.
+    pub loads: Loads,
 }
 
 impl LayeredPoint<'_> {
     /// The steady state at this point.
     pub fn equilibrium(&self) -> Result<LayeredEquilibrium> {
-        equilibrium(self.panel, self.conduction, self.coupling, self.flux)
+        equilibrium_loaded(self.panel, self.conduction, self.coupling, self.loads)
     }
 
     /// The analytic Jacobian of the nodal system (N node temperatures, θ, θ̇) at a steady state.
@@ -152,7 +196,7 @@ impl LayeredPoint<'_> {
             conduction: c,
             model,
             coupling,
-            flux,
+            loads,
         } = *self;
         let n = c.nodes();
         let t = &eq.temperatures;
@@ -167,7 +211,8 @@ impl LayeredPoint<'_> {
         j[(n - 1, n - 1)] -= 4.0 * c.radiation_back * t[n - 1].powi(3) / c.capacity[n - 1];
         let s = eq.theta.sin();
         if coupling == Coupling::ProjectedArea {
-            j[(0, n)] = -c.absorbed * flux * s / c.capacity[0];
+            j[(0, n)] = -(c.absorbed * loads.sun + loads.front) * s / c.capacity[0];
+            j[(n - 1, n)] -= loads.back * s / c.capacity[n - 1];
         }
         j[(n, n + 1)] = 1.0;
         // The static residual is zero at the equilibrium, so the derivative of the non-linear

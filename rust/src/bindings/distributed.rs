@@ -198,6 +198,9 @@ fn simulate_distributed<'py>(
         d.set_item("slope", matrix(py, &r.slope, nodes)?)?;
         d.set_item("theta_f", PyArray1::from_vec(py, r.theta_f))?;
         d.set_item("sunlit", PyArray1::from_vec(py, r.sunlit))?;
+        let (front, back) = r.fluxes;
+        d.set_item("flux_front", PyArray1::from_vec(py, front))?;
+        d.set_item("flux_back", PyArray1::from_vec(py, back))?;
         d.set_item("y_end", PyArray1::from_vec(py, r.y_end))?;
         set_counters(&d, &r.stats)?;
         d.set_item("t_end", r.stats.t_end)?;

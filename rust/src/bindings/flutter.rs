@@ -5,9 +5,14 @@ use super::convert::{
     coupling, dict_of, hinge_model, orbit_from, panel_from, set_named, FlutterPoint,
 };
 use super::error::shield;
-use crate::analysis::flutter::{analyse, analyse_system_at, critical_damping, critical_damping_at};
+use crate::analysis::flutter::{
+    analyse, analyse_system_under, critical_damping, critical_damping_under,
+};
 use crate::analysis::linear::LinearThermal;
 use crate::analysis::stability::Axis;
+use crate::inputs::heating::{Loads, Optics};
+use crate::inputs::orbit::Orbit;
+use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupled;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -35,9 +40,12 @@ fn flutter<'py>(
 }
 
 /// Linear stability of the paper's model at the sunlit equilibrium under every load of `orbit`
-/// at time `t` (its Earth heating and attitude there): the same mapping as [`flutter`].
+/// at time `t` (its Earth heating and attitude there), or with `average` under those loads
+/// averaged over the sunlit arc of the orbit that begins at `t`: the same mapping as
+/// [`flutter`].
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, t, model, coupled, with_critical=true))]
+#[pyo3(signature = (panel, orbit, *, t, model, coupled, with_critical=true, average=false))]
+#[allow(clippy::too_many_arguments)]
 fn flutter_at<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
@@ -46,15 +54,13 @@ fn flutter_at<'py>(
     model: &str,
     coupled: bool,
     with_critical: bool,
+    average: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let p = panel_from(panel)?;
-        p.validate()?;
-        let o = orbit_from(orbit)?;
-        let m = hinge_model(model)?;
-        let c = coupling(coupled);
+        let (p, o, loads) = on_orbit(panel, orbit, t, average)?;
+        let (m, c) = (hinge_model(model)?, coupling(coupled));
         let system = Coupled::new(p, o, m, c);
-        let (eq, jacobian, spectrum) = analyse_system_at(&system, t)?;
+        let (eq, jacobian, spectrum) = analyse_system_under(&system, loads)?;
         let d = PyDict::new(py);
         d.set_item("equilibrium", (eq[0], eq[1], eq[2]))?;
         let rows = (0..4).map(|i| (0..4).map(|j| jacobian[(i, j)]).collect());
@@ -66,10 +72,36 @@ fn flutter_at<'py>(
             spectrum.frequency_hz,
         )?;
         if with_critical {
-            d.set_item("critical_damping", critical_damping_at(&p, &o, t, m, c)?)?;
+            d.set_item(
+                "critical_damping",
+                critical_damping_under(&p, &o, loads, m, c)?,
+            )?;
         }
+        d.set_item("loads", (loads.sun, loads.front, loads.back))?;
         Ok(d)
     })
+}
+
+/// The panel and the orbit of a flutter analysis on an orbit, and the constant loads it is
+/// about: every load of the orbit at time t in full sunlight, or (`average`) their mean over the
+/// sunlit arc of the orbit beginning at t.
+pub(super) fn on_orbit(
+    panel: &Bound<'_, PyDict>,
+    orbit: &Bound<'_, PyDict>,
+    t: f64,
+    average: bool,
+) -> PyResult<(Panel, Orbit, Loads)> {
+    let p = panel_from(panel)?;
+    p.validate()?;
+    let o = orbit_from(orbit)?;
+    let optics = Optics::of(&p);
+    let loads = if average {
+        o.sunlit_average_loads(t, &optics)?
+    } else {
+        Orbit::check_time(t)?;
+        o.sunlit_loads(t, &optics)
+    };
+    Ok((p, o, loads))
 }
 
 /// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as

@@ -2,14 +2,18 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, dict_of, laminate_from, layer_from, panel_dict, panel_from, set_named, FlutterPoint,
-    Grid, RunOptions,
+    coupling, dict_of, hinge_model, laminate_from, layer_from, panel_dict, panel_from, set_named,
+    FlutterPoint, Grid, RunOptions,
 };
 use super::error::shield;
 use super::flutter::set_spectrum;
 use crate::analysis::flutter::check_flux;
-use crate::analysis::layered::LayeredEquilibrium;
+use crate::analysis::layered::{LayeredEquilibrium, LayeredPoint};
+use crate::inputs::heating::Loads;
 use crate::inputs::laminate::{LAYER_FIELDS, MATERIALS};
+use crate::inputs::panel::Panel;
+use crate::models::coupled::Coupling;
+use crate::models::hinge::HingeModel;
 use crate::runs::request::ThermalChoice;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -130,23 +134,61 @@ fn layered_flutter<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
         let (p, m, k) = point.inputs(panel)?;
-        let c = grid.conduction(&p)?;
-        let layered = crate::analysis::layered::LayeredPoint {
-            panel: &p,
-            conduction: &c,
-            model: m,
-            coupling: k,
-            flux: point.flux,
-        };
-        let a = py.detach(|| layered.analyse())?;
-        let d = equilibrium_dict(py, &a.equilibrium)?;
-        let size = a.jacobian.nrows();
-        let rows = (0..size).map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect());
-        set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
-        let cd = py.detach(|| layered.critical_damping())?;
-        d.set_item("critical_damping", cd)?;
+        layered_analysis(py, &p, &grid, (m, k), Loads::sun(point.flux))
+    })
+}
+
+/// [`layered_flutter`] at the sunlit equilibrium under every load of `orbit` at time `t`, or
+/// (`average`) under their mean over the sunlit arc of the orbit beginning at `t` (as
+/// `flutter_at` for the two-layer model).
+#[pyfunction]
+#[pyo3(signature = (panel, grid, orbit, *, t, model, coupled, average=false))]
+#[allow(clippy::too_many_arguments)]
+fn layered_flutter_at<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    grid: Grid<'py>,
+    orbit: &Bound<'py, PyDict>,
+    t: f64,
+    model: &str,
+    coupled: bool,
+    average: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    shield(|| {
+        let (p, _, loads) = super::flutter::on_orbit(panel, orbit, t, average)?;
+        let hinge = (hinge_model(model)?, coupling(coupled));
+        let d = layered_analysis(py, &p, &grid, hinge, loads)?;
+        d.set_item("loads", (loads.sun, loads.front, loads.back))?;
         Ok(d)
     })
+}
+
+/// The flutter analysis of the N-node system of `panel` on `grid` with the hinge model and
+/// coupling `hinge` under constant `loads`, as a mapping: equilibrium, spectrum, critical
+/// damping.
+fn layered_analysis<'py>(
+    py: Python<'py>,
+    panel: &Panel,
+    grid: &Grid<'py>,
+    hinge: (HingeModel, Coupling),
+    loads: Loads,
+) -> PyResult<Bound<'py, PyDict>> {
+    let conduction = grid.conduction(panel)?;
+    let point = LayeredPoint {
+        panel,
+        conduction: &conduction,
+        model: hinge.0,
+        coupling: hinge.1,
+        loads,
+    };
+    let a = py.detach(|| point.analyse())?;
+    let d = equilibrium_dict(py, &a.equilibrium)?;
+    let size = a.jacobian.nrows();
+    let rows = (0..size).map(|i| (0..size).map(|j| a.jacobian[(i, j)]).collect());
+    set_spectrum(&d, rows, &a.eigenvalues, a.growth_rate, a.frequency_hz)?;
+    let cd = py.detach(|| point.critical_damping())?;
+    d.set_item("critical_damping", cd)?;
+    Ok(d)
 }
 
 /// Integrates the N-node laminate coupled to the hinge; node temperatures as a (time × node)
@@ -192,6 +234,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(conduction_grid, m)?)?;
     m.add_function(wrap_pyfunction!(layered_steady_state, m)?)?;
     m.add_function(wrap_pyfunction!(layered_flutter, m)?)?;
+    m.add_function(wrap_pyfunction!(layered_flutter_at, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_layers, m)?)?;
     Ok(())
 }

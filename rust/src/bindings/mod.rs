@@ -282,7 +282,7 @@ pub(crate) fn transient_dict(py: Python<'_>, run: Transient) -> PyResult<Bound<'
                 names: vec!["theta".into(), "theta_dot".into()],
                 columns: vec![run.theta, run.theta_dot],
                 sunlit: run.sunlit,
-                fluxes: None,
+                fluxes: Some(run.fluxes),
                 moment: run.moment,
                 t: run.t,
                 stats: run.stats,

@@ -24,6 +24,7 @@
 //! for the Earth's diffuse loads this is exact while the Earth is in full view and an
 //! approximation beyond).
 
+use crate::error::{Error, Result};
 use crate::inputs::attitude::Attitude;
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
@@ -148,6 +149,63 @@ impl FaceFluxes {
     }
 }
 
+impl FaceFluxes {
+    /// What the faces absorb of these fluxes with `optics`: the front's sunlight as a flux factor
+    /// (the paper's form), the rest in W/m².
+    pub fn absorbed(&self, optics: &Optics) -> Loads {
+        Loads {
+            sun: self.sun_front / optics.solar_constant,
+            front: optics.absorptivity_front * self.albedo_front
+                + optics.emissivity_front * self.ir_front,
+            back: optics.absorptivity_back * (self.sun_back + self.albedo_back)
+                + optics.emissivity_back * self.ir_back,
+        }
+    }
+}
+
+/// What heats a flat face at one time, before its orientation (see [`Orbit::sources`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sources {
+    /// Unit vectors to the Sun and to the satellite from the Earth's centre.
+    pub sun: [f64; 3],
+    pub position: [f64; 3],
+    /// C · scale · s, W/m².
+    pub direct: f64,
+    /// a · C · scale · max(cos Z, 0), W/m² (times a face's view factor: its albedo).
+    pub albedo: f64,
+    /// E_IR, W/m².
+    pub earth_ir: f64,
+    /// H = r/R_E.
+    pub height_ratio: f64,
+}
+
+impl Sources {
+    /// The incident fluxes on the faces of a plate whose front normal is `normal` (unit); the
+    /// front exactly on the Sun when `on_sun` (the paper's plate, its incidence exactly 0).
+    pub fn fluxes(&self, normal: [f64; 3], on_sun: bool) -> FaceFluxes {
+        let cos_sun = if on_sun {
+            1.0
+        } else {
+            dot(normal, self.sun).clamp(-1.0, 1.0)
+        };
+        let h = self.height_ratio;
+        // The direction to the Earth's centre is −position.
+        let cos_front = -dot(normal, self.position);
+        let (view_front, view_back) = (
+            earth_view_factor(cos_front, h),
+            earth_view_factor(-cos_front, h),
+        );
+        FaceFluxes {
+            sun_front: self.direct * cos_sun.max(0.0),
+            sun_back: self.direct * (-cos_sun).max(0.0),
+            albedo_front: self.albedo * view_front,
+            albedo_back: self.albedo * view_back,
+            ir_front: self.earth_ir * view_front,
+            ir_back: self.earth_ir * view_back,
+        }
+    }
+}
+
 /// The geometry of one time: the unit vectors to the Sun and to the satellite (from the Earth's
 /// centre) and the front normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -201,42 +259,191 @@ impl Orbit {
     /// solar constant C (W/m²), before the structure's area factor.
     pub fn face_fluxes(&self, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
         let g = self.geometry(t);
-        let cos_sun = match self.attitude {
-            // Exactly 1: the paper's plate.
-            Attitude::SunPointing => 1.0,
-            _ => dot(g.normal, g.sun).clamp(-1.0, 1.0),
-        };
+        self.sources(&g, t, s, solar_constant)
+            .fluxes(g.normal, self.attitude == Attitude::SunPointing)
+    }
+
+    /// What heats a flat face at time t, whatever its normal: the Sun's and the satellite's
+    /// directions, the direct sunlight C · scale · s, the albedo's sunlit-Earth factor
+    /// a · C · scale · max(cos Z, 0), the Earth's infrared and H = r/R_E.
+    pub fn sources(&self, g: &Geometry, t: f64, s: f64, solar_constant: f64) -> Sources {
         let sunlight = solar_constant * self.flux_scale(t);
-        let direct = sunlight * s;
-        let h = self.radius / self.earth_radius;
-        // The direction to the Earth's centre is −position.
-        let cos_front = -dot(g.normal, g.position);
-        let (view_front, view_back) = (
-            earth_view_factor(cos_front, h),
-            earth_view_factor(-cos_front, h),
-        );
-        let lit = self.albedo * sunlight * dot(g.position, g.sun).max(0.0);
-        FaceFluxes {
-            sun_front: direct * cos_sun.max(0.0),
-            sun_back: direct * (-cos_sun).max(0.0),
-            albedo_front: lit * view_front,
-            albedo_back: lit * view_back,
-            ir_front: self.earth_ir * view_front,
-            ir_back: self.earth_ir * view_back,
+        Sources {
+            sun: g.sun,
+            position: g.position,
+            direct: sunlight * s,
+            albedo: self.albedo * sunlight * dot(g.position, g.sun).max(0.0),
+            earth_ir: self.earth_ir,
+            height_ratio: self.radius / self.earth_radius,
         }
     }
 
     /// The loads the thermal models absorb at time t for the illuminated fraction `s`: the
     /// front's sunlight as a flux factor (the paper's form) and the rest absorbed, W/m².
     pub fn loads(&self, t: f64, s: f64, optics: &Optics) -> Loads {
-        let f = self.face_fluxes(t, s, optics.solar_constant);
-        Loads {
-            sun: f.sun_front / optics.solar_constant,
-            front: optics.absorptivity_front * f.albedo_front
-                + optics.emissivity_front * f.ir_front,
-            back: optics.absorptivity_back * (f.sun_back + f.albedo_back)
-                + optics.emissivity_back * f.ir_back,
+        self.face_fluxes(t, s, optics.solar_constant)
+            .absorbed(optics)
+    }
+
+    /// The direction of the panel's length at time t (unit, in the plane of its faces): about
+    /// which a bent panel's elements turn. Taken in the plane of the front normal and the orbit
+    /// normal h, as the wing of an array that tracks the Sun about h lies along its drive axis
+    /// (there the Sun stays in the plane of the normal and the length); with the normal on h,
+    /// the direction a quarter orbit past the node.
+    pub fn length_direction(&self, t: f64, normal: [f64; 3]) -> [f64; 3] {
+        let along_plane = |d: [f64; 3]| {
+            let c = dot(d, normal);
+            let p = [0, 1, 2].map(|k| d[k] - c * normal[k]);
+            let l = norm(p);
+            (l > 1e-9).then(|| p.map(|x| x / l))
+        };
+        let h = self.normal(t);
+        // With the normal on h, h × (the node) is a unit vector in the faces' plane.
+        along_plane(h).unwrap_or_else(|| cross(h, self.node_direction(t)))
+    }
+
+    /// Every load at time t in full sunlight (s = 1), absorbed with `optics`: the front's
+    /// sunlight alone, at the Sun's distance there, on an orbit without Earth heating or
+    /// attitude (the paper's arithmetic).
+    pub fn sunlit_loads(&self, t: f64, optics: &Optics) -> Loads {
+        if self.has_face_loads() {
+            self.loads(t, 1.0, optics)
+        } else {
+            Loads::sun(self.flux_scale(t))
         }
+    }
+
+    /// Every load at time t in the Sun's illuminated fraction there, as a run's samples read
+    /// the state: on an orbit without Earth heating or attitude, the front's sunlight alone,
+    /// s × flux scale.
+    pub fn loads_at(&self, t: f64, optics: &Optics) -> Loads {
+        let s = self.illumination(t);
+        if self.has_face_loads() {
+            self.loads(t, s, optics)
+        } else {
+            Loads::sun(s * self.flux_scale(t))
+        }
+    }
+
+    /// The flux reaching the front and the back face at each of the times `t`, W/m² (in the
+    /// Sun's illuminated fraction there, the structure's area factor not applied).
+    pub fn face_flux_samples(&self, t: &[f64], solar_constant: f64) -> (Vec<f64>, Vec<f64>) {
+        t.iter()
+            .map(|&t| {
+                let f = self.face_fluxes(t, self.illumination(t), solar_constant);
+                (f.front(), f.back())
+            })
+            .unzip()
+    }
+}
+
+/// Where `f` changes sign in (a, b), when its ends differ in sign: bisection to the rounding of t.
+fn sign_change(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Option<f64> {
+    let (mut lo, mut hi) = (a, b);
+    let low_sign = f(lo) > 0.0;
+    if low_sign == (f(hi) > 0.0) {
+        return None;
+    }
+    while hi - lo > 1e-12 * hi.abs().max(1.0) {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if (f(mid) > 0.0) == low_sign {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// Nodes and weights of the five-point Gauss–Legendre rule on [−1, 1].
+const GAUSS_5: [(f64, f64); 5] = [
+    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+    (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.0, 0.568_888_888_888_888_9),
+    (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+];
+
+/// Subintervals of the sunlit-arc average per orbit period. The loads are smooth on each piece
+/// between their kinks — where the Sun crosses a face's plane (max(±n·Ŝ, 0)) and where the
+/// sub-satellite point crosses the terminator (the albedo's max(cos Z, 0)), which are found and
+/// split at — but for the view factor's edges of full view, where its second derivative jumps
+/// (an O(h³) error of the subinterval there: a relative ~1e-10 of the average).
+const AVERAGE_SUBINTERVALS: f64 = 2000.0;
+
+impl Orbit {
+    /// The times in (x0, x1) where a load has a kink — the Sun crossing the faces' plane, the
+    /// sub-satellite point crossing the terminator — each where its cosine changes sign between
+    /// the ends (the interval is short against the orbit: at most one crossing of each), found
+    /// by bisection; sorted.
+    fn kinks(&self, x0: f64, x1: f64) -> Vec<f64> {
+        let incidence = |t: f64| {
+            let g = self.geometry(t);
+            dot(g.normal, g.sun)
+        };
+        let zenith = |t: f64| dot(self.position(t), self.sun_direction(t));
+        let mut out = Vec::new();
+        if self.attitude != Attitude::SunPointing {
+            out.extend(sign_change(incidence, x0, x1));
+        }
+        if self.albedo != 0.0 {
+            out.extend(sign_change(zenith, x0, x1));
+        }
+        out.sort_by(f64::total_cmp);
+        out
+    }
+
+    /// The loads averaged over the sunlit arc of the orbit that begins at `t0` (one period):
+    /// (1/τ) ∫ loads(t, s(t)) dt over the times with s(t) > 0 (the penumbra's partial Sun
+    /// included), τ their total length. On an orbit without Earth heating or attitude, the
+    /// front's sunlight alone: the mean of s × flux scale. Composite Gauss–Legendre between the
+    /// shadow's breakpoints, split at the loads' kinks ([`AVERAGE_SUBINTERVALS`]).
+    pub fn sunlit_average_loads(&self, t0: f64, optics: &Optics) -> Result<Loads> {
+        Orbit::check_time(t0)?;
+        let t1 = t0 + self.period;
+        let mut edges = vec![t0];
+        edges.extend(self.breakpoints(t0, t1));
+        edges.push(t1);
+        let (mut sum, mut duration) = (Loads::sun(0.0), 0.0);
+        for w in edges.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if b <= a || self.illumination(0.5 * (a + b)) <= 0.0 {
+                continue;
+            }
+            let pieces = ((b - a) / self.period * AVERAGE_SUBINTERVALS)
+                .ceil()
+                .max(1.0);
+            let h = (b - a) / pieces;
+            for i in 0..pieces as usize {
+                let (x0, x1) = (a + i as f64 * h, a + (i + 1) as f64 * h);
+                let mut cuts = vec![x0];
+                cuts.extend(self.kinks(x0, x1));
+                cuts.push(x1);
+                for piece in cuts.windows(2) {
+                    let (mid, half) = (0.5 * (piece[0] + piece[1]), 0.5 * (piece[1] - piece[0]));
+                    for (x, weight) in GAUSS_5 {
+                        let l = self.loads_at(mid + half * x, optics).scaled(half * weight);
+                        sum = Loads {
+                            sun: sum.sun + l.sun,
+                            front: sum.front + l.front,
+                            back: sum.back + l.back,
+                        };
+                    }
+                }
+            }
+            duration += b - a;
+        }
+        if duration <= 0.0 {
+            return Err(Error::invalid(
+                "t",
+                t0,
+                "begins an orbit with no sunlit arc: there is no sunlit forcing to average",
+            ));
+        }
+        Ok(sum.scaled(1.0 / duration))
     }
 }
 
@@ -285,6 +492,46 @@ mod tests {
             );
             assert!((a - b).abs() < 1e-9, "{a} {b}");
         }
+    }
+
+    /// The sunlit-arc average against a plain midpoint sum over a fine grid (the sunlit samples
+    /// only), on an inclined orbit with its eclipse, Earth heating and a tracking attitude; and
+    /// the full Sun alone (the mean of 1) on the paper's orbit with its eclipse.
+    #[test]
+    fn the_sunlit_average_is_the_mean_over_the_lit_samples() {
+        let optics = Optics::of(&Panel::paper());
+        let o = Orbit {
+            albedo: 0.3,
+            earth_ir: 237.0,
+            attitude: Attitude::SunTracking { offset: 0.2 },
+            shadow: Shadow::Cylindrical,
+            ..Orbit::leo(540e3)
+        };
+        let t0 = 123.0;
+        let avg = o.sunlit_average_loads(t0, &optics).unwrap();
+        let n = 2_000_000;
+        let h = o.period / n as f64;
+        let (mut sum, mut lit) = ([0.0; 3], 0usize);
+        for i in 0..n {
+            let t = t0 + (i as f64 + 0.5) * h;
+            if o.illumination(t) > 0.0 {
+                let l = o.loads_at(t, &optics);
+                sum = [sum[0] + l.sun, sum[1] + l.front, sum[2] + l.back];
+                lit += 1;
+            }
+        }
+        let want = sum.map(|x| x / lit as f64);
+        // The midpoint sum's error at the two shadow edges: about h/τ.
+        for (got, want) in [avg.sun, avg.front, avg.back].iter().zip(want) {
+            assert!((got / want - 1.0).abs() < 2e-6, "{got} vs {want}");
+        }
+        let bare = Orbit {
+            shadow: Shadow::Cylindrical,
+            ..Orbit::geo_equinox()
+        };
+        let mean = bare.sunlit_average_loads(0.0, &optics).unwrap();
+        assert_eq!((mean.front, mean.back), (0.0, 0.0));
+        assert!((mean.sun - 1.0).abs() < 1e-12, "{}", mean.sun);
     }
 
     #[test]

@@ -64,6 +64,11 @@ impl Sunlight {
 
     /// Refuses an orbit whose loads this system cannot take: Earth heating or an attitude other
     /// than Sun-pointing on a model that takes the front's sunlight only.
+    /// The panel's optics, when the system absorbs every load of its orbit.
+    pub(crate) fn optics(&self) -> Option<Optics> {
+        self.optics
+    }
+
     pub(crate) fn check(&self, what: &str) -> crate::error::Result<()> {
         if self.orbit.has_face_loads() && self.optics.is_none() {
             return Err(unsupported_face_loads(&self.orbit, what));
@@ -73,7 +78,7 @@ impl Sunlight {
 
     /// The illuminated fraction s at time t inside the current segment.
     #[inline]
-    fn illumination(&self, t: f64) -> f64 {
+    pub(crate) fn illumination(&self, t: f64) -> f64 {
         match self.constant_s {
             Some(s) => s,
             None => {
@@ -286,11 +291,24 @@ where
     /// there when the orbit has them).
     pub fn sunlit_steady_state(&self, t: f64) -> Result<State<D>> {
         if self.sun.face_loads {
-            let loads = self.sun.sunlit_loads(t);
-            let optics = self.sun.optics.expect("face loads come with optics");
-            self.steady_state_loaded(loads, loads.equivalent_flux(&optics))
+            self.steady_state_under(self.sun.sunlit_loads(t))
         } else {
             self.steady_state(self.sun.orbit.flux_scale(t))
+        }
+    }
+
+    /// The steady state under constant `loads`, velocities zero (loads on the faces need the
+    /// panel's optics: the system must have them).
+    pub fn steady_state_under(&self, loads: Loads) -> Result<State<D>> {
+        if !loads.has_face_loads() {
+            return self.steady_state(loads.sun);
+        }
+        match self.sun.optics {
+            Some(optics) => self.steady_state_loaded(loads, loads.equivalent_flux(&optics)),
+            None => Err(unsupported_face_loads(
+                &self.sun.orbit,
+                "a model without optics",
+            )),
         }
     }
 

@@ -16,6 +16,7 @@
 //! against radiation). Measured against the full nodal model in docs/laminates.md.
 
 use crate::error::{Error, Result};
+use crate::inputs::heating::Loads;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::{Conduction, Modes};
 use crate::models::coupled::Coupling;
@@ -54,6 +55,9 @@ pub struct NodalRates {
     moment: Vec<f64>,
     moment_total: f64,
     reference_temperature: f64,
+    /// C₀ and C_{N−1}, J/(m² K): the face nodes that take the loads on each face.
+    capacity_front: f64,
+    capacity_back: f64,
 }
 
 impl NodalRates {
@@ -72,7 +76,17 @@ impl NodalRates {
             moment: c.moment_weight.iter().map(|m| m / inertia).collect(),
             moment_total: c.moment_total / inertia,
             reference_temperature: c.reference_temperature,
+            capacity_front: c.capacity[0],
+            capacity_back: c.capacity[n - 1],
         }
+    }
+
+    /// Adds the loads absorbed on each face (W/m², projected area included) to the face nodes'
+    /// rates, as [`crate::models::thermal::ThermalModel::add_face_rates`] does.
+    #[inline]
+    fn add_face_rates(&self, front: f64, back: f64, dy: &mut [f64]) {
+        dy[0] += front / self.capacity_front;
+        dy[dy.len() - 1] += back / self.capacity_back;
     }
 
     /// Node rates into `dy[..n]`; returns M_T / I_B.
@@ -120,6 +134,14 @@ pub struct Reduced {
     kept: Vec<usize>,
     /// The full modal basis (for initial states and node temperatures).
     pub modes: Modes,
+}
+
+/// The heat absorbed on the front and the back face, W/m² (projected area included), and its
+/// rate through the projected area, W/(m² s).
+#[derive(Debug, Clone, Copy)]
+struct FaceHeat {
+    heat: [f64; 2],
+    rate: [f64; 2],
 }
 
 /// The faces of a state: their heat inputs b(u), the radiative conductances
@@ -257,6 +279,13 @@ impl Layered {
     /// dy/dt at illumination factor `flux` (written into `dy`).
     #[inline]
     pub fn rhs_at_flux(&self, flux: f64, y: &[f64], dy: &mut [f64]) {
+        self.rhs_at_loads(Loads::sun(flux), y, dy)
+    }
+
+    /// dy/dt under `loads` (the front's sunlight as a flux factor and the further loads on each
+    /// face, W/m², all before the projected area), written into `dy`.
+    #[inline]
+    pub fn rhs_at_loads(&self, loads: Loads, y: &[f64], dy: &mut [f64]) {
         let m = self.thermal_size();
         let (th, om) = (y[m], y[m + 1]);
         let (sin, cos) = self.sin_cos(th);
@@ -268,7 +297,10 @@ impl Layered {
         match &self.thermal {
             // In the order of operations of the two-layer system, to the bit.
             Thermal::Nodal(r) => {
-                let moment_rate = r.rates(flux * area, &y[..m], dy);
+                let moment_rate = r.rates(loads.sun * area, &y[..m], dy);
+                if loads.has_face_loads() {
+                    r.add_face_rates(loads.front * area, loads.back * area, &mut dy[..m]);
+                }
                 let forced = generalised_moment(moment_rate, self.damping, self.stiffness, th, om);
                 dy[m + 1] = angular_acceleration(self.model, forced, om, sin, cos);
             }
@@ -276,12 +308,28 @@ impl Layered {
             // ready before the faces are solved, so that M_T is two operations from the end.
             Thermal::Modal(r) => {
                 let (reciprocal, bias) = self.hinge_terms(th, om, sin, cos);
-                let flux_rate = self.area_rate(sin, om) * flux;
-                let moment = r
-                    .evaluate(&self.conduction, flux * area, flux_rate, &y[..m], dy)
-                    .0;
+                let heat = self.face_heat(loads, area, self.area_rate(sin, om));
+                let moment = r.evaluate(&self.conduction, heat, &y[..m], dy).0;
                 dy[m + 1] = moment * (reciprocal * self.inverse_inertia) - bias;
             }
+        }
+    }
+
+    /// The heat absorbed on each face, W/m², and its rate through the projected area, under
+    /// `loads` at area factor `area` changing at `area_rate`.
+    #[inline(always)]
+    fn face_heat(&self, loads: Loads, area: f64, area_rate: f64) -> FaceHeat {
+        let c = &self.conduction;
+        let flux_rate = area_rate * loads.sun;
+        FaceHeat {
+            heat: [
+                c.absorbed * (loads.sun * area) + loads.front * area,
+                loads.back * area,
+            ],
+            rate: [
+                c.absorbed * flux_rate + loads.front * area_rate,
+                loads.back * area_rate,
+            ],
         }
     }
 
@@ -314,26 +362,23 @@ impl Layered {
         }
     }
 
-    /// (flux × area factor, its rate) in state y under the illumination factor `flux`.
-    fn flux_and_rate(&self, flux: f64, y: &[f64]) -> (f64, f64) {
+    /// The heat on each face and its rate in state y under `loads`.
+    fn face_heat_of(&self, loads: Loads, y: &[f64]) -> FaceHeat {
         let m = self.thermal_size();
         let (sin, cos) = sin_cos(y[m]);
         let area = match self.coupling {
             Coupling::ProjectedArea => cos,
             Coupling::Frozen => 1.0,
         };
-        (flux * area, flux * self.area_rate(sin, y[m + 1]))
+        self.face_heat(loads, area, self.area_rate(sin, y[m + 1]))
     }
 
-    /// M_T of a state at illumination factor `flux` (before the projected area), N m.
-    pub fn moment_of(&self, flux: f64, y: &[f64]) -> f64 {
+    /// M_T of a state under `loads` (before the projected area), N m.
+    pub fn moment_of(&self, loads: Loads, y: &[f64]) -> f64 {
         let m = self.thermal_size();
         match &self.thermal {
             Thermal::Nodal(_) => self.conduction.moment(&y[..m]),
-            Thermal::Modal(r) => {
-                let (f, rate) = self.flux_and_rate(flux, y);
-                r.moment(&self.conduction, f, rate, &y[..m])
-            }
+            Thermal::Modal(r) => r.moment(&self.conduction, self.face_heat_of(loads, y), &y[..m]),
         }
     }
 
@@ -350,14 +395,13 @@ impl Layered {
         moment * self.compliance
     }
 
-    /// Node temperatures of a state at illumination factor `flux` (front first).
-    pub fn node_temperatures(&self, flux: f64, y: &[f64]) -> Vec<f64> {
+    /// Node temperatures of a state under `loads` (front first).
+    pub fn node_temperatures(&self, loads: Loads, y: &[f64]) -> Vec<f64> {
         let m = self.thermal_size();
         match &self.thermal {
             Thermal::Nodal(_) => y[..m].to_vec(),
             Thermal::Modal(r) => {
-                let (f, rate) = self.flux_and_rate(flux, y);
-                r.node_temperatures(&self.conduction, f, rate, &y[..m])
+                r.node_temperatures(&self.conduction, self.face_heat_of(loads, y), &y[..m])
             }
         }
     }
@@ -444,10 +488,10 @@ impl Reduced {
     /// waits for cos θ, enters δ and u linearly and last; J⁻¹ F = adj(J) F / det(J) is formed
     /// while the division runs.
     #[inline(always)]
-    fn faces(&self, c: &Conduction, heat: f64, s: [f64; 2]) -> Faces {
+    fn faces(&self, c: &Conduction, heat: [f64; 2], s: [f64; 2]) -> Faces {
         let sigma = [c.radiation_front, c.radiation_back];
         let s2 = [s[0] * s[0], s[1] * s[1]];
-        // Radiation alone at the slow faces; b(u_slow) = radiated + (heat, 0).
+        // Radiation alone at the slow faces; b(u_slow) = radiated + heat.
         let radiated = [-sigma[0] * (s2[0] * s2[0]), -sigma[1] * (s2[1] * s2[1])];
         let d_slow = [
             (4.0 * sigma[0] * s[0]) * s2[0],
@@ -468,8 +512,8 @@ impl Reduced {
             adj_f[1][0] * radiated[0] + adj_f[1][1] * radiated[1],
         ];
         let delta = [
-            newton[0] * inv_det + jf[0][0] * heat,
-            newton[1] * inv_det + jf[1][0] * heat,
+            newton[0] * inv_det + jf[0][0] * heat[0] + jf[0][1] * heat[1],
+            newton[1] * inv_det + jf[1][0] * heat[0] + jf[1][1] * heat[1],
         ];
         // The remainder σ (6 s² δ² + 4 s δ³ + δ⁴), its coefficients ready before δ.
         let (six, four) = (
@@ -486,8 +530,8 @@ impl Reduced {
         let n = [s[0] + delta[0], s[1] + delta[1]];
         let n2 = [n[0] * n[0], n[1] * n[1]];
         let newton_inputs = [
-            heat - sigma[0] * (n2[0] * n2[0]),
-            -sigma[1] * (n2[1] * n2[1]),
+            heat[0] - sigma[0] * (n2[0] * n2[0]),
+            heat[1] - sigma[1] * (n2[1] * n2[1]),
         ];
         let radiative = [
             (4.0 * sigma[0] * n[0]) * n2[0],
@@ -513,14 +557,13 @@ impl Reduced {
         }
     }
 
-    /// Rates of the kept modes (into dy[..m]) and the thermal moment, under the flux factor
-    /// `flux` (projected area included) changing at `flux_rate` (1/s); see [`Self::evaluate_rows`].
+    /// Rates of the kept modes (into dy[..m]) and the thermal moment, under the heat absorbed on
+    /// each face `heat`; see [`Self::evaluate_rows`].
     #[inline(always)]
     fn evaluate(
         &self,
         c: &Conduction,
-        flux: f64,
-        flux_rate: f64,
+        heat: FaceHeat,
         amp: &[f64],
         dy: &mut [f64],
     ) -> (f64, [f64; 2], [f64; 2]) {
@@ -531,9 +574,9 @@ impl Reduced {
                 match amp.len() {
                     $($m => {
                         let (rows, amp, dy) = kept::<$m>(&self.rows, amp, dy);
-                        self.evaluate_rows(c, flux, flux_rate, rows, amp, dy)
+                        self.evaluate_rows(c, heat, rows, amp, dy)
                     })*
-                    _ => self.evaluate_rows(c, flux, flux_rate, &self.rows, amp, dy),
+                    _ => self.evaluate_rows(c, heat, &self.rows, amp, dy),
                 }
             };
         }
@@ -552,8 +595,7 @@ impl Reduced {
     fn evaluate_rows(
         &self,
         c: &Conduction,
-        flux: f64,
-        flux_rate: f64,
+        heat: FaceHeat,
         rows: &[ModeRow],
         amp: &[f64],
         dy: &mut [f64],
@@ -580,25 +622,27 @@ impl Reduced {
             radiative: d,
             inverse,
             inverse_gain,
-        } = self.faces(c, c.absorbed * flux, slow);
-        // The lag needs ḃ = (α C ḟ, 0) − D u̇, with (I + F D) u̇ = u̇_slow + F (α C ḟ, 0) and the
-        // slow modes' zero-order face rates u̇_slow = P b − (Σ φ_face,k λ_k q_k) (the Jacobian is
-        // taken at the slow faces: the difference is of the next order in this first-order
-        // term). Written as ḃ = c − A b, with A = D J⁻¹ P and c = (α C ḟ, 0) + D J⁻¹ (decay −
-        // F (α C ḟ, 0)), which do not wait for b.
+        } = self.faces(c, heat.heat, slow);
+        // The lag needs ḃ = ḣ − D u̇ (ḣ: the rate of the heat absorbed on each face), with
+        // (I + F D) u̇ = u̇_slow + F ḣ and the slow modes' zero-order face rates u̇_slow = P b −
+        // (Σ φ_face,k λ_k q_k) (the Jacobian is taken at the slow faces: the difference is of the
+        // next order in this first-order term). Written as ḃ = c − A b, with A = D J⁻¹ P and
+        // c = ḣ + D J⁻¹ (decay − F ḣ), which do not wait for b.
         let f = &self.compliance;
-        let heating_rate = c.absorbed * flux_rate;
+        let heating_rate = heat.rate;
         let a = [
             [d[0] * inverse_gain[0][0], d[0] * inverse_gain[0][1]],
             [d[1] * inverse_gain[1][0], d[1] * inverse_gain[1][1]],
         ];
+        // Without a load on the back its terms add zeros: the front's sunlight alone keeps its
+        // arithmetic.
         let v = [
-            decay[0] - f[0][0] * heating_rate,
-            decay[1] - f[1][0] * heating_rate,
+            decay[0] - f[0][0] * heating_rate[0] - f[0][1] * heating_rate[1],
+            decay[1] - f[1][0] * heating_rate[0] - f[1][1] * heating_rate[1],
         ];
         let offset = [
-            heating_rate + d[0] * (inverse[0][0] * v[0] + inverse[0][1] * v[1]),
-            d[1] * (inverse[1][0] * v[0] + inverse[1][1] * v[1]),
+            heating_rate[0] + d[0] * (inverse[0][0] * v[0] + inverse[0][1] * v[1]),
+            heating_rate[1] + d[1] * (inverse[1][0] * v[0] + inverse[1][1] * v[1]),
         ];
         let b_rate = [
             offset[0] - (a[0][0] * b_near[0] + a[0][1] * b_near[1]),
@@ -634,20 +678,13 @@ impl Reduced {
         }
     }
 
-    fn moment(&self, c: &Conduction, flux: f64, flux_rate: f64, amp: &[f64]) -> f64 {
-        Self::with_scratch(amp.len(), |dy| self.evaluate(c, flux, flux_rate, amp, dy).0)
+    fn moment(&self, c: &Conduction, heat: FaceHeat, amp: &[f64]) -> f64 {
+        Self::with_scratch(amp.len(), |dy| self.evaluate(c, heat, amp, dy).0)
     }
 
-    fn node_temperatures(
-        &self,
-        c: &Conduction,
-        flux: f64,
-        flux_rate: f64,
-        amp: &[f64],
-    ) -> Vec<f64> {
+    fn node_temperatures(&self, c: &Conduction, heat: FaceHeat, amp: &[f64]) -> Vec<f64> {
         let n = c.nodes();
-        let (_, b, b_rate) =
-            Self::with_scratch(amp.len(), |dy| self.evaluate(c, flux, flux_rate, amp, dy));
+        let (_, b, b_rate) = Self::with_scratch(amp.len(), |dy| self.evaluate(c, heat, amp, dy));
         let total = self.modes.total_capacity;
         let mut t = vec![0.0; n];
         for (k, &lambda) in self.modes.rates.iter().enumerate() {

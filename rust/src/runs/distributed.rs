@@ -3,16 +3,18 @@
 
 use crate::cancel::Cancel;
 use crate::error::{Error, Result};
+use crate::inputs::heating::Optics;
 use crate::inputs::orbit::Orbit;
 use crate::models::coupled::Sunlight;
-use crate::models::distributed::DistributedPanel;
+use crate::models::distributed::{DistributedPanel, ElementHeat};
 use crate::numerics::integrate::Stats;
 use crate::numerics::integrate::{Dyn, OdeSystem, State};
 use crate::runs::orbits::LimitCrossing;
 use crate::runs::simulate::{run_watched, Limit, OnLimit, TransientSettings};
 use nalgebra::DVector;
 
-/// The distributed panel driven by an orbit's sunlight; state (T_f[n], T_b[n], q[k], q̇[k]).
+/// The distributed panel driven by an orbit's sunlight, and by its Earth heating and attitude
+/// when it has them; state (T_f[n], T_b[n], q[k], q̇[k]).
 #[derive(Debug, Clone)]
 pub struct DistributedSystem {
     pub model: DistributedPanel,
@@ -21,18 +23,33 @@ pub struct DistributedSystem {
 
 impl DistributedSystem {
     pub fn new(model: DistributedPanel, orbit: Orbit) -> Self {
+        let optics = Optics::of(&model.panel);
         DistributedSystem {
             model,
-            sun: Sunlight::new(orbit),
+            sun: Sunlight::with_optics(orbit, optics),
         }
+    }
+
+    /// The orbit's heat on the elements at time t inside the current segment.
+    fn heat(&self, t: f64) -> ElementHeat {
+        let optics = self
+            .sun
+            .optics()
+            .expect("the system is built with the panel's optics");
+        ElementHeat::at(&self.sun.orbit, t, self.sun.illumination(t), optics)
     }
 }
 
 impl OdeSystem<Dyn> for DistributedSystem {
     fn rhs(&self, t: f64, y: &State<Dyn>) -> State<Dyn> {
         let mut dy = DVector::zeros(y.len());
-        self.model
-            .rhs_at_flux(self.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        if self.sun.face_loads {
+            self.model
+                .rhs_loaded(&self.heat(t), y.as_slice(), dy.as_mut_slice());
+        } else {
+            self.model
+                .rhs_at_flux(self.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        }
         dy
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
@@ -42,7 +59,7 @@ impl OdeSystem<Dyn> for DistributedSystem {
         self.sun.enter(a, b);
     }
     fn check_span(&self, t0: f64, t1: f64) -> crate::error::Result<()> {
-        self.sun.check("the distributed panel")?;
+        self.model.check_orbit(&self.sun.orbit)?;
         crate::numerics::integrate::check_span(t0, t1)
     }
 }
@@ -64,6 +81,9 @@ pub struct DistributedRun {
     pub theta_f: Vec<f64>,
     /// s(t), the illuminated fraction.
     pub sunlit: Vec<f64>,
+    /// The flux reaching the flat panel's front and back face at each sample, W/m² (sunlight,
+    /// albedo and Earth infrared in its attitude, the deflection not applied).
+    pub fluxes: (Vec<f64>, Vec<f64>),
     pub stats: Stats,
     pub y_end: Vec<f64>,
     /// Where |θ_f| first passed the validity limit, when one was watched.
@@ -82,6 +102,7 @@ pub fn simulate(
 ) -> Result<DistributedRun> {
     let t_span = settings.span;
     orbit.validate()?;
+    model.check_orbit(&orbit)?;
     let (t0, _) = t_span;
     crate::numerics::integrate::check_span(t_span.0, t_span.1)?;
     let start = match settings.y0 {
@@ -102,6 +123,10 @@ pub fn simulate(
             // Its temperatures as every start state's; the modal amplitudes have no such range.
             crate::models::hinge::check_start_state(&v, model.layers() * model.n(), None)?;
             v
+        }
+        None if orbit.has_face_loads() => {
+            let optics = Optics::of(&model.panel);
+            model.equilibrium_loaded(&ElementHeat::at(&orbit, t0, 1.0, optics))?
         }
         None => model.equilibrium(orbit.flux_scale(t0))?,
     };
@@ -132,6 +157,7 @@ pub fn simulate(
         slope: Vec::with_capacity(traj.t.len()),
         theta_f: Vec::with_capacity(traj.t.len()),
         sunlit: Vec::with_capacity(traj.t.len()),
+        fluxes: orbit.face_flux_samples(&traj.t, model.panel.solar_constant),
         stats: traj.stats,
         y_end: traj.y_end.as_slice().to_vec(),
         crossing,
@@ -150,6 +176,20 @@ pub fn simulate(
 }
 
 impl DistributedPanel {
+    /// Refuses an orbit whose attitude would be set twice: with the Earth's heat or an attitude
+    /// other than Sun-pointing the attitude sets the incidence, and ψ must be 0.
+    pub fn check_orbit(&self, orbit: &Orbit) -> Result<()> {
+        if orbit.has_face_loads() && self.settings.sun_angle != 0.0 {
+            return Err(Error::invalid(
+                "sun_angle",
+                self.settings.sun_angle,
+                "must be 0 with the orbit's Earth heating or an attitude: the attitude sets the \
+                 Sun's incidence on the panel",
+            ));
+        }
+        Ok(())
+    }
+
     /// The validity limit on θ_f as the integrators watch it: |tip rise| <= arm · sin(θ_limit),
     /// the rise an affine function of the state (the modes' share, and the element moments',
     /// which are linear in the temperatures: read off unit temperatures).

@@ -414,7 +414,7 @@ pub fn run_sample_layered(
         conduction: &c,
         model: s.model,
         coupling: s.coupling,
-        flux: 1.0,
+        loads: crate::inputs::heating::Loads::sun(1.0),
     };
     let flutter = point.analyse()?;
     let critical = point.critical_damping()?;

@@ -1,8 +1,9 @@
 //! Runs of the N-node laminate on the hinge: its ODE systems in orbit, one transient, runs of
 //! many orbits with their per-orbit summaries.
 
-use crate::analysis::layered::{equilibrium, start_state};
+use crate::analysis::layered::{equilibrium, equilibrium_loaded, start_state};
 use crate::error::{Error, Result};
+use crate::inputs::heating::{Loads, Optics};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::conduction::Conduction;
@@ -13,7 +14,8 @@ use crate::numerics::integrate::{Dyn, OdeSystem, State};
 use nalgebra::allocator::Allocator;
 use nalgebra::{Const, DVector, DefaultAllocator, Dim, SVector};
 
-/// The N-node system in orbit: the illumination of the current segment drives it.
+/// The N-node system in orbit: the illumination of the current segment drives it, with the
+/// orbit's Earth heating and the attitude's incidence on the outer nodes when it has them.
 #[derive(Debug, Clone)]
 pub struct LayeredOrbit {
     pub system: Layered,
@@ -21,10 +23,23 @@ pub struct LayeredOrbit {
 }
 
 impl LayeredOrbit {
-    pub fn new(system: Layered, orbit: Orbit) -> Self {
+    /// The system on `orbit`, its outer nodes absorbing every load of the orbit with `panel`'s
+    /// optics.
+    pub fn new(system: Layered, panel: &Panel, orbit: Orbit) -> Self {
         LayeredOrbit {
             system,
-            sun: Sunlight::new(orbit),
+            sun: Sunlight::with_optics(orbit, Optics::of(panel)),
+        }
+    }
+
+    /// dy/dt at time t inside the current segment (written into `dy`): the front's sunlight
+    /// alone on the paper's orbits (their arithmetic kept), else every load.
+    #[inline]
+    fn rhs_into(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        if self.sun.face_loads {
+            self.system.rhs_at_loads(self.sun.loads(t), y, dy);
+        } else {
+            self.system.rhs_at_flux(self.sun.flux(t), y, dy);
         }
     }
 }
@@ -33,8 +48,7 @@ impl OdeSystem<Dyn> for LayeredOrbit {
     #[inline]
     fn rhs(&self, t: f64, y: &State<Dyn>) -> State<Dyn> {
         let mut dy = DVector::zeros(y.len());
-        self.system
-            .rhs_at_flux(self.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        self.rhs_into(t, y.as_slice(), dy.as_mut_slice());
         dy
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
@@ -58,9 +72,7 @@ impl<const S: usize> OdeSystem<Const<S>> for Fixed<S> {
     #[inline]
     fn rhs(&self, t: f64, y: &State<Const<S>>) -> State<Const<S>> {
         let mut dy = SVector::<f64, S>::zeros();
-        self.0
-            .system
-            .rhs_at_flux(self.0.sun.flux(t), y.as_slice(), dy.as_mut_slice());
+        self.0.rhs_into(t, y.as_slice(), dy.as_mut_slice());
         dy
     }
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
@@ -121,6 +133,9 @@ pub struct LayeredRun {
     pub moment: Vec<f64>,
     /// The illumination at each sample.
     pub sunlit: Vec<f64>,
+    /// The flux reaching the front and the back face at each sample, W/m² (as
+    /// [`crate::runs::request::CoupledRun::fluxes`]).
+    pub fluxes: (Vec<f64>, Vec<f64>),
     pub stats: crate::numerics::integrate::Stats,
     /// The end state as node temperatures, θ, θ̇ (a run can resume from it).
     pub y_end: Vec<f64>,
@@ -160,7 +175,7 @@ pub fn simulate(
     let system = Layered::new(panel, conduction, model, coupling, FAST_MODE_FACTOR)?;
     let y_start = system.state_from_nodes(&start[..n], start[n], start[n + 1]);
     let size = y_start.len();
-    let orb = LayeredOrbit::new(system.clone(), *orbit);
+    let orb = LayeredOrbit::new(system.clone(), panel, *orbit);
     let m = system.thermal_size();
     // θ is the state's component m in every form of the system.
     let watch = limit.map(|l| l.on_component(m));
@@ -169,11 +184,13 @@ pub fn simulate(
         size,
         sample_run(method, t_span, &y_start, output, watch.as_ref(), cancel)
     )?;
-    let area_free = |t: f64| orbit.illumination(t) * orbit.flux_scale(t);
+    let optics = Optics::of(panel);
+    let loads = |t: f64| orbit.loads_at(t, &optics);
     let stopped = crossing.is_some() && watch.is_some_and(|l| l.stop);
     let mut run = LayeredRun {
         nodes: n,
         sunlit: t.iter().map(|&t| orbit.illumination(t)).collect(),
+        fluxes: orbit.face_flux_samples(&t, optics.solar_constant),
         stopped,
         theta: y.iter().map(|v| v[m]).collect(),
         theta_dot: y.iter().map(|v| v[m + 1]).collect(),
@@ -187,11 +204,11 @@ pub fn simulate(
             .map(|(t, y)| crate::runs::orbits::LimitCrossing::in_run(orbit, t_span.0, t, y[m])),
     };
     for (t, y) in run.t.iter().zip(&y) {
-        let temps = system.node_temperatures(area_free(*t), y);
+        let temps = system.node_temperatures(loads(*t), y);
         run.moment.push(system.conduction.moment(&temps));
         run.temperatures.extend(temps);
     }
-    let mut end = system.node_temperatures(area_free(stats.t_end), &y_end);
+    let mut end = system.node_temperatures(loads(stats.t_end), &y_end);
     end.push(y_end[m]);
     end.push(y_end[m + 1]);
     run.y_end = end;
@@ -293,12 +310,21 @@ impl crate::runs::orbits::SummaryView for LayeredView {
     fn theta_eq(&self, flux: f64) -> Result<f64> {
         Ok(equilibrium(&self.panel, &self.system.conduction, self.coupling, flux)?.theta)
     }
+    fn theta_eq_loaded(&self, orbit: &Orbit, t: f64) -> Result<f64> {
+        let loads = orbit.sunlit_loads(t, &Optics::of(&self.panel));
+        Ok(equilibrium_loaded(&self.panel, &self.system.conduction, self.coupling, loads)?.theta)
+    }
     fn angles(&self, t: f64, y: &[f64]) -> (f64, f64) {
-        let flux = self.illumination(t) * self.orbit.flux_scale(t);
+        let s = self.illumination(t);
+        let loads = if self.orbit.has_face_loads() {
+            self.orbit.loads(t, s, &Optics::of(&self.panel))
+        } else {
+            Loads::sun(s * self.orbit.flux_scale(t))
+        };
         let theta = y[self.system.thermal_size()];
         (
             theta,
-            self.system.moment_of(flux, y) / self.panel.hinge_stiffness,
+            self.system.moment_of(loads, y) / self.panel.hinge_stiffness,
         )
     }
     fn rate(&self, y: &[f64]) -> f64 {
@@ -360,7 +386,7 @@ pub(crate) fn run_orbits_reading(
     let (system, start) = req.system()?;
     let mut view = LayeredView::new(system.clone(), s.panel, s.orbit, s.coupling);
     view.slope_reads = slope_reads;
-    let orb = LayeredOrbit::new(system.clone(), s.orbit);
+    let orb = LayeredOrbit::new(system.clone(), &s.panel, s.orbit);
     let size = start.len();
     let theta_index = system.thermal_size();
     let mut run = on_fastest_state!(
@@ -399,9 +425,8 @@ impl LayeredRunRequest {
     /// A state `y` of `system` at time t as (node temperatures, θ, θ̇).
     pub(crate) fn nodal(&self, system: &Layered, t: f64, y: &[f64]) -> Vec<f64> {
         let m = system.thermal_size();
-        let orbit = &self.spec.orbit;
-        let flux = orbit.illumination(t) * orbit.flux_scale(t);
-        let mut out = system.node_temperatures(flux, y);
+        let loads = self.spec.orbit.loads_at(t, &Optics::of(&self.spec.panel));
+        let mut out = system.node_temperatures(loads, y);
         out.extend([y[m], y[m + 1]]);
         out
     }

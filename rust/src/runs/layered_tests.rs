@@ -2,6 +2,7 @@
 
 use crate::analysis::layered::{equilibrium, start_state, LayeredEquilibrium, LayeredPoint};
 use crate::error::Error;
+use crate::inputs::heating::Loads;
 use crate::inputs::laminate::{wing_layup, Laminate, MATERIALS};
 use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
@@ -27,7 +28,7 @@ fn point<'a>(
         conduction: c,
         model,
         coupling,
-        flux: 1.0,
+        loads: crate::inputs::heating::Loads::sun(1.0),
     }
 }
 
@@ -154,7 +155,9 @@ fn quasi_static_fast_modes_are_exact_in_steady_state() {
         let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
         let mut dy = vec![0.0; y.len()];
         sys.rhs_at_flux(1.0, &y, &mut dy);
-        let m = sys.conduction.moment(&sys.node_temperatures(1.0, &y));
+        let m = sys
+            .conduction
+            .moment(&sys.node_temperatures(Loads::sun(1.0), &y));
         // The moment is a sum of large terms that nearly cancel (M_T = Σ μ_i T_i − Σ μ_i T_ref):
         // compare against their size.
         let size: f64 = c
@@ -164,12 +167,47 @@ fn quasi_static_fast_modes_are_exact_in_steady_state() {
             .map(|(m, t)| (m * t).abs())
             .sum();
         assert!((m - eq.moment).abs() < 1e-13 * size, "{m} vs {}", eq.moment);
-        let t = sys.node_temperatures(1.0, &y);
+        let t = sys.node_temperatures(Loads::sun(1.0), &y);
         for (a, b) in t.iter().zip(&eq.temperatures) {
             assert!((a / b - 1.0).abs() < 1e-12);
         }
         for (i, v) in dy.iter().enumerate() {
             assert!(v.abs() < 1e-9 * (1.0 + y[i].abs()), "{i}: {v}");
+        }
+    }
+}
+
+/// Under loads on both faces (the Earth's, sunlight on the back) the steady state is a fixed
+/// point of the nodal model and of the slow-mode model alike (whose fast modes take the back's
+/// load through their face compliance), and the moment and node temperatures it reads are the
+/// equilibrium's; the loads raise the back face.
+#[test]
+fn face_loads_on_both_forms_are_exact_in_steady_state() {
+    let lam = wing_layup();
+    let p = lam.equivalent_panel(&Panel::paper()).unwrap();
+    let c = Conduction::new(&p, &lam, 20).unwrap();
+    let loads = Loads {
+        sun: 0.8,
+        front: 60.0,
+        back: 250.0,
+    };
+    for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+        let eq = crate::analysis::layered::equilibrium_loaded(&p, &c, coupling, loads).unwrap();
+        let bare = crate::analysis::layered::equilibrium_loaded(&p, &c, coupling, Loads::sun(0.8))
+            .unwrap();
+        assert!(eq.temperatures[19] > bare.temperatures[19] + 5.0);
+        for factor in [FAST_MODE_FACTOR, f64::INFINITY] {
+            let sys = Layered::new(&p, c.clone(), HingeModel::Nonlinear, coupling, factor).unwrap();
+            let y = sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0);
+            let mut dy = vec![0.0; y.len()];
+            sys.rhs_at_loads(loads, &y, &mut dy);
+            for (i, v) in dy.iter().enumerate() {
+                assert!(v.abs() < 1e-9 * (1.0 + y[i].abs()), "{factor} {i}: {v}");
+            }
+            let t = sys.node_temperatures(loads, &y);
+            for (a, b) in t.iter().zip(&eq.temperatures) {
+                assert!((a / b - 1.0).abs() < 1e-12, "{a} {b}");
+            }
         }
     }
 }
@@ -235,7 +273,7 @@ fn fast_mode_factor_measurement() {
             let sys = nonlinear_system(&p, &c, factor);
             let kept = sys.thermal_size();
             let y0 = DVector::from_vec(sys.state_from_nodes(&eq.temperatures, eq.theta, 0.0));
-            let mut orb = LayeredOrbit::new(sys, orbit);
+            let mut orb = LayeredOrbit::new(sys, &p, orbit);
             let method = Method::Dopri5(Tolerances {
                 rtol: 1e-8,
                 atol: 1e-10,

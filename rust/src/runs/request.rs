@@ -167,15 +167,9 @@ where
         columns: (0..names.len()).map(|i| traj.column(i)).collect(),
         moment: traj.y.iter().map(|y| sys.moment(y)).collect(),
         sunlit: traj.t.iter().map(|&t| orbit.illumination(t)).collect(),
-        fluxes: sys.solar_constant().map(|c| {
-            traj.t
-                .iter()
-                .map(|&t| {
-                    let f = orbit.face_fluxes(t, orbit.illumination(t), c);
-                    (f.front(), f.back())
-                })
-                .unzip()
-        }),
+        fluxes: sys
+            .solar_constant()
+            .map(|c| orbit.face_flux_samples(&traj.t, c)),
         stopped: crossing.is_some() && watch.is_some_and(|l| l.stop),
         crossing,
         names,

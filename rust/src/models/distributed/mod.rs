@@ -13,6 +13,15 @@
 //! consistent nodal loads.
 //! With the coupling frozen the factor is cos ψ for every element.
 //!
+//! Under an orbit's Earth heating or an attitude other than Sun-pointing ([`ElementHeat`]) the
+//! rigid front normal n is the attitude's and each element's normal is (n + ρ_e x̂)/√(1 + ρ_e²),
+//! x̂ the panel's length direction ([`crate::inputs::orbit::Orbit::length_direction`], from
+//! element 0 to the last; the deflection is positive along −n, away from a Sun on the normal):
+//! every element takes the loads of [`crate::inputs::heating`] — sunlight on either face, albedo
+//! and Earth infrared through its own view factor — at its own orientation, which is how the
+//! deflection feeds back on the heating (the flat panel's normal for every element with the
+//! coupling frozen). ψ is then set by the attitude and must be 0.
+//!
 //! The structure is reduced to its first k elastic modes q (state), the others quasi-static:
 //! w = Φ q + R M. The state is y = (temperatures of element 0, of element 1, ..., q[0..k],
 //! q̇[0..k]) and the modal equations are q̈ᵢ + 2ζωᵢ q̇ᵢ + ωᵢ² qᵢ = Σ_e Gᵢₑ M_e.
@@ -24,6 +33,9 @@
 pub mod structure;
 
 use crate::error::{require_finite, require_non_negative, Error, Result};
+use crate::inputs::attitude::Attitude;
+use crate::inputs::heating::{Loads, Optics, Sources};
+use crate::inputs::orbit::Orbit;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::thermal::ThermalModel;
@@ -105,6 +117,45 @@ impl Clone for DistributedPanel {
     fn clone(&self) -> Self {
         DistributedPanel::new(&self.panel, self.settings)
             .expect("settings that built a model build it again")
+    }
+}
+
+/// The orbit's heat on the elements at one time: what reaches a flat face, the rigid front
+/// normal n, the panel's length direction x̂ and the panel's optics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementHeat {
+    pub sources: Sources,
+    pub normal: [f64; 3],
+    pub length: [f64; 3],
+    pub optics: Optics,
+    /// The attitude is Sun-pointing: the flat panel's incidence is exactly 0.
+    on_sun: bool,
+}
+
+impl ElementHeat {
+    /// The heat of `orbit` at time t for the Sun's illuminated fraction `s`.
+    pub fn at(orbit: &Orbit, t: f64, s: f64, optics: Optics) -> Self {
+        let g = orbit.geometry(t);
+        ElementHeat {
+            sources: orbit.sources(&g, t, s, optics.solar_constant),
+            normal: g.normal,
+            length: orbit.length_direction(t, g.normal),
+            optics,
+            on_sun: orbit.attitude == Attitude::SunPointing,
+        }
+    }
+
+    /// The loads absorbed by an element whose chord has slope ρ (normal (n + ρ x̂)/√(1 + ρ²)).
+    pub fn loads(&self, slope: f64) -> Loads {
+        if slope == 0.0 {
+            return self
+                .sources
+                .fluxes(self.normal, self.on_sun)
+                .absorbed(&self.optics);
+        }
+        let r = 1.0 / (1.0 + slope * slope).sqrt();
+        let normal = [0, 1, 2].map(|k| (self.normal[k] + slope * self.length[k]) * r);
+        self.sources.fluxes(normal, false).absorbed(&self.optics)
     }
 }
 
@@ -241,20 +292,39 @@ impl DistributedPanel {
 
     /// The right-hand side under illumination factor `flux` (s × flux scale).
     pub fn rhs_at_flux(&self, flux: f64, y: &[f64], dy: &mut [f64]) {
+        let sun = self.settings.sun_angle.sin_cos();
+        let frozen = self.settings.coupling == Coupling::Frozen;
+        self.rhs_with(y, dy, |slope, temps, out| {
+            let area = if frozen { sun.1 } else { incidence(sun, slope) };
+            self.thermal.rates(flux * area, temps, out);
+        });
+    }
+
+    /// The right-hand side under the orbit's `heat` (each element at its own orientation).
+    pub fn rhs_loaded(&self, heat: &ElementHeat, y: &[f64], dy: &mut [f64]) {
+        self.rhs_with(y, dy, |slope, temps, out| {
+            let loads = heat.loads(slope);
+            self.thermal.rates(loads.sun, temps, out);
+            self.thermal.add_face_rates(loads.front, loads.back, out);
+        });
+    }
+
+    /// The right-hand side, each element's temperature rates written by `heat(ρ, temps, out)`
+    /// from its chord slope ρ (0 with the coupling frozen) and its temperatures.
+    #[inline]
+    fn rhs_with(&self, y: &[f64], dy: &mut [f64], heat: impl Fn(f64, &[f64], &mut [f64])) {
         let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
         let r = &self.reduction;
         let moments = self.moments(y);
         let q = self.modal(y);
         let v = &y[nt + k..];
         let gm = self.modal_forces(&moments);
-        let areas = match self.settings.coupling {
-            Coupling::ProjectedArea => self.areas(&self.slopes_with(q, &moments, &gm)),
-            Coupling::Frozen => self.areas(&vec![0.0; n]),
+        let slopes = match self.settings.coupling {
+            Coupling::ProjectedArea => self.slopes_with(q, &moments, &gm),
+            Coupling::Frozen => vec![0.0; n],
         };
-        for (e, area) in areas.iter().enumerate() {
-            let temps = self.element(y, e);
-            self.thermal
-                .rates(flux * area, temps, &mut dy[e * s..(e + 1) * s]);
+        for (e, &slope) in slopes.iter().enumerate() {
+            heat(slope, self.element(y, e), &mut dy[e * s..(e + 1) * s]);
         }
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
@@ -262,6 +332,77 @@ impl DistributedPanel {
             dy[nt + i] = v[i];
             dy[nt + k + i] = gm[i] - 2.0 * zeta * w * v[i] - w * w * q[i];
         }
+    }
+
+    /// The equilibrium under the orbit's constant `heat`: Newton on every element's heat
+    /// balance with the structure in its static shape, its Jacobian by differences.
+    pub fn equilibrium_loaded(&self, heat: &ElementHeat) -> Result<Vec<f64>> {
+        let (n, s, nt) = (self.n(), self.layers(), self.temps());
+        let coupled = self.settings.coupling == Coupling::ProjectedArea;
+        let fs = &self.reduction.slope_static;
+        // Start from the uniform flat panel under its loads, heating it as the front's sunlight
+        // would as much.
+        let flat = heat.loads(0.0);
+        let mut guess = vec![0.0; s];
+        self.thermal
+            .initial_guess(flat.equivalent_flux(&heat.optics), &mut guess);
+        let x = DVector::from_fn(nt, |i, _| guess[i % s]);
+        let residual = |x: &DVector<f64>| {
+            let moments = self.moments(x.as_slice());
+            let mut f = DVector::zeros(nt);
+            let mut flows = vec![0.0; s];
+            for e in 0..n {
+                let slope = if coupled {
+                    (0..n).map(|j| fs[(e, j)] * moments[j]).sum()
+                } else {
+                    0.0
+                };
+                let loads = heat.loads(slope);
+                self.thermal
+                    .heat_flows(loads.sun, self.element(x.as_slice(), e), &mut flows);
+                self.thermal
+                    .add_face_flows(loads.front, loads.back, &mut flows);
+                f.rows_mut(e * s, s).copy_from_slice(&flows);
+            }
+            f
+        };
+        let residual_and_jacobian = |x: &DVector<f64>| {
+            let f = residual(x);
+            let mut jac = DMatrix::zeros(nt, nt);
+            for j in 0..nt {
+                let h = 1e-6 * x[j].abs().max(1.0);
+                let mut xp = x.clone();
+                xp[j] += h;
+                jac.set_column(j, &((residual(&xp) - &f) / h));
+            }
+            (f, jac)
+        };
+        self.settle(x, residual_and_jacobian)
+    }
+
+    /// Newton on every element's heat balance from the temperatures `x`, then the state at rest
+    /// in static equilibrium with them, refused when its tip rise exceeds the arm.
+    fn settle(
+        &self,
+        x: DVector<f64>,
+        residual_and_jacobian: impl FnMut(&DVector<f64>) -> (DVector<f64>, DMatrix<f64>),
+    ) -> Result<Vec<f64>> {
+        let nt = self.temps();
+        let settled =
+            |x: &DVector<f64>, dx: &DVector<f64>| (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]);
+        let x = newton(
+            "distributed steady state",
+            x,
+            nt,
+            residual_and_jacobian,
+            settled,
+        )?;
+        let y = self.static_state(x.as_slice());
+        self.theta_f(&y, 0.0).map_err(|_| Error::NoConvergence {
+            what: "distributed steady state".into(),
+            reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
+        })?;
+        Ok(y)
     }
 
     /// The modal coordinates in static equilibrium with the element moments: q = G M / ω².
@@ -415,21 +556,7 @@ impl DistributedPanel {
             }
             (f, jac)
         };
-        let settled =
-            |x: &DVector<f64>, dx: &DVector<f64>| (0..nt).all(|i| dx[i].abs() < 1e-12 * x[i]);
-        let x = newton(
-            "distributed steady state",
-            x,
-            nt,
-            residual_and_jacobian,
-            settled,
-        )?;
-        let y = self.static_state(x.as_slice());
-        self.theta_f(&y, 0.0).map_err(|_| Error::NoConvergence {
-            what: "distributed steady state".into(),
-            reason: "the tip rise exceeds the arm: the panel is far too soft".into(),
-        })?;
-        Ok(y)
+        self.settle(x, residual_and_jacobian)
     }
 
     /// ∂f/∂y of the right-hand side at state `y` under illumination factor `flux`.

@@ -23,7 +23,7 @@ fn point<'a>(panel: &'a Panel, c: &'a Conduction) -> LayeredPoint<'a> {
         conduction: c,
         model: MODEL,
         coupling: COUPLING,
-        flux: 1.0,
+        loads: crate::inputs::heating::Loads::sun(1.0),
     }
 }
 

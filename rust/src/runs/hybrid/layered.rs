@@ -2,6 +2,7 @@
 
 use crate::analysis::layered::equilibrium;
 use crate::error::{Error, Result};
+use crate::inputs::heating::Loads;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupling;
 use crate::models::hinge::HingeModel;
@@ -60,7 +61,7 @@ impl<const S: usize> HybridLayered<S> {
     }
 
     fn angle(&self, flux: f64, y: &SVector<f64, S>) -> f64 {
-        self.orbit.system.moment_of(flux, y.as_slice()) / self.panel.hinge_stiffness
+        self.orbit.system.moment_of(Loads::sun(flux), y.as_slice()) / self.panel.hinge_stiffness
     }
 }
 
@@ -205,7 +206,7 @@ pub fn run_orbits_hybrid(
             match start.len() {
                 $($s => hybrid_run::<$s>(
                     HybridLayered {
-                        orbit: LayeredOrbit::new(system.clone(), spec.orbit),
+                        orbit: LayeredOrbit::new(system.clone(), &spec.panel, spec.orbit),
                         panel: spec.panel,
                         coupling: spec.coupling,
                     },
