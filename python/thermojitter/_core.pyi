@@ -196,6 +196,14 @@ class _FlutterPoint(TypedDict):
     coupled: bool
     flux: float
 
+class _OrbitPoint(TypedDict):
+    """A flutter analysis on an orbit: at time t, or averaged over the sunlit arc from t."""
+
+    t: float
+    model: str
+    coupled: bool
+    average: bool
+
 class IntegrationError(RuntimeError): ...
 
 @final
@@ -273,14 +281,7 @@ def simulate_spacecraft(
 # --- flutter analysis ---------------------------------------------------------------------------
 def flutter(panel: dict[str, float], point: _FlutterPoint) -> dict[str, Any]: ...
 def flutter_at(
-    panel: dict[str, float],
-    orbit: dict[str, Any],
-    *,
-    t: float,
-    model: str,
-    coupled: bool,
-    with_critical: bool = True,
-    average: bool = False,
+    panel: dict[str, float], orbit: dict[str, Any], point: _OrbitPoint, with_critical: bool = True
 ) -> dict[str, Any]: ...
 
 # --- long runs ----------------------------------------------------------------------------------
@@ -469,14 +470,7 @@ def layered_flutter(
     panel: dict[str, float], grid: _Grid, point: _FlutterPoint
 ) -> dict[str, Any]: ...
 def layered_flutter_at(
-    panel: dict[str, float],
-    grid: _Grid,
-    orbit: dict[str, Any],
-    *,
-    t: float,
-    model: str,
-    coupled: bool,
-    average: bool = False,
+    panel: dict[str, float], grid: _Grid, orbit: dict[str, Any], point: _OrbitPoint
 ) -> dict[str, Any]: ...
 def simulate_layers(
     panel: dict[str, float],

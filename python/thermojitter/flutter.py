@@ -132,14 +132,14 @@ def flutter(
     # On an orbit with more than the front's sunlight, or averaged over its sunlit arc: the
     # engine takes the orbit's loads itself.
     on_orbit = orbit is not None and (average or has_face_loads(orbit, attitude))
+    at_point: _core._OrbitPoint = {"t": t, "model": model, "coupled": coupled, "average": average}
     if layers is not None:
         nodes = check_layers(layers)
         if on_orbit:
             assert orbit is not None
             raw = _core.layered_flutter_at(
-                panel.as_dict(), grid_args(panel, nodes), engine_orbit(orbit, attitude), t=t,
-                model=model, coupled=coupled, average=average,
-            )  # fmt: skip
+                panel.as_dict(), grid_args(panel, nodes), engine_orbit(orbit, attitude), at_point
+            )
             if average:
                 point["flux"] = float(raw["loads"][0])
         else:
@@ -148,10 +148,7 @@ def flutter(
     else:
         if on_orbit:
             assert orbit is not None
-            at = engine_orbit(orbit, attitude)
-            raw = _core.flutter_at(
-                panel.as_dict(), at, t=t, model=model, coupled=coupled, average=average
-            )
+            raw = _core.flutter_at(panel.as_dict(), engine_orbit(orbit, attitude), at_point)
             if average:
                 point["flux"] = float(raw["loads"][0])
         else:

@@ -2,6 +2,7 @@
 
 use super::error::invalid;
 use crate::inputs::attitude::Attitude;
+use crate::inputs::heating::{Loads, Optics};
 use crate::inputs::laminate::{Laminate, Layer, LAYER_FIELDS};
 use crate::inputs::orbit::Shadow;
 use crate::models::conduction::Conduction;
@@ -433,6 +434,41 @@ impl FlutterPoint {
         let m = hinge_model(&self.model)?;
         crate::analysis::flutter::check_flux(self.flux)?;
         Ok((p, m, coupling(self.coupled)))
+    }
+}
+
+/// A flutter analysis on an orbit, as both analyses (`flutter_at`, `layered_flutter_at`)
+/// receive it: the mapping `point` = {t, model, coupled, average}. [`OrbitPoint::inputs`] gives
+/// the panel, the orbit and the constant loads it is about: every load of the orbit at time t in
+/// full sunlight, or (`average`) their mean over the sunlit arc of the orbit beginning at t.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct OrbitPoint {
+    pub t: f64,
+    pub model: String,
+    pub coupled: bool,
+    pub average: bool,
+}
+
+impl OrbitPoint {
+    /// The panel, the orbit, the hinge (model, coupling) and the loads of the analysis.
+    pub fn inputs(
+        &self,
+        panel: &Bound<'_, PyDict>,
+        orbit: &Bound<'_, PyDict>,
+    ) -> PyResult<(Panel, Orbit, (HingeModel, Coupling), Loads)> {
+        let p = panel_from(panel)?;
+        p.validate()?;
+        let o = orbit_from(orbit)?;
+        let optics = Optics::of(&p);
+        let loads = if self.average {
+            o.sunlit_average_loads(self.t, &optics)?
+        } else {
+            Orbit::check_time(self.t)?;
+            o.sunlit_loads(self.t, &optics)
+        };
+        let hinge = (hinge_model(&self.model)?, coupling(self.coupled));
+        Ok((p, o, hinge, loads))
     }
 }
 

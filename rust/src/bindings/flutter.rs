@@ -2,7 +2,7 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, dict_of, hinge_model, orbit_from, panel_from, set_named, FlutterPoint,
+    coupling, dict_of, hinge_model, panel_from, set_named, FlutterPoint, OrbitPoint,
 };
 use super::error::shield;
 use crate::analysis::flutter::{
@@ -10,9 +10,6 @@ use crate::analysis::flutter::{
 };
 use crate::analysis::linear::LinearThermal;
 use crate::analysis::stability::Axis;
-use crate::inputs::heating::{Loads, Optics};
-use crate::inputs::orbit::Orbit;
-use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupled;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -40,25 +37,20 @@ fn flutter<'py>(
 }
 
 /// Linear stability of the paper's model at the sunlit equilibrium under every load of `orbit`
-/// at time `t` (its Earth heating and attitude there), or with `average` under those loads
-/// averaged over the sunlit arc of the orbit that begins at `t`: the same mapping as
-/// [`flutter`].
+/// at the `point`'s time t (its Earth heating and attitude there), or with `average` under
+/// those loads averaged over the sunlit arc of the orbit that begins at t: the same mapping as
+/// [`flutter`], with the loads.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, *, t, model, coupled, with_critical=true, average=false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, orbit, point, with_critical=true))]
 fn flutter_at<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
-    t: f64,
-    model: &str,
-    coupled: bool,
+    point: OrbitPoint,
     with_critical: bool,
-    average: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let (p, o, loads) = on_orbit(panel, orbit, t, average)?;
-        let (m, c) = (hinge_model(model)?, coupling(coupled));
+        let (p, o, (m, c), loads) = point.inputs(panel, orbit)?;
         let system = Coupled::new(p, o, m, c);
         let (eq, jacobian, spectrum) = analyse_system_under(&system, loads)?;
         let d = PyDict::new(py);
@@ -80,28 +72,6 @@ fn flutter_at<'py>(
         d.set_item("loads", (loads.sun, loads.front, loads.back))?;
         Ok(d)
     })
-}
-
-/// The panel and the orbit of a flutter analysis on an orbit, and the constant loads it is
-/// about: every load of the orbit at time t in full sunlight, or (`average`) their mean over the
-/// sunlit arc of the orbit beginning at t.
-pub(super) fn on_orbit(
-    panel: &Bound<'_, PyDict>,
-    orbit: &Bound<'_, PyDict>,
-    t: f64,
-    average: bool,
-) -> PyResult<(Panel, Orbit, Loads)> {
-    let p = panel_from(panel)?;
-    p.validate()?;
-    let o = orbit_from(orbit)?;
-    let optics = Optics::of(&p);
-    let loads = if average {
-        o.sunlit_average_loads(t, &optics)?
-    } else {
-        Orbit::check_time(t)?;
-        o.sunlit_loads(t, &optics)
-    };
-    Ok((p, o, loads))
 }
 
 /// The linear stability of an equilibrium into `d`: its Jacobian (`rows`), eigenvalues (as

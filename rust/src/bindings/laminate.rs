@@ -2,8 +2,8 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, dict_of, hinge_model, laminate_from, layer_from, panel_dict, panel_from, set_named,
-    FlutterPoint, Grid, RunOptions,
+    coupling, dict_of, laminate_from, layer_from, panel_dict, panel_from, set_named, FlutterPoint,
+    Grid, OrbitPoint, RunOptions,
 };
 use super::error::shield;
 use super::flutter::set_spectrum;
@@ -138,25 +138,19 @@ fn layered_flutter<'py>(
     })
 }
 
-/// [`layered_flutter`] at the sunlit equilibrium under every load of `orbit` at time `t`, or
-/// (`average`) under their mean over the sunlit arc of the orbit beginning at `t` (as
+/// [`layered_flutter`] at the sunlit equilibrium under every load of `orbit` at the `point`'s
+/// time t, or (`average`) under their mean over the sunlit arc of the orbit beginning at t (as
 /// `flutter_at` for the two-layer model).
 #[pyfunction]
-#[pyo3(signature = (panel, grid, orbit, *, t, model, coupled, average=false))]
-#[allow(clippy::too_many_arguments)]
 fn layered_flutter_at<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     grid: Grid<'py>,
     orbit: &Bound<'py, PyDict>,
-    t: f64,
-    model: &str,
-    coupled: bool,
-    average: bool,
+    point: OrbitPoint,
 ) -> PyResult<Bound<'py, PyDict>> {
     shield(|| {
-        let (p, _, loads) = super::flutter::on_orbit(panel, orbit, t, average)?;
-        let hinge = (hinge_model(model)?, coupling(coupled));
+        let (p, _, hinge, loads) = point.inputs(panel, orbit)?;
         let d = layered_analysis(py, &p, &grid, hinge, loads)?;
         d.set_item("loads", (loads.sun, loads.front, loads.back))?;
         Ok(d)
