@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import Any
 
 import hypothesis.strategies as st
 import numpy as np
@@ -246,11 +247,23 @@ def test_models_that_take_the_front_sunlight_only_refuse_the_earths_heat() -> No
     with pytest.raises(tj.ParameterError) as err:
         tj.simulate(boom, tj.Orbit.leo(540e3), (0.0, 100.0), attitude=tj.Attitude.nadir())
     assert err.value.parameter == "attitude"
-    # The N-node model's hybrid propagator takes the sunlit forcing as constant between
-    # eclipses: it refuses them (method="rk45" runs them).
-    with pytest.raises(tj.ParameterError) as err, pytest.warns(tj.HybridFallbackWarning):
-        tj.simulate_orbits(tj.Panel.paper(), orbit, 1, layers=4, method="hybrid", progress=False)
-    assert err.value.parameter == "earth_ir"
+
+
+def test_the_n_node_hybrid_runs_earth_heating_in_full_and_says_so() -> None:
+    # Its propagator takes the sunlit forcing as constant between eclipses: under the Earth's
+    # loads it runs the orbits in full, the very run method="rk45" gives, and says so.
+    orbit = tj.Orbit.leo(540e3).replace(earth_ir=237.0, albedo=0.3)
+    kw: dict[str, Any] = {"layers": 4, "progress": False, "orbits_per_call": 2}
+    full = tj.simulate_orbits(tj.Panel.paper(), orbit, 2, method="rk45", **kw)
+    with pytest.warns(tj.HybridFallbackWarning):
+        hybrid = tj.simulate_orbits(tj.Panel.paper(), orbit, 2, method="hybrid", **kw)
+    assert "hybrid_fallback" in hybrid.settings
+    for name, column in full.columns.items():
+        np.testing.assert_array_equal(hybrid.columns[name], column, err_msg=name)
+    p = hybrid.propagation
+    assert p["t_linear"] == p["t_exponential"] == 0.0
+    assert p["t_fallback"] == pytest.approx(2 * orbit.period, rel=1e-12)
+    assert p["n_fallback_steps"] == full.n_steps
 
 
 def test_attitudes_and_heat_loads_are_checked() -> None:

@@ -190,10 +190,11 @@ pub fn run_orbits_hybrid(
         return Ok(LayeredHybrid { run, split: out });
     }
     if req.spec.orbit.has_face_loads() {
-        return Err(crate::models::coupled::unsupported_face_loads(
-            &req.spec.orbit,
-            "the laminate's N-node model",
-        ));
+        // As the two-layer hybrid: the Earth's loads and an attitude vary the forcing along
+        // every arc, so the orbits run in full, all of their time counted as the fallback's.
+        let run = crate::runs::layered::run_orbits(req, cancel)?;
+        let split = crate::runs::hybrid::counted_as_fallback(&run.summaries, run.stats.n_steps);
+        return Ok(LayeredHybrid { run, split });
     }
     let (system, start) = req.system()?;
     let args = HybridArgs {

@@ -166,16 +166,30 @@ pub fn run_orbits_hybrid(
 /// Sun-pointing make it vary along every arc, so such an orbit runs here, at the accuracy of
 /// the full integration.
 fn fully_integrated(run: OrbitRun) -> HybridRun {
-    let t_fallback = run.summaries.iter().map(|s| s.t_end - s.t_start).sum();
+    let split = counted_as_fallback(&run.summaries, run.stats.n_steps);
+    HybridRun { run, ..split }
+}
+
+/// The split of a run integrated in full over `summaries`' orbits with `n_steps` steps: all of
+/// its time and steps the fallback's (its `run` left empty, as [`Propagated::split`]'s).
+pub(crate) fn counted_as_fallback(
+    summaries: &[crate::runs::orbits::OrbitSummary],
+    n_steps: u64,
+) -> HybridRun {
     HybridRun {
+        run: OrbitRun {
+            summaries: Vec::new(),
+            stats: Stats::default(),
+            y_end: Vector4::zeros(),
+            crossing: None,
+        },
         t_linear: 0.0,
         t_exponential: 0.0,
-        t_fallback,
+        t_fallback: summaries.iter().map(|s| s.t_end - s.t_start).sum(),
         n_arcs: 0,
         n_exp_steps: 0,
-        n_fallback_steps: run.stats.n_steps,
+        n_fallback_steps: n_steps,
         n_reread_steps: 0,
-        run,
     }
 }
 
