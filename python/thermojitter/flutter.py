@@ -133,28 +133,26 @@ def flutter(
     # engine takes the orbit's loads itself.
     on_orbit = orbit is not None and (average or has_face_loads(orbit, attitude))
     at_point: _core._OrbitPoint = {"t": t, "model": model, "coupled": coupled, "average": average}
-    if layers is not None:
-        nodes = check_layers(layers)
-        if on_orbit:
-            assert orbit is not None
-            raw = _core.layered_flutter_at(
-                panel.as_dict(), grid_args(panel, nodes), engine_orbit(orbit, attitude), at_point
-            )
-            if average:
-                point["flux"] = float(raw["loads"][0])
+    pd = panel.as_dict()
+    nodes = None if layers is None else check_layers(layers)
+    at = engine_orbit(orbit, attitude) if on_orbit and orbit is not None else None
+    if nodes is not None:
+        grid = grid_args(panel, nodes)
+        if at is not None:
+            raw = _core.layered_flutter_at(pd, grid, at, at_point)
         else:
-            raw = _core.layered_flutter(panel.as_dict(), grid_args(panel, nodes), point)
+            raw = _core.layered_flutter(pd, grid, point)
+    elif at is not None:
+        raw = _core.flutter_at(pd, at, at_point)
+    else:
+        raw = _core.flutter(pd, point)
+    if average:  # the mean of the front's flux factor over the arc
+        point["flux"] = float(raw["loads"][0])
+    if nodes is not None:
         result = _layered_result(raw, point)
     else:
-        if on_orbit:
-            assert orbit is not None
-            raw = _core.flutter_at(panel.as_dict(), engine_orbit(orbit, attitude), at_point)
-            if average:
-                point["flux"] = float(raw["loads"][0])
-        else:
-            raw = _core.flutter(panel.as_dict(), point)
         tf, tb, th = raw["equilibrium"]
-        moment = float(_core.moment(panel.as_dict(), np.array([tf]), np.array([tb]))[0])
+        moment = float(_core.moment(pd, np.array([tf]), np.array([tb]))[0])
         equilibrium = Equilibrium(T_front=tf, T_back=tb, theta=th, thermal_moment=moment)
         result = _result(raw, equilibrium, point)
     return dataclasses.replace(result, panel=panel, orbit=orbit)
