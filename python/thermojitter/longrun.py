@@ -367,13 +367,13 @@ def simulate_orbits(
       ``result.settings["hybrid_fallback"]`` and by one
       :class:`thermojitter.errors.HybridFallbackWarning`.
     - Slow time (``method="hybrid"`` on an orbit shorter than 6 h, with or without the Earth's
-      loads and an attitude; the two-layer model): the temperatures are integrated on their own time scale with the hinge on
-      its slow manifold, the ringing carried in closed form as a complex amplitude along the
-      hinge mode (the thermal coupling, hence flutter, in its eigenvalue; the non-linear hinge's
-      frequency shift with amplitude from its conservative period), the penumbrae integrated in
-      full. Orbits where the ringing passes 0.03 rad or the thermal rates are not slow against
-      the hinge are integrated in full with rk45 from their start, with the rest of the run
-      (``propagation["n_refused_orbits"]``, and a
+      loads and an attitude; the two-layer model): the temperatures are integrated on their own
+      time scale with the hinge on its slow manifold, the ringing carried in closed form as a
+      complex amplitude along the hinge mode (the thermal coupling, hence flutter, in its
+      eigenvalue; the non-linear hinge's frequency shift with amplitude from its conservative
+      period), the penumbrae integrated in full. Orbits where the ringing passes 0.03 rad or
+      the thermal rates are not slow against the hinge are integrated in full with rk45 from
+      their start, with the rest of the run (``propagation["n_refused_orbits"]``, and a
       :class:`thermojitter.errors.HybridFallbackWarning`); ``propagation["t_slow"]`` is the
       time carried on slow time.
 

@@ -46,14 +46,15 @@ use std::ops::ControlFlow;
 pub const SEPARATION_LIMIT: f64 = 0.1;
 /// Largest ringing amplitude |z| (rad) carried in closed form.
 pub const RING_LIMIT: f64 = 0.03;
-/// Samples of the ringing per hinge period read by the summaries.
-const SAMPLES_PER_PERIOD: f64 = 16.0;
+/// Reads per hinge period of a span shorter than a period, and the half-width of the parabola
+/// that refines a peak, as a fraction of the period.
+const READS_PER_PERIOD: f64 = 16.0;
 /// Time step (s) of the derivative of θ₀' along the thermal flow.
 const FLOW_STEP: f64 = 0.5;
 /// Error control of the slow integration of T̄.
 const SLOW_TOLERANCES: Tolerances = Tolerances {
-    rtol: 1e-8,
-    atol: 1e-6,
+    rtol: 1e-7,
+    atol: 1e-5,
     max_step: 600.0,
     max_steps: 50_000_000,
 };
@@ -296,12 +297,12 @@ fn hinge_eigenvalue(j: &Matrix4<f64>, guess: Complex<f64>) -> Option<Complex<f64
     for _ in 0..50 {
         let p = (((x + c3) * x + c2) * x + c1) * x + c0;
         let dp = ((x * 4.0 + 3.0 * c3) * x + 2.0 * c2) * x + c1;
-        if dp.norm() == 0.0 {
+        if dp.norm_sqr() == 0.0 {
             return None;
         }
         let dx = p / dp;
         x -= dx;
-        if dx.norm() <= 1e-14 * x.norm() {
+        if dx.norm_sqr() <= 1e-28 * x.norm_sqr() {
             return (x.im.abs() > 0.0 && x.is_finite()).then_some(x);
         }
     }
@@ -339,7 +340,6 @@ struct Ringing<'a, 'c> {
     refusal: Option<Refusal>,
     error: Option<crate::Error>,
     steps: u64,
-    samples: Vec<(f64, f64, f64)>,
 }
 
 /// The three Gauss–Legendre nodes on [−1, 1] and their weights.
@@ -349,26 +349,39 @@ const GAUSS3: [(f64, f64); 3] = [
     (0.774_596_669_241_483_4, 5.0 / 9.0),
 ];
 
-/// Lagrange interpolation through (xs, ys) at x.
-fn lagrange<T>(xs: &[f64; 5], ys: &[T; 5], x: f64) -> T
+/// The polynomial through five points in Newton's form (divided differences once, then four
+/// multiply-adds a value).
+#[derive(Clone, Copy)]
+struct Newton5<T> {
+    xs: [f64; 5],
+    cs: [T; 5],
+}
+
+impl<T> Newton5<T>
 where
-    T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+    T: Copy
+        + std::ops::Mul<f64, Output = T>
+        + std::ops::Add<Output = T>
+        + std::ops::Sub<Output = T>,
 {
-    let mut acc: Option<T> = None;
-    for i in 0..5 {
-        let mut l = 1.0;
-        for k in 0..5 {
-            if k != i {
-                l *= (x - xs[k]) / (xs[i] - xs[k]);
+    fn new(xs: &[f64; 5], ys: &[T; 5]) -> Self {
+        let mut cs = *ys;
+        for level in 1..5 {
+            for i in (level..5).rev() {
+                cs[i] = (cs[i] - cs[i - 1]) * (1.0 / (xs[i] - xs[i - level]));
             }
         }
-        let term = ys[i] * l;
-        acc = Some(match acc {
-            Some(a) => a + term,
-            None => term,
-        });
+        Newton5 { xs: *xs, cs }
     }
-    acc.expect("five points")
+
+    #[inline]
+    fn at(&self, x: f64) -> T {
+        let mut acc = self.cs[4];
+        for i in (0..4).rev() {
+            acc = acc * (x - self.xs[i]) + self.cs[i];
+        }
+        acc
+    }
 }
 
 impl Ringing<'_, '_> {
@@ -411,103 +424,101 @@ impl Ringing<'_, '_> {
             let shift = m.frequency_shift(points[i].y[2], amp);
             *r = md.lambda - wv + Complex::new(0.0, shift);
         }
-        // ∫ rate from t0, the quadratic through the nodes integrated exactly.
+        // The rate as q0 + q1 x + q2 x² in x = 2 (t − t0)/h − 1 through the nodes x = −g, 0, g,
+        // and ∫ rate from t0, that quadratic integrated exactly.
+        let g = GAUSS3[2].0;
+        let q0 = rate[1];
+        let q1 = (rate[2] - rate[0]) / (2.0 * g);
+        let q2 = (rate[2] + rate[0] - rate[1] * 2.0) / (2.0 * g * g);
+        let scaled = |t: f64| 2.0 * (t - t0) / h - 1.0;
         let exponent = |t: f64| -> Complex<f64> {
-            let x = 2.0 * (t - t0) / h - 1.0; // in [−1, 1]
-            let xs = [GAUSS3[0].0, GAUSS3[1].0, GAUSS3[2].0];
-            let mut acc = Complex::new(0.0, 0.0);
-            for i in 0..3 {
-                // ∫_{-1}^{x} l_i(s) ds of the Lagrange basis polynomial l_i.
-                let (a, b) = match i {
-                    0 => (xs[1], xs[2]),
-                    1 => (xs[0], xs[2]),
-                    _ => (xs[0], xs[1]),
-                };
-                let denom = (xs[i] - a) * (xs[i] - b);
-                let prim = |s: f64| s * s * s / 3.0 - (a + b) * s * s / 2.0 + a * b * s;
-                acc += rate[i] * ((prim(x) - prim(-1.0)) / denom);
-            }
-            acc * (0.5 * h)
+            let x = scaled(t);
+            (q0 * (x + 1.0) + q1 * (0.5 * (x * x - 1.0)) + q2 * ((x * x * x + 1.0) / 3.0))
+                * (0.5 * h)
+        };
+        let rate_at = |t: f64| {
+            let x = scaled(t);
+            q0 + q1 * x + q2 * (x * x)
         };
         let z0 = self.z;
         let z_at = |t: f64| z0 * exponent(t).exp();
-        let thetas: [f64; 5] = std::array::from_fn(|k| points[k].y[2]);
-        let lags: [f64; 5] = std::array::from_fn(|k| points[k].lag);
+        let thetas = Newton5::new(&ts, &std::array::from_fn(|k| points[k].y[2]));
+        let lags = Newton5::new(&ts, &std::array::from_fn(|k| points[k].lag));
+        // κ = 1 − (M_T per kelvin / K_el)(v_f − v_b): the dynamic part's share of the ringing
+        // (the ringing's own thermal swing moves the quasi-static angle); its modulus and angle
+        // interpolated apart, so that reads take no complex transcendental.
         let kappa: [Complex<f64>; 5] = std::array::from_fn(|k| {
             Complex::new(1.0, 0.0)
                 - (modes[k].v[0] - modes[k].v[1]) * (m.moment_per_kelvin / m.stiffness)
         });
-        let theta_at = |t: f64| lagrange(&ts, &thetas, t) + z_at(t).re;
-        let dynamic_at = |t: f64| lagrange(&ts, &lags, t) + (lagrange(&ts, &kappa, t) * z_at(t)).re;
-        // Samples resolving the ringing.
+        let log_kappa = Newton5::new(&ts, &kappa.map(|k| k.norm().ln()));
+        let arg_kappa = Newton5::new(&ts, &kappa.map(|k| k.arg()));
+        let (log_z0, arg0) = (z0.norm().ln(), z0.arg());
+        let log_amp = |t: f64| log_z0 + exponent(t).re;
+        let phase = |t: f64| arg0 + exponent(t).im;
+        let theta_at = |t: f64| thetas.at(t) + log_amp(t).exp() * phase(t).cos();
+        let dynamic_at = |t: f64| {
+            lags.at(t) + (log_amp(t) + log_kappa.at(t)).exp() * (phase(t) + arg_kappa.at(t)).cos()
+        };
         let period = 2.0 * PI / modes[2].lambda.im.abs();
-        let n = ((h / period * SAMPLES_PER_PERIOD).ceil() as usize).max(2);
-        self.samples.clear();
-        let mut dyn_abs: f64 = 0.0;
+        let speed = |t: f64| rate_at(t).im;
+        let kappa_at = |t: f64| Complex::from_polar(log_kappa.at(t).exp(), arg_kappa.at(t));
+        // θ = θ̄ + A cos φ and the dynamic part = lag + |κ| A cos(φ + arg κ).
+        let theta_wave = Wave {
+            value: &theta_at,
+            envelope: &|t: f64| thetas.at(t) + log_amp(t).exp(),
+            phase: &phase,
+            speed: &speed,
+            period,
+        };
+        let dynamic_envelope = |t: f64| (log_amp(t) + log_kappa.at(t)).exp();
+        let dynamic_wave = Wave {
+            value: &dynamic_at,
+            envelope: &|t: f64| lags.at(t) + dynamic_envelope(t),
+            phase: &|t: f64| phase(t) + arg_kappa.at(t),
+            speed: &speed,
+            period,
+        };
+        let neg_dynamic = |t: f64| -dynamic_at(t);
+        let dynamic_low = Wave {
+            value: &neg_dynamic,
+            envelope: &|t: f64| -lags.at(t) + dynamic_envelope(t),
+            phase: &|t: f64| phase(t) + arg_kappa.at(t) + PI,
+            speed: &speed,
+            period,
+        };
+        let dyn_abs = dynamic_wave
+            .largest(t0, t1)
+            .max(dynamic_low.largest(t0, t1));
+        // ∫ (dynamic)²: lag² + |κz|²/2 by Gauss–Legendre, and the oscillating terms
+        // 2 lag Re(κz) + Re((κz)²)/2 by their leading term [F/L']: they swing at the hinge's
+        // frequency, L' the exponent's rate.
         let mut sq = 0.0;
-        let mut last_dyn = 0.0;
-        for i in 0..=n {
-            let t = if i == n {
-                t1
-            } else {
-                t0 + h * i as f64 / n as f64
-            };
-            let (th, dy) = (theta_at(t), dynamic_at(t));
-            if i > 0 {
-                sq += 0.5 * (dy * dy + last_dyn * last_dyn) * (h / n as f64);
-            }
-            last_dyn = dy;
-            dyn_abs = dyn_abs.max(dy.abs());
-            self.samples.push((t, th, dy));
+        for (x, wt) in GAUSS_5 {
+            let t = t0 + 0.5 * h * (1.0 + x);
+            let (lag, w) = (lags.at(t), kappa_at(t) * z_at(t));
+            sq += 0.5 * h * wt * (lag * lag + 0.5 * w.norm_sqr());
         }
-        // The largest |dynamic| among the samples, refined by the parabola through its
-        // neighbours (the samples alone may miss the peak by 1 − cos(π/16) ≈ 2 % of it).
-        let best = (0..self.samples.len())
-            .max_by(|&i, &k| self.samples[i].2.abs().total_cmp(&self.samples[k].2.abs()))
-            .unwrap_or(0);
-        if best > 0 && best + 1 < self.samples.len() {
-            let [p, c, q] = [best - 1, best, best + 1].map(|i| self.samples[i].2.abs());
-            let curv = p - 2.0 * c + q;
-            if curv < 0.0 {
-                let off = (0.5 * (p - q) / curv).clamp(-1.0, 1.0);
-                let tr = self.samples[best].0 + off * (h / n as f64);
-                dyn_abs = dyn_abs.max(dynamic_at(tr).abs());
-            }
-        }
+        let swing = |t: f64| {
+            let (lag, w, r) = (lags.at(t), kappa_at(t) * z_at(t), rate_at(t));
+            (w * (2.0 * lag) / r + w * w / (4.0 * r)).re
+        };
+        sq += swing(t1) - swing(t0);
+        let sq = sq.max(0.0);
         let z1 = z_at(t1);
         if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
             return Err(Refusal::Ringing);
         }
-        let samples = &self.samples;
+        let theta_low = |t: f64| -theta_at(t);
+        let theta_min_wave = Wave {
+            value: &theta_low,
+            envelope: &|t: f64| -thetas.at(t) + log_amp(t).exp(),
+            phase: &|t: f64| phase(t) + PI,
+            speed: &speed,
+            period,
+        };
         let extremes = |a: f64, b: f64| -> (f64, f64) {
-            let (mut lo, mut hi) = (theta_at(a), theta_at(a));
-            let end = theta_at(b);
-            lo = lo.min(end);
-            hi = hi.max(end);
-            let first = samples.partition_point(|s| s.0 < a);
-            let last = samples.partition_point(|s| s.0 <= b);
-            let dt = h / n as f64;
-            for i in first..last {
-                let th = samples[i].1;
-                // A local extreme among the samples: refine it by the parabola through its
-                // neighbours.
-                if i > 0 && i + 1 < samples.len() {
-                    let (p, q) = (samples[i - 1].1, samples[i + 1].1);
-                    if (th >= p && th >= q) || (th <= p && th <= q) {
-                        let curv = p - 2.0 * th + q;
-                        if curv != 0.0 {
-                            let off = (0.5 * (p - q) / curv).clamp(-1.0, 1.0);
-                            let tr = (samples[i].0 + off * dt).clamp(a, b);
-                            let v = theta_at(tr);
-                            lo = lo.min(v);
-                            hi = hi.max(v);
-                        }
-                    }
-                }
-                lo = lo.min(th);
-                hi = hi.max(th);
-            }
-            (lo, hi)
+            (-theta_min_wave.largest(a, b), theta_wave.largest(a, b))
         };
         let (lo, hi) = extremes(t0, t1);
         let limit = self.obs.collector.options.theta_limit;
@@ -528,6 +539,78 @@ impl Ringing<'_, '_> {
         Ok(())
     }
 }
+
+/// A slow value plus a swing at the hinge's frequency, s(t) + A(t) cos φ(t): its largest value
+/// over a span is at one of the peaks (φ = 2πm) next to the envelope's largest, s + A, or at an
+/// end of the span.
+struct Wave<'f> {
+    value: &'f dyn Fn(f64) -> f64,
+    envelope: &'f dyn Fn(f64) -> f64,
+    phase: &'f dyn Fn(f64) -> f64,
+    /// φ'.
+    speed: &'f dyn Fn(f64) -> f64,
+    period: f64,
+}
+
+impl Wave<'_> {
+    fn largest(&self, a: f64, b: f64) -> f64 {
+        let f = self.value;
+        let mut best = f(a).max(f(b));
+        if b <= a {
+            return best;
+        }
+        let d = self.period / READS_PER_PERIOD;
+        if b - a <= self.period {
+            let n = ((b - a) / d).ceil().max(1.0) as usize;
+            for i in 1..n {
+                best = best.max(self.refined(a + (b - a) * i as f64 / n as f64, d, a, b));
+            }
+            return best;
+        }
+        // The envelope's largest on a few points, then the peaks around it.
+        let mut t_star = a;
+        let mut e_best = f64::NEG_INFINITY;
+        for i in 0..=ENVELOPE_READS {
+            let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
+            let e = (self.envelope)(t);
+            if e > e_best {
+                (e_best, t_star) = (e, t);
+            }
+        }
+        let ph = (self.phase)(t_star);
+        let m0 = (ph / (2.0 * PI)).round();
+        for dm in [-1.0, 0.0, 1.0] {
+            let target = 2.0 * PI * (m0 + dm);
+            let mut t = t_star + (target - ph) / (self.speed)(t_star);
+            for _ in 0..2 {
+                t -= ((self.phase)(t) - target) / (self.speed)(t);
+            }
+            if t >= a && t <= b {
+                best = best.max(self.refined(t, d, a, b));
+            }
+        }
+        best
+    }
+
+    /// f near t, refined by the parabola through t ± d (kept within [a, b]).
+    fn refined(&self, t: f64, d: f64, a: f64, b: f64) -> f64 {
+        let f = self.value;
+        let (lo, hi) = ((t - d).max(a), (t + d).min(b));
+        let (p, c, q) = (f(lo), f(t), f(hi));
+        let mut best = c.max(p).max(q);
+        if hi - t == t - lo && t > lo {
+            let curv = p - 2.0 * c + q;
+            if curv < 0.0 {
+                let off = (0.5 * (p - q) / curv).clamp(-1.0, 1.0);
+                best = best.max(f(t + off * d));
+            }
+        }
+        best
+    }
+}
+
+/// Points at which a span's envelope is read to find its largest.
+const ENVELOPE_READS: usize = 8;
 
 /// The slope at x of the quartic through five points.
 fn lagrange_slope(xs: &[f64; 5], ys: &[Complex<f64>; 5], x: f64) -> Complex<f64> {
@@ -689,7 +772,6 @@ pub(crate) fn run_slow(
                 refusal: None,
                 error: None,
                 steps: 0,
-                samples: Vec::new(),
             };
             let mut flow = SlowFlow { model: &model };
             let temps = Vector2::new(manifold.y[0], manifold.y[1]);
