@@ -61,11 +61,13 @@ class Series:
     label: str
     sizes: list[int] = field(default_factory=list)
     times: list[float] = field(default_factory=list)
+    steps: list[int] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
-    def add(self, size: int, wall: float, note: str = "") -> None:
+    def add(self, size: int, wall: float, steps: int, note: str = "") -> None:
         self.sizes.append(size)
         self.times.append(wall)
+        self.steps.append(steps)
         self.notes.append(note)
 
     def slopes(self) -> tuple[float, float]:
@@ -111,20 +113,27 @@ def orbits_run(
 
 def how(runs: tj.OrbitSummaries) -> str:
     """What a hybrid run did: its share on the non-linear model, or that it ran rk45."""
-    steps = f"{runs.n_steps} steps"
     if runs.settings.get("hybrid_fallback") or runs.fallback:
-        return f"ran rk45 (the hybrid's fallback), {steps}"
+        return "ran rk45 (the hybrid's fallback)"
     if runs.propagation:
-        return f"{steps}, non-linear model on {100 * runs.nonlinear_fraction:.1f} % of the time"
-    return steps
+        return f"non-linear model on {100 * runs.nonlinear_fraction:.1f} % of the time"
+    return ""
 
 
 def table(series: Sequence[Series], size_name: str) -> None:
-    print(f"| series | {size_name} | wall s | ms per unit | note |")
-    print("|---|---|---|---|---|")
+    """The measured rows (wall time, and per unit of the size and per integrator step), then
+    the slopes."""
+    print(
+        f"| series | {size_name} | wall s | ms per {size_name[:-1]} | steps | ns per step | note |"
+    )
+    print("|---|---|---|---|---|---|---|")
     for s in series:
-        for size, wall, note in zip(s.sizes, s.times, s.notes, strict=True):
-            print(f"| {s.label} | {size} | {wall:.4f} | {1e3 * wall / size:.3f} | {note} |")
+        for size, wall, steps, note in zip(s.sizes, s.times, s.steps, s.notes, strict=True):
+            per_step = f"{1e9 * wall / steps:.0f}" if steps else "-"
+            print(
+                f"| {s.label} | {size} | {wall:.4f} | {1e3 * wall / size:.3f} | {steps} | "
+                f"{per_step} | {note} |"
+            )
     print()
     print("| series | slope, all points | slope, last three |")
     print("|---|---|---|")
@@ -142,9 +151,9 @@ def horizon(args: argparse.Namespace) -> list[Series]:
     panel = tj.Panel()
     alt = 540e3
     orbits = {
-        f"GEO geo_year({args.start})": tj.Orbit.geo_year(args.start),
+        "GEO geo_year": tj.Orbit.geo_year(args.start),
         "LEO leo(540 km)": tj.Orbit.leo(alt),
-        "LEO circular(540 km, 28.5 deg)": tj.Orbit.circular(alt, inclination=math.radians(28.5)),
+        "LEO 28.5 deg + Earth": tj.Orbit.circular(alt, inclination=math.radians(28.5)),
     }
     counts = {
         ("GEO", "hybrid"): args.geo_hybrid_orbits,
@@ -152,7 +161,11 @@ def horizon(args: argparse.Namespace) -> list[Series]:
         ("LEO", "hybrid"): args.leo_orbits,
         ("LEO", "rk45"): args.leo_orbits,
     }
-    part("1. Horizon: Table 1, simulate_orbits against the number of orbits")
+    part(
+        f"1. Horizon: Table 1, simulate_orbits against the number of orbits (GEO: geo_year "
+        f"from {args.start}; LEO 28.5 deg + Earth: Orbit.circular(540e3, inclination 28.5 deg), "
+        "conical shadow, albedo and Earth infrared)"
+    )
     out = []
     for name, orbit in orbits.items():
         for method in ("hybrid", "rk45"):
@@ -161,7 +174,7 @@ def horizon(args: argparse.Namespace) -> list[Series]:
                 wall, runs = median_time(
                     lambda n=n, m=method, o=orbit: orbits_run(panel, o, n, m), args.repeat
                 )
-                s.add(n, wall, how(runs))
+                s.add(n, wall, runs.n_steps, how(runs))
             out.append(s)
     table(out, "orbits")
     print(f"\nload average after: {machine.load()}")
@@ -193,7 +206,7 @@ def layers(args: argparse.Namespace) -> list[Series]:
             except tj.ParameterError as error:
                 print(f"{method}, {nodes} nodes refused: {error}")
                 continue
-            s.add(nodes, wall, how(runs))
+            s.add(nodes, wall, runs.n_steps, how(runs))
         out.append(s)
     table(out, "nodes")
     print(f"\nload average after: {machine.load()}")
@@ -218,7 +231,7 @@ def elements(args: argparse.Namespace) -> list[Series]:
             return tj.simulate_distributed(panel, orbit, span, elements=n, t_eval=[span[1]])
 
         wall, sol = median_time(run, args.repeat)
-        full.add(n, wall, f"{sol.n_steps} steps, {sol.y_end.size} states")
+        full.add(n, wall, sol.n_steps, f"{sol.y_end.size} states")
     out = [full]
     long = distributed_long_run(panel, orbit, args)
     if long is not None:
@@ -262,33 +275,46 @@ def distributed_long_run(
                 ),
                 args.repeat,
             )
-            s.add(tj.distributed_defaults(panel)["elements"], wall, how(runs))
+            s.add(tj.distributed_defaults(panel)["elements"], wall, runs.n_steps, how(runs))
             break
-        s.add(n, wall, how(runs))
+        s.add(n, wall, runs.n_steps, how(runs))
     return s
 
 
 def figure(parts: Sequence[Sequence[Series]], path: Path, dpi: int = 100) -> None:
+    """One log-log panel per axis of growth, each with a dotted line of slope 1 for scale."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, NullFormatter
 
-    titles = ("horizon (Table 1)", "nodes through the thickness (wing)", "distributed elements")
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    titles = ("horizon (Table 1)", "nodes through the thickness (CFRP wing)", "distributed panel")
     xlabels = ("orbits", "nodes N", "elements")
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 5.2))
     for ax, series, title, xlabel in zip(axes, parts, titles, xlabels, strict=True):
-        for s in series:
-            if not s.sizes:
-                continue
+        drawn = [s for s in series if s.sizes]
+        for s in drawn:
             whole, _ = s.slopes()
-            ax.loglog(s.sizes, s.times, "o-", ms=3, label=f"{s.label} ({whole:.2f})")
+            ax.loglog(s.sizes, s.times, "o-", ms=3, label=f"{s.label} (slope {whole:.2f})")
+        if drawn:
+            x = np.array([min(min(s.sizes) for s in drawn), max(max(s.sizes) for s in drawn)])
+            ax.loglog(x, drawn[0].times[0] * x / x[0], ":", color="grey", label="slope 1")
         ax.set_title(title, fontsize=10)
         ax.set_xlabel(xlabel)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=6, loc="upper left")
+        ax.xaxis.set_major_formatter(plain)
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_major_formatter(plain)
+        if drawn and len(drawn[0].sizes) > 1 and max(drawn[0].sizes) / min(drawn[0].sizes) < 20:
+            ax.set_xticks(sorted({n for s in drawn for n in s.sizes}))
+        low, high = ax.get_ylim()
+        if high / low < 20:  # less than about a decade: label the minor ticks too
+            ax.yaxis.set_minor_formatter(plain)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), frameon=False)
     axes[0].set_ylabel("wall time, s")
-    fig.suptitle("cost growth (log-log; fitted slope in brackets)", fontsize=10)
+    fig.suptitle("cost growth of a run (log-log)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
@@ -299,7 +325,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "default": {
         "geo_hybrid_orbits": [1, 3, 10, 30, 100, 300, 1000, 3653],
         "geo_rk45_orbits": [1, 3, 10, 30, 100],
-        "leo_orbits": [1, 3, 10, 30, 100, 300],
+        "leo_orbits": [1, 3, 10, 30, 100, 300, 1000],
         "layers": [5, 6, 8, 12, 20, 40],
         "layer_orbits": 3,
         "layer_orbit": "geo",

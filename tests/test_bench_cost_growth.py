@@ -22,15 +22,16 @@ def test_quick_run_reports_every_series() -> None:
     out = done.stdout
     for title in ("## 1. Horizon", "## 2. Nodes through the thickness", "## 3. Elements"):
         assert title in out
-    rows = re.findall(r"^\| (.+?) \| (\d+) \| ([0-9.]+) \| [0-9.]+ \| (.*) \|$", out, re.M)
+    row = r"^\| (.+?) \| (\d+) \| ([0-9.]+) \| [0-9.]+ \| (\d+) \| (\d+|-) \| (.*) \|$"
     by_series: dict[str, list[tuple[int, str]]] = {}
-    for label, size, _, note in rows:
+    for label, size, _, steps, _, note in re.findall(row, out, re.M):
+        assert int(steps) > 0, (label, size)
         by_series.setdefault(label, []).append((int(size), note))
     # --quick: two sizes in every series, six orbit series, two layer series, one distributed.
     assert len(by_series) >= 9, sorted(by_series)
     assert all(len(v) == 2 for v in by_series.values()), by_series
     # With the Earth's loads the hybrid runs rk45, and the table says so (not a warning).
-    inclined = [k for k in by_series if k.startswith("LEO circular") and k.endswith("hybrid")]
+    inclined = [k for k in by_series if k.startswith("LEO 28.5 deg") and k.endswith("hybrid")]
     assert inclined and all("fallback" in note for _, note in by_series[inclined[0]])
     assert all("fallback" not in note for _, note in by_series["LEO leo(540 km) hybrid"])
     assert "HybridFallbackWarning" not in done.stderr
