@@ -21,8 +21,10 @@ elements of the distributed panel, side by side in one run, with a log-log figur
 
 Each time is the median of repeated runs (repeated until about a second has been spent, at most
 ``--repeat`` times); each series gets the slope of log(time) against log(size), over all its
-points and over its last three (the growth once fixed costs are paid). Times are wall seconds;
-the machine may be shared, so the load average is printed before and after each part.
+points and over its last three (the growth once fixed costs are paid). Times are wall seconds,
+with this process's CPU seconds beside them: every run here uses one thread, and on a shared
+machine the CPU time is the steadier of the two. The load average is printed before and after
+each part.
 
     python benches/cost_growth.py [--quick] [--big] [--no-figure] [--figure PATH]
         [--repeat 5] [--start 2026-03-01] [--layer-orbits 3] [--element-span 0.1]
@@ -40,7 +42,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -55,6 +57,14 @@ from laminates import wing  # noqa: E402  (examples/laminates.py)
 HERE = Path(__file__).resolve().parent
 
 
+class Timing(NamedTuple):
+    wall: float
+    """Median wall seconds."""
+    cpu: float
+    """Median CPU seconds of this process: less sensitive than the wall time to other work on a
+    shared machine (the runs timed here use one thread)."""
+
+
 @dataclass
 class Series:
     """One line of the figure: wall time against a size."""
@@ -63,18 +73,25 @@ class Series:
     label: str
     sizes: list[int] = field(default_factory=list)
     times: list[float] = field(default_factory=list)
+    cpu: list[float] = field(default_factory=list)
     steps: list[int] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
-    def add(self, size: int, wall: float, steps: int, note: str = "") -> None:
+    def add(self, size: int, timing: Timing, steps: int, note: str = "") -> None:
         self.sizes.append(size)
-        self.times.append(wall)
+        self.times.append(timing.wall)
+        self.cpu.append(timing.cpu)
         self.steps.append(steps)
         self.notes.append(note)
 
-    def slopes(self) -> tuple[float, float]:
-        """The slope of log(time) against log(size) over every point and over the last three."""
-        return slope(self.sizes, self.times), slope(self.sizes[-3:], self.times[-3:])
+    def slopes(self) -> tuple[float, float, float]:
+        """The slope of log(wall time) against log(size) over every point and over the last
+        three, and that of log(CPU time) over every point."""
+        return (
+            slope(self.sizes, self.times),
+            slope(self.sizes[-3:], self.times[-3:]),
+            slope(self.sizes, self.cpu),
+        )
 
 
 def slope(sizes: Sequence[int], times: Sequence[float]) -> float:
@@ -83,16 +100,18 @@ def slope(sizes: Sequence[int], times: Sequence[float]) -> float:
     return float(np.polyfit(np.log(sizes), np.log(times), 1)[0])
 
 
-def median_time(run: Callable[[], Any], repeat: int, budget: float = 1.0) -> tuple[float, Any]:
-    """The median wall time of ``run`` over at most ``repeat`` calls, stopping once ``budget``
-    seconds have been spent (a long run is timed once), and the last result."""
-    times: list[float] = []
+def median_time(run: Callable[[], Any], repeat: int, budget: float = 1.0) -> tuple[Timing, Any]:
+    """The median wall and CPU times of ``run`` over at most ``repeat`` calls, stopping once
+    ``budget`` wall seconds have been spent (a long run is timed once), and the last result."""
+    walls: list[float] = []
+    cpus: list[float] = []
     result = None
-    while len(times) < max(1, repeat) and (not times or sum(times) < budget):
-        start = time.perf_counter()
+    while len(walls) < max(1, repeat) and (not walls or sum(walls) < budget):
+        start, start_cpu = time.perf_counter(), time.process_time()
         result = run()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), result
+        walls.append(time.perf_counter() - start)
+        cpus.append(time.process_time() - start_cpu)
+    return Timing(statistics.median(walls), statistics.median(cpus)), result
 
 
 def orbits_run(
@@ -123,25 +142,28 @@ def how(runs: tj.OrbitSummaries) -> str:
 
 
 def table(series: Sequence[Series], size_name: str) -> None:
-    """The measured rows (wall time, and per unit of the size and per integrator step), then
+    """The measured rows (wall and CPU time, per unit of the size and per integrator step), then
     the slopes."""
+    unit = size_name[:-1]
     print(
-        f"| series | {size_name} | wall s | ms per {size_name[:-1]} | steps | ns per step | note |"
+        f"| series | {size_name} | wall s | CPU s | wall ms per {unit} | steps | CPU ns per step "
+        "| note |"
     )
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for s in series:
-        for size, wall, steps, note in zip(s.sizes, s.times, s.steps, s.notes, strict=True):
-            per_step = f"{1e9 * wall / steps:.0f}" if steps else "-"
+        rows = zip(s.sizes, s.times, s.cpu, s.steps, s.notes, strict=True)
+        for size, wall, cpu, steps, note in rows:
+            per_step = f"{1e9 * cpu / steps:.0f}" if steps else "-"
             print(
-                f"| {s.label} | {size} | {wall:.4f} | {1e3 * wall / size:.3f} | {steps} | "
-                f"{per_step} | {note} |"
+                f"| {s.label} | {size} | {wall:.4f} | {cpu:.4f} | {1e3 * wall / size:.3f} | "
+                f"{steps} | {per_step} | {note} |"
             )
     print()
-    print("| series | slope, all points | slope, last three |")
-    print("|---|---|---|")
+    print("| series | slope (wall), all points | slope (wall), last three | slope (CPU), all |")
+    print("|---|---|---|---|")
     for s in series:
-        whole, tail = s.slopes()
-        print(f"| {s.label} | {whole:.2f} | {tail:.2f} |")
+        whole, tail, cpu = s.slopes()
+        print(f"| {s.label} | {whole:.2f} | {tail:.2f} | {cpu:.2f} |")
 
 
 def part(title: str) -> None:
@@ -174,10 +196,10 @@ def horizon(args: argparse.Namespace) -> list[Series]:
         for method in ("hybrid", "rk45"):
             s = Series("orbits", f"{name} {method}")
             for n in counts[(name[:3], method)]:
-                wall, runs = median_time(
+                timing, runs = median_time(
                     lambda n=n, m=method, o=orbit: orbits_run(panel, o, n, m), args.repeat
                 )
-                s.add(n, wall, runs.n_steps, how(runs))
+                s.add(n, timing, runs.n_steps, how(runs))
             out.append(s)
     table(out, "orbits")
     print(f"\nload average after: {machine.load()}")
@@ -205,11 +227,11 @@ def layers(args: argparse.Namespace) -> list[Series]:
                 def run(m: str = method, n: int = nodes) -> tj.OrbitSummaries:
                     return orbits_run(panel, orbit, args.layer_orbits, m, layers=n)
 
-                wall, runs = median_time(run, args.repeat)
+                timing, runs = median_time(run, args.repeat)
             except tj.ParameterError as error:
                 print(f"{method}, {nodes} nodes refused: {error}")
                 continue
-            s.add(nodes, wall, runs.n_steps, how(runs))
+            s.add(nodes, timing, runs.n_steps, how(runs))
         out.append(s)
     table(out, "nodes")
     print(f"\nload average after: {machine.load()}")
@@ -233,8 +255,8 @@ def elements(args: argparse.Namespace) -> list[Series]:
         def run(n: int = n) -> tj.DistributedSolution:
             return tj.simulate_distributed(panel, orbit, span, elements=n, t_eval=[span[1]])
 
-        wall, sol = median_time(run, args.repeat)
-        full.add(n, wall, sol.n_steps, f"{sol.y_end.size} states")
+        timing, sol = median_time(run, args.repeat)
+        full.add(n, timing, sol.n_steps, f"{sol.y_end.size} states")
     out = [full]
     long = distributed_long_run(panel, orbit, args)
     if long is not None:
@@ -276,17 +298,17 @@ def distributed_long_run(
                     elements=n,
                 )  # fmt: skip
 
-            wall, runs = median_time(run, args.repeat)
+            timing, runs = median_time(run, args.repeat)
         except TypeError:  # no elements= keyword: the default mesh only
-            wall, runs = median_time(
+            timing, runs = median_time(
                 lambda: orbits_run(
                     panel, orbit, args.distributed_orbits, "hybrid", model="distributed"
                 ),
                 args.repeat,
             )
-            s.add(tj.distributed_defaults(panel)["elements"], wall, runs.n_steps, how(runs))
+            s.add(tj.distributed_defaults(panel)["elements"], timing, runs.n_steps, how(runs))
             break
-        s.add(n, wall, runs.n_steps, how(runs))
+        s.add(n, timing, runs.n_steps, how(runs))
     return s
 
 
@@ -305,7 +327,7 @@ def figure(parts: Sequence[Sequence[Series]], path: Path, dpi: int = 100) -> Non
     for ax, series, title, xlabel in zip(axes, parts, titles, xlabels, strict=True):
         drawn = [s for s in series if s.sizes]
         for s in drawn:
-            whole, _ = s.slopes()
+            whole = s.slopes()[0]
             ax.loglog(s.sizes, s.times, "o-", ms=3, label=f"{s.label} (slope {whole:.2f})")
         if drawn:
             x = np.array([min(min(s.sizes) for s in drawn), max(max(s.sizes) for s in drawn)])
