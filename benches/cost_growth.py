@@ -312,8 +312,9 @@ def distributed_long_run(
     return s
 
 
-def figure(parts: Sequence[Sequence[Series]], path: Path, dpi: int = 100) -> None:
-    """One log-log panel per axis of growth, each with a dotted line of slope 1 for scale."""
+def figure(parts: Sequence[Sequence[Series]], path: Path, dpi: int = 90) -> None:
+    """One log-log panel per axis of growth: wall time (solid) and CPU time (dashed, same
+    colour) of each series, and a dotted line of slope 1 for scale."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -328,7 +329,10 @@ def figure(parts: Sequence[Sequence[Series]], path: Path, dpi: int = 100) -> Non
         drawn = [s for s in series if s.sizes]
         for s in drawn:
             whole = s.slopes()[0]
-            ax.loglog(s.sizes, s.times, "o-", ms=3, label=f"{s.label} (slope {whole:.2f})")
+            (line,) = ax.loglog(
+                s.sizes, s.times, "o-", ms=3, label=f"{s.label} (slope {whole:.2f})"
+            )
+            ax.loglog(s.sizes, s.cpu, "--", lw=0.8, color=line.get_color())
         if drawn:
             x = np.array([min(min(s.sizes) for s in drawn), max(max(s.sizes) for s in drawn)])
             ax.loglog(x, drawn[0].times[0] * x / x[0], ":", color="grey", label="slope 1")
@@ -344,10 +348,14 @@ def figure(parts: Sequence[Sequence[Series]], path: Path, dpi: int = 100) -> Non
         if high / low < 20:  # less than about a decade: label the minor ticks too
             ax.yaxis.set_minor_formatter(plain)
         ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), frameon=False)
-    axes[0].set_ylabel("wall time, s")
-    fig.suptitle("cost growth of a run (log-log)", fontsize=10)
+    axes[0].set_ylabel("time, s")
+    fig.suptitle(
+        "cost growth of a run (log-log): wall time, solid; CPU time, dashed; slopes of the wall "
+        "time",
+        fontsize=10,
+    )
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
+    fig.savefig(path, dpi=dpi, pil_kwargs={"optimize": True})
     plt.close(fig)
     print(f"\nfigure: {path} ({path.stat().st_size / 1024:.0f} KB)")
 
