@@ -67,7 +67,7 @@ class Timing(NamedTuple):
 
 @dataclass
 class Series:
-    """One line of the figure: wall time against a size."""
+    """One line of the figure: wall and CPU time against a size."""
 
     axis: str  # "orbits", "layers" or "elements"
     label: str
@@ -299,7 +299,9 @@ def distributed_long_run(
                 )  # fmt: skip
 
             timing, runs = median_time(run, args.repeat)
-        except TypeError:  # no elements= keyword: the default mesh only
+        except TypeError as error:  # no elements= keyword: the default mesh only
+            if isinstance(error, tj.ParameterError):  # a ParameterTypeError is a TypeError too
+                raise
             timing, runs = median_time(
                 lambda: orbits_run(
                     panel, orbit, args.distributed_orbits, "hybrid", model="distributed"

@@ -3,6 +3,7 @@ each run did. Its timings are not checked (speed is measured in benches/, never 
 
 from __future__ import annotations
 
+import math
 import re
 import subprocess
 import sys
@@ -28,15 +29,32 @@ def test_quick_run_reports_every_series() -> None:
     for label, size, steps, _, note in re.findall(row, out, re.M):
         assert int(steps) > 0, (label, size)
         by_series.setdefault(label, []).append((int(size), note))
-    # --quick: two sizes in every series, six orbit series, two layer series, one distributed.
-    assert len(by_series) >= 9, sorted(by_series)
-    assert all(len(v) == 2 for v in by_series.values()), by_series
+    # --quick: two sizes in each of the six orbit series, the two layer series and the full
+    # distributed run (a distributed long run, once simulate_orbits has one, may add a series).
+    known = list(QUICK_SIZES)
+    for label in known:
+        assert [size for size, _ in by_series.get(label, [])] == QUICK_SIZES[label], label
     # With the Earth's loads the hybrid runs rk45, and the table says so (not a warning).
-    inclined = [k for k in by_series if k.startswith("LEO 28.5 deg") and k.endswith("hybrid")]
-    assert inclined and all("fallback" in note for _, note in by_series[inclined[0]])
+    assert all("fallback" in note for _, note in by_series["LEO 28.5 deg + Earth hybrid"])
     assert all("fallback" not in note for _, note in by_series["LEO leo(540 km) hybrid"])
     assert "HybridFallbackWarning" not in done.stderr
-    # A slope per series, finite where there are two sizes.
-    slope = r"-?[0-9.]+"
-    slopes = re.findall(rf"^\| (.+?) \| {slope} \| {slope} \| {slope} \|$", out, re.M)
+    # A slope for every series, finite for those of two sizes.
+    slopes = dict(
+        re.findall(r"^\| (.+?) \| (-?[0-9.]+|nan) \| (?:-?[0-9.]+|nan) \| \S+ \|$", out, re.M)
+    )
     assert set(slopes) == set(by_series)
+    assert all(math.isfinite(float(slopes[label])) for label in known)
+
+
+QUICK_SIZES = {
+    **{f"GEO geo_year {m}": s for m, s in (("hybrid", [1, 3]), ("rk45", [1, 2]))},
+    **{
+        f"{orbit} {m}": [1, 3]
+        for orbit in ("LEO leo(540 km)", "LEO 28.5 deg + Earth")
+        for m in ("hybrid", "rk45")
+    },
+    "wing hybrid": [5, 6],
+    "wing rk45": [5, 6],
+    "simulate_distributed (full)": [5, 10],
+}
+"""The sizes of ``--quick`` (benches/cost_growth.py, PRESETS["quick"])."""
