@@ -196,9 +196,11 @@ def horizon(args: argparse.Namespace) -> list[Series]:
         for method in ("hybrid", "rk45"):
             s = Series("orbits", f"{name} {method}")
             for n in counts[(name[:3], method)]:
-                timing, runs = median_time(
-                    lambda n=n, m=method, o=orbit: orbits_run(panel, o, n, m), args.repeat
-                )
+
+                def run(o: tj.Orbit = orbit, m: str = method, n: int = n) -> tj.OrbitSummaries:
+                    return orbits_run(panel, o, n, m)
+
+                timing, runs = median_time(run, args.repeat)
                 s.add(n, timing, runs.n_steps, how(runs))
             out.append(s)
     table(out, "orbits")
