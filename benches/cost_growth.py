@@ -132,6 +132,21 @@ def orbits_run(
         )
 
 
+def time_orbits(
+    series: Series,
+    size: int,
+    repeat: int,
+    panel: tj.Panel,
+    orbit: tj.Orbit,
+    n_orbits: int,
+    method: str,
+    **kw: Any,
+) -> None:
+    """Times ``n_orbits`` of ``simulate_orbits`` and adds the row at ``size`` to ``series``."""
+    timing, runs = median_time(lambda: orbits_run(panel, orbit, n_orbits, method, **kw), repeat)
+    series.add(size, timing, runs.n_steps, how(runs))
+
+
 def how(runs: tj.OrbitSummaries) -> str:
     """What a hybrid run did: its share on the non-linear model, or that it ran rk45."""
     if runs.settings.get("hybrid_fallback") or runs.fallback:
@@ -196,12 +211,7 @@ def horizon(args: argparse.Namespace) -> list[Series]:
         for method in ("hybrid", "rk45"):
             s = Series("orbits", f"{name} {method}")
             for n in counts[(name[:3], method)]:
-
-                def run(o: tj.Orbit = orbit, m: str = method, n: int = n) -> tj.OrbitSummaries:
-                    return orbits_run(panel, o, n, m)
-
-                timing, runs = median_time(run, args.repeat)
-                s.add(n, timing, runs.n_steps, how(runs))
+                time_orbits(s, n, args.repeat, panel, orbit, n, method)
             out.append(s)
     table(out, "orbits")
     print(f"\nload average after: {machine.load()}")
@@ -225,15 +235,10 @@ def layers(args: argparse.Namespace) -> list[Series]:
         s = Series("layers", f"wing {method}")
         for nodes in args.layers:
             try:
-
-                def run(m: str = method, n: int = nodes) -> tj.OrbitSummaries:
-                    return orbits_run(panel, orbit, args.layer_orbits, m, layers=n)
-
-                timing, runs = median_time(run, args.repeat)
+                time_orbits(s, nodes, args.repeat, panel, orbit, args.layer_orbits, method,
+                            layers=nodes)  # fmt: skip
             except tj.ParameterError as error:
                 print(f"{method}, {nodes} nodes refused: {error}")
-                continue
-            s.add(nodes, timing, runs.n_steps, how(runs))
         out.append(s)
     table(out, "nodes")
     print(f"\nload average after: {machine.load()}")
@@ -291,28 +296,18 @@ def distributed_long_run(
     s = Series(
         "elements", f'simulate_orbits(model="distributed"), {args.distributed_orbits} orbits'
     )
+    n_orbits = args.distributed_orbits
     for n in args.elements:
         try:
-
-            def run(n: int = n) -> tj.OrbitSummaries:
-                return orbits_run(
-                    panel, orbit, args.distributed_orbits, "hybrid", model="distributed",
-                    elements=n,
-                )  # fmt: skip
-
-            timing, runs = median_time(run, args.repeat)
+            time_orbits(s, n, args.repeat, panel, orbit, n_orbits, "hybrid", model="distributed",
+                        elements=n)  # fmt: skip
         except TypeError as error:  # no elements= keyword: the default mesh only
             if isinstance(error, tj.ParameterError):  # a ParameterTypeError is a TypeError too
                 raise
-            timing, runs = median_time(
-                lambda: orbits_run(
-                    panel, orbit, args.distributed_orbits, "hybrid", model="distributed"
-                ),
-                args.repeat,
-            )
-            s.add(tj.distributed_defaults(panel)["elements"], timing, runs.n_steps, how(runs))
+            default = tj.distributed_defaults(panel)["elements"]
+            time_orbits(s, default, args.repeat, panel, orbit, n_orbits, "hybrid",
+                        model="distributed")  # fmt: skip
             break
-        s.add(n, timing, runs.n_steps, how(runs))
     return s
 
 
