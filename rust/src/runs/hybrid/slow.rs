@@ -709,27 +709,28 @@ const RING_ACCURACY: f64 = 3e-3;
 
 /// Whether every summary of the orbit just run (the collector's current one) holds the accuracy
 /// gate (2 %, or 1e-6 rad below 5e-5 rad) by twice the error the ringing of amplitude up to
-/// `ring` may carry: a column near 0 (θ_min of a panel that barely bends back) cannot.
+/// `ring` may carry: a column near 0 (θ_min of a panel that barely bends back) cannot. The RMS
+/// of the dynamic part scales with the ringing, so its error is that fraction of itself.
 fn within_gate<V: crate::runs::orbits::SummaryView>(c: &Collector<V>, ring: f64) -> bool {
     let s = &c.current;
-    let bound = RING_ACCURACY * ring;
-    [
-        s.theta_max,
-        s.theta_min,
-        s.amplitude,
-        c.rms_so_far(),
-        s.jitter_peak,
-        s.entry_theta_min,
-        s.exit_theta_max,
-        s.entry_peak,
-        s.exit_peak,
-    ]
-    .into_iter()
-    .filter(|v| !v.is_nan())
-    .all(|v| {
+    let holds = |v: f64, bound: f64| {
         let gate = if v.abs() < 5e-5 { 1e-6 } else { 0.02 * v.abs() };
-        bound <= 0.5 * gate
-    })
+        v.is_nan() || bound <= 0.5 * gate
+    };
+    let rms = c.rms_so_far();
+    holds(rms, RING_ACCURACY * rms)
+        && [
+            s.theta_max,
+            s.theta_min,
+            s.amplitude,
+            s.jitter_peak,
+            s.entry_theta_min,
+            s.exit_theta_max,
+            s.entry_peak,
+            s.exit_peak,
+        ]
+        .into_iter()
+        .all(|v| holds(v, RING_ACCURACY * ring))
 }
 
 /// Runs the orbits of `spec` from `y0` on slow time, each orbit in full where a guard refuses it
