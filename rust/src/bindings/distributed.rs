@@ -2,11 +2,13 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, crossing_tuple, orbit_from, panel_from, required_item, set_counters, RunOptions,
+    coupling, crossing_tuple, orbit_from, panel_from, required_item, set_counters, OrbitsRun,
+    RunOptions,
 };
 use super::error::{invalid, shield};
 use crate::analysis::flutter::check_flux;
 use crate::models::distributed::{DistributedPanel, Settings, Support};
+use crate::runs::orbits::{OrbitRunSpec, SummaryOptions};
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -214,7 +216,104 @@ fn simulate_distributed<'py>(
     })
 }
 
+/// The default start state of a distributed run on an orbit at t0 (the sunlit equilibrium at
+/// rest at that date's flux, or under the orbit's loads there).
+#[pyfunction]
+fn distributed_start_state(
+    py: Python<'_>,
+    panel: &Bound<'_, PyDict>,
+    settings: &Bound<'_, PyDict>,
+    orbit: &Bound<'_, PyDict>,
+    t0: f64,
+) -> PyResult<Vec<f64>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        let o = orbit_from(orbit)?;
+        o.validate().map_err(PyErr::from)?;
+        m.check_orbit(&o).map_err(PyErr::from)?;
+        py.detach(|| crate::runs::distributed::start_state(&m, &o, t0))
+            .map_err(PyErr::from)
+    })
+}
+
+/// Integrates the distributed panel over whole orbits and returns one summary per orbit (the
+/// hinge runs' columns, θ read as θ_f, with `tip_max` and `tip_min`); with `hybrid` (its
+/// settings) on linear arcs where their checks hold, adding how the simulated time was split.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, settings, orbits, *, t_start, first_index, y0, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
+#[allow(clippy::too_many_arguments)]
+fn run_distributed_orbits<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    orbits: OrbitsRun<'py>,
+    t_start: f64,
+    first_index: u64,
+    y0: Vec<f64>,
+    theta_limit: f64,
+    stop_at_limit: bool,
+    steps_per_period: f64,
+    cancel: Option<&Bound<'py, CancelToken>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    cancellable(cancel, |cancel| {
+        let m = model_from(panel, settings)?;
+        let o = orbit_from(orbit)?;
+        let (hinge, coupling, method) = orbits.hinge()?;
+        crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
+        let spec = OrbitRunSpec {
+            panel: m.panel,
+            orbit: o,
+            model: hinge,
+            coupling,
+            method,
+            t_start,
+            first_index,
+            n_orbits: orbits.n_orbits,
+            options: SummaryOptions {
+                window: orbits.window,
+                theta_limit,
+                stop_at_limit,
+                steps_per_period,
+            },
+        };
+        let hybrid = orbits.hybrid()?;
+        let out = py.detach(|| {
+            crate::runs::distributed_orbits::run_distributed_orbits(
+                &m,
+                &spec,
+                &y0,
+                hybrid.as_ref(),
+                cancel,
+            )
+        })?;
+        let summaries = crate::runs::layered::LayeredSummaries {
+            summaries: out.summaries,
+            stats: out.stats,
+            y_end: out.y_end,
+            crossing: out.crossing,
+        };
+        let d = super::orbits::summary_dict(py, &summaries, &method)?;
+        d.set_item("tip_max", PyArray1::from_vec(py, out.tip_max))?;
+        d.set_item("tip_min", PyArray1::from_vec(py, out.tip_min))?;
+        if let Some(split) = out.split {
+            d.set_item("t_linear", split.t_linear)?;
+            d.set_item("t_exponential", 0.0)?;
+            d.set_item("t_fallback", split.t_full)?;
+            d.set_item("n_arcs", split.n_arcs)?;
+            d.set_item("n_exp_steps", 0u64)?;
+            d.set_item("n_fallback_steps", split.n_full_steps)?;
+            d.set_item("n_reread_steps", 0u64)?;
+            d.set_item("n_refused_arcs", split.n_refused)?;
+        }
+        modal_info(py, &m, &d)?;
+        Ok(d)
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(run_distributed_orbits, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_start_state, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
     m.add_function(wrap_pyfunction!(hinge_equivalent_damping_ratio, m)?)?;

@@ -124,11 +124,7 @@ pub fn simulate(
             crate::models::hinge::check_start_state(&v, model.layers() * model.n(), None)?;
             v
         }
-        None if orbit.has_face_loads() => {
-            let optics = Optics::of(&model.panel);
-            model.equilibrium_loaded(&ElementHeat::at(&orbit, t0, 1.0, optics))?
-        }
-        None => model.equilibrium(orbit.flux_scale(t0))?,
+        None => start_state(model, &orbit, t0)?,
     };
     let mut system = DistributedSystem::new(model.clone(), orbit);
     let watch = settings.limit.map(|on| model.limit(on));
@@ -173,6 +169,18 @@ pub fn simulate(
         out.sunlit.push(orbit.illumination(*t));
     }
     Ok(out)
+}
+
+/// The default start of a run of `model` on `orbit` at t0: the sunlit equilibrium at rest under
+/// the Sun's distance at t0, and under the Earth's loads and the attitude there when the orbit
+/// has them.
+pub fn start_state(model: &DistributedPanel, orbit: &Orbit, t0: f64) -> Result<Vec<f64>> {
+    Orbit::check_time(t0)?;
+    if orbit.has_face_loads() {
+        let optics = Optics::of(&model.panel);
+        return model.equilibrium_loaded(&ElementHeat::at(orbit, t0, 1.0, optics));
+    }
+    model.equilibrium(orbit.flux_scale(t0))
 }
 
 impl DistributedPanel {
