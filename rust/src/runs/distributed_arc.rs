@@ -1,9 +1,9 @@
 //! Exact propagation of the distributed panel's linearised system over a sunlit arc.
 //!
-//! About the sunlit equilibrium y_r at the arc's initial flux, with the flux drifting linearly
-//! (the Sun's distance), the deviation δ = y − y_r obeys δ' = A δ + b τ, A the Jacobian at y_r.
-//! Its solution is the quasi-static drift p0 + p1 τ (p1 = −A⁻¹ b, p0 = A⁻¹ p1) plus the free
-//! response, split into two exact parts:
+//! About a sunlit equilibrium y_r (at a flux near the arc's), with the flux's offset from it and
+//! its linear drift (the Sun's distance) as forcings, the deviation δ = y − y_r obeys
+//! δ' = A δ + c + b τ, A the Jacobian at y_r. Its solution is the quasi-static drift p0 + p1 τ
+//! (p1 = −A⁻¹ b, p0 = A⁻¹ (p1 − c)) plus the free response, split into two exact parts:
 //!
 //! - the structural pairs: the complex eigenpairs of A whose frequency is that of a kept elastic
 //!   mode, 2 Re(v_k c_k e^{λ_k τ}) with c_k = w_k·δ_h(0) (right and left eigenvectors by inverse
@@ -143,10 +143,12 @@ pub(crate) struct LinearArc {
 }
 
 impl LinearArc {
-    /// The arc from y0 about `y_ref` with Jacobian `a`, its structural `pairs`, and the drift
-    /// forcing b τ.
+    /// The arc from y0 about `y_ref` with Jacobian `a`, its structural `pairs`, and the forcing
+    /// c + b τ.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         a: &DMatrix<f64>,
+        c: &DVector<f64>,
         b: &DVector<f64>,
         y_ref: &DVector<f64>,
         y0: &DVector<f64>,
@@ -159,7 +161,7 @@ impl LinearArc {
             reason: "singular Jacobian".into(),
         };
         let p1 = -lu.solve(b).ok_or_else(singular)?;
-        let p0 = lu.solve(&p1).ok_or_else(singular)?;
+        let p0 = lu.solve(&(&p1 - c)).ok_or_else(singular)?;
         let h0 = y0 - y_ref - &p0;
         let coeff: Vec<C64> = pairs.iter().map(|p| p.coordinate(&h0)).collect();
         let mut r0 = h0;
@@ -317,6 +319,7 @@ impl ArcSignal {
     }
 
     /// The value at the end (exact: a node).
+    #[cfg(test)]
     pub fn at_end(&self) -> f64 {
         let tau = self.cells() as f64 * self.step;
         let mut v = self.values[self.cells()];
@@ -514,12 +517,13 @@ mod tests {
         let scale = DVector::from_element(4, 1.0);
         let pairs = structural_pairs(&a, &scale, 1, 0.1).expect("one pair");
         let length = 1000.0;
-        let arc = LinearArc::new(&a, &b, &y_ref, &y0, pairs, length).unwrap();
+        let c = DVector::from_vec(vec![2e-3, 0.0, 0.0, 1e-4]);
+        let arc = LinearArc::new(&a, &c, &b, &y_ref, &y0, pairs, length).unwrap();
         // Against a fine RK4 integration of δ' = A δ + b τ.
         let mut d = &y0 - &y_ref;
         let n = 200_000;
         let dt = length / n as f64;
-        let f = |tau: f64, d: &DVector<f64>| &a * d + &b * tau;
+        let f = |tau: f64, d: &DVector<f64>| &a * d + &c + &b * tau;
         let w = DVector::from_vec(vec![0.0, 0.0, 1.0, 0.0]);
         let signal = arc.signal(&w, 0.0);
         let (mut lo, mut hi, mut sq) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);

@@ -370,6 +370,7 @@ pub fn run_distributed_orbits(
         split: DistributedSplit::default(),
         drift: (0.0, spec.t_start, 0.0),
         eclipses: EclipseTable::until(&spec.orbit, spec.t_end()),
+        reference: None,
     };
     let arcs = hybrid.filter(|_| !spec.orbit.has_face_loads());
     match arcs {
@@ -408,6 +409,13 @@ pub fn run_distributed_orbits(
     })
 }
 
+/// The right-hand side of `model` in full Sun under the flux factor `flux`.
+fn rhs(model: &DistributedPanel, flux: f64, y: &DVector<f64>) -> DVector<f64> {
+    let mut dy = DVector::zeros(y.len());
+    model.rhs_at_flux(flux, y.as_slice(), dy.as_mut_slice());
+    dy
+}
+
 /// `method` with its step capped at T₁/steps_per_period (adaptive methods; 0: no cap), T₁ the
 /// first kept mode's period.
 fn capped(method: &Method, model: &DistributedPanel, steps_per_period: f64) -> Method {
@@ -437,7 +445,26 @@ struct Driver<'a, 'c> {
     /// The drift in θ_f that arcs have left in the state: (error rad, at t, decay rate 1/s).
     drift: (f64, f64, f64),
     eclipses: EclipseTable,
+    /// The last linearisation: kept while the flux stays within [`REFERENCE_SPAN`] of its own.
+    reference: Option<Reference>,
 }
+
+/// A sunlit equilibrium and what the arcs need of it.
+struct Reference {
+    flux: f64,
+    y: DVector<f64>,
+    a: nalgebra::DMatrix<f64>,
+    lu: nalgebra::LU<f64, D, D>,
+    /// ∂f/∂flux at the equilibrium (the rates are linear in the flux).
+    sensitivity: DVector<f64>,
+    /// The structural pairs, once found (None inside: not found).
+    pairs: Option<Option<Vec<crate::runs::distributed_arc::Pair>>>,
+}
+
+/// Relative change of the flux over which a linearisation is kept: the flux's offset from it
+/// is a forcing of the arc, and the non-linear remainder at each arc's start (checked) holds
+/// what the offset leaves out.
+const REFERENCE_SPAN: f64 = 1e-4;
 
 /// A linear arc ready to be read: the arc and the drift it leaves at its end.
 struct Plan {
@@ -541,7 +568,9 @@ impl Driver<'_, '_> {
         let rise_static = arc.signal(&r.rise_static.w, r.rise_static.c);
         let tip = arc.signal(&r.tip.w, r.tip.c);
         let length = end - t0;
-        let tol = |s: &crate::runs::distributed_arc::ArcSignal| READ_RTOL * s.variation();
+        // With a floor of READ_RTOL of the gate's absolute 1e-6 rad as a rise (m) at the arm.
+        let floor = READ_RTOL * 1e-6 * r.arm;
+        let tol = |s: &crate::runs::distributed_arc::ArcSignal| READ_RTOL * s.variation() + floor;
         let signals = [&rise, &dynamic, &rise_static, &tip];
         if signals
             .iter()
@@ -602,14 +631,41 @@ impl Driver<'_, '_> {
         Ok(true)
     }
 
+    /// Keeps the linearisation for `flux`: the kept one, or a new one at that flux.
+    fn refresh(&mut self, flux: f64) -> Result<()> {
+        let stale = self
+            .reference
+            .as_ref()
+            .is_none_or(|r| (r.flux - flux).abs() > REFERENCE_SPAN * flux);
+        if stale {
+            let model = self.model;
+            let y = DVector::from_vec(model.equilibrium(flux)?);
+            let a = model.jacobian(flux, y.as_slice());
+            let sensitivity = rhs(model, 1.0, &y) - rhs(model, 0.0, &y);
+            self.reference = Some(Reference {
+                flux,
+                lu: a.clone().lu(),
+                y,
+                a,
+                sensitivity,
+                pairs: None,
+            });
+        }
+        Ok(())
+    }
+
     /// The arc from (t, y) to `end` with its checks; None where one fails.
     fn plan(&mut self, end: f64, settings: &HybridSettings) -> Result<Option<Plan>> {
         let model = self.model;
-        let (t0, y) = (self.t, &self.y);
+        let t0 = self.t;
         let flux0 = self.orbit.flux_scale(t0);
         let flux1 = self.orbit.flux_scale(end);
-        let y_ref = DVector::from_vec(model.equilibrium(flux0)?);
-        let a = model.jacobian(flux0, y_ref.as_slice());
+        let scale = self.scale();
+        self.refresh(flux0)?;
+        let reference = self.reference.as_mut().expect("refreshed");
+        let offset = &reference.sensitivity * (flux0 - reference.flux);
+        let (y_ref, a) = (reference.y.clone(), reference.a.clone());
+        let y = &self.y;
         let r = &self.reads.readers;
         let x_ref = r.rise.at(y_ref.as_slice()) / r.arm;
         let theta = |y: &DVector<f64>| r.angle(r.rise.at(y.as_slice()));
@@ -617,26 +673,23 @@ impl Driver<'_, '_> {
             return Ok(None);
         }
         // The non-linear remainder at the start as a static θ_f error.
-        let rhs = |flux: f64, y: &DVector<f64>| {
-            let mut dy = DVector::zeros(y.len());
-            model.rhs_at_flux(flux, y.as_slice(), dy.as_mut_slice());
-            dy
-        };
-        let remainder = rhs(flux0, y) - &a * (y - &y_ref);
-        let Some(z) = a.clone().lu().solve(&remainder) else {
+        let remainder = rhs(model, flux0, y) - &a * (y - &y_ref) - &offset;
+        let Some(z) = reference.lu.solve(&remainder) else {
             return Ok(None);
         };
         let grad = &r.rise.w / (r.arm * (1.0 - x_ref * x_ref).sqrt());
         if grad.dot(&z).abs() > settings.linear_tolerance {
             return Ok(None);
         }
-        let Some(pairs) = structural_pairs(&a, &self.scale(), model.k(), 0.1 * model.reduction.omega[0])
-        else {
+        let slowest = 0.1 * model.reduction.omega[0];
+        let pairs = reference
+            .pairs
+            .get_or_insert_with(|| structural_pairs(&a, &scale, model.k(), slowest));
+        let Some(pairs) = pairs.clone() else {
             return Ok(None);
         };
-        let sensitivity = rhs(1.0, &y_ref) - rhs(0.0, &y_ref);
-        let b = sensitivity * ((flux1 - flux0) / (end - t0));
-        let Ok(arc) = LinearArc::new(&a, &b, &y_ref, y, pairs, end - t0) else {
+        let b = &reference.sensitivity * ((flux1 - flux0) / (end - t0));
+        let Ok(arc) = LinearArc::new(&a, &offset, &b, &y_ref, y, pairs, end - t0) else {
             return Ok(None);
         };
         // The drift of the dropped non-linear terms, against what the gate allows.
@@ -644,7 +697,7 @@ impl Driver<'_, '_> {
         let spent = error * (rate * (t0 - at)).min(50.0).exp();
         let jitter = gate_scale(&self.reads.collector);
         let allowed = (DRIFT_RTOL * jitter).max(DRIFT_ATOL) - spent;
-        let (largest, at_end, slowest) = self.arc_drift(&arc, &a, &grad, t0, &rhs);
+        let (largest, at_end, slowest) = self.arc_drift(&arc, &a, &grad, t0);
         if largest > allowed {
             return Ok(None);
         }
@@ -690,8 +743,8 @@ impl Driver<'_, '_> {
         a: &nalgebra::DMatrix<f64>,
         grad: &DVector<f64>,
         t0: f64,
-        rhs: &impl Fn(f64, &DVector<f64>) -> DVector<f64>,
     ) -> (f64, f64, f64) {
+        let model = self.model;
         let (mut largest, mut at_end, mut slowest) = (0.0, 0.0, f64::NEG_INFINITY);
         let length = arc.length;
         for (pair, &c) in arc.pairs.iter().zip(&arc.coeff) {
@@ -711,7 +764,7 @@ impl Driver<'_, '_> {
                     let y = arc.state_near_node(node, tau);
                     let h = pair.part(c, tau);
                     let flux = self.orbit.flux_scale(t0 + tau);
-                    let defect = a * &h - rhs(flux, &y) + rhs(flux, &(&y - &h));
+                    let defect = a * &h - rhs(model, flux, &y) + rhs(model, flux, &(&y - &h));
                     mean += (-pair.lambda * tau).exp() * pair.coordinate(&defect);
                 }
                 mean / DRIFT_SAMPLES as f64 / c
