@@ -179,3 +179,45 @@ def test_a_boom_is_not_a_distributed_panel() -> None:
     with pytest.raises(tj.ParameterError) as err:
         tj.simulate_orbits(tj.Boom(30.0, 6e-3, 5e-5), GEO, 1, model="distributed", progress=False)
     assert err.value.parameter == "model"
+
+
+def test_each_monte_carlo_sample_is_its_own_run() -> None:
+    vary = {"damping": ("uniform", 1.0, 3.0), "emissivity_front": ("uniform", 0.7, 0.9)}
+    kw = {"method": "hybrid", "solver": SOLVER, **SMALL}
+    frame = tj.monte_carlo(
+        PAPER, GEO, vary=vary, n=3, seed=7, model="distributed", threads=2, progress=False, **kw
+    )
+    assert frame.attrs["n_failed"] == 0
+    for i in (0, 2):
+        panel = PAPER.replace(
+            damping=frame.damping[i], emissivity_front=frame.emissivity_front[i]
+        )
+        run = tj.simulate_orbits(panel, GEO, 1, model="distributed", progress=False, **kw)
+        assert frame.amplitude[i] == run.amplitude[0]
+        assert frame.exit_peak[i] == run.exit_peak[0]
+        assert frame.jitter_peak[i] == run.jitter_peak[0]
+        assert frame.tip_max[i] == run.tip_max[0]
+        assert frame.theta_eq[i] == run.theta_eq[0]
+        fl = tj.distributed_flutter(panel, **SMALL)
+        assert frame.critical_damping[i] == fl.critical_damping
+        assert bool(frame.stable[i]) == fl.stable
+    # Threads change nothing.
+    one = tj.monte_carlo(
+        PAPER, GEO, vary=vary, n=3, seed=7, model="distributed", threads=1, progress=False, **kw
+    )
+    assert one.drop(columns="error").equals(frame.drop(columns="error"))
+
+
+def test_a_distributed_study_refuses_what_it_does_not_take() -> None:
+    with pytest.raises(tj.ParameterError) as err:
+        tj.monte_carlo(
+            PAPER, GEO, vary={"albedo": ("uniform", 0.1, 0.3)}, n=2, seed=1,
+            model="distributed", progress=False,
+        )  # fmt: skip
+    assert err.value.parameter == "vary.albedo"
+    with pytest.raises(tj.ParameterError) as err:
+        tj.monte_carlo(
+            PAPER, GEO, vary={"damping": ("uniform", 1.0, 3.0)}, n=2, seed=1, elements=8,
+            progress=False,
+        )  # fmt: skip
+    assert err.value.parameter == "elements"

@@ -373,6 +373,23 @@ def simulate_distributed(
     *,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
+def distributed_start_state(
+    panel: dict[str, float], settings: dict[str, Any], orbit: dict[str, Any], t0: float
+) -> list[float]: ...
+def run_distributed_orbits(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    settings: dict[str, Any],
+    orbits: _Orbits,
+    *,
+    t_start: float,
+    first_index: int,
+    y0: list[float],
+    theta_limit: float,
+    stop_at_limit: bool,
+    steps_per_period: float,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
 
 # --- orbit options (issue 4)
 def eclipses(
