@@ -221,3 +221,29 @@ def test_a_distributed_study_refuses_what_it_does_not_take() -> None:
             progress=False,
         )  # fmt: skip
     assert err.value.parameter == "elements"
+
+
+def test_the_critical_damping_year_figure_plots_the_api_values() -> None:
+    from thermojitter.reports.plots import cd_year_figure, pyplot
+
+    orbit = tj.Orbit.geo_year("2026-01-01")
+    data = tj.critical_damping_year(PAPER, orbit, samples=4, **SMALL)
+    fig = cd_year_figure(data)
+    try:
+        hinge, distributed = fig.axes[0].lines[:2]
+        flux_line = fig.axes[1].lines[0]
+        days = hinge.get_xdata()
+        assert days[0] == 0.0 and days[-1] == pytest.approx(365.25)
+        for k, day in enumerate(days):
+            t = day * 86400.0
+            flux = float(orbit.flux_scale(np.array([t]))[0])
+            assert flux_line.get_ydata()[k] == pytest.approx(flux, rel=1e-12)
+            want = tj.flutter(PAPER, orbit=orbit, t=t).critical_damping
+            assert hinge.get_ydata()[k] == pytest.approx(want, rel=1e-9)
+            want = tj.distributed_flutter(PAPER, flux=flux, **SMALL).critical_damping
+            assert distributed.get_ydata()[k] == pytest.approx(want, rel=1e-9)
+        # Perihelion (early January) heats more than aphelion (early July): the flux falls
+        # then rises over the year, and each c_d* follows its own analysis of that flux.
+        assert flux_line.get_ydata()[0] > 1.0 > flux_line.get_ydata()[2]
+    finally:
+        pyplot().close(fig)

@@ -57,6 +57,7 @@ from thermojitter.nastran import NastranBeam, from_nastran, to_nastran
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.persist import ResultFileError, load, save
+from thermojitter.reports.distributed import CriticalDampingYear, critical_damping_year
 from thermojitter.results import (
     Equilibrium,
     HingeSolution,
@@ -104,6 +105,7 @@ __all__ = [
     "CalibrationResult",
     "CheckpointError",
     "ConvergenceError",
+    "CriticalDampingYear",
     "DistributedFlutterResult",
     "DistributedSolution",
     "Equilibrium",
@@ -144,6 +146,7 @@ __all__ = [
     "calibrate",
     "calibrate_from_csv",
     "compare_with_beam",
+    "critical_damping_year",
     "distributed_defaults",
     "distributed_flutter",
     "distributed_frequencies",
