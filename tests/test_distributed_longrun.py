@@ -83,7 +83,9 @@ def test_linear_arcs_match_the_full_integration(
 @pytest.fixture(scope="module")
 def one_orbit() -> tuple[tj.OrbitSummaries, tj.DistributedSolution]:
     kw = {"solver": SOLVER, **SMALL}
-    run = tj.simulate_orbits(PAPER, GEO, 1, model="distributed", method="rk45", progress=False, **kw)
+    run = tj.simulate_orbits(
+        PAPER, GEO, 1, model="distributed", method="rk45", progress=False, **kw
+    )
     sol = tj.simulate_distributed(PAPER, GEO, (0.0, GEO.period), dt_out=0.25, **kw)
     return run, sol
 
@@ -189,9 +191,7 @@ def test_each_monte_carlo_sample_is_its_own_run() -> None:
     )
     assert frame.attrs["n_failed"] == 0
     for i in (0, 2):
-        panel = PAPER.replace(
-            damping=frame.damping[i], emissivity_front=frame.emissivity_front[i]
-        )
+        panel = PAPER.replace(damping=frame.damping[i], emissivity_front=frame.emissivity_front[i])
         run = tj.simulate_orbits(panel, GEO, 1, model="distributed", progress=False, **kw)
         assert frame.amplitude[i] == run.amplitude[0]
         assert frame.exit_peak[i] == run.exit_peak[0]

@@ -21,8 +21,10 @@ from thermojitter.boom import (
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
 from thermojitter.distributed import (
+    CriticalDampingYear,
     DistributedFlutterResult,
     DistributedSolution,
+    critical_damping_year,
     distributed_defaults,
     distributed_flutter,
     distributed_frequencies,
@@ -57,7 +59,6 @@ from thermojitter.nastran import NastranBeam, from_nastran, to_nastran
 from thermojitter.orbit import Orbit
 from thermojitter.panel import Panel, beam_frequency, hinge_stiffness, natural_frequency
 from thermojitter.persist import ResultFileError, load, save
-from thermojitter.reports.distributed import CriticalDampingYear, critical_damping_year
 from thermojitter.results import (
     Equilibrium,
     HingeSolution,

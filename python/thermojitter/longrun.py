@@ -451,13 +451,16 @@ def simulate_orbits(
     split is in ``result.propagation`` (``t_linear``, ``t_fallback`` the full integration,
     ``n_arcs``, ``n_refused_arcs``).
     """
-    given = {"elements": elements, "modes": modes, "support": support, "damping_ratio": damping_ratio}
+    given = {
+        "elements": elements,
+        "modes": modes,
+        "support": support,
+        "damping_ratio": damping_ratio,
+    }
     model = checks.choice("model", model, ("nonlinear", "linear", "distributed"))  # type: ignore[assignment]
     refuse_distributed_only(model, given)
     distributed = model == "distributed"
-    dsettings = (
-        distributed_request(panel, orbit, layers, coupled, given) if distributed else None
-    )
+    dsettings = distributed_request(panel, orbit, layers, coupled, given) if distributed else None
     boom = isinstance(panel, Boom)
     if isinstance(panel, Boom):
         checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
@@ -700,9 +703,7 @@ def simulate_orbits(
         t_end=float(columns["t_end"][-1]) if columns["t_end"] else float(t_start),
         n_steps=counters["n_steps"],
         n_rhs=counters["n_rhs"],
-        propagation={
-            k: counters[k] for k in (*HYBRID_COUNTERS, "n_refused_arcs") if k in counters
-        },
+        propagation={k: counters[k] for k in (*HYBRID_COUNTERS, "n_refused_arcs") if k in counters},
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,

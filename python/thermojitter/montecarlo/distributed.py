@@ -34,6 +34,12 @@ damping, N m s/rad), ``tip_max``/``tip_min`` the tip deflection's extremes over 
 ``t_nonlinear`` the time integrated in full (s)."""
 
 
+def _largest(values: np.ndarray) -> float:
+    """The largest finite value, NaN when there is none (no orbit with an eclipse)."""
+    finite = values[np.isfinite(values)]
+    return float(finite.max()) if finite.size else math.nan
+
+
 def row_of(run: OrbitSummaries) -> dict[str, Any]:
     """The metrics a run's summaries give (all but the stability columns)."""
     c = run.columns
@@ -51,8 +57,8 @@ def row_of(run: OrbitSummaries) -> dict[str, Any]:
         "theta_eq": float(c["theta_eq"][0]),
         "theta_abs_max": float(max(np.max(c["theta_max"]), -np.min(c["theta_min"]))),
         "amplitude": float(np.max(amplitude)),
-        "entry_peak": float(np.nanmax(c["entry_peak"])) if np.isfinite(c["entry_peak"]).any() else math.nan,
-        "exit_peak": float(np.nanmax(c["exit_peak"])) if np.isfinite(c["exit_peak"]).any() else math.nan,
+        "entry_peak": _largest(c["entry_peak"]),
+        "exit_peak": _largest(c["exit_peak"]),
         # Orbits of equal length: the RMS over the horizon from each orbit's.
         "jitter_rms": float(np.sqrt(np.mean(c["jitter_rms"] ** 2))),
         "jitter_peak": float(np.max(c["jitter_peak"])),

@@ -323,7 +323,7 @@ def orbit_year_figure(
 
 def cd_year_figure(data: Any, *, title: str = "Table 1 on GEO") -> Any:
     """The critical damping c_d* of the hinge model and of the distributed panel over a year, on
-    one axes (``data``: a :class:`thermojitter.reports.distributed.CriticalDampingYear`), with
+    one axes (``data``: a :class:`thermojitter.CriticalDampingYear`), with
     the solar flux scale beneath. Lines in the order hinge, distributed (top axes)."""
     fig, (top, bottom) = figure(2, height=5.6)
     days = data.days
