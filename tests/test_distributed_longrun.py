@@ -247,3 +247,17 @@ def test_the_critical_damping_year_figure_plots_the_api_values() -> None:
         assert flux_line.get_ydata()[0] > 1.0 > flux_line.get_ydata()[2]
     finally:
         pyplot().close(fig)
+
+
+def test_the_validity_limit_stops_the_run_at_the_crossing() -> None:
+    # θ_f overshoots its equilibrium after the shadow exit (about 0.157 rad on Table 1): a limit
+    # of 0.12 rad is crossed there, in the first orbit, where the series crosses it.
+    kw = {"model": "distributed", "solver": SOLVER, "progress": False, **SMALL}
+    with pytest.warns(tj.ValidityLimitWarning):
+        run = tj.simulate_orbits(PAPER, GEO, 3, theta_limit=0.12, **kw)
+    crossing = run.limit_crossing
+    assert crossing is not None and crossing.orbit == 0 and len(run) == 1
+    assert 0.12 <= crossing.theta < 0.121
+    sol = tj.simulate_distributed(PAPER, GEO, (0.0, GEO.period), dt_out=1.0, **SMALL)
+    first = sol.t[np.argmax(sol.theta_f > 0.12)]
+    assert crossing.t == pytest.approx(first, abs=1.0)

@@ -79,6 +79,8 @@ __all__ = [
     "derived",
     "distributed_defaults",
     "distributed_flutter",
+    "distributed_start_state",
+    "run_distributed_orbits",
     "distributed_info",
     "eclipses",
     "energy",
@@ -381,13 +383,8 @@ def run_distributed_orbits(
     orbit: dict[str, Any],
     settings: dict[str, Any],
     orbits: _Orbits,
+    chunk: dict[str, Any],
     *,
-    t_start: float,
-    first_index: int,
-    y0: list[float],
-    theta_limit: float,
-    stop_at_limit: bool,
-    steps_per_period: float,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...
 

@@ -74,7 +74,7 @@ def row_of(run: OrbitSummaries) -> dict[str, Any]:
 
 
 def distributed_study(
-    panel: Panel,
+    panel: Panel | Any,
     orbit: Orbit,
     vary: Mapping[str, Any],
     n: int,

@@ -236,48 +236,56 @@ fn distributed_start_state(
     })
 }
 
+/// A chunk of a long run as `thermojitter.longrun` passes it, one mapping: its start state, the
+/// time and index of its first orbit, and what it watches.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct Chunk {
+    y0: Vec<f64>,
+    t_start: f64,
+    first_index: u64,
+    theta_limit: f64,
+    stop_at_limit: bool,
+    steps_per_period: f64,
+}
+
 /// Integrates the distributed panel over whole orbits and returns one summary per orbit (the
 /// hinge runs' columns, θ read as θ_f, with `tip_max` and `tip_min`); with `hybrid` (its
 /// settings) on linear arcs where their checks hold, adding how the simulated time was split.
 #[pyfunction]
-#[pyo3(signature = (panel, orbit, settings, orbits, *, t_start, first_index, y0, theta_limit, stop_at_limit, steps_per_period, cancel=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (panel, orbit, settings, orbits, chunk, *, cancel=None))]
 fn run_distributed_orbits<'py>(
     py: Python<'py>,
     panel: &Bound<'py, PyDict>,
     orbit: &Bound<'py, PyDict>,
     settings: &Bound<'py, PyDict>,
     orbits: OrbitsRun<'py>,
-    t_start: f64,
-    first_index: u64,
-    y0: Vec<f64>,
-    theta_limit: f64,
-    stop_at_limit: bool,
-    steps_per_period: f64,
+    chunk: Chunk,
     cancel: Option<&Bound<'py, CancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cancellable(cancel, |cancel| {
         let m = model_from(panel, settings)?;
-        let o = orbit_from(orbit)?;
         let (hinge, coupling, method) = orbits.hinge()?;
-        crate::models::hinge::check_hinge_angle("theta_limit", theta_limit)?;
+        crate::models::hinge::check_hinge_angle("theta_limit", chunk.theta_limit)?;
+        let options = SummaryOptions {
+            window: orbits.window,
+            theta_limit: chunk.theta_limit,
+            stop_at_limit: chunk.stop_at_limit,
+            steps_per_period: chunk.steps_per_period,
+        };
         let spec = OrbitRunSpec {
             panel: m.panel,
-            orbit: o,
+            orbit: orbit_from(orbit)?,
             model: hinge,
             coupling,
             method,
-            t_start,
-            first_index,
+            t_start: chunk.t_start,
+            first_index: chunk.first_index,
             n_orbits: orbits.n_orbits,
-            options: SummaryOptions {
-                window: orbits.window,
-                theta_limit,
-                stop_at_limit,
-                steps_per_period,
-            },
+            options,
         };
         let hybrid = orbits.hybrid()?;
+        let y0 = chunk.y0;
         let out = py.detach(|| {
             crate::runs::distributed_orbits::run_distributed_orbits(
                 &m,
@@ -297,14 +305,23 @@ fn run_distributed_orbits<'py>(
         d.set_item("tip_max", PyArray1::from_vec(py, out.tip_max))?;
         d.set_item("tip_min", PyArray1::from_vec(py, out.tip_min))?;
         if let Some(split) = out.split {
-            d.set_item("t_linear", split.t_linear)?;
-            d.set_item("t_exponential", 0.0)?;
-            d.set_item("t_fallback", split.t_full)?;
-            d.set_item("n_arcs", split.n_arcs)?;
-            d.set_item("n_exp_steps", 0u64)?;
-            d.set_item("n_fallback_steps", split.n_full_steps)?;
-            d.set_item("n_reread_steps", 0u64)?;
-            d.set_item("n_refused_arcs", split.n_refused)?;
+            // Named as the hybrid runs' counters: its full integration is their fallback.
+            for (name, value) in [
+                ("t_linear", split.t_linear),
+                ("t_exponential", 0.0),
+                ("t_fallback", split.t_full),
+            ] {
+                d.set_item(name, value)?;
+            }
+            for (name, value) in [
+                ("n_arcs", split.n_arcs),
+                ("n_exp_steps", 0),
+                ("n_fallback_steps", split.n_full_steps),
+                ("n_reread_steps", 0),
+                ("n_refused_arcs", split.n_refused),
+            ] {
+                d.set_item(name, value)?;
+            }
         }
         modal_info(py, &m, &d)?;
         Ok(d)

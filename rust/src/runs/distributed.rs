@@ -107,21 +107,7 @@ pub fn simulate(
     crate::numerics::integrate::check_span(t_span.0, t_span.1)?;
     let start = match settings.y0 {
         Some(v) => {
-            if v.len() != model.state_size() {
-                return Err(Error::invalid(
-                    "y0",
-                    format!("{} components", v.len()),
-                    &format!(
-                        "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
-                        model.state_size(),
-                        model.layers(),
-                        model.n(),
-                        model.k()
-                    ),
-                ));
-            }
-            // Its temperatures as every start state's; the modal amplitudes have no such range.
-            crate::models::hinge::check_start_state(&v, model.layers() * model.n(), None)?;
+            check_state(model, &v)?;
             v
         }
         None => start_state(model, &orbit, t0)?,
@@ -169,6 +155,25 @@ pub fn simulate(
         out.sunlit.push(orbit.illumination(*t));
     }
     Ok(out)
+}
+
+/// Refuses a start state that is not `model`'s: its size, and its temperatures as every start
+/// state's (the modal amplitudes have no such range).
+pub(crate) fn check_state(model: &DistributedPanel, v: &[f64]) -> Result<()> {
+    if v.len() != model.state_size() {
+        return Err(Error::invalid(
+            "y0",
+            format!("{} components", v.len()),
+            &format!(
+                "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
+                model.state_size(),
+                model.layers(),
+                model.n(),
+                model.k()
+            ),
+        ));
+    }
+    crate::models::hinge::check_start_state(v, model.layers() * model.n(), None)
 }
 
 /// The default start of a run of `model` on `orbit` at t0: the sunlit equilibrium at rest under

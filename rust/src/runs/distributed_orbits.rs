@@ -67,7 +67,13 @@ pub(crate) struct Affine {
 impl Affine {
     #[inline]
     pub fn at(&self, y: &[f64]) -> f64 {
-        self.w.as_slice().iter().zip(y).map(|(a, b)| a * b).sum::<f64>() + self.c
+        self.w
+            .as_slice()
+            .iter()
+            .zip(y)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            + self.c
     }
 
     /// The functional a·q + b·M of the modal coordinates q and the element moments M, as one of
@@ -265,7 +271,11 @@ impl Observer<D> for Reads<'_> {
             rising(y_mid.as_slice()),
             rising(step.y1.as_slice()),
         );
-        let reads = if r0 == r_mid && r_mid == r1 { 2 } else { READS_PER_STEP };
+        let reads = if r0 == r_mid && r_mid == r1 {
+            2
+        } else {
+            READS_PER_STEP
+        };
         let h = (step.t1 - step.t0) / reads as f64;
         for j in 1..=reads {
             let read = if j == reads {
@@ -298,35 +308,11 @@ pub fn run_distributed_orbits(
     hybrid: Option<&HybridSettings>,
     cancel: &Cancel,
 ) -> Result<DistributedOrbitRun> {
-    cancel.check()?;
-    spec.options.check()?;
-    spec.orbit.validate()?;
-    spec.method.validate()?;
+    // What every hybrid run is asked (the hybrid's settings checked when given).
+    let defaults = HybridSettings::default();
+    crate::runs::hybrid::check_request(spec, y0, hybrid.unwrap_or(&defaults), cancel)?;
     model.check_orbit(&spec.orbit)?;
-    if let Some(h) = hybrid {
-        h.validate()?;
-    }
-    if spec.n_orbits == 0 {
-        return Err(Error::invalid("n_orbits", 0, "must be >= 1"));
-    }
-    crate::error::require_finite("t_start", spec.t_start)?;
-    if y0.len() != model.state_size() {
-        return Err(Error::invalid(
-            "y0",
-            format!("{} components", y0.len()),
-            &format!(
-                "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
-                model.state_size(),
-                model.layers(),
-                model.n(),
-                model.k()
-            ),
-        ));
-    }
-    if let Some(v) = y0.iter().find(|v| !v.is_finite()) {
-        return Err(Error::invalid("y0", v, "every component must be finite"));
-    }
-    crate::models::hinge::check_start_state(y0, model.temps(), None)?;
+    crate::runs::distributed::check_state(model, y0)?;
     let options = spec.options;
     if !(0.0..=crate::runs::orbits::MAX_STEPS_PER_PERIOD).contains(&options.steps_per_period) {
         return Err(Error::invalid(
@@ -359,7 +345,6 @@ pub fn run_distributed_orbits(
         method,
         system: DistributedSystem::new(model.clone(), spec.orbit),
         reads: &mut reads,
-        t_start: spec.t_start,
         t_end: spec.t_end(),
         t: spec.t_start,
         y: DVector::from_column_slice(y0),
@@ -387,7 +372,9 @@ pub fn run_distributed_orbits(
     } = driver;
     stats.t_end = t;
     stats.stopped = t < t_end && reads.collector.crossing.is_some();
-    let done = reads.collector.finish(stats, DVector::from_column_slice(y.as_slice()));
+    let done = reads
+        .collector
+        .finish(stats, DVector::from_column_slice(y.as_slice()));
     let n = done.summaries.len();
     let tips = &reads.tips[..n];
     Ok(DistributedOrbitRun {
@@ -436,7 +423,6 @@ struct Driver<'a, 'c> {
     method: Method,
     system: DistributedSystem,
     reads: &'a mut Reads<'c>,
-    t_start: f64,
     t_end: f64,
     t: f64,
     y: DVector<f64>,
@@ -473,37 +459,43 @@ struct Plan {
 }
 
 impl Driver<'_, '_> {
-    /// The full integration from t to `end`.
+    /// The full integration from t to `end` (or to where the reads stopped it).
     fn full(&mut self, end: f64) -> Result<()> {
-        let (stats, y) = solve(
+        let start = self.y.clone();
+        let outcome = solve(
             &mut self.system,
             &self.method,
             self.t,
-            self.y.clone(),
+            start,
             end,
             &mut *self.reads,
-        )?;
-        if let Some(e) = self.reads.error.take() {
-            return Err(e);
-        }
-        self.split.t_full += stats.t_end - self.t;
-        self.split.n_full_steps += stats.n_steps;
-        self.stats.n_steps += stats.n_steps;
-        self.stats.n_rejected += stats.n_rejected;
-        self.stats.n_rhs += stats.n_rhs;
-        self.t = if stats.stopped { stats.t_end } else { end };
-        self.y = y;
+        );
+        let (done, y) = match (outcome, self.reads.error.take()) {
+            (_, Some(e)) | (Err(e), None) => return Err(e),
+            (Ok(run), None) => run,
+        };
+        let reached = if done.stopped { done.t_end } else { end };
+        self.split.t_full += reached - self.t;
+        self.split.n_full_steps += done.n_steps;
+        let s = &mut self.stats;
+        (s.n_steps, s.n_rejected, s.n_rhs) = (
+            s.n_steps + done.n_steps,
+            s.n_rejected + done.n_rejected,
+            s.n_rhs + done.n_rhs,
+        );
+        (self.t, self.y) = (reached, y);
         Ok(())
     }
 
-    /// End of the orbit that holds (t, t + dt].
+    /// End of the orbit that holds (t, t + dt]: the collector's current orbit (that of the last
+    /// point read, t), or the next when t is its end.
     fn orbit_end(&self, t: f64) -> f64 {
-        let p = self.orbit.period;
-        let k = ((t - self.t_start) / p).floor();
-        let mut end = self.t_start + k * p + p;
-        if end - t <= 1e-9 * p {
-            end += p;
-        }
+        let current = self.reads.collector.current.t_end;
+        let end = if current - t <= 1e-9 * self.orbit.period {
+            current + self.orbit.period
+        } else {
+            current
+        };
         end.min(self.t_end)
     }
 
@@ -572,10 +564,7 @@ impl Driver<'_, '_> {
         let floor = READ_RTOL * 1e-6 * r.arm;
         let tol = |s: &crate::runs::distributed_arc::ArcSignal| READ_RTOL * s.variation() + floor;
         let signals = [&rise, &dynamic, &rise_static, &tip];
-        if signals
-            .iter()
-            .any(|s| s.max_interpolation_error() > tol(s))
-        {
+        if signals.iter().any(|s| s.max_interpolation_error() > tol(s)) {
             return Ok(false);
         }
         let (lo, hi) = rise.extremes(0.0, length, tol(&rise));
@@ -615,13 +604,9 @@ impl Driver<'_, '_> {
                 (angle(l), angle(h))
             }
         };
-        self.reads.collector.record_span(
-            t0,
-            end,
-            &extremes,
-            g * dlo.abs().max(dhi.abs()),
-            sq,
-        )?;
+        self.reads
+            .collector
+            .record_span(t0, end, &extremes, g * dlo.abs().max(dhi.abs()), sq)?;
         self.reads.tip(tlo, thi);
         self.y = arc.state_at_node(arc.cells());
         self.t = end;
@@ -703,7 +688,11 @@ impl Driver<'_, '_> {
         }
         Ok(Some(Plan {
             arc,
-            drift: (spent * (slowest * (end - t0)).min(50.0).exp() + at_end, end, slowest),
+            drift: (
+                spent * (slowest * (end - t0)).min(50.0).exp() + at_end,
+                end,
+                slowest,
+            ),
         }))
     }
 
@@ -749,8 +738,12 @@ impl Driver<'_, '_> {
         let length = arc.length;
         for (pair, &c) in arc.pairs.iter().zip(&arc.coeff) {
             slowest = slowest.max(pair.lambda.re);
-            let gv: crate::runs::distributed_arc::C64 =
-                pair.right.iter().zip(grad.iter()).map(|(v, g)| v * *g).sum();
+            let gv: crate::runs::distributed_arc::C64 = pair
+                .right
+                .iter()
+                .zip(grad.iter())
+                .map(|(v, g)| v * *g)
+                .sum();
             let amp0 = 2.0 * (gv * c).norm();
             if !(amp0 > 0.0) {
                 continue;
@@ -796,6 +789,10 @@ impl Driver<'_, '_> {
             largest += end.max(along);
             at_end += end;
         }
-        (largest, at_end, if slowest.is_finite() { slowest } else { 0.0 })
+        (
+            largest,
+            at_end,
+            if slowest.is_finite() { slowest } else { 0.0 },
+        )
     }
 }
