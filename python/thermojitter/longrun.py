@@ -304,7 +304,12 @@ def _distributed_call(settings: dict[str, Any]) -> Callable[..., dict[str, Any]]
     ``_core.run_orbits`` is."""
 
     def call(
-        panel: dict[str, float], orbit: dict[str, Any], orbits: Any, *, cancel: Any = None, **kw: Any
+        panel: dict[str, float],
+        orbit: dict[str, Any],
+        orbits: Any,
+        *,
+        cancel: Any = None,
+        **kw: Any,
     ) -> Any:
         return _core.run_distributed_orbits(panel, orbit, settings, orbits, kw, cancel=cancel)
 
