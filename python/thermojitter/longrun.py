@@ -576,10 +576,13 @@ def simulate_orbits(
         per_orbit = orbit.period * f1 * steps_per_period if method == "rk45" else 0.0
         if method == "rk4":
             per_orbit = orbit.period / float(full["dt"])
+        cap = (
+            "a fixed step dt" if method == "rk4" else f"the step capped at T₁/{steps_per_period:g}"
+        )
+        least = per_orbit * n_orbits
         refuse_beyond_budget(
-            "n_orbits", n_orbits, per_orbit * n_orbits, budget,
-            f"{per_orbit:.3g} per orbit with the step capped at T₁/{steps_per_period:g}",
-        )  # fmt: skip
+            "n_orbits", n_orbits, least, budget, f"{per_orbit:.3g} per orbit with {cap}"
+        )
     elif method != "hybrid":
         # A boom's step is capped by its equivalent hinge's period, the panel's of the same hinge.
         hinge = panel.derived["hinge_panel"] if isinstance(panel, Boom) else panel.as_dict()

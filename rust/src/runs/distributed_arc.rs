@@ -81,7 +81,8 @@ pub(crate) fn structural_pairs(
         let right = DVector::from_fn(n, |i, _| right[i] * scale[i]);
         let left = DVector::from_fn(n, |i, _| left[i] / scale[i]);
         let norm: C64 = left.iter().zip(right.iter()).map(|(w, v)| w * v).sum();
-        if !(norm.norm() > 1e-12 * left.norm() * right.norm()) {
+        let size = norm.norm();
+        if size.is_nan() || size <= 1e-12 * left.norm() * right.norm() {
             return None;
         }
         pairs.push(Pair {

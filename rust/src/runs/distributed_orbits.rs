@@ -239,7 +239,7 @@ impl Reads<'_> {
     /// One point (t, y) of the solution standing for the interval dt before it.
     fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
         let rise = self.readers.rise.at(y);
-        if !(rise.abs() <= self.readers.arm) {
+        if rise.is_nan() || rise.abs() > self.readers.arm {
             return Err(Error::Integration {
                 t,
                 reason: format!(
@@ -745,7 +745,7 @@ impl Driver<'_, '_> {
                 .map(|(v, g)| v * *g)
                 .sum();
             let amp0 = 2.0 * (gv * c).norm();
-            if !(amp0 > 0.0) {
+            if amp0.is_nan() || amp0 <= 0.0 {
                 continue;
             }
             let period = 2.0 * std::f64::consts::PI / pair.lambda.im;
