@@ -210,17 +210,29 @@ def test_at_geo_the_earth_changes_the_equilibrium_angle_by_less_than_a_percent()
     assert abs(low.theta[0] - alone.theta[0]) > 0.5 * abs(alone.theta[0])
 
 
-@pytest.mark.parametrize(
-    "orbit",
-    [
-        tj.Orbit.circular(540e3, math.radians(28.5), 0.4, "2026-06-01"),
-        tj.Orbit.geo_year("2026-03-08").replace(albedo=0.3, earth_ir=237.0),
-    ],
-    ids=["inclined-leo", "geo-spring"],
-)
-def test_the_hybrid_runs_earth_heating_in_full_and_says_so(orbit: tj.Orbit) -> None:
+def test_the_hybrid_runs_earth_heating_on_a_low_orbit_on_slow_time_within_the_gate() -> None:
     from test_hybrid import assert_gate
 
+    orbit = tj.Orbit.circular(540e3, math.radians(28.5), 0.4, "2026-06-01")
+    n = 3
+    full = tj.simulate_orbits(tj.Panel.paper(), orbit, n, method="rk45", orbits_per_call=n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tj.HybridFallbackWarning)
+        hybrid = tj.simulate_orbits(tj.Panel.paper(), orbit, n, method="hybrid", orbits_per_call=n)
+    assert "hybrid_fallback" not in hybrid.settings
+    assert_gate(full, hybrid)
+    p = hybrid.propagation
+    assert p["t_linear"] == p["t_exponential"] == 0.0
+    assert p["n_refused_orbits"] == 0
+    # Slow time but for the penumbrae, integrated in full.
+    assert p["t_slow"] + p["t_fallback"] == pytest.approx(n * orbit.period, rel=1e-12)
+    assert 0.0 < p["t_fallback"] < 0.01 * n * orbit.period
+
+
+def test_the_hybrid_runs_earth_heating_on_geo_in_full_and_says_so() -> None:
+    from test_hybrid import assert_gate
+
+    orbit = tj.Orbit.geo_year("2026-03-08").replace(albedo=0.3, earth_ir=237.0)
     n = 3
     full = tj.simulate_orbits(tj.Panel.paper(), orbit, n, method="rk45", orbits_per_call=n)
     with pytest.warns(tj.HybridFallbackWarning):
@@ -228,9 +240,10 @@ def test_the_hybrid_runs_earth_heating_in_full_and_says_so(orbit: tj.Orbit) -> N
     assert "hybrid_fallback" in hybrid.settings
     assert_gate(full, hybrid)
     p = hybrid.propagation
-    assert p["t_linear"] == p["t_exponential"] == 0.0
+    assert p["t_linear"] == p["t_exponential"] == p["t_slow"] == 0.0
     assert p["t_fallback"] == pytest.approx(n * orbit.period, rel=1e-12)
-    # Without the Earth's heat the hybrid propagates as before, with no warning.
+    # Without the Earth's heat the hybrid propagates by its linear arcs as before, with no
+    # warning.
     with warnings.catch_warnings():
         warnings.simplefilter("error", tj.HybridFallbackWarning)
         bare = orbit.replace(albedo=0.0, earth_ir=0.0)

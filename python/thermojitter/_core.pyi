@@ -128,6 +128,8 @@ LINEAR_FIELDS: list[str]
 PAPER_PANEL: dict[str, float]
 ENSEMBLE_LANES: int  # SIMD lanes of one lockstep group
 ENSEMBLE_RUNS_PER_CORE: int  # samples one core runs at once (its groups' lanes)
+SLOW_RING_LIMIT: float  # largest ringing (rad) the hybrid carries on slow time
+SLOW_ORBIT: float  # orbits shorter than this (s) run on slow time under the hybrid
 KERNEL_VARIABLE: str  # environment variable: "portable" forces the kernels without FMA
 KERNEL_CHOICES: list[str]  # its values ("auto", "portable")
 SOLVER_DEFAULTS: dict[str, Any]

@@ -49,10 +49,18 @@ from thermojitter.solver import ATOL, MAX_STEPS, RTOL, HybridSettings, SolverSet
 
 HYBRID_FALLBACK = (
     "Earth heating or an attitude other than Sun-pointing vary the sunlit forcing, which the "
-    "hybrid propagator takes as constant between eclipses: every orbit was integrated in full "
-    "with rk45 (the hybrid's fallback)"
+    "hybrid propagator takes as constant between eclipses on orbits of 6 h or more and in the "
+    "N-node model: every orbit was integrated in full with rk45 (the hybrid's fallback)"
 )
-"""Why a hybrid run with the Earth's loads or another attitude is integrated in full."""
+"""Why a hybrid run with the Earth's loads or another attitude is integrated in full: on a long
+orbit, or with the N-node model (short orbits of the two-layer model run on slow time)."""
+
+SLOW_REFUSED = (
+    "{n} orbit(s) of this hybrid run were integrated in full with rk45 (the hybrid's fallback): "
+    "on slow time the ringing grew past {ring} rad or the thermal rates were not slow against "
+    "the hinge, where its closed form does not hold"
+)
+"""What a hybrid run says when its slow-time guards gave orbits back to the full integration."""
 
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
@@ -70,10 +78,11 @@ DISTRIBUTED_ONLY = ("elements", "modes", "support", "damping_ratio")
 
 HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
-    "n_reread_steps",
+    "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits",
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
-integrator of the non-linear model and the hinge-resolved fallback."""
+integrator of the non-linear model, slow time (short orbits and varying loads) and the
+hinge-resolved fallback."""
 
 
 @dataclass
@@ -131,7 +140,7 @@ class OrbitSummaries(Persistent):
         p = self.propagation
         if not p:
             return 1.0
-        total = p["t_linear"] + p["t_exponential"] + p["t_fallback"]
+        total = p["t_linear"] + p["t_exponential"] + p["t_fallback"] + p.get("t_slow", 0.0)
         return (p["t_exponential"] + p["t_fallback"]) / total if total > 0 else 0.0
 
     def __getattr__(self, name: str) -> NDArray[Any]:
@@ -428,11 +437,22 @@ def simulate_orbits(
     - ``attitude``: where the front face points (:class:`thermojitter.Attitude`, default
       Sun-pointing); with it or with the orbit's Earth heating each face takes its own loads (see
       :func:`thermojitter.simulate`), and each orbit's ``theta_eq`` is the sunlit equilibrium
-      under the loads at the orbit's start. The hybrid propagator takes the sunlit forcing as
-      constant between eclipses, which these loads are not: such a run is integrated in full
-      with rk45 (``result.propagation`` counts all of it as the fallback's), said in
+      under the loads at the orbit's start. On an orbit shorter than 6 h the hybrid runs them on
+      slow time (below); elsewhere, and in the N-node model (``layers=N``), it takes the sunlit
+      forcing as constant between eclipses, which these loads are not, and integrates such a run
+      in full with rk45 (``result.propagation`` counts all of it as the fallback's), said in
       ``result.settings["hybrid_fallback"]`` and by one
       :class:`thermojitter.errors.HybridFallbackWarning`.
+    - Slow time (``method="hybrid"`` on an orbit shorter than 6 h, with or without the Earth's
+      loads and an attitude; the two-layer model): the temperatures are integrated on their own
+      time scale with the hinge on its slow manifold, the ringing carried in closed form as a
+      complex amplitude along the hinge mode (the thermal coupling, hence flutter, in its
+      eigenvalue; the non-linear hinge's frequency shift with amplitude from its conservative
+      period), the penumbrae integrated in full. Orbits where the ringing passes 0.03 rad or
+      the thermal rates are not slow against the hinge are integrated in full with rk45 from
+      their start, with the rest of the run (``propagation["n_refused_orbits"]``, and a
+      :class:`thermojitter.errors.HybridFallbackWarning`); ``propagation["t_slow"]`` is the
+      time carried on slow time.
 
     A :class:`thermojitter.Boom` in place of the panel runs the tube: ``y0`` and ``y_end`` are
     (T_mean, T_circ, θ, θ̇), the summaries read θ (the tip deflection over the length) and its
@@ -549,7 +569,8 @@ def simulate_orbits(
         settings["hybrid"] = hybrid_settings
     if "attitude" in engine_orbit_args:
         settings["attitude"] = engine_orbit_args["attitude"]
-    if method == "hybrid" and has_face_loads(orbit, attitude):
+    slow = orbit.period < _core.SLOW_ORBIT and nodes is None and not distributed
+    if method == "hybrid" and not slow and has_face_loads(orbit, attitude):
         settings["hybrid_fallback"] = HYBRID_FALLBACK
         warnings.warn(HYBRID_FALLBACK, HybridFallbackWarning, stacklevel=2)
     # The distributed model's engine call takes the hinge model's mapping (its `model` unused).
@@ -655,7 +676,7 @@ def simulate_orbits(
                     counters["n_steps"] += int(raw["n_steps"])
                     counters["n_rhs"] += int(raw["n_rhs"])
                     for name in HYBRID_COUNTERS if method == "hybrid" else ():
-                        counters[name] += raw[name]
+                        counters[name] = counters.get(name, 0) + raw[name]
                     if "n_refused_arcs" in counters:
                         counters["n_refused_arcs"] += raw["n_refused_arcs"]
                     if crossing is None and on_limit != "ignore":
@@ -693,6 +714,9 @@ def simulate_orbits(
                         path, settings, n_orbits, columns, y, next_index, counters, crossing
                     )
     warn_crossing(crossing, theta_limit, on_limit)
+    if counters.get("n_refused_orbits", 0) > 0:
+        said = SLOW_REFUSED.format(n=counters["n_refused_orbits"], ring=_core.SLOW_RING_LIMIT)
+        warnings.warn(said, HybridFallbackWarning, stacklevel=2)
     if report:
         kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
         if path is not None:

@@ -7,7 +7,6 @@ import contextlib
 import hashlib
 import math
 import os
-import warnings
 from collections.abc import Generator, Mapping, Sequence
 from typing import Any
 
@@ -19,10 +18,9 @@ from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
 from thermojitter.attitude import Attitude, engine_orbit
 from thermojitter.boom import Boom, check_attitude
-from thermojitter.errors import HybridFallbackWarning, ParameterError
+from thermojitter.errors import ParameterError
 from thermojitter.longrun import (
     DEFAULT_THETA_LIMIT,
-    HYBRID_FALLBACK,
     orbit_count,
     refuse_beyond_budget,
 )
@@ -117,17 +115,6 @@ def face_loads(options: Mapping[str, Any], inputs: Mapping[str, Any]) -> bool:
         or "attitude" in orbit
         or any((v != 0.0).any() for v in drawn)
     )
-
-
-def warn_hybrid_fallback(options: Mapping[str, Any], inputs: Mapping[str, Any]) -> None:
-    """Says, once, that the hybrid propagator integrates in full the samples with the Earth's
-    loads or another attitude (each then has ``t_nonlinear`` equal to ``t_reached``)."""
-    if options["hybrid"] is not None and not options.get("boom") and face_loads(options, inputs):
-        warnings.warn(
-            f"{HYBRID_FALLBACK} for the samples with them (their t_nonlinear is the whole run)",
-            HybridFallbackWarning,
-            stacklevel=4,
-        )
 
 
 def with_layers(
@@ -231,7 +218,6 @@ def run_design(
     if threads is not None:
         threads = checks.integer("threads", threads, 1, _core.MAX_THREADS)
     _refuse_beyond_budget(matrix, options, settings)
-    warn_hybrid_fallback(options, inputs)
     if chunk_size is None:
         chunk_size = default_chunk_size(n)
     else:

@@ -131,9 +131,9 @@ def monte_carlo(
       drawn (``albedo``, ``earth_ir``), a sample's ``theta_eq``, ``growth_rate``,
       ``frequency_hz`` and ``critical_damping`` are those of its equilibrium in full sunlight
       under every load at t = 0 (``tj.flutter(panel, orbit=..., t=0, attitude=...)``), and its run
-      starts there, as ``simulate_orbits`` does; the hybrid propagator integrates such samples in
-      full with its rk45 fallback (one :class:`thermojitter.errors.HybridFallbackWarning` says
-      so). Each sample equals the single ``simulate_orbits`` run of its panel on its orbit.
+      starts there, as ``simulate_orbits`` does; the hybrid propagator runs such samples on slow
+      time (see ``simulate_orbits``; ``t_nonlinear`` counts the time it integrated in full).
+      Each sample equals the single ``simulate_orbits`` run of its panel on its orbit.
     - A :class:`thermojitter.Boom` in place of the panel: ``vary`` names boom parameters (and
       ``inclination``, ``raan``; a boom takes no Earth heating nor attitude); each sample is the
       tube's flutter analysis at full Sun (``critical_damping`` is then the first mode's

@@ -178,11 +178,17 @@ fn run_boom_orbits<'py>(
         let d = summary_dict(py, &out, &method)?;
         if hybrid.is_some() {
             let simulated = out.stats.t_end - t_start;
-            for (name, value) in [("t_linear", 0.0), ("t_exponential", 0.0)] {
+            for (name, value) in [("t_linear", 0.0), ("t_exponential", 0.0), ("t_slow", 0.0)] {
                 d.set_item(name, value)?;
             }
             d.set_item("t_fallback", simulated)?;
-            for name in ["n_arcs", "n_exp_steps", "n_reread_steps"] {
+            for name in [
+                "n_arcs",
+                "n_exp_steps",
+                "n_reread_steps",
+                "n_slow_steps",
+                "n_refused_orbits",
+            ] {
                 d.set_item(name, 0u64)?;
             }
             d.set_item("n_fallback_steps", out.stats.n_steps)?;

@@ -309,6 +309,7 @@ fn run_distributed_orbits<'py>(
             for (name, value) in [
                 ("t_linear", split.t_linear),
                 ("t_exponential", 0.0),
+                ("t_slow", 0.0),
                 ("t_fallback", split.t_full),
             ] {
                 d.set_item(name, value)?;
@@ -318,6 +319,8 @@ fn run_distributed_orbits<'py>(
                 ("n_exp_steps", 0),
                 ("n_fallback_steps", split.n_full_steps),
                 ("n_reread_steps", 0),
+                ("n_slow_steps", 0),
+                ("n_refused_orbits", 0),
                 ("n_refused_arcs", split.n_refused),
             ] {
                 d.set_item(name, value)?;

@@ -455,6 +455,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("MAX_THREADS", crate::runs::ensemble::MAX_THREADS)?;
     m.add("VALIDITY_LIMIT", crate::models::hinge::VALIDITY_LIMIT)?;
+    m.add("SLOW_RING_LIMIT", crate::runs::hybrid::slow::RING_LIMIT)?;
+    m.add("SLOW_ORBIT", crate::runs::hybrid::slow::SHORT_ORBIT)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;

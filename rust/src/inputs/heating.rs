@@ -358,15 +358,6 @@ fn sign_change(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Option<f64> {
     Some(0.5 * (lo + hi))
 }
 
-/// Nodes and weights of the five-point Gauss–Legendre rule on [−1, 1].
-const GAUSS_5: [(f64, f64); 5] = [
-    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
-    (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
-    (0.0, 0.568_888_888_888_888_9),
-    (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
-    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
-];
-
 /// Subintervals of the sunlit-arc average per orbit period. The loads are smooth on each piece
 /// between their kinks — where the Sun crosses a face's plane (max(±n·Ŝ, 0)) and where the
 /// sub-satellite point crosses the terminator (the albedo's max(cos Z, 0)), which are found and
@@ -424,7 +415,7 @@ impl Orbit {
                 cuts.push(x1);
                 for piece in cuts.windows(2) {
                     let (mid, half) = (0.5 * (piece[0] + piece[1]), 0.5 * (piece[1] - piece[0]));
-                    for (x, weight) in GAUSS_5 {
+                    for (x, weight) in crate::numerics::quadrature::GAUSS_5 {
                         let l = self.loads_at(mid + half * x, optics).scaled(half * weight);
                         sum = Loads {
                             sun: sum.sun + l.sun,

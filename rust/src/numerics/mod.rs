@@ -4,6 +4,7 @@
 pub mod cpu;
 pub mod integrate;
 pub mod newton;
+pub mod quadrature;
 pub(crate) mod simd;
 #[cfg(test)]
 pub(crate) mod testing;

@@ -1195,8 +1195,9 @@ mod tests {
 
     #[test]
     fn a_hybrid_sample_stops_at_its_budget_every_step_counted() {
-        // On a low orbit the hybrid falls back on the full integration every orbit; each
-        // stretch used to get the whole budget, so the run took that many steps per orbit.
+        // A panel whose thermal rates are not slow against its hinge: on a low orbit the
+        // hybrid's slow time refuses it and integrates the run in full. Each stretch of a
+        // fallback used to get the whole budget, so the run took that many steps per orbit.
         // A budget of a few orbits' steps, each stretch well within it.
         let budget = 100_000;
         let s = EnsembleSettings {
@@ -1210,7 +1211,11 @@ mod tests {
             }),
             ..settings()
         };
-        let err = run_sample(&Panel::paper(), &s, &Cancel::new()).expect_err("budget");
+        let fast = Panel {
+            specific_heat: Panel::paper().specific_heat / 10.0,
+            ..Panel::paper()
+        };
+        let err = run_sample(&fast, &s, &Cancel::new()).expect_err("budget");
         assert!(
             err.to_string().contains("max_steps = 100000 reached"),
             "{err}"

@@ -262,6 +262,19 @@ pub(crate) struct Collector<V> {
     eclipses: EclipseTable,
 }
 
+/// What a collector has taken up to a time between two of its reads, to go back to
+/// ([`Collector::rewind`]): a propagator that gives an orbit back reads it again another way.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Mark {
+    done: usize,
+    current: OrbitSummary,
+    sq_sum: f64,
+    duration: f64,
+    crossing: Option<LimitCrossing>,
+    end: (f64, f64),
+    calm: Calm,
+}
+
 impl<V: SummaryView> Collector<V> {
     /// A collector of the orbits of `spec`, the first starting with hinge angle θ0.
     pub(crate) fn new(view: V, spec: &OrbitRunSpec, theta0: f64) -> Result<Self> {
@@ -335,6 +348,29 @@ impl<V: SummaryView> Collector<V> {
             .first()
             .map(|e| (e.outer.0.max(t0), e.outer.1.min(t1)));
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
+    }
+
+    pub(crate) fn mark(&self) -> Mark {
+        Mark {
+            done: self.done.len(),
+            current: self.current,
+            sq_sum: self.sq_sum,
+            duration: self.duration,
+            crossing: self.crossing,
+            end: self.end,
+            calm: self.calm,
+        }
+    }
+
+    /// Forgets everything taken since `mark`.
+    pub(crate) fn rewind(&mut self, mark: Mark) {
+        self.done.truncate(mark.done);
+        self.current = mark.current;
+        self.sq_sum = mark.sq_sum;
+        self.duration = mark.duration;
+        self.crossing = mark.crossing;
+        self.end = mark.end;
+        self.calm = mark.calm;
     }
 
     /// The run's summaries, with its counters and end state: the last orbit closed.

@@ -27,6 +27,7 @@ mod laminate_tests;
 pub mod layered;
 pub mod linear;
 pub(crate) mod model;
+pub mod slow;
 
 use crate::cancel::Cancel;
 use crate::error::{require_positive, Error, Result};
@@ -104,6 +105,12 @@ pub struct HybridRun {
     /// Exponential steps whose band of θ failed its check and that were read again, resolving
     /// the hinge.
     pub n_reread_steps: u64,
+    /// Simulated time carried on slow time ([`slow`]: short orbits, varying loads), s, and its
+    /// steps.
+    pub t_slow: f64,
+    pub n_slow_steps: u64,
+    /// Orbits the slow-time guards gave back to the full integration.
+    pub n_refused_orbits: u64,
 }
 
 /// What the state at a sunlit time allows.
@@ -148,6 +155,16 @@ pub fn run_orbits_hybrid(
     let OrbitRunRequest { ref spec, y0 } = *req;
     spec.panel.validate()?;
     check_request(spec, y0.as_slice(), settings, cancel)?;
+    if slow::applies(spec) {
+        let (run, split) = slow::run_slow(spec, y0, cancel)?;
+        let mut out = counted_as_fallback(&[], split.n_full_steps);
+        out.t_fallback = split.t_full;
+        out.t_slow = split.t_slow;
+        out.n_slow_steps = split.n_slow_steps;
+        out.n_refused_orbits = split.n_refused;
+        out.run = run;
+        return Ok(out);
+    }
     if spec.orbit.has_face_loads() {
         return Ok(fully_integrated(
             crate::runs::orbits::run_orbits_cancellable(req, cancel)?,
@@ -190,6 +207,9 @@ pub(crate) fn counted_as_fallback(
         n_exp_steps: 0,
         n_fallback_steps: n_steps,
         n_reread_steps: 0,
+        t_slow: 0.0,
+        n_slow_steps: 0,
+        n_refused_orbits: 0,
     }
 }
 
@@ -279,6 +299,9 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             n_exp_steps: 0,
             n_fallback_steps: 0,
             n_reread_steps: 0,
+            t_slow: 0.0,
+            n_slow_steps: 0,
+            n_refused_orbits: 0,
         },
         judge: Judge {
             panel,

@@ -1,0 +1,1027 @@
+//! Slow-time propagation of the two-layer panel on orbits that leave the hybrid no linear arc:
+//! an eclipse every orbit (low orbits), or loads that vary along every arc (the Earth's heat, an
+//! attitude other than Sun-pointing).
+//!
+//! The state is split as y = ȳ(t, T̄) + Re(z v):
+//!
+//! - ȳ = (T̄, θ̄, θ̄') is the hinge's slow manifold over the temperatures T̄. With θ₀ = M_T(T̄)/K_el
+//!   and its derivatives along the thermal flow T̄' = g(t, T̄, θ̄),
+//!   θ̄ = θ₀ − (c_d θ₀' + I_eff θ₀'' + N)/K_el and θ̄' = θ₀' − (c_d/K_el) θ₀'': the hinge equation
+//!   balanced by the slow motion's own damping, inertia (I_B (1 + 3 sin²θ) for the non-linear
+//!   hinge) and, for the non-linear hinge, its velocity term N = 3 I_B θ₀'² sin θ₀ cos θ₀.
+//! - z is the ringing along the hinge eigenvector v (θ component 1) of the Jacobian at ȳ, λ its
+//!   eigenvalue and w the left eigenvector (wᵀv = 1): z' = (λ − wᵀv' + i Δω(|z|)) z, where Δω is the
+//!   non-linear hinge's frequency shift at amplitude |z| (from its conservative period, exact by
+//!   quadrature). The thermal coupling, and with it flutter, is in λ.
+//!
+//! T̄ is integrated on the thermal time scale (Dormand–Prince on two states); z is carried in
+//! closed form over each step (the exponent's rate a quadratic through three Gauss nodes). Where
+//! the loads change on the hinge's time scale, the penumbra, the full model is integrated with
+//! the hinge resolved, and the state is split again after it; at a cylindrical shadow's jump the
+//! split is made again on the new side, so the jump of ȳ goes into z.
+//!
+//! Guards: the thermal rates must be slow against the hinge (the split's premise), the ringing
+//! small (the closed form is linear in it, with the non-linear hinge's frequency shift), the
+//! split must converge, |θ| stay within the run's limit. An orbit where one fails is integrated
+//! again in full from its start, and so is the rest of the run.
+
+use crate::cancel::Cancel;
+use crate::error::Result;
+use crate::inputs::heating::Loads;
+use crate::inputs::orbit::{breakpoints_of, EclipseTable, Shadow};
+use crate::models::coupled::Coupled;
+use crate::models::hinge::HingeModel;
+use crate::numerics::integrate::{
+    solve, DenseStep, Method, Observer, OdeSystem, State, Tolerances,
+};
+use crate::numerics::quadrature::GAUSS_5;
+use crate::runs::orbits::{resolve_hinge, Collector, OrbitRunSpec, SummaryObserver, TwoLayerView};
+use crate::runs::orbits::{Summarised, STEPS_PER_HINGE_PERIOD};
+use nalgebra::{Complex, Matrix4, Vector2, Vector4, U2, U4};
+use std::f64::consts::PI;
+use std::ops::ControlFlow;
+
+/// Largest ratio of the thermal block's rates (a Gershgorin bound) to the hinge's angular
+/// frequency at which the split is trusted.
+pub const SEPARATION_LIMIT: f64 = 0.1;
+/// Largest ringing amplitude |z| (rad) carried in closed form.
+pub const RING_LIMIT: f64 = 0.03;
+/// Reads per hinge period of a span shorter than a period, and the half-width of the parabola
+/// that refines a peak, as a fraction of the period.
+const READS_PER_PERIOD: f64 = 16.0;
+/// Time step (s) of the derivative of θ₀' along the thermal flow.
+const FLOW_STEP: f64 = 0.5;
+/// Error control of the slow integration of T̄.
+const SLOW_TOLERANCES: Tolerances = Tolerances {
+    rtol: 1e-7,
+    atol: 1e-5,
+    max_step: 600.0,
+    max_steps: 50_000_000,
+};
+
+/// The two-layer panel on its hinge, read on slow time.
+#[derive(Clone)]
+struct SlowModel {
+    system: Coupled,
+    model: HingeModel,
+    stiffness: f64,
+    damping: f64,
+    inertia: f64,
+    moment_per_kelvin: f64,
+    /// The segment being integrated: the loads' side of each shadow edge, and the flow's
+    /// derivative kept inside it.
+    segment: (f64, f64),
+}
+
+/// A point of the slow manifold.
+#[derive(Clone, Copy, Debug)]
+struct Manifold {
+    y: Vector4<f64>,
+    /// T̄'.
+    rates: Vector2<f64>,
+    /// θ̄ − θ₀: the quasi-static deflection's lag, the slow part of the dynamic part.
+    lag: f64,
+}
+
+/// The hinge mode at a point of the slow manifold.
+#[derive(Clone, Copy, Debug)]
+struct Mode {
+    lambda: Complex<f64>,
+    v: [Complex<f64>; 4],
+    w: [Complex<f64>; 4],
+    /// A bound on the thermal block's rates over the hinge's angular frequency.
+    separation: f64,
+}
+
+impl SlowModel {
+    fn new(spec: &OrbitRunSpec) -> Self {
+        let p = &spec.panel;
+        SlowModel {
+            system: Coupled::new(spec.panel, spec.orbit, spec.model, spec.coupling),
+            model: spec.model,
+            stiffness: p.hinge_stiffness,
+            damping: p.damping,
+            inertia: p.hinge_inertia(),
+            moment_per_kelvin: p.moment_per_kelvin(),
+            segment: (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+
+    fn enter(&mut self, a: f64, b: f64) {
+        self.segment = (a, b);
+        self.system.enter_segment(a, b);
+    }
+
+    fn loads(&self, t: f64) -> Loads {
+        if self.system.has_face_loads() {
+            self.system.loads_at(t)
+        } else {
+            Loads::sun(self.system.flux_at(t))
+        }
+    }
+
+    fn theta0(&self, temps: &Vector2<f64>) -> f64 {
+        self.moment_per_kelvin * (temps[0] - temps[1]) / self.stiffness
+    }
+
+    /// T' with the hinge at θ, at rest.
+    fn thermal(&self, loads: Loads, temps: &Vector2<f64>, theta: f64) -> Vector2<f64> {
+        let y = Vector4::new(temps[0], temps[1], theta, 0.0);
+        let f = self.system.rhs_at_loads(loads, &y);
+        Vector2::new(f[0], f[1])
+    }
+
+    /// θ₀' at time t (temperatures `temps`), on θ₀.
+    fn theta0_rate(&self, t: f64, temps: &Vector2<f64>) -> (f64, Vector2<f64>) {
+        let rates = self.thermal(self.loads(t), temps, self.theta0(temps));
+        (
+            self.moment_per_kelvin * (rates[0] - rates[1]) / self.stiffness,
+            rates,
+        )
+    }
+
+    /// The slow manifold at (t, T̄).
+    fn manifold(&self, t: f64, temps: &Vector2<f64>) -> Manifold {
+        let th0 = self.theta0(temps);
+        let (th0_rate, rates0) = self.theta0_rate(t, temps);
+        // θ₀'' along the flow, by differences kept inside the segment.
+        let (a, b) = self.segment;
+        let (mut lo, mut hi) = ((t - FLOW_STEP).max(a), (t + FLOW_STEP).min(b));
+        if hi - lo < 1e-3 * FLOW_STEP {
+            (lo, hi) = (t, t + FLOW_STEP);
+        }
+        let at = |s: f64| self.theta0_rate(s, &(temps + rates0 * (s - t))).0;
+        let th0_accel = (at(hi) - at(lo)) / (hi - lo);
+        let (sin, cos) = th0.sin_cos();
+        let (inertia, velocity) = match self.model {
+            HingeModel::Linear => (self.inertia, 0.0),
+            HingeModel::Nonlinear => (
+                self.inertia * self.model.inertia_factor(sin),
+                3.0 * self.inertia * th0_rate * th0_rate * sin * cos,
+            ),
+        };
+        let lag = -(self.damping * th0_rate + inertia * th0_accel + velocity) / self.stiffness;
+        let theta = th0 + lag;
+        let theta_rate = th0_rate - self.damping / self.stiffness * th0_accel;
+        let rates = self.thermal(self.loads(t), temps, theta);
+        Manifold {
+            y: Vector4::new(temps[0], temps[1], theta, theta_rate),
+            rates,
+            lag,
+        }
+    }
+
+    /// The Jacobian of the full model at (t, y), by central differences.
+    fn jacobian(&self, loads: Loads, y: &Vector4<f64>) -> Matrix4<f64> {
+        let mut j = Matrix4::zeros();
+        for k in 0..4 {
+            let h = if k < 2 {
+                1e-6 * y[k].abs().max(1.0)
+            } else {
+                1e-7
+            };
+            let (mut plus, mut minus) = (*y, *y);
+            plus[k] += h;
+            minus[k] -= h;
+            let d = (self.system.rhs_at_loads(loads, &plus)
+                - self.system.rhs_at_loads(loads, &minus))
+                / (plus[k] - minus[k]);
+            j.set_column(k, &d);
+        }
+        j
+    }
+
+    /// The hinge mode of the Jacobian at (t, y), its eigenvalue found by Newton's method on the
+    /// characteristic polynomial from `guess`.
+    fn mode(&self, t: f64, y: &Vector4<f64>, guess: Complex<f64>) -> Option<Mode> {
+        let j = self.jacobian(self.loads(t), y);
+        let lambda = hinge_eigenvalue(&j, guess)?;
+        let c = |r: usize, k: usize| Complex::new(j[(r, k)], 0.0);
+        // v = (v0, v1, 1, λ): the two thermal rows.
+        let (a, b, cc, d) = (c(0, 0) - lambda, c(0, 1), c(1, 0), c(1, 1) - lambda);
+        let r0 = -(c(0, 2) + c(0, 3) * lambda);
+        let r1 = -(c(1, 2) + c(1, 3) * lambda);
+        let det = a * d - b * cc;
+        if det.norm() == 0.0 {
+            return None;
+        }
+        let v0 = (r0 * d - b * r1) / det;
+        let v1 = (a * r1 - cc * r0) / det;
+        let v = [v0, v1, Complex::new(1.0, 0.0), lambda];
+        // wᵀ(J − λ) = 0 with w3 = 1; θ' = θ̇ makes J's θ row (0, 0, 0, 1).
+        let (s0, s1) = (-c(3, 0), -c(3, 1));
+        let det_w = a * d - cc * b;
+        let w0 = (s0 * d - cc * s1) / det_w;
+        let w1 = (a * s1 - b * s0) / det_w;
+        let w2 = -(w0 * c(0, 3) + w1 * c(1, 3) + c(3, 3) - lambda);
+        let mut w = [w0, w1, w2, Complex::new(1.0, 0.0)];
+        let norm: Complex<f64> = (0..4).map(|k| w[k] * v[k]).sum();
+        if norm.norm() == 0.0 {
+            return None;
+        }
+        for x in &mut w {
+            *x /= norm;
+        }
+        let block = j[(0, 0)].abs().max(j[(1, 1)].abs()) + j[(0, 1)].abs().max(j[(1, 0)].abs());
+        Some(Mode {
+            lambda,
+            v,
+            w,
+            separation: block / lambda.im.abs(),
+        })
+    }
+
+    /// The non-linear hinge's angular frequency at amplitude `amp` about `theta` minus its
+    /// small-oscillation value: the conservative hinge's period 2 ∫₀^π sqrt(m(θ + A cos u)/K_el) du,
+    /// m(θ) = I_B (1 + 3 sin²θ), by Gauss–Legendre quadrature (the integrand is smooth).
+    fn frequency_shift(&self, theta: f64, amp: f64) -> f64 {
+        if self.model == HingeModel::Linear || amp == 0.0 {
+            return 0.0;
+        }
+        let period = |a: f64| {
+            let sum: f64 = GAUSS_5
+                .iter()
+                .map(|&(x, wt)| {
+                    let u = 0.5 * PI * (x + 1.0);
+                    let s = (theta + a * u.cos()).sin();
+                    wt * (self.inertia * self.model.inertia_factor(s) / self.stiffness).sqrt()
+                })
+                .sum();
+            PI * sum
+        };
+        2.0 * PI / period(amp) - 2.0 * PI / period(0.0)
+    }
+
+    /// Splits the state y at t into the slow manifold over T̄ and the ringing z: the fixed point
+    /// of T̄ = T − Re(z v_T), z = 2 wᵀ(y − ȳ).
+    fn split(
+        &self,
+        t: f64,
+        y: &Vector4<f64>,
+        guess: Complex<f64>,
+    ) -> Option<(Manifold, Mode, Complex<f64>)> {
+        let mut temps = Vector2::new(y[0], y[1]);
+        let mut lambda = guess;
+        for _ in 0..20 {
+            let m = self.manifold(t, &temps);
+            let mode = self.mode(t, &m.y, lambda)?;
+            lambda = mode.lambda;
+            let d = y - m.y;
+            let z: Complex<f64> = 2.0 * (0..4).map(|k| mode.w[k] * d[k]).sum::<Complex<f64>>();
+            let next = Vector2::new(y[0] - (z * mode.v[0]).re, y[1] - (z * mode.v[1]).re);
+            let moved = (next - temps).abs().max();
+            temps = next;
+            if moved <= 1e-12 * temps.abs().max() {
+                let m = self.manifold(t, &temps);
+                let mode = self.mode(t, &m.y, lambda)?;
+                let d = y - m.y;
+                let z = 2.0 * (0..4).map(|k| mode.w[k] * d[k]).sum::<Complex<f64>>();
+                return Some((m, mode, z));
+            }
+        }
+        None
+    }
+}
+
+/// The root of det(λ − J) nearest `guess` by Newton's method on the characteristic polynomial
+/// (its coefficients by Faddeev–LeVerrier); None unless it converges to an oscillation.
+fn hinge_eigenvalue(j: &Matrix4<f64>, guess: Complex<f64>) -> Option<Complex<f64>> {
+    let c3 = -j.trace();
+    let m2 = j + Matrix4::identity() * c3;
+    let c2 = -(j * m2).trace() / 2.0;
+    let m3 = j * m2 + Matrix4::identity() * c2;
+    let c1 = -(j * m3).trace() / 3.0;
+    let m4 = j * m3 + Matrix4::identity() * c1;
+    let c0 = -(j * m4).trace() / 4.0;
+    let mut x = guess;
+    for _ in 0..50 {
+        let p = (((x + c3) * x + c2) * x + c1) * x + c0;
+        let dp = ((x * 4.0 + 3.0 * c3) * x + 2.0 * c2) * x + c1;
+        if dp.norm_sqr() == 0.0 {
+            return None;
+        }
+        let dx = p / dp;
+        x -= dx;
+        if dx.norm_sqr() <= 1e-28 * x.norm_sqr() {
+            return (x.im.abs() > 0.0 && x.is_finite()).then_some(x);
+        }
+    }
+    None
+}
+
+/// T̄' on the slow manifold: the system the slow integration solves.
+struct SlowFlow<'m> {
+    model: &'m SlowModel,
+}
+
+impl OdeSystem<U2> for SlowFlow<'_> {
+    fn rhs(&self, t: f64, y: &State<U2>) -> State<U2> {
+        self.model.manifold(t, &Vector2::new(y[0], y[1])).rates
+    }
+}
+
+/// Why the slow path gave an orbit back to the full integration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Refusal {
+    Separation,
+    Ringing,
+    Split,
+    Limit,
+}
+
+/// What the slow integration carries from step to step, and reads into the summaries.
+struct Ringing<'a, 'c> {
+    model: &'a SlowModel,
+    obs: &'a mut SummaryObserver<'c, TwoLayerView>,
+    /// z and the hinge mode at the last step's end.
+    z: Complex<f64>,
+    mode: Mode,
+    manifold: Manifold,
+    refusal: Option<Refusal>,
+    error: Option<crate::Error>,
+    steps: u64,
+}
+
+/// The three Gauss–Legendre nodes on [−1, 1] and their weights.
+const GAUSS3: [(f64, f64); 3] = [
+    (-0.774_596_669_241_483_4, 5.0 / 9.0),
+    (0.0, 8.0 / 9.0),
+    (0.774_596_669_241_483_4, 5.0 / 9.0),
+];
+
+/// The polynomial through five points in Newton's form (divided differences once, then four
+/// multiply-adds a value).
+#[derive(Clone, Copy)]
+struct Newton5<T> {
+    xs: [f64; 5],
+    cs: [T; 5],
+}
+
+impl<T> Newton5<T>
+where
+    T: Copy
+        + std::ops::Mul<f64, Output = T>
+        + std::ops::Add<Output = T>
+        + std::ops::Sub<Output = T>,
+{
+    fn new(xs: &[f64; 5], ys: &[T; 5]) -> Self {
+        let mut cs = *ys;
+        for level in 1..5 {
+            for i in (level..5).rev() {
+                cs[i] = (cs[i] - cs[i - 1]) * (1.0 / (xs[i] - xs[i - level]));
+            }
+        }
+        Newton5 { xs: *xs, cs }
+    }
+
+    #[inline]
+    fn at(&self, x: f64) -> T {
+        let mut acc = self.cs[4];
+        for i in (0..4).rev() {
+            acc = acc * (x - self.xs[i]) + self.cs[i];
+        }
+        acc
+    }
+}
+
+impl Ringing<'_, '_> {
+    /// Carries z over the accepted step and reads the step into the summaries.
+    fn take(&mut self, step: &DenseStep<U2>) -> std::result::Result<(), Refusal> {
+        let (t0, t1) = (step.t0, step.t1);
+        let h = t1 - t0;
+        let m = self.model;
+        // The manifold and mode at the step's ends and its three Gauss nodes.
+        let mut ts = [0.0; 5];
+        ts[0] = t0;
+        ts[4] = t1;
+        for (k, &(x, _)) in GAUSS3.iter().enumerate() {
+            ts[k + 1] = t0 + 0.5 * h * (1.0 + x);
+        }
+        let mut points = [self.manifold; 5];
+        let mut modes = [self.mode; 5];
+        let mut guess = self.mode.lambda;
+        for k in 1..5 {
+            let temps = if k == 4 { step.y1 } else { step.eval(ts[k]) };
+            points[k] = m.manifold(ts[k], &temps);
+            modes[k] = m.mode(ts[k], &points[k].y, guess).ok_or(Refusal::Split)?;
+            guess = modes[k].lambda;
+        }
+        if modes.iter().any(|md| md.separation > SEPARATION_LIMIT) {
+            return Err(Refusal::Separation);
+        }
+        // The exponent's rate at the nodes: λ − wᵀv' + i Δω, v' from the quartic through the
+        // five modes.
+        let amp = self.z.norm();
+        let mut rate = [Complex::new(0.0, 0.0); 3];
+        for (k, r) in rate.iter_mut().enumerate() {
+            let i = k + 1;
+            let md = &modes[i];
+            let mut wv = Complex::new(0.0, 0.0);
+            for c in 0..4 {
+                let vs: [Complex<f64>; 5] = std::array::from_fn(|q| modes[q].v[c]);
+                wv += md.w[c] * lagrange_slope(&ts, &vs, ts[i]);
+            }
+            let shift = m.frequency_shift(points[i].y[2], amp);
+            *r = md.lambda - wv + Complex::new(0.0, shift);
+        }
+        // The rate as q0 + q1 x + q2 x² in x = 2 (t − t0)/h − 1 through the nodes x = −g, 0, g,
+        // and ∫ rate from t0, that quadratic integrated exactly.
+        let g = GAUSS3[2].0;
+        let q0 = rate[1];
+        let q1 = (rate[2] - rate[0]) / (2.0 * g);
+        let q2 = (rate[2] + rate[0] - rate[1] * 2.0) / (2.0 * g * g);
+        let scaled = |t: f64| 2.0 * (t - t0) / h - 1.0;
+        let exponent = |t: f64| -> Complex<f64> {
+            let x = scaled(t);
+            (q0 * (x + 1.0) + q1 * (0.5 * (x * x - 1.0)) + q2 * ((x * x * x + 1.0) / 3.0))
+                * (0.5 * h)
+        };
+        let rate_at = |t: f64| {
+            let x = scaled(t);
+            q0 + q1 * x + q2 * (x * x)
+        };
+        let z0 = self.z;
+        let z_at = |t: f64| z0 * exponent(t).exp();
+        let thetas = Newton5::new(&ts, &std::array::from_fn(|k| points[k].y[2]));
+        let lags = Newton5::new(&ts, &std::array::from_fn(|k| points[k].lag));
+        // κ = 1 − (M_T per kelvin / K_el)(v_f − v_b): the dynamic part's share of the ringing
+        // (the ringing's own thermal swing moves the quasi-static angle); its modulus and angle
+        // interpolated apart, so that reads take no complex transcendental.
+        let kappa: [Complex<f64>; 5] = std::array::from_fn(|k| {
+            Complex::new(1.0, 0.0)
+                - (modes[k].v[0] - modes[k].v[1]) * (m.moment_per_kelvin / m.stiffness)
+        });
+        let log_kappa = Newton5::new(&ts, &kappa.map(|k| k.norm().ln()));
+        let arg_kappa = Newton5::new(&ts, &kappa.map(|k| k.arg()));
+        let (log_z0, arg0) = (z0.norm().ln(), z0.arg());
+        let log_amp = |t: f64| log_z0 + exponent(t).re;
+        let phase = |t: f64| arg0 + exponent(t).im;
+        let theta_at = |t: f64| thetas.at(t) + log_amp(t).exp() * phase(t).cos();
+        let dynamic_at = |t: f64| {
+            lags.at(t) + (log_amp(t) + log_kappa.at(t)).exp() * (phase(t) + arg_kappa.at(t)).cos()
+        };
+        let period = 2.0 * PI / modes[2].lambda.im.abs();
+        let speed = |t: f64| rate_at(t).im;
+        let kappa_at = |t: f64| Complex::from_polar(log_kappa.at(t).exp(), arg_kappa.at(t));
+        // θ = θ̄ + A cos φ and the dynamic part = lag + |κ| A cos(φ + arg κ).
+        let theta_wave = Wave {
+            value: &theta_at,
+            envelope: &|t: f64| thetas.at(t) + log_amp(t).exp(),
+            phase: &phase,
+            speed: &speed,
+            period,
+        };
+        let dynamic_envelope = |t: f64| (log_amp(t) + log_kappa.at(t)).exp();
+        let dynamic_wave = Wave {
+            value: &dynamic_at,
+            envelope: &|t: f64| lags.at(t) + dynamic_envelope(t),
+            phase: &|t: f64| phase(t) + arg_kappa.at(t),
+            speed: &speed,
+            period,
+        };
+        let neg_dynamic = |t: f64| -dynamic_at(t);
+        let dynamic_low = Wave {
+            value: &neg_dynamic,
+            envelope: &|t: f64| -lags.at(t) + dynamic_envelope(t),
+            phase: &|t: f64| phase(t) + arg_kappa.at(t) + PI,
+            speed: &speed,
+            period,
+        };
+        let dyn_abs = dynamic_wave
+            .largest(t0, t1)
+            .max(dynamic_low.largest(t0, t1));
+        // ∫ (dynamic)²: lag² + |κz|²/2 by Gauss–Legendre, and the oscillating terms
+        // 2 lag Re(κz) + Re((κz)²)/2 by their leading term [F/L']: they swing at the hinge's
+        // frequency, L' the exponent's rate.
+        let mut sq = 0.0;
+        for (x, wt) in GAUSS_5 {
+            let t = t0 + 0.5 * h * (1.0 + x);
+            let (lag, w) = (lags.at(t), kappa_at(t) * z_at(t));
+            sq += 0.5 * h * wt * (lag * lag + 0.5 * w.norm_sqr());
+        }
+        let swing = |t: f64| {
+            let (lag, w, r) = (lags.at(t), kappa_at(t) * z_at(t), rate_at(t));
+            (w * (2.0 * lag) / r + w * w / (4.0 * r)).re
+        };
+        sq += swing(t1) - swing(t0);
+        let sq = sq.max(0.0);
+        let z1 = z_at(t1);
+        if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
+            return Err(Refusal::Ringing);
+        }
+        let theta_low = |t: f64| -theta_at(t);
+        let theta_min_wave = Wave {
+            value: &theta_low,
+            envelope: &|t: f64| -thetas.at(t) + log_amp(t).exp(),
+            phase: &|t: f64| phase(t) + PI,
+            speed: &speed,
+            period,
+        };
+        let extremes = |a: f64, b: f64| -> (f64, f64) {
+            (-theta_min_wave.largest(a, b), theta_wave.largest(a, b))
+        };
+        let (lo, hi) = extremes(t0, t1);
+        let limit = self.obs.collector.options.theta_limit;
+        if hi > limit || lo < -limit {
+            return Err(Refusal::Limit);
+        }
+        if let Err(e) = self
+            .obs
+            .collector
+            .record_span(t0, t1, &extremes, dyn_abs, sq)
+        {
+            self.error = Some(e);
+        }
+        self.z = z1;
+        self.mode = modes[4];
+        self.manifold = points[4];
+        self.steps += 1;
+        Ok(())
+    }
+}
+
+/// A slow value plus a swing at the hinge's frequency, s(t) + A(t) cos φ(t): its largest value
+/// over a span is at one of the peaks (φ = 2πm) next to the envelope's largest, s + A, or at an
+/// end of the span.
+struct Wave<'f> {
+    value: &'f dyn Fn(f64) -> f64,
+    envelope: &'f dyn Fn(f64) -> f64,
+    phase: &'f dyn Fn(f64) -> f64,
+    /// φ'.
+    speed: &'f dyn Fn(f64) -> f64,
+    period: f64,
+}
+
+impl Wave<'_> {
+    fn largest(&self, a: f64, b: f64) -> f64 {
+        let f = self.value;
+        let mut best = f(a).max(f(b));
+        if b <= a {
+            return best;
+        }
+        let d = self.period / READS_PER_PERIOD;
+        if b - a <= self.period {
+            let n = ((b - a) / d).ceil().max(1.0) as usize;
+            for i in 1..n {
+                best = best.max(self.refined(a + (b - a) * i as f64 / n as f64, d, a, b));
+            }
+            return best;
+        }
+        // The envelope's largest on a few points, then the peaks around it.
+        let mut t_star = a;
+        let mut e_best = f64::NEG_INFINITY;
+        for i in 0..=ENVELOPE_READS {
+            let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
+            let e = (self.envelope)(t);
+            if e > e_best {
+                (e_best, t_star) = (e, t);
+            }
+        }
+        let ph = (self.phase)(t_star);
+        let m0 = (ph / (2.0 * PI)).round();
+        for dm in [-1.0, 0.0, 1.0] {
+            let target = 2.0 * PI * (m0 + dm);
+            let mut t = t_star + (target - ph) / (self.speed)(t_star);
+            for _ in 0..2 {
+                t -= ((self.phase)(t) - target) / (self.speed)(t);
+            }
+            if t >= a && t <= b {
+                best = best.max(self.refined(t, d, a, b));
+            }
+        }
+        best
+    }
+
+    /// f near t, refined by the parabola through t ± d (kept within [a, b]).
+    fn refined(&self, t: f64, d: f64, a: f64, b: f64) -> f64 {
+        let f = self.value;
+        let (lo, hi) = ((t - d).max(a), (t + d).min(b));
+        let (p, c, q) = (f(lo), f(t), f(hi));
+        let mut best = c.max(p).max(q);
+        if hi - t == t - lo && t > lo {
+            let curv = p - 2.0 * c + q;
+            if curv < 0.0 {
+                let off = (0.5 * (p - q) / curv).clamp(-1.0, 1.0);
+                best = best.max(f(t + off * d));
+            }
+        }
+        best
+    }
+}
+
+/// Points at which a span's envelope is read to find its largest.
+const ENVELOPE_READS: usize = 8;
+
+/// The slope at x of the quartic through five points.
+fn lagrange_slope(xs: &[f64; 5], ys: &[Complex<f64>; 5], x: f64) -> Complex<f64> {
+    let mut acc = Complex::new(0.0, 0.0);
+    for i in 0..5 {
+        let mut slope = 0.0;
+        for m in 0..5 {
+            if m == i {
+                continue;
+            }
+            let mut term = 1.0 / (xs[i] - xs[m]);
+            for k in 0..5 {
+                if k != i && k != m {
+                    term *= (x - xs[k]) / (xs[i] - xs[k]);
+                }
+            }
+            slope += term;
+        }
+        acc += ys[i] * slope;
+    }
+    acc
+}
+
+impl Observer<U2> for Ringing<'_, '_> {
+    fn on_step(&mut self, step: &DenseStep<U2>) -> ControlFlow<()> {
+        if let Err(e) = self.obs.cancel.check() {
+            self.error = Some(e);
+            return ControlFlow::Break(());
+        }
+        match self.take(step) {
+            Ok(()) if self.error.is_none() => ControlFlow::Continue(()),
+            Ok(()) => ControlFlow::Break(()),
+            Err(r) => {
+                self.refusal = Some(r);
+                ControlFlow::Break(())
+            }
+        }
+    }
+}
+
+/// Orbits shorter than this (s) leave the hybrid no linear arc when they have an eclipse: an
+/// eclipse every orbit and a thermal recovery after it.
+pub const SHORT_ORBIT: f64 = 6.0 * 3600.0;
+
+/// Whether the hybrid runs `spec` on slow time: a two-layer run on a short orbit (with or
+/// without the Earth's heat and an attitude). Longer orbits keep the hybrid's linear arcs, and
+/// under varying loads its full integration: at GEO the dynamic part is a few 1e-5 rad, where
+/// the slow manifold's truncation was measured at up to 2.3 % of it (1.1e-6 rad, past the gate).
+pub(crate) fn applies(spec: &OrbitRunSpec) -> bool {
+    spec.orbit.period < SHORT_ORBIT
+}
+
+/// How a slow-time run split its work.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SlowSplit {
+    /// Simulated time carried on slow time, and in full (penumbrae, refused orbits), s.
+    pub t_slow: f64,
+    pub t_full: f64,
+    pub n_slow_steps: u64,
+    pub n_full_steps: u64,
+    /// Orbits given back to the full integration by a guard.
+    pub n_refused: u64,
+}
+
+/// Runs the orbits of `spec` from `y0` on slow time, each orbit in full where a guard refuses it
+/// (and every orbit after it). The summaries are the full integration's (`spec.method`, the
+/// step capped at the hinge period as the run's options ask).
+pub(crate) fn run_slow(
+    spec: &OrbitRunSpec,
+    y0: Vector4<f64>,
+    cancel: &Cancel,
+) -> Result<(Summarised<U4>, SlowSplit)> {
+    let options = spec.options;
+    let steps = if options.steps_per_period > 0.0 {
+        options.steps_per_period
+    } else {
+        STEPS_PER_HINGE_PERIOD
+    };
+    let full_method = resolve_hinge(&spec.method, &spec.panel, steps);
+    let view = TwoLayerView {
+        panel: spec.panel,
+        coupling: spec.coupling,
+    };
+    let mut obs = SummaryObserver {
+        collector: Collector::new(view, spec, y0[2])?,
+        error: None,
+        cancel,
+    };
+    let mut model = SlowModel::new(spec);
+    let mut full = model.system;
+    let t_end = spec.t_end();
+    let mut eclipses = EclipseTable::until(&spec.orbit, t_end);
+    let mut split = SlowSplit::default();
+    let mut stats = crate::numerics::integrate::Stats {
+        t_end: spec.t_start,
+        ..Default::default()
+    };
+    let mut y = y0;
+    let mut t = spec.t_start;
+    let mut lambda = Complex::new(0.0, spec.panel.natural_angular_frequency());
+    let slow_method = Method::Dopri5(SLOW_TOLERANCES);
+    for k in 0..spec.n_orbits {
+        let orbit_start = t;
+        let orbit_end = if k + 1 == spec.n_orbits {
+            t_end
+        } else {
+            spec.t_start + (k + 1) as f64 * spec.orbit.period
+        };
+        let mark = obs.collector.mark();
+        let y_start = y;
+        let mut cuts = vec![orbit_start];
+        cuts.extend(breakpoints_of(
+            eclipses.overlapping(orbit_start, orbit_end),
+            orbit_start,
+            orbit_end,
+        ));
+        cuts.push(orbit_end);
+        let mut refused = false;
+        let (mut slow_steps, mut full_steps, mut slow_time) = (0, 0, 0.0);
+        for pair in cuts.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            if b <= a {
+                continue;
+            }
+            let mid = spec.orbit.illumination_on(0.5 * (a + b), a, b);
+            if matches!(spec.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0 {
+                let (st, y1) = solve(&mut full, &full_method, a, y, b, &mut obs)?;
+                if let Some(e) = obs.error.take() {
+                    return Err(e);
+                }
+                full_steps += st.n_steps;
+                stats.n_rhs += st.n_rhs;
+                y = y1;
+                if st.stopped {
+                    // The full integration stopped at the run's limit.
+                    split.n_full_steps += full_steps;
+                    stats.n_steps += slow_steps + full_steps;
+                    stats.stopped = true;
+                    stats.t_end = st.t_end;
+                    return Ok((obs.collector.finish(stats, y), split));
+                }
+                continue;
+            }
+            model.enter(a, b);
+            let Some((manifold, mode, z)) = model.split(a, &y, lambda) else {
+                refused = true;
+                break;
+            };
+            if mode.separation > SEPARATION_LIMIT || z.norm() > RING_LIMIT {
+                refused = true;
+                break;
+            }
+            let mut ring = Ringing {
+                model: &model,
+                obs: &mut obs,
+                z,
+                mode,
+                manifold,
+                refusal: None,
+                error: None,
+                steps: 0,
+            };
+            let mut flow = SlowFlow { model: &model };
+            let temps = Vector2::new(manifold.y[0], manifold.y[1]);
+            let (st, _) = solve(&mut flow, &slow_method, a, temps, b, &mut ring)?;
+            if let Some(e) = ring.error.take() {
+                return Err(e);
+            }
+            if ring.refusal.is_some() {
+                refused = true;
+                break;
+            }
+            stats.n_rhs += st.n_rhs;
+            slow_steps += ring.steps;
+            slow_time += b - a;
+            lambda = ring.mode.lambda;
+            let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
+            y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
+        }
+        if refused {
+            // This orbit and the rest of the run in full, from the orbit's start.
+            obs.collector.rewind(mark);
+            let (st, y1) = solve(
+                &mut full,
+                &full_method,
+                orbit_start,
+                y_start,
+                t_end,
+                &mut obs,
+            )?;
+            if let Some(e) = obs.error.take() {
+                return Err(e);
+            }
+            split.n_refused += spec.n_orbits - k;
+            split.n_full_steps += st.n_steps;
+            split.t_full += st.t_end - orbit_start;
+            stats.n_rhs += st.n_rhs;
+            stats.n_steps += st.n_steps;
+            stats.stopped = st.stopped;
+            stats.t_end = st.t_end;
+            y = y1;
+            break;
+        }
+        split.n_slow_steps += slow_steps;
+        split.n_full_steps += full_steps;
+        split.t_slow += slow_time;
+        split.t_full += (orbit_end - orbit_start) - slow_time;
+        stats.n_steps += slow_steps + full_steps;
+        t = orbit_end;
+        stats.t_end = t;
+    }
+    Ok((obs.collector.finish(stats, y), split))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inputs::orbit::Orbit;
+    use crate::inputs::panel::Panel;
+    use crate::models::coupled::Coupling;
+    use crate::runs::orbits::{
+        run_orbits, start_state, OrbitRunRequest, OrbitSummary, SummaryOptions,
+    };
+
+    fn spec(panel: Panel, orbit: Orbit, model: HingeModel, n: u64) -> OrbitRunSpec {
+        OrbitRunSpec {
+            panel,
+            orbit,
+            model,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: n,
+            options: SummaryOptions {
+                window: 600.0,
+                theta_limit: 0.5,
+                stop_at_limit: true,
+                steps_per_period: STEPS_PER_HINGE_PERIOD,
+            },
+        }
+    }
+
+    /// The largest error of `got` against `want` over every θ column, as a fraction of the
+    /// accuracy gate (2 %, or 1e-6 rad below 5e-5 rad).
+    fn gate(want: &[OrbitSummary], got: &[OrbitSummary]) -> f64 {
+        assert_eq!(want.len(), got.len());
+        let cols = |s: &OrbitSummary| {
+            [
+                s.theta_max,
+                s.theta_min,
+                s.amplitude,
+                s.jitter_rms,
+                s.jitter_peak,
+                s.entry_theta_min,
+                s.exit_theta_max,
+                s.entry_peak,
+                s.exit_peak,
+            ]
+        };
+        let mut worst: f64 = 0.0;
+        for (w, g) in want.iter().zip(got) {
+            for (a, b) in cols(w).into_iter().zip(cols(g)) {
+                assert_eq!(a.is_nan(), b.is_nan());
+                if a.is_nan() {
+                    continue;
+                }
+                let r = if a.abs() >= 5e-5 {
+                    (b - a).abs() / (0.02 * a.abs())
+                } else {
+                    (b - a).abs() / 1e-6
+                };
+                worst = worst.max(r);
+            }
+        }
+        worst
+    }
+
+    fn compare(panel: Panel, orbit: Orbit, model: HingeModel, n: u64) -> (f64, SlowSplit) {
+        let s = spec(panel, orbit, model, n);
+        let y0 = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
+        let full = run_orbits(&OrbitRunRequest { spec: s, y0 }).unwrap();
+        let (slow, split) = run_slow(&s, y0, &Cancel::new()).unwrap();
+        (gate(&full.summaries, &slow.summaries), split)
+    }
+
+    #[test]
+    fn low_orbits_on_slow_time_hold_the_gate_of_the_full_integration() {
+        let leo = Orbit::leo(540e3);
+        let conical = Orbit {
+            shadow: Shadow::Penumbra,
+            ..leo
+        };
+        for (orbit, model) in [
+            (leo, HingeModel::Nonlinear),
+            (leo, HingeModel::Linear),
+            (conical, HingeModel::Nonlinear),
+        ] {
+            let (worst, split) = compare(Panel::paper(), orbit, model, 4);
+            assert!(
+                worst < 0.5,
+                "{model:?} {:?}: {worst} of the gate",
+                orbit.shadow
+            );
+            assert_eq!(split.n_refused, 0);
+            assert!(split.t_slow > 0.99 * 4.0 * orbit.period);
+        }
+    }
+
+    #[test]
+    fn a_fluttering_panel_holds_the_gate_until_its_ringing_is_given_back() {
+        // Half the critical damping: the ringing grows each orbit, past the closed form's
+        // limit after a few, and the rest runs in full.
+        let panel = Panel {
+            damping: 1.08,
+            ..Panel::paper()
+        };
+        let (worst, split) = compare(panel, Orbit::leo(540e3), HingeModel::Nonlinear, 8);
+        assert!(worst < 0.5, "{worst} of the gate");
+        assert!(split.n_refused > 0 && split.n_refused < 8, "{split:?}");
+    }
+
+    #[test]
+    fn the_hinge_eigenvalue_is_a_root_of_the_jacobian() {
+        let panel = Panel::paper();
+        let orbit = Orbit::leo(540e3);
+        let s = spec(panel, orbit, HingeModel::Nonlinear, 1);
+        let mut model = SlowModel::new(&s);
+        model.enter(0.0, 100.0);
+        let y = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
+        let m = model.manifold(0.0, &Vector2::new(y[0], y[1]));
+        let mode = model
+            .mode(
+                0.0,
+                &m.y,
+                Complex::new(0.0, panel.natural_angular_frequency()),
+            )
+            .unwrap();
+        let j = model.jacobian(model.loads(0.0), &m.y);
+        let nearest = j
+            .complex_eigenvalues()
+            .iter()
+            .map(|e| (e - mode.lambda).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest < 1e-10 * mode.lambda.norm(), "{nearest}");
+        // v and w are the right and left eigenvectors, w·v = 1.
+        let jc = j.map(|x| Complex::new(x, 0.0));
+        let v = nalgebra::Vector4::from(mode.v);
+        let w = nalgebra::Vector4::from(mode.w);
+        let scale = mode.lambda.norm();
+        assert!((jc * v - v * mode.lambda).norm() < 1e-10 * scale);
+        assert!((jc.transpose() * w - w * mode.lambda).norm() < 1e-10 * scale * w.norm());
+        assert!((w.dot(&v) - Complex::new(1.0, 0.0)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn the_split_gives_back_the_state() {
+        let panel = Panel::paper();
+        let orbit = Orbit::leo(540e3);
+        let s = spec(panel, orbit, HingeModel::Nonlinear, 1);
+        let mut model = SlowModel::new(&s);
+        model.enter(1900.0, 3000.0); // in the umbra
+        let mut y = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
+        y[2] += 0.004;
+        y[3] -= 0.002;
+        let guess = Complex::new(0.0, panel.natural_angular_frequency());
+        let (m, mode, z) = model.split(1900.0, &y, guess).unwrap();
+        let back = m.y + Vector4::from_fn(|i, _| (z * mode.v[i]).re);
+        assert!((back - y).abs().max() < 1e-9, "{back} vs {y}");
+        assert!(z.norm() > 1e-3);
+    }
+
+    #[test]
+    fn the_frequency_shift_is_that_of_the_conservative_hinge() {
+        // The period of I_B (1 + 3 sin²θ) θ̈ + 3 I_B θ̇² sin θ cos θ + K (θ − θc) = 0 from rest at
+        // θc + A, by RK4 at a small step: the time to the next turning point, twice.
+        let panel = Panel::paper();
+        let s = spec(panel, Orbit::leo(540e3), HingeModel::Nonlinear, 1);
+        let model = SlowModel::new(&s);
+        let (i, k) = (panel.hinge_inertia(), panel.hinge_stiffness);
+        let (centre, amp) = (0.085, 0.02);
+        let accel = |th: f64, om: f64| {
+            let (sn, cs) = th.sin_cos();
+            (-k * (th - centre) - 3.0 * i * om * om * sn * cs) / (i * (1.0 + 3.0 * sn * sn))
+        };
+        let (mut th, mut om, mut t) = (centre + amp, 0.0_f64, 0.0);
+        let dt = 1e-4;
+        loop {
+            let f = |th: f64, om: f64| (om, accel(th, om));
+            let k1 = f(th, om);
+            let k2 = f(th + 0.5 * dt * k1.0, om + 0.5 * dt * k1.1);
+            let k3 = f(th + 0.5 * dt * k2.0, om + 0.5 * dt * k2.1);
+            let k4 = f(th + dt * k3.0, om + dt * k3.1);
+            let next = om + dt / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+            th += dt / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+            if om < 0.0 && next >= 0.0 {
+                // The turning point by linear interpolation of θ̇ within the step.
+                t += dt * (-om) / (next - om);
+                break;
+            }
+            om = next;
+            t += dt;
+        }
+        let measured = 2.0 * PI / (2.0 * t);
+        let small = 2.0 * PI / (2.0 * PI * (i * (1.0 + 3.0 * centre.sin().powi(2)) / k).sqrt());
+        let shift = model.frequency_shift(centre, amp);
+        assert!(shift < 0.0);
+        assert!(
+            (small + shift - measured).abs() < 1e-3 * shift.abs(),
+            "{} vs {measured}",
+            small + shift
+        );
+    }
+}
