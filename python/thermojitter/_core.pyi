@@ -10,6 +10,8 @@ _F = NDArray[np.float64]
 
 __all__ = [
     "least_steps",
+    "SLOW_ORBIT",
+    "SLOW_RING_LIMIT",
     "leo_orbit",
     "eclipse_duration",
     "SIDEREAL_DAY",
