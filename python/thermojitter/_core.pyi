@@ -83,6 +83,7 @@ __all__ = [
     "distributed_flutter",
     "distributed_start_state",
     "run_distributed_orbits",
+    "summary_metrics",
     "distributed_info",
     "eclipses",
     "energy",
@@ -382,6 +383,7 @@ def simulate_distributed(
 def distributed_start_state(
     panel: dict[str, float], settings: dict[str, Any], orbit: dict[str, Any], t0: float
 ) -> list[float]: ...
+def summary_metrics(columns: dict[str, Any], t_end: float) -> list[tuple[str, float]]: ...
 def run_distributed_orbits(
     panel: dict[str, float],
     orbit: dict[str, Any],

@@ -34,38 +34,18 @@ damping, N m s/rad), ``tip_max``/``tip_min`` the tip deflection's extremes over 
 ``t_nonlinear`` the time integrated in full (s)."""
 
 
-def _largest(values: np.ndarray) -> float:
-    """The largest finite value, NaN when there is none (no orbit with an eclipse)."""
-    finite = values[np.isfinite(values)]
-    return float(finite.max()) if finite.size else math.nan
-
-
 def row_of(run: OrbitSummaries) -> dict[str, Any]:
-    """The metrics a run's summaries give (all but the stability columns)."""
+    """The metrics a run's summaries give (all but the stability columns), read by the engine
+    as the hinge studies read theirs, and the tip's extremes."""
     c = run.columns
-    amplitude = c["amplitude"]
-    index = np.arange(len(amplitude), dtype=float)
-    finite = amplitude > 0.0
-    slope = (
-        float(np.polyfit(index[finite], np.log(amplitude[finite]), 1)[0])
-        if finite.sum() >= 2
-        else math.nan
-    )
     crossing = run.limit_crossing
     p = run.propagation
     return {
         "theta_eq": float(c["theta_eq"][0]),
-        "theta_abs_max": float(max(np.max(c["theta_max"]), -np.min(c["theta_min"]))),
-        "amplitude": float(np.max(amplitude)),
-        "entry_peak": _largest(c["entry_peak"]),
-        "exit_peak": _largest(c["exit_peak"]),
-        # Orbits of equal length: the RMS over the horizon from each orbit's.
-        "jitter_rms": float(np.sqrt(np.mean(c["jitter_rms"] ** 2))),
-        "jitter_peak": float(np.max(c["jitter_peak"])),
+        **dict(_core.summary_metrics({k: v.tolist() for k, v in c.items()}, run.t_end)),
         "tip_max": float(np.max(c["tip_max"])),
         "tip_min": float(np.min(c["tip_min"])),
         "orbit_limit": math.nan if crossing is None else float(crossing.orbit),
-        "amplitude_slope": slope,
         "t_nonlinear": float(p["t_fallback"]) if p else run.t_end - float(c["t_start"][0]),
         "t_reached": run.t_end,
         "n_steps": run.n_steps,

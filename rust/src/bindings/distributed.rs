@@ -331,7 +331,76 @@ fn run_distributed_orbits<'py>(
     })
 }
 
+/// The metrics a study reads off per-orbit summary columns (`thermojitter.longrun`'s, as
+/// arrays) of a run that ended at `t_end`: theta_abs_max, amplitude, entry_peak, exit_peak,
+/// jitter_rms, jitter_peak, amplitude_slope (`crate::runs::ensemble::summary_metrics`).
+#[pyfunction]
+fn summary_metrics(columns: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Vec<(String, f64)>> {
+    shield(|| {
+        let col = |name: &str| -> PyResult<Vec<f64>> {
+            required_item(columns, name, "an array of numbers")
+        };
+        let index: Vec<u64> = required_item(columns, "index", "an array of integers")?;
+        let names = [
+            "t_start",
+            "t_end",
+            "theta_eq",
+            "theta_max",
+            "theta_min",
+            "amplitude",
+            "jitter_rms",
+            "jitter_peak",
+            "t_entry",
+            "t_exit",
+            "entry_theta_min",
+            "exit_theta_max",
+            "entry_peak",
+            "exit_peak",
+        ];
+        let values = names.iter().map(|n| col(n)).collect::<PyResult<Vec<_>>>()?;
+        if let Some(bad) = values.iter().position(|v| v.len() != index.len()) {
+            return Err(invalid(
+                names[bad],
+                values[bad].len(),
+                "must hold one value per orbit",
+            ));
+        }
+        let v = |k: usize, i: usize| values[k][i];
+        let rows: Vec<crate::runs::orbits::OrbitSummary> = (0..index.len())
+            .map(|i| crate::runs::orbits::OrbitSummary {
+                index: index[i],
+                t_start: v(0, i),
+                t_end: v(1, i),
+                theta_eq: v(2, i),
+                theta_max: v(3, i),
+                theta_min: v(4, i),
+                amplitude: v(5, i),
+                jitter_rms: v(6, i),
+                jitter_peak: v(7, i),
+                t_entry: v(8, i),
+                t_exit: v(9, i),
+                entry_theta_min: v(10, i),
+                exit_theta_max: v(11, i),
+                entry_peak: v(12, i),
+                exit_peak: v(13, i),
+            })
+            .collect();
+        let m = crate::runs::ensemble::summary_metrics(&rows, t_end);
+        let out = [
+            "theta_abs_max",
+            "amplitude",
+            "entry_peak",
+            "exit_peak",
+            "jitter_rms",
+            "jitter_peak",
+            "amplitude_slope",
+        ];
+        Ok(out.iter().zip(m).map(|(n, x)| (n.to_string(), x)).collect())
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(summary_metrics, m)?)?;
     m.add_function(wrap_pyfunction!(run_distributed_orbits, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_start_state, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
