@@ -57,8 +57,8 @@ orbit, or with the N-node model (short orbits of the two-layer model run on slow
 
 SLOW_REFUSED = (
     "{n} orbit(s) of this hybrid run were integrated in full with rk45 (the hybrid's fallback): "
-    "on slow time the ringing grew past {ring} rad or the thermal rates were not slow against "
-    "the hinge, where its closed form does not hold"
+    "on slow time the ringing grew past {ring} rad, the thermal rates were not slow against the "
+    "hinge, or a summary lay too near 0 for the accuracy its closed form holds"
 )
 """What a hybrid run says when its slow-time guards gave orbits back to the full integration."""
 
@@ -448,9 +448,10 @@ def simulate_orbits(
       time scale with the hinge on its slow manifold, the ringing carried in closed form as a
       complex amplitude along the hinge mode (the thermal coupling, hence flutter, in its
       eigenvalue; the non-linear hinge's frequency shift with amplitude from its conservative
-      period), the penumbrae integrated in full. Orbits where the ringing passes 0.03 rad or
-      the thermal rates are not slow against the hinge are integrated in full with rk45 from
-      their start, with the rest of the run (``propagation["n_refused_orbits"]``, and a
+      period), the penumbrae integrated in full. An orbit where the ringing passes 0.03 rad,
+      the thermal rates are not slow against the hinge, or a summary lies too near 0 for the
+      closed form's accuracy (0.3 % of the ringing's amplitude) is integrated again in full
+      with rk45 from its start (``propagation["n_refused_orbits"]``, and a
       :class:`thermojitter.errors.HybridFallbackWarning`); ``propagation["t_slow"]`` is the
       time carried on slow time.
 

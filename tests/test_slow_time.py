@@ -1,0 +1,138 @@
+"""Slow time, the hybrid's propagation of orbits shorter than 6 h: drawn panels (Table 1 varied,
+thin metal, CFRP) on drawn low orbits (altitude, inclination, node, date, conical or cylindrical
+shadow, with or without the Earth's heat), both hinge models, damping from well below to well
+above the flutter analysis' critical value; against the hinge-resolved rk45 run, held to the
+accuracy gate on every orbit and every summary column. Orbits the slow time gives back to the
+full integration are said by a warning and still hold the gate.
+
+THERMOJITTER_SLOW=1 draws many more cases over longer spans.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+import os
+import warnings
+from dataclasses import dataclass
+
+import hypothesis.strategies as st
+import pytest
+from hypothesis import HealthCheck, Phase, given, note, settings
+from test_hybrid_properties import (
+    compared_orbits,
+    gate_failures,
+    metal_layer,
+    optics,
+    with_drawn_damping,
+)
+
+import thermojitter as tj
+from conftest import panels
+from thermojitter import materials as mat
+
+SLOW = bool(os.environ.get("THERMOJITTER_SLOW"))
+
+
+@dataclass(frozen=True)
+class Case:
+    panel: tj.Panel
+    orbit: tj.Orbit
+    model: str
+    n: int
+    text: str
+
+
+@st.composite
+def cases(draw: st.DrawFn) -> Case:
+    kind = draw(st.sampled_from(["paper", "paper", "metal", "cfrp"]))
+    if kind == "paper":
+        panel = draw(panels(spread=0.2))
+    else:
+        layer = (
+            metal_layer(draw)
+            if kind == "metal"
+            else mat.CFRP_M55J_QI.layer(draw(st.floats(0.5e-3, 3e-3)))
+        )
+        panel = tj.Panel.from_laminate(
+            tj.Laminate([layer], **optics(draw)), length=draw(st.floats(1.0, 5.0))
+        )
+    panel = with_drawn_damping(draw, panel)
+    altitude = draw(st.floats(400e3, 1500e3))
+    shadow = draw(st.sampled_from(["conical", "cylindrical"]))
+    if draw(st.booleans()):
+        orbit = tj.Orbit.leo(altitude, shadow=shadow)
+    else:
+        epoch = dt.date(2026, 1, 1) + dt.timedelta(days=draw(st.integers(0, 364)))
+        heated = draw(st.booleans())
+        orbit = tj.Orbit.circular(
+            altitude,
+            inclination=draw(st.floats(0.0, math.radians(98.0))),
+            raan=draw(st.floats(0.0, 2.0 * math.pi)),
+            epoch=epoch.isoformat(),
+            shadow=shadow,
+            albedo=draw(st.floats(0.2, 0.4)) if heated else 0.0,
+            earth_ir=draw(st.floats(200.0, 260.0)) if heated else 0.0,
+        )
+    model = draw(st.sampled_from(["nonlinear", "linear"]))
+    n = (12 if kind == "paper" else 6) if SLOW else (3 if kind == "paper" else 2)
+    fields = {k: v for k, v in panel.as_dict().items() if k != "layup"}
+    return Case(panel, orbit, model, n, f"{kind} {fields} on {orbit}, {model}, {n} orbits")
+
+
+@settings(
+    max_examples=60 if SLOW else 10,
+    deadline=None,
+    phases=list(Phase) if SLOW else [p for p in Phase if p is not Phase.shrink],
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(case=cases())
+def test_slow_time_holds_the_gate_of_the_full_run(case: Case) -> None:
+    note(case.text)
+    kw = {"orbits_per_call": case.n, "progress": False, "model": case.model}
+    full = tj.simulate_orbits(case.panel, case.orbit, case.n, method="rk45", **kw)  # type: ignore[arg-type]
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always", tj.HybridFallbackWarning)
+        hybrid = tj.simulate_orbits(case.panel, case.orbit, case.n, method="hybrid", **kw)  # type: ignore[arg-type]
+    p = hybrid.propagation
+    assert p["t_linear"] == p["t_exponential"] == 0.0
+    # The time on slow time, in full (penumbrae, refused orbits) adds up to the run.
+    reached = hybrid.t_end - 0.0
+    assert p["t_slow"] + p["t_fallback"] == pytest.approx(reached, rel=1e-9)
+    refused = p["n_refused_orbits"]
+    assert (refused > 0) == any(w.category is tj.HybridFallbackWarning for w in said)
+    m = compared_orbits(full, hybrid, case.n)
+    failures = gate_failures(full, hybrid, m)
+    assert not failures, (
+        f"{case.text}: {len(failures)} outside the gate in {m} orbits ({refused} refused); "
+        + "; ".join(failures[:5])
+    )
+
+
+def test_table_1_on_a_low_orbit_runs_on_slow_time_within_a_tenth_of_the_gate() -> None:
+    orbit = tj.Orbit.circular(540e3, inclination=math.radians(28.5), epoch="2026-06-01")
+    kw = {"orbits_per_call": 4, "progress": False}
+    full = tj.simulate_orbits(tj.Panel.paper(), orbit, 4, method="rk45", **kw)
+    hybrid = tj.simulate_orbits(tj.Panel.paper(), orbit, 4, method="hybrid", **kw)
+    p = hybrid.propagation
+    assert p["n_refused_orbits"] == 0
+    # Everything but the penumbrae on slow time, at a small fraction of rk45's steps.
+    assert p["t_fallback"] < 0.01 * 4 * orbit.period
+    assert hybrid.n_steps * 20 < full.n_steps
+    for name in ("jitter_rms", "jitter_peak", "theta_max", "theta_min", "exit_peak"):
+        a, b = full.columns[name], hybrid.columns[name]
+        assert (abs(b - a) <= 0.5 * 0.02 * abs(a)).all(), (name, a, b)
+
+
+def test_a_panel_with_fast_thermal_rates_is_given_back_to_the_full_integration() -> None:
+    # A third of Table 1's heat capacity: its thermal rates are no longer slow against the
+    # hinge (the slow manifold's premise), so every orbit runs in full, and says so.
+    panel = tj.Panel.paper().replace(specific_heat=300.0)
+    orbit = tj.Orbit.leo(540e3)
+    full = tj.simulate_orbits(panel, orbit, 2, method="rk45", progress=False)
+    with pytest.warns(tj.HybridFallbackWarning, match="2 orbit"):
+        hybrid = tj.simulate_orbits(panel, orbit, 2, method="hybrid", progress=False)
+    assert hybrid.propagation["n_refused_orbits"] == 2
+    assert hybrid.propagation["t_slow"] == 0.0
+    for name, column in full.columns.items():
+        assert (hybrid.columns[name] == column).all() or name in ("index",), name
