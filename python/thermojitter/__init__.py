@@ -21,8 +21,10 @@ from thermojitter.boom import (
 from thermojitter.calibrate import CalibrationResult, calibrate, calibrate_from_csv
 from thermojitter.checkpoint import CheckpointError
 from thermojitter.distributed import (
+    CriticalDampingYear,
     DistributedFlutterResult,
     DistributedSolution,
+    critical_damping_year,
     distributed_defaults,
     distributed_flutter,
     distributed_frequencies,
@@ -104,6 +106,7 @@ __all__ = [
     "CalibrationResult",
     "CheckpointError",
     "ConvergenceError",
+    "CriticalDampingYear",
     "DistributedFlutterResult",
     "DistributedSolution",
     "Equilibrium",
@@ -144,6 +147,7 @@ __all__ = [
     "calibrate",
     "calibrate_from_csv",
     "compare_with_beam",
+    "critical_damping_year",
     "distributed_defaults",
     "distributed_flutter",
     "distributed_frequencies",

@@ -10,6 +10,8 @@ _F = NDArray[np.float64]
 
 __all__ = [
     "least_steps",
+    "SLOW_ORBIT",
+    "SLOW_RING_LIMIT",
     "leo_orbit",
     "eclipse_duration",
     "SIDEREAL_DAY",
@@ -79,6 +81,9 @@ __all__ = [
     "derived",
     "distributed_defaults",
     "distributed_flutter",
+    "distributed_start_state",
+    "run_distributed_orbits",
+    "summary_metrics",
     "distributed_info",
     "eclipses",
     "energy",
@@ -372,6 +377,19 @@ def simulate_distributed(
     orbit: dict[str, Any],
     settings: dict[str, Any],
     run: _Run,
+    *,
+    cancel: CancelToken | None = None,
+) -> dict[str, Any]: ...
+def distributed_start_state(
+    panel: dict[str, float], settings: dict[str, Any], orbit: dict[str, Any], t0: float
+) -> list[float]: ...
+def summary_metrics(columns: dict[str, Any], t_end: float) -> list[tuple[str, float]]: ...
+def run_distributed_orbits(
+    panel: dict[str, float],
+    orbit: dict[str, Any],
+    settings: dict[str, Any],
+    orbits: _Orbits,
+    chunk: dict[str, Any],
     *,
     cancel: CancelToken | None = None,
 ) -> dict[str, Any]: ...

@@ -505,3 +505,61 @@ def distributed_convergence(
     ratio = values[-1] / values[-2]
     order = math.log(d1 / d2) / math.log(ratio) if d1 > 0 and d2 > 0 else math.inf
     return rows, order
+
+
+@dataclass(frozen=True)
+class CriticalDampingYear:
+    """The critical damping c_d* of the hinge model and of the distributed panel (as the
+    hinge-equivalent c_d = 2 I_B ω₁ ζ*) over a year, N m s/rad, at the sampled times ``t`` (s)
+    and their solar flux scale ``flux``."""
+
+    t: Array
+    flux: Array
+    hinge: Array
+    distributed: Array
+    settings: dict[str, Any]
+
+    @property
+    def days(self) -> Array:
+        return (self.t - self.t[0]) / 86400.0
+
+
+def critical_damping_year(
+    panel: Panel | None = None,
+    orbit: Orbit | None = None,
+    *,
+    samples: int = 25,
+    span: float = 365.25 * 86400.0,
+    elements: int | None = None,
+    modes: int | None = None,
+    support: Literal["free-free", "cantilever"] = "free-free",
+) -> CriticalDampingYear:
+    """c_d* of the hinge model (:func:`thermojitter.flutter` on ``orbit`` at each sampled time:
+    the flux of that day) and of the distributed panel (:func:`thermojitter.distributed_flutter`
+    at the same flux) at ``samples`` evenly spaced times over ``span`` s from t = 0. Defaults:
+    Table 1 on ``Orbit.geo_year("2026-01-01")``, the distributed model's default mesh."""
+    from thermojitter import errors as checks
+    from thermojitter.flutter import flutter
+
+    panel = Panel.paper() if panel is None else panel
+    orbit = Orbit.geo_year("2026-01-01") if orbit is None else orbit
+    samples = checks.integer("samples", samples, 2)
+    span = checks.positive("span", span)
+    t = np.linspace(0.0, span, samples)
+    flux = np.asarray(orbit.flux_scale(t), dtype=float)
+    hinge = np.array([flutter(panel, orbit=orbit, t=float(ti)).critical_damping for ti in t])
+    distributed = np.array(
+        [
+            distributed_flutter(
+                panel, flux=float(f), elements=elements, modes=modes, support=support
+            ).critical_damping
+            for f in flux
+        ]
+    )
+    return CriticalDampingYear(
+        t=t,
+        flux=flux,
+        hinge=hinge,
+        distributed=distributed,
+        settings={"elements": elements, "modes": modes, "support": support},
+    )

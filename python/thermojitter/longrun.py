@@ -69,6 +69,13 @@ SUMMARY_FIELDS = (
 )  # fmt: skip
 """Columns of the per-orbit summaries (angles rad, times s; NaN where an orbit has no eclipse)."""
 
+TIP_FIELDS = ("tip_max", "tip_min")
+"""Columns a run of the distributed panel adds: the largest and smallest tip deflection of each
+orbit, m (positive away from the Sun)."""
+
+DISTRIBUTED_ONLY = ("elements", "modes", "support", "damping_ratio")
+"""Settings of ``simulate_orbits`` that only ``model="distributed"`` takes."""
+
 HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
     "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits",
@@ -87,7 +94,11 @@ class OrbitSummaries(Persistent):
     (max abs(θ − θ_eq)), ``jitter_rms`` and ``jitter_peak`` (of θ − M_T/K_el, the oscillation about
     the quasi-static deflection), ``t_entry``/``t_exit`` (umbra), ``entry_theta_min`` and
     ``exit_theta_max`` (in the window after entry and exit), ``entry_peak``/``exit_peak``
-    (max abs(θ − θ_eq) in those windows).
+    (max abs(θ − θ_eq) in those windows). A run of the distributed panel
+    (``model="distributed"``) reads θ as its hinge-equivalent angle θ_f, the quasi-static part as
+    θ_f of the static state with the same temperatures (the kept modes at rest in equilibrium
+    with the element moments), and adds ``tip_max`` and ``tip_min`` (the tip deflection's
+    extremes in the orbit, m, positive away from the Sun).
     """
 
     columns: dict[str, NDArray[Any]]
@@ -187,8 +198,8 @@ def refuse_beyond_budget(name: str, value: Any, least: float, max_steps: int, wh
         )
 
 
-def _empty_columns() -> dict[str, list[Any]]:
-    return {name: [] for name in SUMMARY_FIELDS}
+def _empty_columns(fields: tuple[str, ...] = SUMMARY_FIELDS) -> dict[str, list[Any]]:
+    return {name: [] for name in fields}
 
 
 def _save_checkpoint(
@@ -254,11 +265,17 @@ def _check_extension(
         )
 
 
-def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
-    """The state of a checked checkpoint; refuses one whose rows do not run 0..next_index−1 (a
-    file the checksum vouches for was written by this code, so this guards its logic)."""
+def _restore(
+    path: Path,
+    content: dict[str, Any],
+    fields: tuple[str, ...] = SUMMARY_FIELDS,
+    size: int = 4,
+) -> tuple[Any, ...]:
+    """The state of a checked checkpoint (``fields`` its columns, ``size`` its state's); refuses
+    one whose rows do not run 0..next_index−1 (a file the checksum vouches for was written by
+    this code, so this guards its logic)."""
     try:
-        columns = {k: list(content["columns"][k]) for k in SUMMARY_FIELDS}
+        columns = {k: list(content["columns"][k]) for k in fields}
         next_index = int(content["next_index"])
         y = [float(v) for v in content["y"]]
         counters = dict(content["counters"])
@@ -271,7 +288,7 @@ def _restore(path: Path, content: dict[str, Any]) -> tuple[Any, ...]:
         raise checkpoints.CheckpointError(
             "checkpoint", path, f"holds rows {rows[:1]}..{rows[-1:]} for next_index {next_index}"
         )
-    if len(y) != 4 or any(len(v) != len(rows) for v in columns.values()):
+    if len(y) != size or any(len(v) != len(rows) for v in columns.values()):
         raise checkpoints.CheckpointError("checkpoint", path, "has columns of unequal length")
     return columns, y, next_index, counters, LimitCrossing.of(crossing)
 
@@ -291,13 +308,69 @@ def _boom_orbits(
     return _core.run_boom_orbits(boom, orbit, spec, y0, hybrid=orbits.get("hybrid"), cancel=cancel)
 
 
+def _distributed_call(settings: dict[str, Any]) -> Callable[..., dict[str, Any]]:
+    """``_core.run_distributed_orbits`` with the distributed model's ``settings``, called as
+    ``_core.run_orbits`` is."""
+
+    def call(
+        panel: dict[str, float],
+        orbit: dict[str, Any],
+        orbits: Any,
+        *,
+        cancel: Any = None,
+        **kw: Any,
+    ) -> Any:
+        return _core.run_distributed_orbits(panel, orbit, settings, orbits, kw, cancel=cancel)
+
+    return call
+
+
+def distributed_request(
+    panel: Any,
+    orbit: Orbit,
+    layers: int | None,
+    coupled: bool,
+    given: dict[str, Any],
+) -> dict[str, Any]:
+    """The distributed model's settings of a long run (``given``: elements, modes, support,
+    damping_ratio as passed), checked: a Panel, Sun-pointing through the orbit's attitude."""
+    from thermojitter.distributed import distributed_settings
+
+    if not isinstance(panel, Panel):
+        raise checks.ParameterError(
+            "model", "distributed", "takes a thermojitter.Panel (the distributed panel's mesh)"
+        )
+    check_inputs(panel, orbit)
+    return distributed_settings(
+        panel,
+        support=given["support"],
+        elements=given["elements"],
+        modes=given["modes"],
+        damping_ratio=given["damping_ratio"],
+        coupled=coupled,
+        layers=2 if layers is None else layers,
+    )
+
+
+def refuse_distributed_only(model: str, given: dict[str, Any]) -> None:
+    """A ParameterError naming the first distributed-only setting given to another model."""
+    if model == "distributed":
+        return
+    defaults = {"support": "free-free"}
+    for name in DISTRIBUTED_ONLY:
+        if given[name] is not None and given[name] != defaults.get(name):
+            raise checks.ParameterError(
+                name, given[name], "is a setting of model='distributed' only"
+            )
+
+
 def simulate_orbits(
     panel: Panel | Boom,
     orbit: Orbit,
     n_orbits: int,
     *,
     t_start: float = 0.0,
-    model: Literal["nonlinear", "linear"] = "nonlinear",
+    model: Literal["nonlinear", "linear", "distributed"] = "nonlinear",
     coupled: bool = True,
     method: Literal["hybrid", "rk45", "rk4"] = "hybrid",
     rtol: float = RTOL,
@@ -318,6 +391,10 @@ def simulate_orbits(
     layers: int | None = None,
     solver: SolverSettings | None = None,
     attitude: Attitude | None = None,
+    elements: int | None = None,
+    modes: int | None = None,
+    support: Literal["free-free", "cantilever"] = "free-free",
+    damping_ratio: float | None = None,
 ) -> OrbitSummaries:
     """Integrates ``n_orbits`` whole orbits of the coupled system, keeping one summary per orbit.
 
@@ -383,7 +460,35 @@ def simulate_orbits(
     quasi-static part as the panel's. ``method="hybrid"`` runs it with the full integration
     (the hybrid's linear arcs are the plate's modal form) and says so: ``result.fallback`` gives
     the reason and ``propagation`` puts all the time in ``t_fallback``.
+
+    ``model="distributed"`` runs the distributed panel (:func:`thermojitter.simulate_distributed`:
+    ``elements`` two-layer elements, ``modes`` elastic modes, ``support``, ``damping_ratio``, and
+    ``layers`` the elements' through-thickness model, default 2; defaults
+    :func:`thermojitter.distributed_defaults`), two-way coupled unless ``coupled=False``. The
+    summaries read θ as its hinge-equivalent angle θ_f and add ``tip_max``/``tip_min``; ``y0`` and
+    ``y_end`` are its state (the temperatures of each element, then q and q̇), the default start
+    its sunlit equilibrium. ``method="rk45"`` integrates it in full (the step capped at
+    T₁/``steps_per_period``, T₁ the first kept mode's period; every step read at eight points);
+    ``"hybrid"`` (default) propagates the sunlit arcs near the equilibrium exactly in the
+    linearised system's modal form (the structural pairs in closed form, the thermal part by the
+    matrix exponential) and integrates the shadow crossings and their recovery in full with rk45.
+    An arc is taken only where its checks hold (the non-linear remainder at its start below
+    ``hybrid.linear_tolerance`` as a static θ_f error, the oscillation below
+    ``hybrid.linear_amplitude``, the drift of the dropped non-linear terms within half the
+    accuracy gate, the reads' interpolation error); elsewhere the run goes on in full. The
+    split is in ``result.propagation`` (``t_linear``, ``t_fallback`` the full integration,
+    ``n_arcs``, ``n_refused_arcs``).
     """
+    given = {
+        "elements": elements,
+        "modes": modes,
+        "support": support,
+        "damping_ratio": damping_ratio,
+    }
+    model = checks.choice("model", model, ("nonlinear", "linear", "distributed"))  # type: ignore[assignment]
+    refuse_distributed_only(model, given)
+    distributed = model == "distributed"
+    dsettings = distributed_request(panel, orbit, layers, coupled, given) if distributed else None
     boom = isinstance(panel, Boom)
     if isinstance(panel, Boom):
         checks.instance("orbit", orbit, Orbit, "a thermojitter.Orbit")
@@ -396,7 +501,6 @@ def simulate_orbits(
     n_orbits = checks.integer("n_orbits", n_orbits, 1)
     orbits_per_call = checks.integer("orbits_per_call", orbits_per_call, 1)
     on_limit = checks.choice("on_limit", on_limit, ("stop", "flag", "ignore"))  # type: ignore[assignment]
-    model = checks.choice("model", model, ("nonlinear", "linear"))  # type: ignore[assignment]
     coupled = checks.flag("coupled", coupled)
     t_start = checks.finite("t_start", t_start)
     window = checks.positive("window", window)
@@ -410,7 +514,7 @@ def simulate_orbits(
     # Each chunk is checked by the engine; the whole run is checked here, before any work.
     n_orbits = orbit_count("n_orbits", n_orbits, orbit, t_start)
     method = checks.choice("method", method, ("hybrid", "rk45", "rk4"))  # type: ignore[assignment]
-    nodes = None if layers is None else check_layers(layers)
+    nodes = None if layers is None or distributed else check_layers(layers)
     # The N-node model's layup (layers is refused for a boom).
     layup = None if isinstance(panel, Boom) or nodes is None else layup_dict(panel)
     used = SolverSettings.of(
@@ -427,7 +531,11 @@ def simulate_orbits(
     full = used.as_dict()
     if y0 is not None:
         y0 = start_state(y0, len(y0) if hasattr(y0, "__len__") else 4)  # type: ignore[assignment]
-    if y0 is None and boom:
+    if y0 is None and dsettings is not None:
+        y0 = tuple(
+            _core.distributed_start_state(panel.as_dict(), dsettings, engine_orbit_args, t_start)
+        )
+    elif y0 is None and boom:
         y0 = tuple(_core.boom_start_state(panel.as_dict(), orbit.as_dict(), t_start, coupled))
     elif y0 is None:
         # The engine's default start: the sunlit equilibrium at the start date's solar flux.
@@ -455,16 +563,25 @@ def simulate_orbits(
     if nodes is not None:
         settings["layers"] = nodes
         settings["layup"] = layup
+    if dsettings is not None:
+        settings["distributed"] = dsettings
     hybrid_settings = HybridSettings.of(hybrid).as_dict()
     if method == "hybrid":
         settings["hybrid"] = hybrid_settings
     if "attitude" in engine_orbit_args:
         settings["attitude"] = engine_orbit_args["attitude"]
-    slow = orbit.period < _core.SLOW_ORBIT and nodes is None
+    slow = orbit.period < _core.SLOW_ORBIT and nodes is None and not distributed
     if method == "hybrid" and not slow and has_face_loads(orbit, attitude):
         settings["hybrid_fallback"] = HYBRID_FALLBACK
         warnings.warn(HYBRID_FALLBACK, HybridFallbackWarning, stacklevel=2)
-    run: dict[str, Any] = {"model": model, "coupled": coupled, "solver": full, "window": window}
+    # The distributed model's engine call takes the hinge model's mapping (its `model` unused).
+    engine_model = "nonlinear" if distributed else model
+    run: dict[str, Any] = {
+        "model": engine_model,
+        "coupled": coupled,
+        "solver": full,
+        "window": window,
+    }
     if nodes is not None and isinstance(panel, Panel):
         run.update(layup=layup_dict(panel), nodes=nodes)
     if method == "hybrid":
@@ -476,7 +593,19 @@ def simulate_orbits(
     }
 
     budget = int(full["max_steps"])  # for the whole run, every orbit together
-    if method != "hybrid":
+    if method != "hybrid" and dsettings is not None:
+        f1 = float(_core.distributed_info(panel.as_dict(), dsettings)["frequencies_hz"][0])
+        per_orbit = orbit.period * f1 * steps_per_period if method == "rk45" else 0.0
+        if method == "rk4":
+            per_orbit = orbit.period / float(full["dt"])
+        cap = (
+            "a fixed step dt" if method == "rk4" else f"the step capped at T₁/{steps_per_period:g}"
+        )
+        least = per_orbit * n_orbits
+        refuse_beyond_budget(
+            "n_orbits", n_orbits, least, budget, f"{per_orbit:.3g} per orbit with {cap}"
+        )
+    elif method != "hybrid":
         # A boom's step is capped by its equivalent hinge's period, the panel's of the same hinge.
         hinge = panel.derived["hinge_panel"] if isinstance(panel, Boom) else panel.as_dict()
         row = np.array([[hinge[f] for f in _core.PANEL_FIELDS]])
@@ -488,18 +617,23 @@ def simulate_orbits(
             "n_orbits", n_orbits, least * n_orbits, budget, f"{least:.3g} per orbit with {cap}"
         )
 
-    columns = _empty_columns()
+    fields = SUMMARY_FIELDS + TIP_FIELDS if distributed else SUMMARY_FIELDS
+    columns = _empty_columns(fields)
     y = [float(v) for v in y0]
     next_index = 0
     counters: dict[str, Any] = {"n_steps": 0, "n_rhs": 0}
     if method == "hybrid":
         counters.update({name: 0 for name in HYBRID_COUNTERS})
+        if distributed:
+            counters["n_refused_arcs"] = 0
     crossing: LimitCrossing | None = None
     path = checks.path("checkpoint", checkpoint) if checkpoint is not None else None
     if path is not None:
         saved = checkpoints.load(path, settings)
         if saved is not None:
-            columns, y, next_index, counters, crossing = _restore(path, saved)
+            columns, y, next_index, counters, crossing = _restore(
+                path, saved, fields, len(settings["y0"])
+            )
             _check_extension(path, saved, n_orbits, orbits_per_call, next_index)
 
     ran_with: dict[str, Any] | None = None  # the settings the engine reports it ran with
@@ -517,8 +651,15 @@ def simulate_orbits(
                 # places.
                 count = min(orbits_per_call - next_index % orbits_per_call, n_orbits - next_index)
                 t0 = float(t_start) + next_index * orbit.period
+                call: Callable[..., Any] = (
+                    _distributed_call(dsettings)
+                    if dsettings is not None
+                    else _boom_orbits
+                    if boom
+                    else _core.run_orbits
+                )
                 raw = engine.call(
-                    _boom_orbits if boom else _core.run_orbits,
+                    call,
                     panel.as_dict(),
                     engine_orbit_args,
                     orbits_args(run, count),
@@ -528,7 +669,7 @@ def simulate_orbits(
                     **watch,
                 )
                 with ctrl_c.hold():
-                    for name in SUMMARY_FIELDS:
+                    for name in fields:
                         columns[name].extend(np.asarray(raw[name]).tolist())
                     y = list(raw["y_end"])
                     ran_with = raw["solver"]
@@ -537,6 +678,8 @@ def simulate_orbits(
                     counters["n_rhs"] += int(raw["n_rhs"])
                     for name in HYBRID_COUNTERS if method == "hybrid" else ():
                         counters[name] = counters.get(name, 0) + raw[name]
+                    if "n_refused_arcs" in counters:
+                        counters["n_refused_arcs"] += raw["n_refused_arcs"]
                     if crossing is None and on_limit != "ignore":
                         crossing = LimitCrossing.of(raw["crossing"])
                     if raw["stopped"]:
@@ -595,7 +738,7 @@ def simulate_orbits(
         t_end=float(columns["t_end"][-1]) if columns["t_end"] else float(t_start),
         n_steps=counters["n_steps"],
         n_rhs=counters["n_rhs"],
-        propagation={k: counters[k] for k in HYBRID_COUNTERS if k in counters},
+        propagation={k: counters[k] for k in (*HYBRID_COUNTERS, "n_refused_arcs") if k in counters},
         limit_crossing=crossing,
         interrupted=interrupted,
         settings=settings,

@@ -60,7 +60,7 @@ def monte_carlo(
     checkpoint: str | os.PathLike[str] | None = None,
     chunk_size: int | None = None,
     progress: bool = True,
-    model: Literal["nonlinear", "linear"] = "nonlinear",
+    model: Literal["nonlinear", "linear", "distributed"] = "nonlinear",
     coupled: bool = True,
     method: Literal["rk45", "rk4", "hybrid"] | None = None,
     rtol: float = RTOL,
@@ -71,6 +71,10 @@ def monte_carlo(
     solver: SolverSettings | None = None,
     layers: int | None = None,
     attitude: Attitude | None = None,
+    elements: int | None = None,
+    modes: int | None = None,
+    support: Literal["free-free", "cantilever"] = "free-free",
+    damping_ratio: float | None = None,
 ) -> Any:
     """Runs ``n`` panels drawn around ``panel`` and returns a pandas DataFrame, one row a sample:
     the sampled parameters, then the metrics (see ``METRICS``).
@@ -137,7 +141,57 @@ def monte_carlo(
       integrated in full (the tube has no hybrid form).
 
     The frame is identical, bit for bit, for any ``threads``, ``chunk_size`` and backend.
+
+    ``model="distributed"`` runs the distributed panel (``elements``, ``modes``, ``support``,
+    ``damping_ratio``, ``layers`` as in ``simulate_orbits``): ``vary`` names panel parameters,
+    each sample is its own ``simulate_orbits(..., model="distributed")`` run over ``horizon``
+    orbits (``method``, ``window``, ``solver``, ``attitude`` passed on; ``method=None`` as above)
+    with its row read off the run's summaries
+    (:data:`thermojitter.montecarlo.distributed.DISTRIBUTED_METRICS`), the samples one per thread
+    (``threads``). ``threshold``, ``backend``, ``checkpoint`` and ``chunk_size`` are the hinge
+    studies' only.
     """
+    if model == "distributed":
+        from thermojitter.montecarlo.distributed import distributed_study
+        from thermojitter.montecarlo.driver import default_method
+
+        check_structure(panel, orbit)
+        for name, value in (
+            ("threshold", threshold), ("backend", backend), ("checkpoint", checkpoint),
+            ("chunk_size", chunk_size),
+        ):  # fmt: skip
+            if value is not None:
+                raise ParameterError(name, value, "is not a setting of model='distributed'")
+        n = check_n(n)
+        seed = check_seed(seed, None)
+        sampler = checks.choice("sampler", sampler, ("random", "lhs", "sobol"))  # type: ignore[assignment]
+        run = {
+            "n_orbits": horizon,
+            "coupled": coupled,
+            "method": default_method(method, orbit, horizon),
+            "window": window,
+            "rtol": rtol,
+            "atol": atol,
+            "dt": dt,
+            "max_steps": max_steps,
+            "solver": solver,
+            "attitude": attitude,
+        }
+        settings = {
+            "elements": elements, "modes": modes, "support": support,
+            "damping_ratio": damping_ratio, "layers": layers,
+        }  # fmt: skip
+        vary = check_vary(vary, False)
+        return distributed_study(
+            panel, orbit, vary, n, seed, sampler, checks.flag("truncate", truncate), threads,
+            run, settings,
+        )  # fmt: skip
+    from thermojitter.longrun import refuse_distributed_only
+
+    refuse_distributed_only(
+        str(model),
+        {"elements": elements, "modes": modes, "support": support, "damping_ratio": damping_ratio},
+    )
     check_structure(panel, orbit)
     vary = check_vary(vary, isinstance(panel, Boom))
     n = check_n(n)

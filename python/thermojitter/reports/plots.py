@@ -321,6 +321,28 @@ def orbit_year_figure(
     return fig
 
 
+def cd_year_figure(data: Any, *, title: str = "Table 1 on GEO") -> Any:
+    """The critical damping c_d* of the hinge model and of the distributed panel over a year, on
+    one axes (``data``: a :class:`thermojitter.CriticalDampingYear`), with
+    the solar flux scale beneath. Lines in the order hinge, distributed (top axes)."""
+    fig, (top, bottom) = figure(2, height=5.6)
+    days = data.days
+    top.plot(days, data.hinge, "o-", ms=3, lw=1.0, color="C0", label="hinge model, c_d*")
+    top.plot(
+        days, data.distributed, "s-", ms=3, lw=1.0, color="C3",
+        label="distributed panel, c_d* (hinge-equivalent 2 I_B ω₁ ζ*)",
+    )  # fmt: skip
+    top.set_ylabel("critical damping c_d* [N m s/rad]")
+    top.set_title(f"{title}: critical damping over the year")
+    bottom.plot(days, data.flux, lw=1.0, color="C1", label="solar flux scale")
+    bottom.set_ylabel("flux / 1 au")
+    bottom.set_xlabel("time [days]")
+    for ax in (top, bottom):
+        ax.grid(alpha=0.3)
+    legend(fig)
+    return fig
+
+
 def face_flux_figure(
     t: Array, flux_front: Array, flux_back: Array, orbit: Any, *, title: str = "run"
 ) -> Any:

@@ -2,11 +2,13 @@
 
 use super::cancel::{cancellable, CancelToken};
 use super::convert::{
-    coupling, crossing_tuple, orbit_from, panel_from, required_item, set_counters, RunOptions,
+    coupling, crossing_tuple, orbit_from, panel_from, required_item, set_counters, OrbitsRun,
+    RunOptions,
 };
 use super::error::{invalid, shield};
 use crate::analysis::flutter::check_flux;
 use crate::models::distributed::{DistributedPanel, Settings, Support};
+use crate::runs::orbits::{OrbitRunSpec, SummaryOptions};
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -214,7 +216,193 @@ fn simulate_distributed<'py>(
     })
 }
 
+/// The default start state of a distributed run on an orbit at t0 (the sunlit equilibrium at
+/// rest at that date's flux, or under the orbit's loads there).
+#[pyfunction]
+fn distributed_start_state(
+    py: Python<'_>,
+    panel: &Bound<'_, PyDict>,
+    settings: &Bound<'_, PyDict>,
+    orbit: &Bound<'_, PyDict>,
+    t0: f64,
+) -> PyResult<Vec<f64>> {
+    shield(|| {
+        let m = model_from(panel, settings)?;
+        let o = orbit_from(orbit)?;
+        o.validate().map_err(PyErr::from)?;
+        m.check_orbit(&o).map_err(PyErr::from)?;
+        py.detach(|| crate::runs::distributed::start_state(&m, &o, t0))
+            .map_err(PyErr::from)
+    })
+}
+
+/// A chunk of a long run as `thermojitter.longrun` passes it, one mapping: its start state, the
+/// time and index of its first orbit, and what it watches.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct Chunk {
+    y0: Vec<f64>,
+    t_start: f64,
+    first_index: u64,
+    theta_limit: f64,
+    stop_at_limit: bool,
+    steps_per_period: f64,
+}
+
+/// Integrates the distributed panel over whole orbits and returns one summary per orbit (the
+/// hinge runs' columns, θ read as θ_f, with `tip_max` and `tip_min`); with `hybrid` (its
+/// settings) on linear arcs where their checks hold, adding how the simulated time was split.
+#[pyfunction]
+#[pyo3(signature = (panel, orbit, settings, orbits, chunk, *, cancel=None))]
+fn run_distributed_orbits<'py>(
+    py: Python<'py>,
+    panel: &Bound<'py, PyDict>,
+    orbit: &Bound<'py, PyDict>,
+    settings: &Bound<'py, PyDict>,
+    orbits: OrbitsRun<'py>,
+    chunk: Chunk,
+    cancel: Option<&Bound<'py, CancelToken>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    cancellable(cancel, |cancel| {
+        let m = model_from(panel, settings)?;
+        let (hinge, coupling, method) = orbits.hinge()?;
+        crate::models::hinge::check_hinge_angle("theta_limit", chunk.theta_limit)?;
+        let options = SummaryOptions {
+            window: orbits.window,
+            theta_limit: chunk.theta_limit,
+            stop_at_limit: chunk.stop_at_limit,
+            steps_per_period: chunk.steps_per_period,
+        };
+        let spec = OrbitRunSpec {
+            panel: m.panel,
+            orbit: orbit_from(orbit)?,
+            model: hinge,
+            coupling,
+            method,
+            t_start: chunk.t_start,
+            first_index: chunk.first_index,
+            n_orbits: orbits.n_orbits,
+            options,
+        };
+        let hybrid = orbits.hybrid()?;
+        let y0 = chunk.y0;
+        let out = py.detach(|| {
+            crate::runs::distributed_orbits::run_distributed_orbits(
+                &m,
+                &spec,
+                &y0,
+                hybrid.as_ref(),
+                cancel,
+            )
+        })?;
+        let summaries = crate::runs::layered::LayeredSummaries {
+            summaries: out.summaries,
+            stats: out.stats,
+            y_end: out.y_end,
+            crossing: out.crossing,
+        };
+        let d = super::orbits::summary_dict(py, &summaries, &method)?;
+        d.set_item("tip_max", PyArray1::from_vec(py, out.tip_max))?;
+        d.set_item("tip_min", PyArray1::from_vec(py, out.tip_min))?;
+        if let Some(split) = out.split {
+            // Named as the hybrid runs' counters: its full integration is their fallback.
+            for (name, value) in [
+                ("t_linear", split.t_linear),
+                ("t_exponential", 0.0),
+                ("t_slow", 0.0),
+                ("t_fallback", split.t_full),
+            ] {
+                d.set_item(name, value)?;
+            }
+            for (name, value) in [
+                ("n_arcs", split.n_arcs),
+                ("n_exp_steps", 0),
+                ("n_fallback_steps", split.n_full_steps),
+                ("n_reread_steps", 0),
+                ("n_slow_steps", 0),
+                ("n_refused_orbits", 0),
+                ("n_refused_arcs", split.n_refused),
+            ] {
+                d.set_item(name, value)?;
+            }
+        }
+        modal_info(py, &m, &d)?;
+        Ok(d)
+    })
+}
+
+/// The metrics a study reads off per-orbit summary columns (`thermojitter.longrun`'s, as
+/// arrays) of a run that ended at `t_end`: theta_abs_max, amplitude, entry_peak, exit_peak,
+/// jitter_rms, jitter_peak, amplitude_slope (`crate::runs::ensemble::summary_metrics`).
+#[pyfunction]
+fn summary_metrics(columns: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Vec<(String, f64)>> {
+    shield(|| {
+        let col = |name: &str| -> PyResult<Vec<f64>> {
+            required_item(columns, name, "an array of numbers")
+        };
+        let index: Vec<u64> = required_item(columns, "index", "an array of integers")?;
+        let names = [
+            "t_start",
+            "t_end",
+            "theta_eq",
+            "theta_max",
+            "theta_min",
+            "amplitude",
+            "jitter_rms",
+            "jitter_peak",
+            "t_entry",
+            "t_exit",
+            "entry_theta_min",
+            "exit_theta_max",
+            "entry_peak",
+            "exit_peak",
+        ];
+        let values = names.iter().map(|n| col(n)).collect::<PyResult<Vec<_>>>()?;
+        if let Some(bad) = values.iter().position(|v| v.len() != index.len()) {
+            return Err(invalid(
+                names[bad],
+                values[bad].len(),
+                "must hold one value per orbit",
+            ));
+        }
+        let v = |k: usize, i: usize| values[k][i];
+        let rows: Vec<crate::runs::orbits::OrbitSummary> = (0..index.len())
+            .map(|i| crate::runs::orbits::OrbitSummary {
+                index: index[i],
+                t_start: v(0, i),
+                t_end: v(1, i),
+                theta_eq: v(2, i),
+                theta_max: v(3, i),
+                theta_min: v(4, i),
+                amplitude: v(5, i),
+                jitter_rms: v(6, i),
+                jitter_peak: v(7, i),
+                t_entry: v(8, i),
+                t_exit: v(9, i),
+                entry_theta_min: v(10, i),
+                exit_theta_max: v(11, i),
+                entry_peak: v(12, i),
+                exit_peak: v(13, i),
+            })
+            .collect();
+        let m = crate::runs::ensemble::summary_metrics(&rows, t_end);
+        let out = [
+            "theta_abs_max",
+            "amplitude",
+            "entry_peak",
+            "exit_peak",
+            "jitter_rms",
+            "jitter_peak",
+            "amplitude_slope",
+        ];
+        Ok(out.iter().zip(m).map(|(n, x)| (n.to_string(), x)).collect())
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(summary_metrics, m)?)?;
+    m.add_function(wrap_pyfunction!(run_distributed_orbits, m)?)?;
+    m.add_function(wrap_pyfunction!(distributed_start_state, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_distributed, m)?)?;
     m.add_function(wrap_pyfunction!(distributed_info, m)?)?;
     m.add_function(wrap_pyfunction!(hinge_equivalent_damping_ratio, m)?)?;

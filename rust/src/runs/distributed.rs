@@ -107,28 +107,10 @@ pub fn simulate(
     crate::numerics::integrate::check_span(t_span.0, t_span.1)?;
     let start = match settings.y0 {
         Some(v) => {
-            if v.len() != model.state_size() {
-                return Err(Error::invalid(
-                    "y0",
-                    format!("{} components", v.len()),
-                    &format!(
-                        "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
-                        model.state_size(),
-                        model.layers(),
-                        model.n(),
-                        model.k()
-                    ),
-                ));
-            }
-            // Its temperatures as every start state's; the modal amplitudes have no such range.
-            crate::models::hinge::check_start_state(&v, model.layers() * model.n(), None)?;
+            check_state(model, &v)?;
             v
         }
-        None if orbit.has_face_loads() => {
-            let optics = Optics::of(&model.panel);
-            model.equilibrium_loaded(&ElementHeat::at(&orbit, t0, 1.0, optics))?
-        }
-        None => model.equilibrium(orbit.flux_scale(t0))?,
+        None => start_state(model, &orbit, t0)?,
     };
     let mut system = DistributedSystem::new(model.clone(), orbit);
     let watch = settings.limit.map(|on| model.limit(on));
@@ -173,6 +155,37 @@ pub fn simulate(
         out.sunlit.push(orbit.illumination(*t));
     }
     Ok(out)
+}
+
+/// Refuses a start state that is not `model`'s: its size, and its temperatures as every start
+/// state's (the modal amplitudes have no such range).
+pub(crate) fn check_state(model: &DistributedPanel, v: &[f64]) -> Result<()> {
+    if v.len() != model.state_size() {
+        return Err(Error::invalid(
+            "y0",
+            format!("{} components", v.len()),
+            &format!(
+                "must hold {} (the {} temperatures of each of {} elements, then q and q̇ of {} modes)",
+                model.state_size(),
+                model.layers(),
+                model.n(),
+                model.k()
+            ),
+        ));
+    }
+    crate::models::hinge::check_start_state(v, model.layers() * model.n(), None)
+}
+
+/// The default start of a run of `model` on `orbit` at t0: the sunlit equilibrium at rest under
+/// the Sun's distance at t0, and under the Earth's loads and the attitude there when the orbit
+/// has them.
+pub fn start_state(model: &DistributedPanel, orbit: &Orbit, t0: f64) -> Result<Vec<f64>> {
+    Orbit::check_time(t0)?;
+    if orbit.has_face_loads() {
+        let optics = Optics::of(&model.panel);
+        return model.equilibrium_loaded(&ElementHeat::at(orbit, t0, 1.0, optics));
+    }
+    model.equilibrium(orbit.flux_scale(t0))
 }
 
 impl DistributedPanel {

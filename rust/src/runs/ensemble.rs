@@ -260,6 +260,28 @@ fn reduce(run: &Ran<'_>) -> (f64, f64, f64, f64, f64, f64) {
     (theta_abs_max, amplitude, entry, exit, rms, jitter_peak)
 }
 
+/// What a study reads off the summaries of a run that ended at `t_end`, for runs summarised
+/// outside a batch (the distributed panel's): max |θ|, the largest amplitude, entry and exit
+/// peaks, the jitter's RMS over the run and its peak, and the amplitude's log slope per orbit.
+pub fn summary_metrics(summaries: &[OrbitSummary], t_end: f64) -> [f64; 7] {
+    let run = Ran {
+        summaries,
+        t_end,
+        n_steps: 0,
+        crossing: None,
+    };
+    let (theta_abs_max, amplitude, entry, exit, rms, peak) = reduce(&run);
+    [
+        theta_abs_max,
+        amplitude,
+        entry,
+        exit,
+        rms,
+        peak,
+        log_slope(&run),
+    ]
+}
+
 /// First orbit whose largest |θ| passed `limit`, as a float (NaN: none).
 fn first_orbit_beyond(run: &Ran<'_>, limit: f64) -> f64 {
     run.summaries

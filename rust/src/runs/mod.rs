@@ -4,6 +4,8 @@
 pub mod beam;
 pub mod boom;
 pub mod distributed;
+pub mod distributed_arc;
+pub mod distributed_orbits;
 pub mod ensemble;
 pub mod hybrid;
 pub mod layered;

@@ -428,8 +428,8 @@ const QUASI_STATIC_RATIO: f64 = 0.1;
 /// and in rad: half the accuracy gate (2 %, 1e-6 rad). The estimate is an upper bound (the
 /// largest error along the arc, and the arcs' errors added): on Table 1 near its critical
 /// damping it is about three times the drift measured against the full integration.
-const DRIFT_RTOL: f64 = 1e-2;
-const DRIFT_ATOL: f64 = 5e-7;
+pub(crate) const DRIFT_RTOL: f64 = 1e-2;
+pub(crate) const DRIFT_ATOL: f64 = 5e-7;
 
 /// How far the interpolant of an exponential step may stray from the step's own formula in what
 /// the summaries read (θ and M_T/K_el), in rad and relative to the deviation from θ_eq.
@@ -467,7 +467,7 @@ const DRIFT_DOUBLINGS: f64 = 10.0;
 
 /// The jitter RMS the summaries read, the scale of the smallest error the gate holds them to:
 /// the last whole orbit's, else this orbit's so far (0 before any oscillation).
-fn gate_scale<V: crate::runs::orbits::SummaryView>(collector: &Collector<V>) -> f64 {
+pub(crate) fn gate_scale<V: crate::runs::orbits::SummaryView>(collector: &Collector<V>) -> f64 {
     match collector.done.last() {
         Some(s) if s.jitter_rms.is_finite() => s.jitter_rms,
         _ => collector.rms_so_far(),
