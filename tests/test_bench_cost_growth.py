@@ -34,8 +34,8 @@ def test_quick_run_reports_every_series() -> None:
     known = list(QUICK_SIZES)
     for label in known:
         assert [size for size, _ in by_series.get(label, [])] == QUICK_SIZES[label], label
-    # With the Earth's loads the hybrid runs rk45, and the table says so (not a warning).
-    assert all("fallback" in note for _, note in by_series["LEO 28.5 deg + Earth hybrid"])
+    # Low orbits run on the hybrid's slow time, with or without the Earth's loads: no fallback.
+    assert all("fallback" not in note for _, note in by_series["LEO 28.5 deg + Earth hybrid"])
     assert all("fallback" not in note for _, note in by_series["LEO leo(540 km) hybrid"])
     assert "HybridFallbackWarning" not in done.stderr
     # A slope for every series, finite for those of two sizes.

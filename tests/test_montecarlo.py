@@ -250,9 +250,13 @@ def test_failed_samples_survive_the_checkpoint_and_dask(tmp_path: Path) -> None:
 
 
 def test_a_study_whose_every_sample_failed_raises() -> None:
+    # A stiff hinge on a panel of little heat capacity: its thermal rates are not slow against
+    # the hinge, so the hybrid's slow time gives the orbit back to the full integration, which
+    # costs far more than the budget's steps.
     stiff = {"hinge_stiffness": [20000.0, 40000.0]}
+    light = PAPER.replace(specific_heat=50.0)
     with pytest.raises(tj.AllSamplesFailedError) as caught:
-        tj.sweep(PAPER, LOW, stiff, **FAILING)
+        tj.sweep(light, LOW, stiff, **FAILING)
     exc = caught.value
     assert isinstance(exc, tj.IntegrationError)  # caught by code that catches a failed run
     assert exc.n == 2 and exc.first_sample == 0

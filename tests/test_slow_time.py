@@ -136,3 +136,33 @@ def test_a_panel_with_fast_thermal_rates_is_given_back_to_the_full_integration()
     assert hybrid.propagation["t_slow"] == 0.0
     for name, column in full.columns.items():
         assert (hybrid.columns[name] == column).all() or name in ("index",), name
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known defect of slow time: a panel whose dynamic part is a small ringing after a "
+    "penumbra (conical shadow) reads its RMS 2.2 % low, 1.09 x the gate, and the orbit's "
+    "accuracy check does not catch it (found by the property test above; cause not found yet)",
+)
+def test_the_known_small_ringing_case_after_a_penumbra_holds_the_gate() -> None:
+    panel = tj.Panel.paper().replace(
+        emissivity_front=0.6951449402057724,
+        emissivity_back=0.8100067626027325,
+        absorptivity=0.2819967071665451,
+        specific_heat=744.3229470165813,
+        mass_per_length=4.408,
+        expansion_coeff=2.325e-05,
+        length=52.506811402093646,
+        youngs_modulus=78012120347.82417,
+        thickness=0.0349797308092525,
+        conductance=28.865834523867928,
+        hinge_stiffness=3550.4,
+        bending_inertia=8.258452914826057e-07,
+        damping=2.114857939095456,
+        solar_constant=1237.2048741034232,
+    )
+    orbit = tj.Orbit.leo(7446405.936556826 - 6378137.0, shadow="conical")
+    kw = {"orbits_per_call": 3, "progress": False, "model": "linear"}
+    full = tj.simulate_orbits(panel, orbit, 3, method="rk45", **kw)  # type: ignore[arg-type]
+    hybrid = tj.simulate_orbits(panel, orbit, 3, method="hybrid", **kw)  # type: ignore[arg-type]
+    assert not gate_failures(full, hybrid, 3)

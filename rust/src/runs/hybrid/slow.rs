@@ -770,8 +770,22 @@ pub(crate) fn run_slow(
     let mut t = spec.t_start;
     let mut lambda = Complex::new(0.0, spec.panel.natural_angular_frequency());
     let slow_method = Method::Dopri5(SLOW_TOLERANCES);
+    // The full integration's step budget holds for the whole run, every kind of step counted
+    // (as the hybrid's): each full stretch alone stops at it, and a run of one stretch an orbit
+    // would otherwise take that many steps an orbit.
+    let budget = full_method.max_steps();
+    let check_budget = |used: u64, t: f64| {
+        if used >= budget {
+            return Err(crate::Error::Integration {
+                t,
+                reason: format!("max_steps = {budget} reached"),
+            });
+        }
+        Ok(())
+    };
     for k in 0..spec.n_orbits {
         let orbit_start = t;
+        check_budget(stats.n_steps + stats.n_rejected, t)?;
         let orbit_end = if k + 1 == spec.n_orbits {
             t_end
         } else {
@@ -796,11 +810,16 @@ pub(crate) fn run_slow(
             }
             let mid = spec.orbit.illumination_on(0.5 * (a + b), a, b);
             if matches!(spec.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0 {
+                check_budget(
+                    stats.n_steps + stats.n_rejected + slow_steps + full_steps,
+                    a,
+                )?;
                 let (st, y1) = solve(&mut full, &full_method, a, y, b, &mut obs)?;
                 if let Some(e) = obs.error.take() {
                     return Err(e);
                 }
                 full_steps += st.n_steps;
+                stats.n_rejected += st.n_rejected;
                 stats.n_rhs += st.n_rhs;
                 y = y1;
                 if st.stopped {
@@ -844,7 +863,12 @@ pub(crate) fn run_slow(
                 break;
             }
             stats.n_rhs += st.n_rhs;
+            stats.n_rejected += st.n_rejected;
             slow_steps += ring.steps;
+            check_budget(
+                stats.n_steps + stats.n_rejected + slow_steps + full_steps,
+                b,
+            )?;
             ring_max = ring_max.max(ring.largest);
             slow_time += b - a;
             lambda = ring.mode.lambda;
@@ -857,6 +881,7 @@ pub(crate) fn run_slow(
         if refused {
             // This orbit in full, from its start; the next one tries slow time again.
             obs.collector.rewind(mark);
+            check_budget(stats.n_steps + stats.n_rejected, orbit_start)?;
             let (st, y1) = solve(
                 &mut full,
                 &full_method,
@@ -870,6 +895,7 @@ pub(crate) fn run_slow(
             }
             split.n_refused += 1;
             split.n_full_steps += st.n_steps;
+            stats.n_rejected += st.n_rejected;
             split.t_full += st.t_end - orbit_start;
             stats.n_rhs += st.n_rhs;
             stats.n_steps += st.n_steps;
