@@ -189,7 +189,14 @@ def test_hybrid_samples_stop_at_their_budget_every_step_counted() -> None:
     fast = P.replace(specific_heat=300.0)
     with pytest.raises(tj.AllSamplesFailedError) as caught:
         tj.monte_carlo(
-            fast, LOW, vary=VARY, n=2, seed=1, horizon=500, method="hybrid", max_steps=100_000,
+            fast,
+            LOW,
+            vary=VARY,
+            n=2,
+            seed=1,
+            horizon=500,
+            method="hybrid",
+            max_steps=100_000,
             **LOOSE,
         )
     frame = caught.value.samples
