@@ -156,14 +156,11 @@ pub fn run_orbits_hybrid(
     spec.panel.validate()?;
     check_request(spec, y0.as_slice(), settings, cancel)?;
     if slow::applies(spec) {
-        let (run, split) = slow::run_slow(spec, y0, cancel)?;
-        let mut out = counted_as_fallback(&[], split.n_full_steps);
-        out.t_fallback = split.t_full;
-        out.t_slow = split.t_slow;
-        out.n_slow_steps = split.n_slow_steps;
-        out.n_refused_orbits = split.n_refused;
-        out.run = run;
-        return Ok(out);
+        let done = slow::run_slow(spec, y0, cancel)?;
+        return Ok(HybridRun {
+            run: done.run,
+            ..done.split
+        });
     }
     if spec.orbit.has_face_loads() {
         return Ok(fully_integrated(

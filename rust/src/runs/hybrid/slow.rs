@@ -32,14 +32,15 @@ use crate::error::Result;
 use crate::inputs::heating::Loads;
 use crate::inputs::orbit::{breakpoints_of, EclipseTable, Shadow};
 use crate::models::coupled::Coupled;
-use crate::models::hinge::HingeModel;
+use crate::models::hinge::{quasi_static, HingeModel};
 use crate::numerics::integrate::{
     solve, DenseStep, Method, Observer, OdeSystem, State, Tolerances,
 };
 use crate::numerics::quadrature::GAUSS_5;
+use crate::runs::hybrid::{counted_as_fallback, Propagated};
+use crate::runs::orbits::STEPS_PER_HINGE_PERIOD;
 use crate::runs::orbits::{resolve_hinge, Collector, OrbitRunSpec, SummaryObserver, TwoLayerView};
-use crate::runs::orbits::{Summarised, STEPS_PER_HINGE_PERIOD};
-use nalgebra::{Complex, Matrix4, Vector2, Vector4, U2, U4};
+use nalgebra::{Complex, Matrix4, Vector2, Vector4, U2};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -77,6 +78,8 @@ struct SlowModel {
     damping: f64,
     inertia: f64,
     moment_per_kelvin: f64,
+    /// The slow integration's scales ([`SlowModel::scaled`]).
+    scales: (f64, f64),
     /// The segment being integrated: the loads' side of each shadow edge, and the flow's
     /// derivative kept inside it.
     segment: (f64, f64),
@@ -110,6 +113,7 @@ impl SlowModel {
             damping: p.damping,
             inertia: p.hinge_inertia(),
             moment_per_kelvin: p.moment_per_kelvin(),
+            scales: scales(p.moment_per_kelvin() / p.hinge_stiffness),
             segment: (f64::NEG_INFINITY, f64::INFINITY),
         }
     }
@@ -127,21 +131,8 @@ impl SlowModel {
         }
     }
 
-    /// The slow integration's state: the mean temperature and T_f − T_b, each over its
-    /// absolute tolerance (T_f − T_b's from [`ANGLE_TOLERANCE`] through M_T/K_el per kelvin).
-    fn scales(&self) -> (f64, f64) {
-        let per_kelvin = (self.moment_per_kelvin / self.stiffness).abs();
-        let difference = if per_kelvin > 0.0 {
-            (ANGLE_TOLERANCE / per_kelvin).min(MEAN_TOLERANCE)
-        } else {
-            MEAN_TOLERANCE
-        };
-        let unit = SLOW_TOLERANCES.atol;
-        (MEAN_TOLERANCE / unit, difference / unit)
-    }
-
     fn scaled(&self, temps: &Vector2<f64>) -> Vector2<f64> {
-        let (mean, difference) = self.scales();
+        let (mean, difference) = self.scales;
         Vector2::new(
             0.5 * (temps[0] + temps[1]) / mean,
             (temps[0] - temps[1]) / difference,
@@ -149,13 +140,13 @@ impl SlowModel {
     }
 
     fn temps(&self, u: &Vector2<f64>) -> Vector2<f64> {
-        let (mean, difference) = self.scales();
+        let (mean, difference) = self.scales;
         let (m, d) = (u[0] * mean, u[1] * difference);
         Vector2::new(m + 0.5 * d, m - 0.5 * d)
     }
 
     fn theta0(&self, temps: &Vector2<f64>) -> f64 {
-        self.moment_per_kelvin * (temps[0] - temps[1]) / self.stiffness
+        quasi_static(self.moment_per_kelvin, self.stiffness, temps[0], temps[1])
     }
 
     /// T' with the hinge at θ, at rest.
@@ -168,10 +159,7 @@ impl SlowModel {
     /// θ₀' at time t (temperatures `temps`), on θ₀.
     fn theta0_rate(&self, t: f64, temps: &Vector2<f64>) -> (f64, Vector2<f64>) {
         let rates = self.thermal(self.loads(t), temps, self.theta0(temps));
-        (
-            self.moment_per_kelvin * (rates[0] - rates[1]) / self.stiffness,
-            rates,
-        )
+        (self.theta0(&rates), rates)
     }
 
     /// The slow manifold at (t, T̄).
@@ -241,10 +229,10 @@ impl SlowModel {
         let v1 = (a * r1 - cc * r0) / det;
         let v = [v0, v1, Complex::new(1.0, 0.0), lambda];
         // wᵀ(J − λ) = 0 with w3 = 1; θ' = θ̇ makes J's θ row (0, 0, 0, 1).
+        // The same 2×2 block, transposed: the same determinant.
         let (s0, s1) = (-c(3, 0), -c(3, 1));
-        let det_w = a * d - cc * b;
-        let w0 = (s0 * d - cc * s1) / det_w;
-        let w1 = (a * s1 - b * s0) / det_w;
+        let w0 = (s0 * d - cc * s1) / det;
+        let w1 = (a * s1 - b * s0) / det;
         let w2 = -(w0 * c(0, 3) + w1 * c(1, 3) + c(3, 3) - lambda);
         let mut w = [w0, w1, w2, Complex::new(1.0, 0.0)];
         let norm: Complex<f64> = (0..4).map(|k| w[k] * v[k]).sum();
@@ -315,6 +303,20 @@ impl SlowModel {
     }
 }
 
+/// The slow integration's state is the mean temperature and T_f − T_b, each over its absolute
+/// tolerance in units of [`SLOW_TOLERANCES`]' atol (T_f − T_b's from [`ANGLE_TOLERANCE`] through
+/// θ₀ per kelvin, `per_kelvin`): these scales.
+fn scales(per_kelvin: f64) -> (f64, f64) {
+    let per_kelvin = per_kelvin.abs();
+    let difference = if per_kelvin > 0.0 {
+        (ANGLE_TOLERANCE / per_kelvin).min(MEAN_TOLERANCE)
+    } else {
+        MEAN_TOLERANCE
+    };
+    let unit = SLOW_TOLERANCES.atol;
+    (MEAN_TOLERANCE / unit, difference / unit)
+}
+
 /// The root of det(λ − J) nearest `guess` by Newton's method on the characteristic polynomial
 /// (its coefficients by Faddeev–LeVerrier); None unless it converges to an oscillation.
 fn hinge_eigenvalue(j: &Matrix4<f64>, guess: Complex<f64>) -> Option<Complex<f64>> {
@@ -354,7 +356,7 @@ impl OdeSystem<U2> for SlowFlow<'_> {
     fn rhs(&self, t: f64, y: &State<U2>) -> State<U2> {
         let m = self.model;
         let rates = m.theta0_rate(t, &m.temps(y)).1;
-        let (mean, difference) = m.scales();
+        let (mean, difference) = m.scales;
         Vector2::new(
             0.5 * (rates[0] + rates[1]) / mean,
             (rates[0] - rates[1]) / difference,
@@ -493,40 +495,25 @@ impl Ringing<'_, '_> {
         let (log_z0, arg0) = (z0.norm().ln(), z0.arg());
         let log_amp = |t: f64| log_z0 + exponent(t).re;
         let phase = |t: f64| arg0 + exponent(t).im;
-        let theta_at = |t: f64| theta_bar(t) + log_amp(t).exp() * phase(t).cos();
-        let dynamic_at = |t: f64| {
-            lags.at(t) + (log_amp(t) + log_kappa.at(t)).exp() * (phase(t) + arg_kappa.at(t)).cos()
-        };
         let period = 2.0 * PI / modes[2].lambda.im.abs();
         let speed = |t: f64| rate_at(t).im;
         let kappa_at = |t: f64| Complex::from_polar(log_kappa.at(t).exp(), arg_kappa.at(t));
         // θ = θ̄ + A cos φ and the dynamic part = lag + |κ| A cos(φ + arg κ).
-        let theta_wave = Wave {
-            value: &theta_at,
-            envelope: &|t: f64| theta_bar(t) + log_amp(t).exp(),
+        let theta = Wave {
+            slow: &theta_bar,
+            amplitude: &|t: f64| log_amp(t).exp(),
             phase: &phase,
             speed: &speed,
             period,
         };
-        let dynamic_envelope = |t: f64| (log_amp(t) + log_kappa.at(t)).exp();
-        let dynamic_wave = Wave {
-            value: &dynamic_at,
-            envelope: &|t: f64| lags.at(t) + dynamic_envelope(t),
+        let dynamic = Wave {
+            slow: &|t: f64| lags.at(t),
+            amplitude: &|t: f64| (log_amp(t) + log_kappa.at(t)).exp(),
             phase: &|t: f64| phase(t) + arg_kappa.at(t),
             speed: &speed,
             period,
         };
-        let neg_dynamic = |t: f64| -dynamic_at(t);
-        let dynamic_low = Wave {
-            value: &neg_dynamic,
-            envelope: &|t: f64| -lags.at(t) + dynamic_envelope(t),
-            phase: &|t: f64| phase(t) + arg_kappa.at(t) + PI,
-            speed: &speed,
-            period,
-        };
-        let dyn_abs = dynamic_wave
-            .largest(t0, t1)
-            .max(dynamic_low.largest(t0, t1));
+        let dyn_abs = dynamic.largest(t0, t1).max(-dynamic.smallest(t0, t1));
         // ∫ (dynamic)²: lag² + |κz|²/2 by Gauss–Legendre, and the oscillating terms
         // 2 lag Re(κz) + Re((κz)²)/2 by their leading term [F/L']: they swing at the hinge's
         // frequency, L' the exponent's rate.
@@ -546,17 +533,7 @@ impl Ringing<'_, '_> {
         if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
             return Err(Refusal::Ringing);
         }
-        let theta_low = |t: f64| -theta_at(t);
-        let theta_min_wave = Wave {
-            value: &theta_low,
-            envelope: &|t: f64| -theta_bar(t) + log_amp(t).exp(),
-            phase: &|t: f64| phase(t) + PI,
-            speed: &speed,
-            period,
-        };
-        let extremes = |a: f64, b: f64| -> (f64, f64) {
-            (-theta_min_wave.largest(a, b), theta_wave.largest(a, b))
-        };
+        let extremes = |a: f64, b: f64| (theta.smallest(a, b), theta.largest(a, b));
         let (lo, hi) = extremes(t0, t1);
         let limit = self.obs.collector.options.theta_limit;
         if hi > limit || lo < -limit {
@@ -580,10 +557,10 @@ impl Ringing<'_, '_> {
 
 /// A slow value plus a swing at the hinge's frequency, s(t) + A(t) cos φ(t): its largest value
 /// over a span is at one of the peaks (φ = 2πm) next to the envelope's largest, s + A, or at an
-/// end of the span.
+/// end of the span; its smallest, that of −s + A cos(φ + π).
 struct Wave<'f> {
-    value: &'f dyn Fn(f64) -> f64,
-    envelope: &'f dyn Fn(f64) -> f64,
+    slow: &'f dyn Fn(f64) -> f64,
+    amplitude: &'f dyn Fn(f64) -> f64,
     phase: &'f dyn Fn(f64) -> f64,
     /// φ'.
     speed: &'f dyn Fn(f64) -> f64,
@@ -592,7 +569,19 @@ struct Wave<'f> {
 
 impl Wave<'_> {
     fn largest(&self, a: f64, b: f64) -> f64 {
-        let f = self.value;
+        self.extreme(a, b, 1.0)
+    }
+
+    fn smallest(&self, a: f64, b: f64) -> f64 {
+        -self.extreme(a, b, -1.0)
+    }
+
+    /// The largest of `sign` (s + A cos φ) over [a, b].
+    fn extreme(&self, a: f64, b: f64, sign: f64) -> f64 {
+        let f = |t: f64| sign * ((self.slow)(t) + (self.amplitude)(t) * (self.phase)(t).cos());
+        let envelope = |t: f64| sign * (self.slow)(t) + (self.amplitude)(t);
+        // The peaks of −(s + A cos φ) are those of cos(φ + π).
+        let turn = if sign < 0.0 { PI } else { 0.0 };
         let mut best = f(a).max(f(b));
         if b <= a {
             return best;
@@ -601,7 +590,7 @@ impl Wave<'_> {
         if b - a <= self.period {
             let n = ((b - a) / d).ceil().max(1.0) as usize;
             for i in 1..n {
-                best = best.max(self.refined(a + (b - a) * i as f64 / n as f64, d, a, b));
+                best = best.max(refined(&f, a + (b - a) * i as f64 / n as f64, d, a, b));
             }
             return best;
         }
@@ -610,7 +599,7 @@ impl Wave<'_> {
         let mut e_best = f64::NEG_INFINITY;
         for i in 0..=ENVELOPE_READS {
             let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
-            let e = (self.envelope)(t);
+            let e = envelope(t);
             if e > e_best {
                 (e_best, t_star) = (e, t);
             }
@@ -622,40 +611,40 @@ impl Wave<'_> {
             (t_star - 0.5 * self.period).max(a),
             (t_star + 0.5 * self.period).min(b),
         );
-        let moved = ((self.envelope)(hi) - (self.envelope)(lo)).abs();
+        let moved = (envelope(hi) - envelope(lo)).abs();
         if moved <= 2e-4 * e_best.abs().max(5e-5) {
             return best.max(e_best);
         }
-        let ph = (self.phase)(t_star);
+        let phase = |t: f64| (self.phase)(t) + turn;
+        let ph = phase(t_star);
         let m0 = (ph / (2.0 * PI)).round();
         for dm in [-1.0, 0.0, 1.0] {
             let target = 2.0 * PI * (m0 + dm);
             let mut t = t_star + (target - ph) / (self.speed)(t_star);
             for _ in 0..2 {
-                t -= ((self.phase)(t) - target) / (self.speed)(t);
+                t -= (phase(t) - target) / (self.speed)(t);
             }
             if t >= a && t <= b {
-                best = best.max(self.refined(t, d, a, b));
+                best = best.max(refined(&f, t, d, a, b));
             }
         }
         best
     }
+}
 
-    /// f near t, refined by the parabola through t ± d (kept within [a, b]).
-    fn refined(&self, t: f64, d: f64, a: f64, b: f64) -> f64 {
-        let f = self.value;
-        let (lo, hi) = ((t - d).max(a), (t + d).min(b));
-        let (p, c, q) = (f(lo), f(t), f(hi));
-        let mut best = c.max(p).max(q);
-        if hi - t == t - lo && t > lo {
-            let curv = p - 2.0 * c + q;
-            if curv < 0.0 {
-                let off = (0.5 * (p - q) / curv).clamp(-1.0, 1.0);
-                best = best.max(f(t + off * d));
-            }
+/// f near t, refined by the parabola through t ± d (kept within [a, b]).
+fn refined(f: &dyn Fn(f64) -> f64, t: f64, d: f64, a: f64, b: f64) -> f64 {
+    let (lo, hi) = ((t - d).max(a), (t + d).min(b));
+    let (p, c, q) = (f(lo), f(t), f(hi));
+    let mut best = c.max(p).max(q);
+    if hi - t == t - lo && t > lo {
+        let curv = p - 2.0 * c + q;
+        if curv < 0.0 {
+            let off = (0.5 * (p - q) / curv).clamp(-1.0, 1.0);
+            best = best.max(f(t + off * d));
         }
-        best
     }
+    best
 }
 
 /// Points at which a span's envelope is read to find its largest.
@@ -688,18 +677,6 @@ pub const SHORT_ORBIT: f64 = 6.0 * 3600.0;
 /// the slow manifold's truncation was measured at up to 2.3 % of it (1.1e-6 rad, past the gate).
 pub(crate) fn applies(spec: &OrbitRunSpec) -> bool {
     spec.orbit.period < SHORT_ORBIT
-}
-
-/// How a slow-time run split its work.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct SlowSplit {
-    /// Simulated time carried on slow time, and in full (penumbrae, refused orbits), s.
-    pub t_slow: f64,
-    pub t_full: f64,
-    pub n_slow_steps: u64,
-    pub n_full_steps: u64,
-    /// Orbits given back to the full integration by a guard.
-    pub n_refused: u64,
 }
 
 /// The ringing's error on slow time, as a fraction of its largest amplitude over the orbit:
@@ -743,7 +720,7 @@ pub(crate) fn run_slow(
     spec: &OrbitRunSpec,
     y0: Vector4<f64>,
     cancel: &Cancel,
-) -> Result<(Summarised<U4>, SlowSplit)> {
+) -> Result<Propagated<4>> {
     let options = spec.options;
     let steps = if options.steps_per_period > 0.0 {
         options.steps_per_period
@@ -764,7 +741,9 @@ pub(crate) fn run_slow(
     let mut full = model.system;
     let t_end = spec.t_end();
     let mut eclipses = EclipseTable::until(&spec.orbit, t_end);
-    let mut split = SlowSplit::default();
+    // How the time was split: slow time, and in full (penumbrae, refused orbits) as the
+    // fallback's.
+    let mut split = counted_as_fallback(&[], 0);
     let mut stats = crate::numerics::integrate::Stats {
         t_end: spec.t_start,
         ..Default::default()
@@ -827,11 +806,14 @@ pub(crate) fn run_slow(
                 y = y1;
                 if st.stopped {
                     // The full integration stopped at the run's limit.
-                    split.n_full_steps += full_steps;
+                    split.n_fallback_steps += full_steps;
                     stats.n_steps += slow_steps + full_steps;
                     stats.stopped = true;
                     stats.t_end = st.t_end;
-                    return Ok((obs.collector.finish(stats, y), split));
+                    return Ok(Propagated {
+                        run: obs.collector.finish(stats, y),
+                        split,
+                    });
                 }
                 continue;
             }
@@ -896,10 +878,10 @@ pub(crate) fn run_slow(
             if let Some(e) = obs.error.take() {
                 return Err(e);
             }
-            split.n_refused += 1;
-            split.n_full_steps += st.n_steps;
+            split.n_refused_orbits += 1;
+            split.n_fallback_steps += st.n_steps;
             stats.n_rejected += st.n_rejected;
-            split.t_full += st.t_end - orbit_start;
+            split.t_fallback += st.t_end - orbit_start;
             stats.n_rhs += st.n_rhs;
             stats.n_steps += st.n_steps;
             stats.stopped = st.stopped;
@@ -912,14 +894,17 @@ pub(crate) fn run_slow(
             continue;
         }
         split.n_slow_steps += slow_steps;
-        split.n_full_steps += full_steps;
+        split.n_fallback_steps += full_steps;
         split.t_slow += slow_time;
-        split.t_full += (orbit_end - orbit_start) - slow_time;
+        split.t_fallback += (orbit_end - orbit_start) - slow_time;
         stats.n_steps += slow_steps + full_steps;
         t = orbit_end;
         stats.t_end = t;
     }
-    Ok((obs.collector.finish(stats, y), split))
+    Ok(Propagated {
+        run: obs.collector.finish(stats, y),
+        split,
+    })
 }
 
 #[cfg(test)]
@@ -928,6 +913,7 @@ mod tests {
     use crate::inputs::orbit::Orbit;
     use crate::inputs::panel::Panel;
     use crate::models::coupled::Coupling;
+    use crate::runs::hybrid::HybridRun;
     use crate::runs::orbits::{
         run_orbits, start_state, OrbitRunRequest, OrbitSummary, SummaryOptions,
     };
@@ -986,12 +972,12 @@ mod tests {
         worst
     }
 
-    fn compare(panel: Panel, orbit: Orbit, model: HingeModel, n: u64) -> (f64, SlowSplit) {
+    fn compare(panel: Panel, orbit: Orbit, model: HingeModel, n: u64) -> (f64, HybridRun) {
         let s = spec(panel, orbit, model, n);
         let y0 = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
         let full = run_orbits(&OrbitRunRequest { spec: s, y0 }).unwrap();
-        let (slow, split) = run_slow(&s, y0, &Cancel::new()).unwrap();
-        (gate(&full.summaries, &slow.summaries), split)
+        let slow = run_slow(&s, y0, &Cancel::new()).unwrap();
+        (gate(&full.summaries, &slow.run.summaries), slow.split)
     }
 
     #[test]
@@ -1012,7 +998,7 @@ mod tests {
                 "{model:?} {:?}: {worst} of the gate",
                 orbit.shadow
             );
-            assert_eq!(split.n_refused, 0);
+            assert_eq!(split.n_refused_orbits, 0);
             assert!(split.t_slow > 0.99 * 4.0 * orbit.period);
         }
     }
@@ -1027,7 +1013,10 @@ mod tests {
         };
         let (worst, split) = compare(panel, Orbit::leo(540e3), HingeModel::Nonlinear, 8);
         assert!(worst < 0.5, "{worst} of the gate");
-        assert!(split.n_refused > 0 && split.n_refused < 8, "{split:?}");
+        assert!(
+            split.n_refused_orbits > 0 && split.n_refused_orbits < 8,
+            "{split:?}"
+        );
     }
 
     #[test]
