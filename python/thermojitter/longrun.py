@@ -62,6 +62,13 @@ SLOW_REFUSED = (
 )
 """What a hybrid run says when its slow-time guards gave orbits back to the full integration."""
 
+
+def on_slow_time(period: float) -> bool:
+    """Whether the hybrid runs the two-layer model on an orbit of this period (s) on slow time
+    (the engine's rule: shorter than ``_core.SLOW_ORBIT``), the Earth's loads included."""
+    return period < _core.SLOW_ORBIT
+
+
 SUMMARY_FIELDS = (
     "index", "t_start", "t_end", "theta_eq", "theta_max", "theta_min", "amplitude", "jitter_rms",
     "jitter_peak", "t_entry", "t_exit", "entry_theta_min", "exit_theta_max", "entry_peak",
@@ -570,7 +577,7 @@ def simulate_orbits(
         settings["hybrid"] = hybrid_settings
     if "attitude" in engine_orbit_args:
         settings["attitude"] = engine_orbit_args["attitude"]
-    slow = orbit.period < _core.SLOW_ORBIT and nodes is None and not distributed
+    slow = on_slow_time(orbit.period) and nodes is None and not distributed
     if method == "hybrid" and not slow and has_face_loads(orbit, attitude):
         settings["hybrid_fallback"] = HYBRID_FALLBACK
         warnings.warn(HYBRID_FALLBACK, HybridFallbackWarning, stacklevel=2)

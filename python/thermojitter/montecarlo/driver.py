@@ -23,6 +23,7 @@ from thermojitter.errors import HybridFallbackWarning, ParameterError
 from thermojitter.longrun import (
     DEFAULT_THETA_LIMIT,
     HYBRID_FALLBACK,
+    on_slow_time,
     orbit_count,
     refuse_beyond_budget,
 )
@@ -123,11 +124,10 @@ def warn_hybrid_fallback(options: Mapping[str, Any], inputs: Mapping[str, Any]) 
     """Says, once, that the hybrid propagator integrates in full the samples with the Earth's
     loads or another attitude on an orbit of 6 h or more (each then has ``t_nonlinear`` equal to
     ``t_reached``); shorter orbits run on slow time."""
-    long_orbit = options["orbit"]["period"] >= _core.SLOW_ORBIT
     if (
         options["hybrid"] is not None
         and not options.get("boom")
-        and long_orbit
+        and not on_slow_time(options["orbit"]["period"])
         and face_loads(options, inputs)
     ):
         warnings.warn(
