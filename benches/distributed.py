@@ -27,6 +27,7 @@ import statistics
 import time
 from typing import Any
 
+import longrun  # benches/longrun.py
 import machine  # benches/machine.py
 import numpy as np
 
@@ -46,25 +47,8 @@ def timed(run: Any) -> tuple[float, Any]:
 
 
 def gate(full: dict[str, np.ndarray], fast: dict[str, np.ndarray]) -> int:
-    """Prints, per column, the largest relative error (values >= 5e-5), the largest absolute
-    error (values below) and the orbits outside the gate; returns how many are."""
-    outside = 0
-    for name in COLUMNS:
-        a, b = np.asarray(full[name]), np.asarray(fast[name])
-        both = np.isfinite(a) & np.isfinite(b)
-        mismatch = int(np.sum(np.isfinite(a) != np.isfinite(b)))
-        big = both & (np.abs(a) >= 5e-5)
-        small = both & (np.abs(a) < 5e-5)
-        rel = np.abs(b[big] - a[big]) / np.abs(a[big])
-        err = np.abs(b[small] - a[small])
-        bad = int(np.sum(rel > 0.02) + np.sum(err > 1e-6)) + mismatch
-        outside += bad
-        print(
-            f"  {name:15s} max rel err {rel.max() if rel.size else 0.0:.2e} ({big.sum()} orbits)"
-            f"  max abs err {err.max() if err.size else 0.0:.2e} ({small.sum()} orbits)"
-            f"  outside the gate: {bad}"
-        )
-    return outside
+    """benches/longrun.py's gate over this bench's columns (θ_f and the tip's)."""
+    return longrun.gate(full, fast, COLUMNS)
 
 
 def hinge_beside(panel: tj.Panel, orbit: tj.Orbit, elements: int, modes: int, repeat: int) -> None:
