@@ -31,6 +31,7 @@ use crate::models::distributed::{DistributedPanel, ElementHeat};
 use crate::numerics::integrate::{solve, DenseStep, Method, Observer, Stats};
 use crate::runs::distributed::DistributedSystem;
 use crate::runs::distributed_arc::{structural_pairs, LinearArc};
+use crate::runs::distributed_umbra::{ShadowedThermal, Umbra, UmbraStep};
 use crate::runs::hybrid::{gate_scale, HybridSettings, DRIFT_ATOL, DRIFT_RTOL};
 use crate::runs::orbits::{Collector, LimitCrossing, OrbitRunSpec, OrbitSummary, SummaryView};
 use nalgebra::{DVector, Dyn as D};
@@ -78,7 +79,7 @@ impl Affine {
 
     /// The functional a·q + b·M of the modal coordinates q and the element moments M, as one of
     /// the state (the moments are affine in the temperatures).
-    fn of(model: &DistributedPanel, a: &[f64], b: &[f64]) -> Affine {
+    pub(crate) fn of(model: &DistributedPanel, a: &[f64], b: &[f64]) -> Affine {
         let s = model.layers();
         let zero = vec![0.0; s];
         let m0 = model.thermal.moment(&zero);
@@ -197,6 +198,10 @@ pub struct DistributedSplit {
     pub n_full_steps: u64,
     /// Attempts at an arc refused by its checks (the run went on in full).
     pub n_refused: u64,
+    /// Simulated time through the umbra (the temperatures integrated alone, the modes exact),
+    /// s, and the steps of that integration.
+    pub t_umbra: f64,
+    pub n_umbra_steps: u64,
 }
 
 /// A summarised run of the distributed panel over whole orbits.
@@ -238,7 +243,21 @@ impl Reads<'_> {
 
     /// One point (t, y) of the solution standing for the interval dt before it.
     fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
-        let rise = self.readers.rise.at(y);
+        let r = &self.readers;
+        let (rise, rise_static, tip) = (r.rise.at(y), r.rise_static.at(y), r.tip.at(y));
+        self.read_values(t, rise, rise_static, tip, dt)
+    }
+
+    /// One point at t, given by its tip rise, its static state's rise and its tip deflection,
+    /// standing for the interval dt before it.
+    fn read_values(
+        &mut self,
+        t: f64,
+        rise: f64,
+        rise_static: f64,
+        tip: f64,
+        dt: f64,
+    ) -> Result<()> {
         if rise.is_nan() || rise.abs() > self.readers.arm {
             return Err(Error::Integration {
                 t,
@@ -248,8 +267,10 @@ impl Reads<'_> {
                 ),
             });
         }
-        self.collector.read(t, y, dt)?;
-        let tip = self.readers.tip.at(y);
+        let (theta, quasi_static) = (self.readers.angle(rise), self.readers.angle(rise_static));
+        let dynamic = theta - quasi_static;
+        self.collector
+            .record(t, theta, theta, dynamic.abs(), dynamic * dynamic * dt, dt)?;
         self.tip(tip, tip);
         Ok(())
     }
@@ -330,6 +351,11 @@ pub fn run_distributed_orbits(
     let tip0 = readers.tip.at(y0);
     let mut tips = vec![(f64::INFINITY, f64::NEG_INFINITY); spec.n_orbits as usize];
     tips[0] = (tip0, tip0);
+    let umbra = Umbra::new(
+        model,
+        [&readers.rise, &readers.rise_static, &readers.tip],
+        READ_RTOL,
+    );
     let mut reads = Reads {
         collector: Collector::new(view, spec, theta0)?,
         readers,
@@ -343,6 +369,8 @@ pub fn run_distributed_orbits(
         model,
         orbit: spec.orbit,
         method,
+        shadow_method: spec.method,
+        umbra,
         system: DistributedSystem::new(model.clone(), spec.orbit),
         reads: &mut reads,
         t_end: spec.t_end(),
@@ -421,6 +449,10 @@ struct Driver<'a, 'c> {
     model: &'a DistributedPanel,
     orbit: Orbit,
     method: Method,
+    /// The method of the temperatures alone in the umbra: the run's, its step not capped by the
+    /// modes (they are propagated exactly).
+    shadow_method: Method,
+    umbra: Umbra,
     system: DistributedSystem,
     reads: &'a mut Reads<'c>,
     t_end: f64,
@@ -487,6 +519,61 @@ impl Driver<'_, '_> {
         Ok(())
     }
 
+    /// From t to `end` inside the umbra: the temperatures integrated alone, the modes propagated
+    /// exactly over each of their steps, and the reads at the spacing of [`Umbra`] (or to where
+    /// they stopped the run).
+    fn through_umbra(&mut self, end: f64) -> Result<()> {
+        let (nt, k) = (self.model.temps(), self.model.k());
+        let y = self.y.as_slice();
+        let count = ((end - self.t) / self.umbra.spacing).ceil().max(1.0) as usize;
+        let mut observer = UmbraReads {
+            umbra: &self.umbra,
+            reads: &mut *self.reads,
+            q: y[nt..nt + k].to_vec(),
+            v: y[nt + k..].to_vec(),
+            start: self.t,
+            end,
+            spacing: (end - self.t) / count as f64,
+            count,
+            next: 1,
+            stop: None,
+            error: None,
+        };
+        let mut system = ShadowedThermal { model: self.model };
+        let temps = DVector::from_column_slice(&y[..nt]);
+        let outcome = solve(
+            &mut system,
+            &self.shadow_method,
+            self.t,
+            temps,
+            end,
+            &mut observer,
+        );
+        let (done, temps) = match (outcome, observer.error.take()) {
+            (_, Some(e)) | (Err(e), None) => return Err(e),
+            (Ok(run), None) => run,
+        };
+        let (reached, y) = match observer.stop.take() {
+            Some(stop) => stop,
+            None => {
+                let mut y = temps.as_slice().to_vec();
+                y.extend_from_slice(&observer.q);
+                y.extend_from_slice(&observer.v);
+                (end, DVector::from_vec(y))
+            }
+        };
+        self.split.t_umbra += reached - self.t;
+        self.split.n_umbra_steps += done.n_steps;
+        let s = &mut self.stats;
+        (s.n_steps, s.n_rejected, s.n_rhs) = (
+            s.n_steps + done.n_steps,
+            s.n_rejected + done.n_rejected,
+            s.n_rhs + done.n_rhs,
+        );
+        (self.t, self.y) = (reached, y);
+        Ok(())
+    }
+
     /// End of the orbit that holds (t, t + dt]: the collector's current orbit (that of the last
     /// point read, t), or the next when t is its end.
     fn orbit_end(&self, t: f64) -> f64 {
@@ -520,7 +607,18 @@ impl Driver<'_, '_> {
                 .map(|e| e.outer.1 + window)
                 .fold(f64::NEG_INFINITY, f64::max);
             let next = if let Some(e) = shadow {
-                e.outer.1 + window
+                match e.umbra {
+                    // The umbra, the temperatures alone: first the penumbra before it in full.
+                    Some((u0, u1)) if t < u1 && matches!(self.shadow_method, Method::Dopri5(_)) => {
+                        if t < u0 {
+                            u0
+                        } else {
+                            self.through_umbra(u1.min(self.t_end))?;
+                            continue;
+                        }
+                    }
+                    _ => e.outer.1 + window,
+                }
             } else if t < release {
                 release
             } else {
@@ -794,5 +892,87 @@ impl Driver<'_, '_> {
             at_end,
             if slowest.is_finite() { slowest } else { 0.0 },
         )
+    }
+}
+
+/// The reads of a span through the umbra: at t_j = start + j Δ (j = 1 ..= count, the last at its
+/// end), each in the step of the temperatures that holds it, the modes carried from step to step.
+struct UmbraReads<'r, 'c> {
+    umbra: &'r Umbra,
+    reads: &'r mut Reads<'c>,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    start: f64,
+    end: f64,
+    spacing: f64,
+    count: usize,
+    /// The next read's j.
+    next: usize,
+    /// Where the reads stopped the run (the limit), and the state there.
+    stop: Option<(f64, DVector<f64>)>,
+    error: Option<Error>,
+}
+
+impl Observer<D> for UmbraReads<'_, '_> {
+    fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()> {
+        if let Err(e) = self.reads.cancel.check() {
+            self.error = Some(e);
+            return ControlFlow::Break(());
+        }
+        let arc = UmbraStep::new(self.umbra, step, &self.q, &self.v);
+        let last = if step.t1 >= self.end {
+            self.count
+        } else {
+            let mut j = (((step.t1 - self.start) / self.spacing).floor() as usize).min(self.count);
+            while j > 0 && self.start + j as f64 * self.spacing > step.t1 {
+                j -= 1;
+            }
+            j
+        };
+        let (first, spacing, start, end, count) =
+            (self.next, self.spacing, self.start, self.end, self.count);
+        let time = |j: usize| {
+            if j == count {
+                end
+            } else {
+                start + j as f64 * spacing
+            }
+        };
+        let mut stopped = None;
+        if last >= first {
+            let reads = &mut *self.reads;
+            let error = &mut self.error;
+            arc.read_uniform(
+                time(first),
+                spacing,
+                last + 1 - first,
+                |i, [rise, rs, tip]| {
+                    let t = time(first + i);
+                    if let Err(e) = reads.read_values(t, rise, rs, tip, spacing) {
+                        *error = Some(e);
+                        return false;
+                    }
+                    if reads.stopped() {
+                        stopped = Some(t);
+                        return false;
+                    }
+                    true
+                },
+            );
+            self.next = last + 1;
+        }
+        if self.error.is_some() {
+            return ControlFlow::Break(());
+        }
+        if let Some(t) = stopped {
+            let (q, v) = arc.modes_at(t);
+            let mut y = step.eval(t).as_slice().to_vec();
+            y.extend_from_slice(&q);
+            y.extend_from_slice(&v);
+            self.stop = Some((t, DVector::from_vec(y)));
+            return ControlFlow::Break(());
+        }
+        (self.q, self.v) = arc.modes_at(step.t1);
+        ControlFlow::Continue(())
     }
 }

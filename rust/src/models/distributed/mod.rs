@@ -300,6 +300,16 @@ impl DistributedPanel {
         });
     }
 
+    /// The temperatures' rates of every element in the umbra (`temps` and `out`: the
+    /// temperatures alone): without sunlight the structure does not enter them, and each element
+    /// cools on its own, as [`Self::rhs_at_flux`] at flux 0 has it.
+    pub fn rates_in_shadow(&self, temps: &[f64], out: &mut [f64]) {
+        let s = self.layers();
+        for (t, o) in temps.chunks_exact(s).zip(out.chunks_exact_mut(s)) {
+            self.thermal.rates(0.0, t, o);
+        }
+    }
+
     /// The right-hand side under the orbit's `heat` (each element at its own orientation).
     pub fn rhs_loaded(&self, heat: &ElementHeat, y: &[f64], dy: &mut [f64]) {
         self.rhs_with(y, dy, |slope, temps, out| {
