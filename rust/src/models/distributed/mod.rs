@@ -239,18 +239,24 @@ impl DistributedPanel {
 
     /// Element moments from the state, N m.
     pub fn moments(&self, y: &[f64]) -> Vec<f64> {
-        (0..self.n())
-            .map(|e| self.thermal.moment(self.element(y, e)))
-            .collect()
+        let mut m = vec![0.0; self.n()];
+        self.thermal.moments_of(&y[..self.temps()], &mut m);
+        m
     }
 
     /// Per-element chord slopes ρ = D Φ q + D R M, written as D S M + D Φ (q − Ω⁻² G M) so that
     /// the static part is integrated in O(n) ([`Reduction::static_slopes`]); `gm` is G M.
     fn slopes_with(&self, q: &[f64], moments: &[f64], gm: &[f64]) -> Vec<f64> {
+        let mut rho = vec![0.0; self.n()];
+        self.slopes_into(q, moments, gm, &mut rho);
+        rho
+    }
+
+    /// [`Self::slopes_with`] into `rho`.
+    fn slopes_into(&self, q: &[f64], moments: &[f64], gm: &[f64], rho: &mut [f64]) {
         let r = &self.reduction;
         let n = self.n();
-        let mut rho = vec![0.0; n];
-        r.static_slopes(moments, &mut rho);
+        r.static_slopes(moments, rho);
         // Column by column (column-major): each pass is a contiguous axpy.
         for (i, col) in r.slope_modal.as_slice().chunks_exact(n).enumerate() {
             let w = r.omega[i];
@@ -259,21 +265,25 @@ impl DistributedPanel {
                 *out += a * x;
             }
         }
-        rho
     }
 
     /// G M: the modal forces of the element moments.
     fn modal_forces(&self, moments: &[f64]) -> Vec<f64> {
+        let mut gm = vec![0.0; self.k()];
+        self.modal_forces_into(moments, &mut gm);
+        gm
+    }
+
+    /// [`Self::modal_forces`] into `gm`.
+    fn modal_forces_into(&self, moments: &[f64], gm: &mut [f64]) {
         let r = &self.reduction;
-        (0..self.k())
-            .map(|i| {
-                moments
-                    .iter()
-                    .enumerate()
-                    .map(|(e, m)| r.force[(i, e)] * m)
-                    .sum()
-            })
-            .collect()
+        for (i, g) in gm.iter_mut().enumerate() {
+            *g = moments
+                .iter()
+                .enumerate()
+                .map(|(e, m)| r.force[(i, e)] * m)
+                .sum();
+        }
     }
 
     /// Per-element chord slopes ρ.
@@ -325,16 +335,23 @@ impl DistributedPanel {
     fn rhs_with(&self, y: &[f64], dy: &mut [f64], heat: impl Fn(f64, &[f64], &mut [f64])) {
         let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
         let r = &self.reduction;
-        let moments = self.moments(y);
+        // The moments, G M and the chord slopes in one buffer.
+        let mut scratch = vec![0.0; 2 * n + k];
+        let (moments, rest) = scratch.split_at_mut(n);
+        let (gm, slopes) = rest.split_at_mut(k);
+        self.thermal.moments_of(&y[..nt], moments);
         let q = self.modal(y);
         let v = &y[nt + k..];
-        let gm = self.modal_forces(&moments);
-        let slopes = match self.settings.coupling {
-            Coupling::ProjectedArea => self.slopes_with(q, &moments, &gm),
-            Coupling::Frozen => vec![0.0; n],
-        };
-        for (e, &slope) in slopes.iter().enumerate() {
-            heat(slope, self.element(y, e), &mut dy[e * s..(e + 1) * s]);
+        self.modal_forces_into(moments, gm);
+        if self.settings.coupling == Coupling::ProjectedArea {
+            self.slopes_into(q, moments, gm, slopes);
+        }
+        for ((&slope, temps), out) in slopes
+            .iter()
+            .zip(y[..nt].chunks_exact(s))
+            .zip(dy[..nt].chunks_exact_mut(s))
+        {
+            heat(slope, temps, out);
         }
         let zeta = self.settings.damping_ratio;
         for i in 0..k {
