@@ -149,6 +149,27 @@ impl Readers {
         }
     }
 
+    /// The tip rise, the static state's rise and the tip deflection of the state `y`, in one
+    /// pass (each sum in the order and from the -0.0 of [`Affine::at`]'s: the same bits).
+    pub fn values(&self, y: &[f64]) -> (f64, f64, f64) {
+        let (mut rise, mut rise_static, mut tip) = (-0.0, -0.0, -0.0);
+        let (a, b, c) = (
+            self.rise.w.as_slice(),
+            self.rise_static.w.as_slice(),
+            self.tip.w.as_slice(),
+        );
+        for (i, v) in y.iter().enumerate().take(a.len()) {
+            rise += a[i] * v;
+            rise_static += b[i] * v;
+            tip += c[i] * v;
+        }
+        (
+            rise + self.rise.c,
+            rise_static + self.rise_static.c,
+            tip + self.tip.c,
+        )
+    }
+
     /// asin(rise/arm), the rise clamped to the arm (runs refuse a rise beyond it first).
     #[inline]
     pub fn angle(&self, rise: f64) -> f64 {
@@ -243,8 +264,7 @@ impl Reads<'_> {
 
     /// One point (t, y) of the solution standing for the interval dt before it.
     fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
-        let r = &self.readers;
-        let (rise, rise_static, tip) = (r.rise.at(y), r.rise_static.at(y), r.tip.at(y));
+        let (rise, rise_static, tip) = self.readers.values(y);
         self.read_values(t, rise, rise_static, tip, dt)
     }
 

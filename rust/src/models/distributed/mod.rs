@@ -276,13 +276,14 @@ impl DistributedPanel {
 
     /// [`Self::modal_forces`] into `gm`.
     fn modal_forces_into(&self, moments: &[f64], gm: &mut [f64]) {
-        let r = &self.reduction;
-        for (i, g) in gm.iter_mut().enumerate() {
-            *g = moments
-                .iter()
-                .enumerate()
-                .map(|(e, m)| r.force[(i, e)] * m)
-                .sum();
+        // Every mode's sum over the elements in their order, the modes side by side (from -0.0,
+        // the neutral element of f64's `Sum`: each the same bits as summed alone).
+        gm.fill(-0.0);
+        let columns = self.reduction.force.as_slice().chunks_exact(gm.len());
+        for (column, m) in columns.zip(moments) {
+            for (g, f) in gm.iter_mut().zip(column) {
+                *g += f * m;
+            }
         }
     }
 
