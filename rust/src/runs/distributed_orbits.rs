@@ -49,6 +49,12 @@ const CHECK_EVERY: f64 = 60.0;
 /// they feed (the amplitude, the jitter peak).
 const READ_RTOL: f64 = 4e-4;
 
+/// The reads' absolute floor: READ_RTOL of the gate's absolute 1e-6 rad as a rise (m) at the
+/// arm `arm`.
+fn read_floor(arm: f64) -> f64 {
+    READ_RTOL * 1e-6 * arm
+}
+
 /// Largest spread of asin's slope over an arc, relative: the jitter (a difference of two θ_f)
 /// is read as the difference of the tip rises times that slope.
 const SLOPE_SPREAD: f64 = 1e-3;
@@ -375,6 +381,7 @@ pub fn run_distributed_orbits(
         model,
         [&readers.rise, &readers.rise_static, &readers.tip],
         READ_RTOL,
+        read_floor(readers.arm),
     );
     let mut reads = Reads {
         collector: Collector::new(view, spec, theta0)?,
@@ -540,22 +547,16 @@ impl Driver<'_, '_> {
     }
 
     /// From t to `end` inside the umbra: the temperatures integrated alone, the modes propagated
-    /// exactly over each of their steps, and the reads at the spacing of [`Umbra`] (or to where
-    /// they stopped the run).
+    /// exactly over each of their steps, and the reads evenly spaced in each step at the spacing
+    /// [`UmbraStep::spacing`] allows (or to where they stopped the run).
     fn through_umbra(&mut self, end: f64) -> Result<()> {
         let (nt, k) = (self.model.temps(), self.model.k());
         let y = self.y.as_slice();
-        let count = ((end - self.t) / self.umbra.spacing).ceil().max(1.0) as usize;
         let mut observer = UmbraReads {
             umbra: &self.umbra,
             reads: &mut *self.reads,
             q: y[nt..nt + k].to_vec(),
             v: y[nt + k..].to_vec(),
-            start: self.t,
-            end,
-            spacing: (end - self.t) / count as f64,
-            count,
-            next: 1,
             stop: None,
             error: None,
         };
@@ -678,8 +679,7 @@ impl Driver<'_, '_> {
         let rise_static = arc.signal(&r.rise_static.w, r.rise_static.c);
         let tip = arc.signal(&r.tip.w, r.tip.c);
         let length = end - t0;
-        // With a floor of READ_RTOL of the gate's absolute 1e-6 rad as a rise (m) at the arm.
-        let floor = READ_RTOL * 1e-6 * r.arm;
+        let floor = read_floor(r.arm);
         let tol = |s: &crate::runs::distributed_arc::ArcSignal| READ_RTOL * s.variation() + floor;
         let signals = [&rise, &dynamic, &rise_static, &tip];
         if signals.iter().any(|s| s.max_interpolation_error() > tol(s)) {
@@ -915,19 +915,13 @@ impl Driver<'_, '_> {
     }
 }
 
-/// The reads of a span through the umbra: at t_j = start + j Δ (j = 1 ..= count, the last at its
-/// end), each in the step of the temperatures that holds it, the modes carried from step to step.
+/// The reads of a span through the umbra: evenly spaced in each step of the temperatures (the
+/// last at its end), the modes carried from step to step.
 struct UmbraReads<'r, 'c> {
     umbra: &'r Umbra,
     reads: &'r mut Reads<'c>,
     q: Vec<f64>,
     v: Vec<f64>,
-    start: f64,
-    end: f64,
-    spacing: f64,
-    count: usize,
-    /// The next read's j.
-    next: usize,
     /// Where the reads stopped the run (the limit), and the state there.
     stop: Option<(f64, DVector<f64>)>,
     error: Option<Error>,
@@ -940,47 +934,31 @@ impl Observer<D> for UmbraReads<'_, '_> {
             return ControlFlow::Break(());
         }
         let arc = UmbraStep::new(self.umbra, step, &self.q, &self.v);
-        let last = if step.t1 >= self.end {
-            self.count
-        } else {
-            let mut j = (((step.t1 - self.start) / self.spacing).floor() as usize).min(self.count);
-            while j > 0 && self.start + j as f64 * self.spacing > step.t1 {
-                j -= 1;
-            }
-            j
-        };
-        let (first, spacing, start, end, count) =
-            (self.next, self.spacing, self.start, self.end, self.count);
+        let h = step.t1 - step.t0;
+        let count = (h / arc.spacing(self.umbra)).ceil().clamp(1.0, 1e9) as usize;
+        let dt = h / count as f64;
         let time = |j: usize| {
             if j == count {
-                end
+                step.t1
             } else {
-                start + j as f64 * spacing
+                step.t0 + j as f64 * dt
             }
         };
         let mut stopped = None;
-        if last >= first {
-            let reads = &mut *self.reads;
-            let error = &mut self.error;
-            arc.read_uniform(
-                time(first),
-                spacing,
-                last + 1 - first,
-                |i, [rise, rs, tip]| {
-                    let t = time(first + i);
-                    if let Err(e) = reads.read_values(t, rise, rs, tip, spacing) {
-                        *error = Some(e);
-                        return false;
-                    }
-                    if reads.stopped() {
-                        stopped = Some(t);
-                        return false;
-                    }
-                    true
-                },
-            );
-            self.next = last + 1;
-        }
+        let reads = &mut *self.reads;
+        let error = &mut self.error;
+        arc.read_uniform(time(1), dt, count, |i, [rise, rs, tip]| {
+            let t = time(i + 1);
+            if let Err(e) = reads.read_values(t, rise, rs, tip, dt) {
+                *error = Some(e);
+                return false;
+            }
+            if reads.stopped() {
+                stopped = Some(t);
+                return false;
+            }
+            true
+        });
         if self.error.is_some() {
             return ControlFlow::Break(());
         }

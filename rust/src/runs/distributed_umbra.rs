@@ -64,14 +64,21 @@ pub(crate) struct Umbra {
     forcing: Vec<Split>,
     /// The functionals read: the tip rise, the static state's rise, the tip deflection.
     reads: [Split; 3],
-    /// Spacing of the reads, s.
-    pub spacing: f64,
+    /// The reads miss no extreme of a read functional or of the dynamic part (the rise less
+    /// the static state's) by more than `read_rtol` of its modes' amplitudes plus `read_floor`.
+    read_rtol: f64,
+    read_floor: f64,
 }
 
 impl Umbra {
-    /// `reads`: the functionals read; `read_rtol`: a peak of each mode is missed between two
-    /// reads by at most this fraction of its amplitude.
-    pub fn new(model: &DistributedPanel, reads: [&Affine; 3], read_rtol: f64) -> Umbra {
+    /// `reads`: the tip rise, the static state's rise and the tip deflection; `read_rtol` and
+    /// `read_floor`: what the reads may miss of an extreme (see [`UmbraStep::spacing`]).
+    pub fn new(
+        model: &DistributedPanel,
+        reads: [&Affine; 3],
+        read_rtol: f64,
+        read_floor: f64,
+    ) -> Umbra {
         let (nt, k, n) = (model.temps(), model.k(), model.n());
         let r = &model.reduction;
         let zeta = model.settings.damping_ratio;
@@ -86,15 +93,14 @@ impl Umbra {
                 Split::of(&Affine::of(model, &vec![0.0; k], &row), nt, k)
             })
             .collect();
-        let fastest = omega.iter().copied().fold(0.0, f64::max);
         Umbra {
             omega,
             zeta,
             lambda,
             forcing,
             reads: reads.map(|f| Split::of(f, nt, k)),
-            // A peak of a mode at ω is missed between samples Δ apart by (ωΔ)²/8 of its size.
-            spacing: (8.0 * read_rtol).sqrt() / fastest,
+            read_rtol,
+            read_floor,
         }
     }
 }
@@ -180,6 +186,47 @@ impl UmbraStep {
             free,
             lambda: u.lambda.clone(),
         }
+    }
+
+    /// The largest spacing of the reads in this step: an extreme of a signal s between two reads
+    /// Δ apart is missed by at most max|s''| Δ²/8, max|s''| bounded by its smooth part's
+    /// coefficients and its modes' amplitudes |α_k| |λ_k|²; that is kept within `read_rtol` of
+    /// Σ|α_k| plus `read_floor`, for each read functional and the dynamic part.
+    pub fn spacing(&self, u: &Umbra) -> f64 {
+        let dynamic = (
+            std::array::from_fn(|m| self.smooth[0][m] - self.smooth[1][m]),
+            self.amps[0]
+                .iter()
+                .zip(&self.amps[1])
+                .map(|(a, b)| a - b)
+                .collect::<Vec<C64>>(),
+        );
+        let signals = [
+            (&self.smooth[0], &self.amps[0]),
+            (&self.smooth[2], &self.amps[2]),
+            (&dynamic.0, &dynamic.1),
+        ];
+        let h2 = self.h * self.h;
+        signals
+            .iter()
+            .map(|(smooth, amps)| {
+                let curvature: f64 = (2..5)
+                    .map(|m| (m * (m - 1)) as f64 * smooth[m].abs() / h2)
+                    .sum::<f64>()
+                    + amps
+                        .iter()
+                        .zip(&self.lambda)
+                        .map(|(a, l)| a.norm() * l.norm_sqr())
+                        .sum::<f64>();
+                let size: f64 = amps.iter().map(|a| a.norm()).sum();
+                let tol = u.read_rtol * size + u.read_floor;
+                if curvature > 0.0 {
+                    (8.0 * tol / curvature).sqrt()
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The read functionals at the times t_first + j Δ (j = 0 .. count), each handed to `read`
