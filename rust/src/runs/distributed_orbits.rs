@@ -14,8 +14,10 @@
 //!   cap theirs at the hinge's).
 //! - **Linear arcs** (with hybrid settings): on sunlit arcs near the equilibrium, past the last
 //!   shadow exit by the summary window, the linearised system is propagated exactly
-//!   ([`crate::runs::distributed_arc`]) and the summaries read off it; the shadow crossings and
-//!   their thermal recovery are integrated in full. An arc is taken only where its own checks
+//!   ([`crate::runs::distributed_arc`]) and the summaries read off it; in the umbra the
+//!   temperatures are integrated alone and the modes propagated exactly
+//!   ([`crate::runs::distributed_umbra`]); the penumbra and the thermal recovery after the exit
+//!   are integrated in full. An arc is taken only where its own checks
 //!   hold: the non-linear remainder at its start as a static θ_f error below
 //!   `linear_tolerance`, the oscillation below `linear_amplitude`, the structural pairs and
 //!   their eigenvectors found to rounding, the reads' interpolation error within their

@@ -278,3 +278,155 @@ impl UmbraStep {
             .unzip()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inputs::panel::Panel;
+    use crate::models::distributed::Settings;
+    use crate::numerics::integrate::{solve, Method, Observer, Tolerances};
+    use crate::runs::distributed_orbits::Readers;
+    use std::ops::ControlFlow;
+
+    /// The whole model without sunlight, the truth the umbra's split is checked against.
+    struct Dark<'a>(&'a DistributedPanel);
+
+    impl OdeSystem<D> for Dark<'_> {
+        fn rhs(&self, _t: f64, y: &State<D>) -> State<D> {
+            let mut dy = DVector::zeros(y.len());
+            self.0.rhs_at_flux(0.0, y.as_slice(), dy.as_mut_slice());
+            dy
+        }
+    }
+
+    /// The full state at `probe` of a run.
+    struct Probe {
+        t: f64,
+        y: Option<DVector<f64>>,
+    }
+
+    impl Observer<D> for Probe {
+        fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()> {
+            if step.t0 < self.t && self.t <= step.t1 {
+                self.y = Some(step.eval(self.t));
+            }
+            ControlFlow::Continue(())
+        }
+    }
+
+    /// The modes carried over the temperatures' steps, and the read functionals at `probe`.
+    struct Carry<'a> {
+        umbra: &'a Umbra,
+        q: Vec<f64>,
+        v: Vec<f64>,
+        probe: f64,
+        read: Option<[f64; 3]>,
+    }
+
+    impl Observer<D> for Carry<'_> {
+        fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()> {
+            let s = UmbraStep::new(self.umbra, step, &self.q, &self.v);
+            if step.t0 < self.probe && self.probe <= step.t1 {
+                s.read_uniform(self.probe, 1.0, 1, |_, values| {
+                    self.read = Some(values);
+                    true
+                });
+            }
+            (self.q, self.v) = s.modes_at(step.t1);
+            ControlFlow::Continue(())
+        }
+    }
+
+    fn tight(rtol: f64) -> Method {
+        Method::Dopri5(Tolerances {
+            rtol,
+            atol: rtol * 1e-2,
+            ..Tolerances::default()
+        })
+    }
+
+    #[test]
+    fn the_umbra_split_is_the_whole_model_without_sunlight() {
+        // The shadow entered from the sunlit equilibrium with every mode ringing (ζ = 1e-3).
+        let panel = Panel::paper();
+        let settings = Settings {
+            elements: 6,
+            modes: 3,
+            damping_ratio: 1e-3,
+            ..Settings::new(&panel)
+        };
+        let model = DistributedPanel::new(&panel, settings).unwrap();
+        let (nt, k) = (model.temps(), model.k());
+        let mut y0 = model.equilibrium(1.0).unwrap();
+        for i in 0..k {
+            y0[nt + i] *= 1.0 + 0.3 / (i + 1) as f64;
+            y0[nt + k + i] = 0.1 * y0[nt + i] * model.reduction.omega[i];
+        }
+        let (end, probe) = (900.0, 437.3);
+        let mut truth = Probe { t: probe, y: None };
+        let (_, full) = solve(
+            &mut Dark(&model),
+            &tight(1e-12),
+            0.0,
+            DVector::from_vec(y0.clone()),
+            end,
+            &mut truth,
+        )
+        .unwrap();
+        let readers = Readers::of(&model);
+        let umbra = Umbra::new(
+            &model,
+            [&readers.rise, &readers.rise_static, &readers.tip],
+            4e-4,
+            0.0,
+        );
+        let mut carry = Carry {
+            umbra: &umbra,
+            q: y0[nt..nt + k].to_vec(),
+            v: y0[nt + k..].to_vec(),
+            probe,
+            read: None,
+        };
+        let (stats, temps) = solve(
+            &mut ShadowedThermal { model: &model },
+            &tight(1e-10),
+            0.0,
+            DVector::from_column_slice(&y0[..nt]),
+            end,
+            &mut carry,
+        )
+        .unwrap();
+        // Steps on the thermal time scale, not the modes' periods (T₁ about 7 s).
+        assert!(stats.n_steps < 200, "{} steps", stats.n_steps);
+        for i in 0..nt {
+            assert!(
+                (temps[i] - full[i]).abs() < 1e-8 * full[i],
+                "T[{i}]: {} vs {}",
+                temps[i],
+                full[i]
+            );
+        }
+        let qmax = (0..k).fold(0.0f64, |a, i| a.max(full[nt + i].abs()));
+        for i in 0..k {
+            let w = model.reduction.omega[i];
+            assert!((carry.q[i] - full[nt + i]).abs() < 1e-7 * qmax, "q[{i}]");
+            assert!(
+                (carry.v[i] - full[nt + k + i]).abs() < 1e-7 * qmax * w,
+                "v[{i}]"
+            );
+        }
+        // The read functionals inside a step: the tip rise, the static rise, the tip.
+        let y = truth.y.unwrap();
+        let read = carry.read.unwrap();
+        for (value, f) in read
+            .iter()
+            .zip([&readers.rise, &readers.rise_static, &readers.tip])
+        {
+            let exact = f.at(y.as_slice());
+            assert!(
+                (value - exact).abs() < 1e-7 * exact.abs().max(readers.arm * 1e-3),
+                "{value} vs {exact}"
+            );
+        }
+    }
+}
