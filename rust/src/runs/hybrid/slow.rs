@@ -166,29 +166,77 @@ impl SlowModel {
     fn manifold(&self, t: f64, temps: &Vector2<f64>) -> Manifold {
         let th0 = self.theta0(temps);
         let (th0_rate, rates0) = self.theta0_rate(t, temps);
-        // θ₀'' along the flow, by differences kept inside the segment.
-        let (a, b) = self.segment;
-        let (mut lo, mut hi) = ((t - FLOW_STEP).max(a), (t + FLOW_STEP).min(b));
-        if hi - lo < 1e-3 * FLOW_STEP {
-            (lo, hi) = (t, t + FLOW_STEP);
-        }
-        let at = |s: f64| self.theta0_rate(s, &(temps + rates0 * (s - t))).0;
-        let th0_accel = (at(hi) - at(lo)) / (hi - lo);
+        let [accel, jerk] = self.flow_derivatives(t, temps, th0_rate, &rates0);
         let (sin, cos) = th0.sin_cos();
-        let (inertia, velocity) = match self.model {
-            HingeModel::Linear => (self.inertia, 0.0),
-            HingeModel::Nonlinear => (
-                self.inertia * self.model.inertia_factor(sin),
-                3.0 * self.inertia * th0_rate * th0_rate * sin * cos,
-            ),
+        let (inertia, velocity, moving) = match self.model {
+            HingeModel::Linear => (self.inertia, 0.0, 0.0),
+            HingeModel::Nonlinear => {
+                // d/dt of I_eff θ₀'' + N beyond I_eff θ₀''': the inertia's and the velocity
+                // term's own change along the flow.
+                let (sc, cos2) = (sin * cos, cos * cos - sin * sin);
+                let moving = self.inertia
+                    * (6.0 * sc * th0_rate * accel
+                        + 3.0 * (2.0 * th0_rate * accel * sc + th0_rate.powi(3) * cos2));
+                (
+                    self.inertia * self.model.inertia_factor(sin),
+                    3.0 * self.inertia * th0_rate * th0_rate * sc,
+                    moving,
+                )
+            }
         };
-        let lag = -(self.damping * th0_rate + inertia * th0_accel + velocity) / self.stiffness;
-        let theta = th0 + lag;
-        let theta_rate = th0_rate - self.damping / self.stiffness * th0_accel;
+        let lag = -(self.damping * th0_rate + inertia * accel + velocity) / self.stiffness;
+        // θ̄' = θ₀' + lag'. Its inertia term I θ₀'''/K_el is ε² of θ₀' (ε the thermal rates over
+        // the hinge's angular frequency): without it a split leaves that much in the ringing.
+        let theta_rate =
+            th0_rate - (self.damping * accel + inertia * jerk + moving) / self.stiffness;
         Manifold {
-            y: Vector4::new(temps[0], temps[1], theta, theta_rate),
+            y: Vector4::new(temps[0], temps[1], th0 + lag, theta_rate),
             lag,
         }
+    }
+
+    /// θ₀'' and θ₀''' along the thermal flow at t, by differences over three times
+    /// [`FLOW_STEP`] apart inside the segment: θ₀' along T + T' s (its slope is θ₀''), then along
+    /// T + T' s + T'' s²/2, T'' from the first pass (its curvature is θ₀''').
+    fn flow_derivatives(
+        &self,
+        t: f64,
+        temps: &Vector2<f64>,
+        th0_rate: f64,
+        rates0: &Vector2<f64>,
+    ) -> [f64; 2] {
+        let (a, b) = self.segment;
+        let h = FLOW_STEP;
+        let times = if t - h >= a && t + h <= b {
+            [t - h, t, t + h]
+        } else if t + 2.0 * h <= b || t - 2.0 * h < a {
+            [t, t + h, t + 2.0 * h]
+        } else {
+            [t - 2.0 * h, t - h, t]
+        };
+        let loads = times.map(|s| (s != t).then(|| self.loads(s)));
+        // θ₀' and T' at the three times, the temperatures along `curve` (of s = time − t).
+        let along = |curve: &dyn Fn(f64) -> Vector2<f64>| {
+            let mut values = [th0_rate; 3];
+            let mut rates = [*rates0; 3];
+            for k in 0..3 {
+                if let Some(l) = loads[k] {
+                    let at = temps + curve(times[k] - t);
+                    rates[k] = self.thermal(l, &at, self.theta0(&at));
+                    values[k] = self.theta0(&rates[k]);
+                }
+            }
+            (values, rates)
+        };
+        let (first, rates) = along(&|s| rates0 * s);
+        let accel = parabola_at(&times, &first, t).0;
+        let (d01, d12) = (
+            (rates[1] - rates[0]) / (times[1] - times[0]),
+            (rates[2] - rates[1]) / (times[2] - times[1]),
+        );
+        let t_accel = d01 + (d12 - d01) * ((2.0 * t - times[0] - times[1]) / (times[2] - times[0]));
+        let (second, _) = along(&|s| rates0 * s + t_accel * (0.5 * s * s));
+        [accel, parabola_at(&times, &second, t).1]
     }
 
     /// The Jacobian of the full model at (t, y), by central differences.
@@ -301,6 +349,14 @@ impl SlowModel {
         }
         None
     }
+}
+
+/// The slope and curvature at t of the parabola through (xs, fs).
+fn parabola_at(xs: &[f64; 3], fs: &[f64; 3], t: f64) -> (f64, f64) {
+    let d01 = (fs[1] - fs[0]) / (xs[1] - xs[0]);
+    let d12 = (fs[2] - fs[1]) / (xs[2] - xs[1]);
+    let second = (d12 - d01) / (xs[2] - xs[0]);
+    (d01 + second * (2.0 * t - xs[0] - xs[1]), 2.0 * second)
 }
 
 /// The slow integration's state is the mean temperature and T_f − T_b, each over its absolute
@@ -1067,6 +1123,55 @@ mod tests {
         let back = m.y + Vector4::from_fn(|i, _| (z * mode.v[i]).re);
         assert!((back - y).abs().max() < 1e-9, "{back} vs {y}");
         assert!(z.norm() > 1e-3);
+    }
+
+    #[test]
+    fn the_manifold_velocity_is_the_rate_of_its_angle_along_the_flow() {
+        // Just inside the umbra the temperatures fall fastest: θ̄' must be dθ̄/dt along the
+        // thermal flow, read here by central differences of θ̄ over a trajectory integrated by
+        // RK4 at a small step. Without the inertia's term I θ₀'''/K_el (ε² of θ₀') it is not.
+        for hinge in [HingeModel::Linear, HingeModel::Nonlinear] {
+            let panel = Panel {
+                specific_heat: 450.0,
+                ..Panel::paper()
+            };
+            let orbit = Orbit::leo(540e3);
+            let mut model = SlowModel::new(&spec(panel, orbit, hinge, 1));
+            model.enter(1900.0, 3000.0);
+            let y = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
+            let flow = |t: f64, temps: &Vector2<f64>| model.theta0_rate(t, temps).1;
+            let dt = 1e-3;
+            let (mut t, mut temps) = (1900.0, Vector2::new(y[0], y[1]));
+            let mut points = Vec::new();
+            for n in 0..60_005 {
+                if n >= 60_000 {
+                    points.push((t, temps));
+                }
+                let k1 = flow(t, &temps);
+                let k2 = flow(t + 0.5 * dt, &(temps + k1 * (0.5 * dt)));
+                let k3 = flow(t + 0.5 * dt, &(temps + k2 * (0.5 * dt)));
+                let k4 = flow(t + dt, &(temps + k3 * dt));
+                temps += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
+                t = 1900.0 + (n + 1) as f64 * dt;
+            }
+            let angle = |k: usize| model.manifold(points[k].0, &points[k].1).y[2];
+            // The fourth-order central difference at the middle point (t = 1960.002).
+            let d = (angle(0) - 8.0 * angle(1) + 8.0 * angle(3) - angle(4)) / (12.0 * dt);
+            let (t_mid, temps_mid) = points[2];
+            let m = model.manifold(t_mid, &temps_mid);
+            let rate = model.theta0_rate(t_mid, &temps_mid).0;
+            // θ₀' − θ̄': the lag's rate, mostly the inertia's term.
+            let lag_rate = (rate - m.y[3]).abs();
+            assert!(
+                lag_rate > 1e-3 * rate.abs(),
+                "{hinge:?}: {lag_rate} vs {rate}"
+            );
+            assert!(
+                (m.y[3] - d).abs() < 0.05 * lag_rate,
+                "{hinge:?}: θ̄' {} vs dθ̄/dt {d} (the lag's rate {lag_rate})",
+                m.y[3]
+            );
+        }
     }
 
     #[test]
