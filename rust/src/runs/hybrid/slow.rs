@@ -93,6 +93,22 @@ struct Manifold {
     lag: f64,
 }
 
+/// The loads at `t` and at three times around it (one of them t) inside the segment.
+#[derive(Clone, Copy)]
+struct FlowLoads {
+    t: f64,
+    times: [f64; 3],
+    loads: [Loads; 3],
+    /// Which of `times` is t.
+    now: usize,
+}
+
+impl FlowLoads {
+    fn at_t(&self) -> Loads {
+        self.loads[self.now]
+    }
+}
+
 /// The hinge mode at a point of the slow manifold.
 #[derive(Clone, Copy, Debug)]
 struct Mode {
@@ -162,11 +178,31 @@ impl SlowModel {
         (self.theta0(&rates), rates)
     }
 
-    /// The slow manifold at (t, T̄).
-    fn manifold(&self, t: f64, temps: &Vector2<f64>) -> Manifold {
+    /// The loads at t and at the two times next to it that the flow's derivatives read.
+    fn flow_loads(&self, t: f64) -> FlowLoads {
+        let (a, b) = self.segment;
+        let h = FLOW_STEP;
+        let (times, now) = if t - h >= a && t + h <= b {
+            ([t - h, t, t + h], 1)
+        } else if t + 2.0 * h <= b || t - 2.0 * h < a {
+            ([t, t + h, t + 2.0 * h], 0)
+        } else {
+            ([t - 2.0 * h, t - h, t], 2)
+        };
+        FlowLoads {
+            t,
+            times,
+            loads: times.map(|s| self.loads(s)),
+            now,
+        }
+    }
+
+    /// The slow manifold at (t, T̄), `flow` the loads around t.
+    fn manifold(&self, flow: &FlowLoads, temps: &Vector2<f64>) -> Manifold {
         let th0 = self.theta0(temps);
-        let (th0_rate, rates0) = self.theta0_rate(t, temps);
-        let [accel, jerk] = self.flow_derivatives(t, temps, th0_rate, &rates0);
+        let rates0 = self.thermal(flow.at_t(), temps, th0);
+        let th0_rate = self.theta0(&rates0);
+        let [accel, jerk] = self.flow_derivatives(flow, temps, th0_rate, &rates0);
         let (sin, cos) = th0.sin_cos();
         let (inertia, velocity, moving) = match self.model {
             HingeModel::Linear => (self.inertia, 0.0, 0.0),
@@ -200,29 +236,20 @@ impl SlowModel {
     /// T + T' s + T'' s²/2, T'' from the first pass (its curvature is θ₀''').
     fn flow_derivatives(
         &self,
-        t: f64,
+        flow: &FlowLoads,
         temps: &Vector2<f64>,
         th0_rate: f64,
         rates0: &Vector2<f64>,
     ) -> [f64; 2] {
-        let (a, b) = self.segment;
-        let h = FLOW_STEP;
-        let times = if t - h >= a && t + h <= b {
-            [t - h, t, t + h]
-        } else if t + 2.0 * h <= b || t - 2.0 * h < a {
-            [t, t + h, t + 2.0 * h]
-        } else {
-            [t - 2.0 * h, t - h, t]
-        };
-        let loads = times.map(|s| (s != t).then(|| self.loads(s)));
+        let (t, times) = (flow.t, flow.times);
         // θ₀' and T' at the three times, the temperatures along `curve` (of s = time − t).
         let along = |curve: &dyn Fn(f64) -> Vector2<f64>| {
             let mut values = [th0_rate; 3];
             let mut rates = [*rates0; 3];
             for k in 0..3 {
-                if let Some(l) = loads[k] {
+                if k != flow.now {
                     let at = temps + curve(times[k] - t);
-                    rates[k] = self.thermal(l, &at, self.theta0(&at));
+                    rates[k] = self.thermal(flow.loads[k], &at, self.theta0(&at));
                     values[k] = self.theta0(&rates[k]);
                 }
             }
@@ -261,8 +288,8 @@ impl SlowModel {
 
     /// The hinge mode of the Jacobian at (t, y), its eigenvalue found by Newton's method on the
     /// characteristic polynomial from `guess`.
-    fn mode(&self, t: f64, y: &Vector4<f64>, guess: Complex<f64>) -> Option<Mode> {
-        let j = self.jacobian(self.loads(t), y);
+    fn mode(&self, loads: Loads, y: &Vector4<f64>, guess: Complex<f64>) -> Option<Mode> {
+        let j = self.jacobian(loads, y);
         let lambda = hinge_eigenvalue(&j, guess)?;
         let c = |r: usize, k: usize| Complex::new(j[(r, k)], 0.0);
         // v = (v0, v1, 1, λ): the two thermal rows.
@@ -330,9 +357,10 @@ impl SlowModel {
     ) -> Option<(Manifold, Mode, Complex<f64>)> {
         let mut temps = Vector2::new(y[0], y[1]);
         let mut lambda = guess;
+        let flow = self.flow_loads(t);
         for _ in 0..20 {
-            let m = self.manifold(t, &temps);
-            let mode = self.mode(t, &m.y, lambda)?;
+            let m = self.manifold(&flow, &temps);
+            let mode = self.mode(flow.at_t(), &m.y, lambda)?;
             lambda = mode.lambda;
             let d = y - m.y;
             let z: Complex<f64> = 2.0 * (0..4).map(|k| mode.w[k] * d[k]).sum::<Complex<f64>>();
@@ -340,8 +368,8 @@ impl SlowModel {
             let moved = (next - temps).abs().max();
             temps = next;
             if moved <= 1e-12 * temps.abs().max() {
-                let m = self.manifold(t, &temps);
-                let mode = self.mode(t, &m.y, lambda)?;
+                let m = self.manifold(&flow, &temps);
+                let mode = self.mode(flow.at_t(), &m.y, lambda)?;
                 let d = y - m.y;
                 let z = 2.0 * (0..4).map(|k| mode.w[k] * d[k]).sum::<Complex<f64>>();
                 return Some((m, mode, z));
@@ -492,8 +520,11 @@ impl Ringing<'_, '_> {
         let mut guess = self.mode.lambda;
         for k in 1..3 {
             let temps = m.temps(&if k == 2 { step.y1 } else { step.eval(ts[k]) });
-            points[k] = m.manifold(ts[k], &temps);
-            modes[k] = m.mode(ts[k], &points[k].y, guess).ok_or(Refusal::Split)?;
+            let flow = m.flow_loads(ts[k]);
+            points[k] = m.manifold(&flow, &temps);
+            modes[k] = m
+                .mode(flow.at_t(), &points[k].y, guess)
+                .ok_or(Refusal::Split)?;
             guess = modes[k].lambda;
         }
         if modes.iter().any(|md| md.separation > SEPARATION_LIMIT) {
@@ -589,12 +620,19 @@ impl Ringing<'_, '_> {
         if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
             return Err(Refusal::Ringing);
         }
-        let extremes = |a: f64, b: f64| (theta.smallest(a, b), theta.largest(a, b));
-        let (lo, hi) = extremes(t0, t1);
+        let (lo, hi) = (theta.smallest(t0, t1), theta.largest(t0, t1));
         let limit = self.obs.collector.options.theta_limit;
         if hi > limit || lo < -limit {
             return Err(Refusal::Limit);
         }
+        // The whole step's extremes are those just read; a window's part of it is read anew.
+        let extremes = |a: f64, b: f64| {
+            if (a, b) == (t0, t1) {
+                (lo, hi)
+            } else {
+                (theta.smallest(a, b), theta.largest(a, b))
+            }
+        };
         if let Err(e) = self
             .obs
             .collector
@@ -1083,10 +1121,10 @@ mod tests {
         let mut model = SlowModel::new(&s);
         model.enter(0.0, 100.0);
         let y = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
-        let m = model.manifold(0.0, &Vector2::new(y[0], y[1]));
+        let m = model.manifold(&model.flow_loads(0.0), &Vector2::new(y[0], y[1]));
         let mode = model
             .mode(
-                0.0,
+                model.loads(0.0),
                 &m.y,
                 Complex::new(0.0, panel.natural_angular_frequency()),
             )
@@ -1154,11 +1192,15 @@ mod tests {
                 temps += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
                 t = 1900.0 + (n + 1) as f64 * dt;
             }
-            let angle = |k: usize| model.manifold(points[k].0, &points[k].1).y[2];
+            let angle = |k: usize| {
+                model
+                    .manifold(&model.flow_loads(points[k].0), &points[k].1)
+                    .y[2]
+            };
             // The fourth-order central difference at the middle point (t = 1960.002).
             let d = (angle(0) - 8.0 * angle(1) + 8.0 * angle(3) - angle(4)) / (12.0 * dt);
             let (t_mid, temps_mid) = points[2];
-            let m = model.manifold(t_mid, &temps_mid);
+            let m = model.manifold(&model.flow_loads(t_mid), &temps_mid);
             let rate = model.theta0_rate(t_mid, &temps_mid).0;
             // θ₀' − θ̄': the lag's rate, mostly the inertia's term.
             let lag_rate = (rate - m.y[3]).abs();
