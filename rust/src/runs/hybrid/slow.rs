@@ -6,9 +6,12 @@
 //!
 //! - ȳ = (T̄, θ̄, θ̄') is the hinge's slow manifold over the temperatures T̄. With θ₀ = M_T(T̄)/K_el
 //!   and its derivatives along the thermal flow T̄' = g(t, T̄, θ̄),
-//!   θ̄ = θ₀ − (c_d θ₀' + I_eff θ₀'' + N)/K_el and θ̄' = θ₀' − (c_d/K_el) θ₀'': the hinge equation
-//!   balanced by the slow motion's own damping, inertia (I_B (1 + 3 sin²θ) for the non-linear
-//!   hinge) and, for the non-linear hinge, its velocity term N = 3 I_B θ₀'² sin θ₀ cos θ₀.
+//!   θ̄ = θ₀ − (c_d θ₀' + I_eff θ₀'' + N)/K_el and its rate along the flow
+//!   θ̄' = θ₀' − (c_d θ₀'' + I_eff θ₀''' + I_eff' θ₀'' + N')/K_el: the hinge equation balanced by
+//!   the slow motion's own damping, inertia (I_B (1 + 3 sin²θ) for the non-linear hinge) and, for
+//!   the non-linear hinge, its velocity term N = 3 I_B θ₀'² sin θ₀ cos θ₀. The inertia's term
+//!   I_eff θ₀''' is ε² of θ₀' (ε the thermal rates over the hinge's angular frequency): as large
+//!   as the ringing a penumbra excites, so a split without it misreads that ringing.
 //! - z is the ringing along the hinge eigenvector v (θ component 1) of the Jacobian at ȳ, λ its
 //!   eigenvalue and w the left eigenvector (wᵀv = 1): z' = (λ − wᵀv' + i Δω(|z|)) z, where Δω is the
 //!   non-linear hinge's frequency shift at amplitude |z| (from its conservative period, exact by
