@@ -45,9 +45,12 @@ class Case:
 
 @st.composite
 def cases(draw: st.DrawFn) -> Case:
-    kind = draw(st.sampled_from(["paper", "paper", "metal", "cfrp"]))
-    if kind == "paper":
+    kind = draw(st.sampled_from(["paper", "paper", "light", "metal", "cfrp"]))
+    if kind in ("paper", "light"):
         panel = draw(panels(spread=0.2))
+        if kind == "light":
+            # Down to 0.4 of the heat capacity: thermal rates closer to the hinge's frequency.
+            panel = panel.replace(specific_heat=panel.specific_heat * draw(st.floats(0.4, 1.0)))
     else:
         layer = (
             metal_layer(draw)
@@ -75,13 +78,14 @@ def cases(draw: st.DrawFn) -> Case:
             earth_ir=draw(st.floats(200.0, 260.0)) if heated else 0.0,
         )
     model = draw(st.sampled_from(["nonlinear", "linear"]))
-    n = (12 if kind == "paper" else 6) if SLOW else (3 if kind == "paper" else 2)
+    short = kind in ("paper", "light")
+    n = (12 if short else 6) if SLOW else (3 if short else 2)
     fields = {k: v for k, v in panel.as_dict().items() if k != "layup"}
     return Case(panel, orbit, model, n, f"{kind} {fields} on {orbit}, {model}, {n} orbits")
 
 
 # The default tier draws the same cases on every machine (the README's test command must pass
-# anywhere); THERMOJITTER_SLOW=1 draws new ones, where the known defect below can show.
+# anywhere); THERMOJITTER_SLOW=1 draws new ones.
 @settings(
     max_examples=60 if SLOW else 10,
     derandomize=not SLOW,
@@ -141,13 +145,9 @@ def test_a_panel_with_fast_thermal_rates_is_given_back_to_the_full_integration()
         assert (hybrid.columns[name] == column).all() or name in ("index",), name
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known defect of slow time: a panel whose dynamic part is a small ringing after a "
-    "penumbra (conical shadow) reads its RMS 2.2 % low, 1.09 x the gate, and the orbit's "
-    "accuracy check does not catch it (found by the property test above; cause not found yet)",
-)
-def test_the_known_small_ringing_case_after_a_penumbra_holds_the_gate() -> None:
+def test_a_small_ringing_after_a_penumbra_holds_the_gate() -> None:
+    # Drawn by the property test while slow time's manifold velocity lacked its inertia term
+    # I θ₀'''/K_el: this ringing, small after the penumbra's gradual excitation, read 2.2 % low.
     panel = tj.Panel.paper().replace(
         emissivity_front=0.6951449402057724,
         emissivity_back=0.8100067626027325,
@@ -169,3 +169,20 @@ def test_the_known_small_ringing_case_after_a_penumbra_holds_the_gate() -> None:
     full = tj.simulate_orbits(panel, orbit, 3, method="rk45", **kw)  # type: ignore[arg-type]
     hybrid = tj.simulate_orbits(panel, orbit, 3, method="hybrid", **kw)  # type: ignore[arg-type]
     assert not gate_failures(full, hybrid, 3)
+
+
+@pytest.mark.parametrize("model", ["linear", "nonlinear"])
+def test_half_the_heat_capacity_on_a_conical_low_orbit_holds_the_gate(model: str) -> None:
+    # One step from Table 1: half its heat capacity doubles the thermal rates against the hinge
+    # (still a twentieth of its frequency). Before the manifold's velocity took I θ₀'''/K_el,
+    # slow time read this panel's jitter_rms 2 % low on every orbit and did not give it back.
+    panel = tj.Panel.paper().replace(specific_heat=450.0)
+    orbit = tj.Orbit.leo(540e3, shadow="conical")
+    kw = {"orbits_per_call": 3, "progress": False, "model": model}
+    full = tj.simulate_orbits(panel, orbit, 3, method="rk45", **kw)  # type: ignore[arg-type]
+    hybrid = tj.simulate_orbits(panel, orbit, 3, method="hybrid", **kw)  # type: ignore[arg-type]
+    assert hybrid.propagation["n_refused_orbits"] == 0
+    assert not gate_failures(full, hybrid, 3)
+    for name in ("jitter_rms", "jitter_peak"):
+        a, b = full.columns[name], hybrid.columns[name]
+        assert (abs(b - a) <= 0.1 * 0.02 * abs(a)).all(), (name, a, b)
