@@ -166,10 +166,9 @@ impl UmbraStep {
         for (j, f) in u.reads.iter().enumerate() {
             let mut s = monomial(step.coefficients_along(&f.temps));
             s[0] += f.c;
-            for i in 0..k {
-                let dp = derivative(&particular[i]);
-                for m in 0..5 {
-                    s[m] += f.q[i] * particular[i][m] + f.v[i] * dp[m] / h;
+            for ((p, wq), wv) in particular.iter().zip(&f.q).zip(&f.v) {
+                for (m, dp) in derivative(p).iter().enumerate() {
+                    s[m] += wq * p[m] + wv * dp / h;
                 }
             }
             smooth[j] = s;
