@@ -121,9 +121,11 @@ class OrbitSummaries(Persistent):
     settings: dict[str, Any] = field(default_factory=dict)
     propagation: dict[str, float] = field(default_factory=dict)
     """Hybrid runs: simulated time (s) by linear arcs (``t_linear``), by the non-linear model
-    (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
-    full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``, and
-    ``n_reread_steps``: exponential steps whose band of θ failed its check and were read again)."""
+    (``t_exponential`` with the exponential integrator — the distributed panel's umbra, its
+    temperatures integrated alone and its modes exactly —, ``t_fallback`` with the
+    hinge-resolved full integration), and the work (``n_arcs``, ``n_exp_steps``,
+    ``n_fallback_steps``, and ``n_reread_steps``: exponential steps whose band of θ failed its
+    check and were read again)."""
     fallback: str | None = None
     """Why a run asked for ``method="hybrid"`` ran the full integration instead (a boom), or
     None."""
