@@ -30,6 +30,7 @@ from test_hybrid_properties import (
 import thermojitter as tj
 from conftest import panels
 from thermojitter import materials as mat
+from thermojitter.longrun import SLOW_GUARDS
 
 SLOW = bool(os.environ.get("THERMOJITTER_SLOW"))
 
@@ -108,6 +109,8 @@ def test_slow_time_holds_the_gate_of_the_full_run(case: Case) -> None:
     assert p["t_slow"] + p["t_fallback"] == pytest.approx(reached, rel=1e-9)
     refused = p["n_refused_orbits"]
     assert (refused > 0) == any(w.category is tj.HybridFallbackWarning for w in said)
+    # Every orbit given back is counted under the guard that gave it back.
+    assert refused == sum(p[key] for key in SLOW_GUARDS)
     m = compared_orbits(full, hybrid, case.n)
     failures = gate_failures(full, hybrid, m)
     assert not failures, (
@@ -131,16 +134,30 @@ def test_table_1_on_a_low_orbit_runs_on_slow_time_within_a_tenth_of_the_gate() -
         assert (abs(b - a) <= 0.5 * 0.02 * abs(a)).all(), (name, a, b)
 
 
-def test_a_panel_with_fast_thermal_rates_is_given_back_to_the_full_integration() -> None:
-    # A third of Table 1's heat capacity: its thermal rates are no longer slow against the
-    # hinge (the slow manifold's premise), so every orbit runs in full, and says so.
-    panel = tj.Panel.paper().replace(specific_heat=300.0)
+@pytest.mark.parametrize(
+    ("specific_heat", "guard", "said"),
+    [
+        # A fifth of Table 1's heat capacity: thermal rates past a tenth of the hinge's angular
+        # frequency, the split's premise.
+        (200.0, "n_refused_separation", "thermal rates not slow against the hinge (2)"),
+        # A third: the rates pass, but the shadow's jump rings the hinge past the closed form's
+        # range.
+        (300.0, "n_refused_ringing", "a ringing past 0.03 rad (2)"),
+    ],
+)
+def test_a_panel_past_a_guard_is_given_back_to_the_full_integration(
+    specific_heat: float, guard: str, said: str
+) -> None:
+    panel = tj.Panel.paper().replace(specific_heat=specific_heat)
     orbit = tj.Orbit.leo(540e3)
     full = tj.simulate_orbits(panel, orbit, 2, method="rk45", progress=False)
-    with pytest.warns(tj.HybridFallbackWarning, match="2 orbit"):
+    with pytest.warns(tj.HybridFallbackWarning, match="2 orbit") as warned:
         hybrid = tj.simulate_orbits(panel, orbit, 2, method="hybrid", progress=False)
-    assert hybrid.propagation["n_refused_orbits"] == 2
-    assert hybrid.propagation["t_slow"] == 0.0
+    p = hybrid.propagation
+    assert p["n_refused_orbits"] == p[guard] == 2
+    fallback = [w for w in warned if w.category is tj.HybridFallbackWarning]
+    assert said in str(fallback[0].message)
+    assert p["t_slow"] == 0.0
     for name, column in full.columns.items():
         assert (hybrid.columns[name] == column).all() or name in ("index",), name
 

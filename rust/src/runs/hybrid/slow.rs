@@ -40,7 +40,7 @@ use crate::numerics::integrate::{
     solve, DenseStep, Method, Observer, OdeSystem, State, Tolerances,
 };
 use crate::numerics::quadrature::GAUSS_5;
-use crate::runs::hybrid::{counted_as_fallback, Propagated};
+use crate::runs::hybrid::{counted_as_fallback, HybridRun, Propagated};
 use crate::runs::orbits::STEPS_PER_HINGE_PERIOD;
 use crate::runs::orbits::{resolve_hinge, Collector, OrbitRunSpec, SummaryObserver, TwoLayerView};
 use nalgebra::{Complex, Matrix4, Vector2, Vector4, U2};
@@ -458,6 +458,22 @@ enum Refusal {
     Ringing,
     Split,
     Limit,
+    /// A summary the orbit's accuracy check could not vouch for.
+    Gate,
+}
+
+impl Refusal {
+    /// Counts an orbit given back for this reason.
+    fn count(self, run: &mut HybridRun) {
+        run.n_refused_orbits += 1;
+        *match self {
+            Refusal::Separation => &mut run.n_refused_separation,
+            Refusal::Ringing => &mut run.n_refused_ringing,
+            Refusal::Split => &mut run.n_refused_split,
+            Refusal::Limit => &mut run.n_refused_limit,
+            Refusal::Gate => &mut run.n_refused_gate,
+        } += 1;
+    }
 }
 
 /// What the slow integration carries from step to step, and reads into the summaries.
@@ -879,7 +895,7 @@ pub(crate) fn run_slow(
             orbit_end,
         ));
         cuts.push(orbit_end);
-        let mut refused = false;
+        let mut refused = None;
         let mut ring_max: f64 = 0.0;
         let (mut slow_steps, mut full_steps, mut slow_time) = (0, 0, 0.0);
         for pair in cuts.windows(2) {
@@ -916,11 +932,15 @@ pub(crate) fn run_slow(
             }
             model.enter(a, b);
             let Some((manifold, mode, z)) = model.split(a, &y, lambda) else {
-                refused = true;
+                refused = Some(Refusal::Split);
                 break;
             };
-            if mode.separation > SEPARATION_LIMIT || z.norm() > RING_LIMIT {
-                refused = true;
+            if mode.separation > SEPARATION_LIMIT {
+                refused = Some(Refusal::Separation);
+                break;
+            }
+            if z.norm() > RING_LIMIT {
+                refused = Some(Refusal::Ringing);
                 break;
             }
             let mut ring = Ringing {
@@ -941,7 +961,7 @@ pub(crate) fn run_slow(
                 return Err(e);
             }
             if ring.refusal.is_some() {
-                refused = true;
+                refused = ring.refusal;
                 break;
             }
             stats.n_rhs += st.n_rhs;
@@ -957,10 +977,10 @@ pub(crate) fn run_slow(
             let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
             y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
         }
-        if !refused && !within_gate(&obs.collector, ring_max) {
-            refused = true;
+        if refused.is_none() && !within_gate(&obs.collector, ring_max) {
+            refused = Some(Refusal::Gate);
         }
-        if refused {
+        if let Some(reason) = refused {
             // This orbit in full, from its start; the next one tries slow time again.
             obs.collector.rewind(mark);
             check_budget(stats.n_steps + stats.n_rejected, orbit_start)?;
@@ -975,7 +995,7 @@ pub(crate) fn run_slow(
             if let Some(e) = obs.error.take() {
                 return Err(e);
             }
-            split.n_refused_orbits += 1;
+            reason.count(&mut split);
             split.n_fallback_steps += st.n_steps;
             stats.n_rejected += st.n_rejected;
             split.t_fallback += st.t_end - orbit_start;
