@@ -538,14 +538,19 @@ impl Driver<'_, '_> {
         let reached = if done.stopped { done.t_end } else { end };
         self.split.t_full += reached - self.t;
         self.split.n_full_steps += done.n_steps;
+        self.add_work(&done);
+        (self.t, self.y) = (reached, y);
+        Ok(())
+    }
+
+    /// Adds the steps and evaluations of a finished integration to the run's.
+    fn add_work(&mut self, done: &Stats) {
         let s = &mut self.stats;
         (s.n_steps, s.n_rejected, s.n_rhs) = (
             s.n_steps + done.n_steps,
             s.n_rejected + done.n_rejected,
             s.n_rhs + done.n_rhs,
         );
-        (self.t, self.y) = (reached, y);
-        Ok(())
     }
 
     /// From t to `end` inside the umbra: the temperatures integrated alone, the modes propagated
@@ -587,12 +592,7 @@ impl Driver<'_, '_> {
         };
         self.split.t_umbra += reached - self.t;
         self.split.n_umbra_steps += done.n_steps;
-        let s = &mut self.stats;
-        (s.n_steps, s.n_rejected, s.n_rhs) = (
-            s.n_steps + done.n_steps,
-            s.n_rejected + done.n_rejected,
-            s.n_rhs + done.n_rhs,
-        );
+        self.add_work(&done);
         (self.t, self.y) = (reached, y);
         Ok(())
     }
