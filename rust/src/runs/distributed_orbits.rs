@@ -33,7 +33,7 @@ use crate::models::distributed::{DistributedPanel, ElementHeat};
 use crate::numerics::integrate::{solve, DenseStep, Method, Observer, Stats};
 use crate::runs::distributed::DistributedSystem;
 use crate::runs::distributed_arc::{structural_pairs, LinearArc};
-use crate::runs::distributed_umbra::{ShadowedThermal, Umbra, UmbraStep};
+use crate::runs::distributed_umbra::{Affine, ShadowedThermal, Umbra, UmbraStep};
 use crate::runs::hybrid::{gate_scale, HybridSettings, DRIFT_ATOL, DRIFT_RTOL};
 use crate::runs::orbits::{Collector, LimitCrossing, OrbitRunSpec, OrbitSummary, SummaryView};
 use nalgebra::{DVector, Dyn as D};
@@ -65,61 +65,6 @@ const SLOPE_SPREAD: f64 = 1e-3;
 /// the third stay apart from the first), and the most doublings of the points where it is read.
 const DRIFT_SAMPLES: usize = 8;
 const DRIFT_DOUBLINGS: f64 = 10.0;
-
-/// An affine functional w·y + c of the state.
-#[derive(Debug, Clone)]
-pub(crate) struct Affine {
-    pub w: DVector<f64>,
-    pub c: f64,
-}
-
-impl Affine {
-    #[inline]
-    pub fn at(&self, y: &[f64]) -> f64 {
-        self.w
-            .as_slice()
-            .iter()
-            .zip(y)
-            .map(|(a, b)| a * b)
-            .sum::<f64>()
-            + self.c
-    }
-
-    /// The functional a·q + b·M of the modal coordinates q and the element moments M, as one of
-    /// the state (the moments are affine in the temperatures).
-    pub(crate) fn of(model: &DistributedPanel, a: &[f64], b: &[f64]) -> Affine {
-        let s = model.layers();
-        let zero = vec![0.0; s];
-        let m0 = model.thermal.moment(&zero);
-        let dm: Vec<f64> = (0..s)
-            .map(|j| {
-                let mut unit = zero.clone();
-                unit[j] = 1.0;
-                model.thermal.moment(&unit) - m0
-            })
-            .collect();
-        let mut w = DVector::zeros(model.state_size());
-        for (e, be) in b.iter().enumerate() {
-            for (j, d) in dm.iter().enumerate() {
-                w[e * s + j] = be * d;
-            }
-        }
-        for (i, ai) in a.iter().enumerate() {
-            w[model.temps() + i] = *ai;
-        }
-        Affine {
-            w,
-            c: m0 * b.iter().sum::<f64>(),
-        }
-    }
-
-    fn minus(&self, other: &Affine) -> Affine {
-        Affine {
-            w: &self.w - &other.w,
-            c: self.c - other.c,
-        }
-    }
-}
 
 /// The state's readers: the tip rise (θ_f = asin(rise/arm)), the rise of the static state with
 /// the same temperatures, and the tip deflection.

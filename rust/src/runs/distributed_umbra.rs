@@ -16,7 +16,6 @@
 use crate::models::distributed::DistributedPanel;
 use crate::numerics::integrate::{DenseStep, OdeSystem, State};
 use crate::runs::distributed_arc::C64;
-use crate::runs::distributed_orbits::Affine;
 use nalgebra::{DVector, Dyn as D};
 
 /// The temperatures alone in the umbra.
@@ -275,6 +274,61 @@ impl UmbraStep {
                 )
             })
             .unzip()
+    }
+}
+
+/// An affine functional w·y + c of the state.
+#[derive(Debug, Clone)]
+pub(crate) struct Affine {
+    pub w: DVector<f64>,
+    pub c: f64,
+}
+
+impl Affine {
+    #[inline]
+    pub fn at(&self, y: &[f64]) -> f64 {
+        self.w
+            .as_slice()
+            .iter()
+            .zip(y)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            + self.c
+    }
+
+    /// The functional a·q + b·M of the modal coordinates q and the element moments M, as one of
+    /// the state (the moments are affine in the temperatures).
+    pub(crate) fn of(model: &DistributedPanel, a: &[f64], b: &[f64]) -> Affine {
+        let s = model.layers();
+        let zero = vec![0.0; s];
+        let m0 = model.thermal.moment(&zero);
+        let dm: Vec<f64> = (0..s)
+            .map(|j| {
+                let mut unit = zero.clone();
+                unit[j] = 1.0;
+                model.thermal.moment(&unit) - m0
+            })
+            .collect();
+        let mut w = DVector::zeros(model.state_size());
+        for (e, be) in b.iter().enumerate() {
+            for (j, d) in dm.iter().enumerate() {
+                w[e * s + j] = be * d;
+            }
+        }
+        for (i, ai) in a.iter().enumerate() {
+            w[model.temps() + i] = *ai;
+        }
+        Affine {
+            w,
+            c: m0 * b.iter().sum::<f64>(),
+        }
+    }
+
+    pub(crate) fn minus(&self, other: &Affine) -> Affine {
+        Affine {
+            w: &self.w - &other.w,
+            c: self.c - other.c,
+        }
     }
 }
 
