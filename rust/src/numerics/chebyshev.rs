@@ -67,9 +67,10 @@ impl EndpointInterpolant {
             refused: [false; PIECES],
         };
         let rounding = TIME_ROUNDINGS * f64::EPSILON * a.abs().max(b.abs());
+        // cos(iπ/n) for i < 2n: the nodes (i ≤ n) and the transform's cos(jmπ/n), jm mod 2n.
+        let turn: [f64; 2 * DEGREE] = std::array::from_fn(|i| (i as f64 * PI / n as f64).cos());
         for k in 0..PIECES {
-            let times: [f64; DEGREE + 1] =
-                std::array::from_fn(|j| time_of(a, b, v_of(k, (j as f64 * PI / n as f64).cos())));
+            let times: [f64; DEGREE + 1] = std::array::from_fn(|j| time_of(a, b, v_of(k, turn[j])));
             let values = times.map(&f);
             let slope = (0..n)
                 .map(|j| ((values[j + 1] - values[j]) / (times[j + 1] - times[j])).abs())
@@ -82,7 +83,7 @@ impl EndpointInterpolant {
                     .enumerate()
                     .map(|(j, fj)| {
                         let w = if j == 0 || j == n { 0.5 } else { 1.0 };
-                        w * fj * ((j * m) as f64 * PI / n as f64).cos()
+                        w * fj * turn[(j * m) % (2 * n)]
                     })
                     .sum();
                 *cm = 2.0 / n as f64 * sum;
@@ -99,7 +100,7 @@ impl EndpointInterpolant {
     }
 
     /// The interpolant at t ∈ [a, b], None in a refused part.
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, t: f64) -> Option<f64> {
         let cos = (1.0 - (t - self.a) * self.scale).clamp(-1.0, 1.0);
         let v = cos.acos() * FRAC_1_PI * PIECES as f64;
