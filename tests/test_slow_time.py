@@ -30,6 +30,7 @@ from test_hybrid_properties import (
 import thermojitter as tj
 from conftest import panels
 from thermojitter import materials as mat
+from thermojitter.longrun import SLOW_GUARDS
 
 SLOW = bool(os.environ.get("THERMOJITTER_SLOW"))
 
@@ -45,9 +46,12 @@ class Case:
 
 @st.composite
 def cases(draw: st.DrawFn) -> Case:
-    kind = draw(st.sampled_from(["paper", "paper", "metal", "cfrp"]))
-    if kind == "paper":
+    kind = draw(st.sampled_from(["paper", "paper", "light", "metal", "cfrp"]))
+    if kind in ("paper", "light"):
         panel = draw(panels(spread=0.2))
+        if kind == "light":
+            # Down to 0.4 of the heat capacity: thermal rates closer to the hinge's frequency.
+            panel = panel.replace(specific_heat=panel.specific_heat * draw(st.floats(0.4, 1.0)))
     else:
         layer = (
             metal_layer(draw)
@@ -75,13 +79,14 @@ def cases(draw: st.DrawFn) -> Case:
             earth_ir=draw(st.floats(200.0, 260.0)) if heated else 0.0,
         )
     model = draw(st.sampled_from(["nonlinear", "linear"]))
-    n = (12 if kind == "paper" else 6) if SLOW else (3 if kind == "paper" else 2)
+    short = kind in ("paper", "light")
+    n = (12 if short else 6) if SLOW else (3 if short else 2)
     fields = {k: v for k, v in panel.as_dict().items() if k != "layup"}
     return Case(panel, orbit, model, n, f"{kind} {fields} on {orbit}, {model}, {n} orbits")
 
 
 # The default tier draws the same cases on every machine (the README's test command must pass
-# anywhere); THERMOJITTER_SLOW=1 draws new ones, where the known defect below can show.
+# anywhere); THERMOJITTER_SLOW=1 draws new ones.
 @settings(
     max_examples=60 if SLOW else 10,
     derandomize=not SLOW,
@@ -104,6 +109,8 @@ def test_slow_time_holds_the_gate_of_the_full_run(case: Case) -> None:
     assert p["t_slow"] + p["t_fallback"] == pytest.approx(reached, rel=1e-9)
     refused = p["n_refused_orbits"]
     assert (refused > 0) == any(w.category is tj.HybridFallbackWarning for w in said)
+    # Every orbit given back is counted under the guard that gave it back.
+    assert refused == sum(p[key] for key in SLOW_GUARDS)
     m = compared_orbits(full, hybrid, case.n)
     failures = gate_failures(full, hybrid, m)
     assert not failures, (
@@ -127,27 +134,37 @@ def test_table_1_on_a_low_orbit_runs_on_slow_time_within_a_tenth_of_the_gate() -
         assert (abs(b - a) <= 0.5 * 0.02 * abs(a)).all(), (name, a, b)
 
 
-def test_a_panel_with_fast_thermal_rates_is_given_back_to_the_full_integration() -> None:
-    # A third of Table 1's heat capacity: its thermal rates are no longer slow against the
-    # hinge (the slow manifold's premise), so every orbit runs in full, and says so.
-    panel = tj.Panel.paper().replace(specific_heat=300.0)
+@pytest.mark.parametrize(
+    ("specific_heat", "guard", "said"),
+    [
+        # A fifth of Table 1's heat capacity: thermal rates past a tenth of the hinge's angular
+        # frequency, the split's premise.
+        (200.0, "n_refused_separation", "thermal rates not slow against the hinge (2)"),
+        # A third: the rates pass, but the shadow's jump rings the hinge past the closed form's
+        # range.
+        (300.0, "n_refused_ringing", "a ringing past 0.03 rad (2)"),
+    ],
+)
+def test_a_panel_past_a_guard_is_given_back_to_the_full_integration(
+    specific_heat: float, guard: str, said: str
+) -> None:
+    panel = tj.Panel.paper().replace(specific_heat=specific_heat)
     orbit = tj.Orbit.leo(540e3)
     full = tj.simulate_orbits(panel, orbit, 2, method="rk45", progress=False)
-    with pytest.warns(tj.HybridFallbackWarning, match="2 orbit"):
+    with pytest.warns(tj.HybridFallbackWarning, match="2 orbit") as warned:
         hybrid = tj.simulate_orbits(panel, orbit, 2, method="hybrid", progress=False)
-    assert hybrid.propagation["n_refused_orbits"] == 2
-    assert hybrid.propagation["t_slow"] == 0.0
+    p = hybrid.propagation
+    assert p["n_refused_orbits"] == p[guard] == 2
+    fallback = [w for w in warned if w.category is tj.HybridFallbackWarning]
+    assert said in str(fallback[0].message)
+    assert p["t_slow"] == 0.0
     for name, column in full.columns.items():
         assert (hybrid.columns[name] == column).all() or name in ("index",), name
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known defect of slow time: a panel whose dynamic part is a small ringing after a "
-    "penumbra (conical shadow) reads its RMS 2.2 % low, 1.09 x the gate, and the orbit's "
-    "accuracy check does not catch it (found by the property test above; cause not found yet)",
-)
-def test_the_known_small_ringing_case_after_a_penumbra_holds_the_gate() -> None:
+def test_a_small_ringing_after_a_penumbra_holds_the_gate() -> None:
+    # Drawn by the property test while slow time's manifold velocity lacked its inertia term
+    # I θ₀'''/K_el: this ringing, small after the penumbra's gradual excitation, read 2.2 % low.
     panel = tj.Panel.paper().replace(
         emissivity_front=0.6951449402057724,
         emissivity_back=0.8100067626027325,
@@ -169,3 +186,20 @@ def test_the_known_small_ringing_case_after_a_penumbra_holds_the_gate() -> None:
     full = tj.simulate_orbits(panel, orbit, 3, method="rk45", **kw)  # type: ignore[arg-type]
     hybrid = tj.simulate_orbits(panel, orbit, 3, method="hybrid", **kw)  # type: ignore[arg-type]
     assert not gate_failures(full, hybrid, 3)
+
+
+@pytest.mark.parametrize("model", ["linear", "nonlinear"])
+def test_half_the_heat_capacity_on_a_conical_low_orbit_holds_the_gate(model: str) -> None:
+    # One step from Table 1: half its heat capacity doubles the thermal rates against the hinge
+    # (still a twentieth of its frequency). Before the manifold's velocity took I θ₀'''/K_el,
+    # slow time read this panel's jitter_rms 2 % low on every orbit and did not give it back.
+    panel = tj.Panel.paper().replace(specific_heat=450.0)
+    orbit = tj.Orbit.leo(540e3, shadow="conical")
+    kw = {"orbits_per_call": 3, "progress": False, "model": model}
+    full = tj.simulate_orbits(panel, orbit, 3, method="rk45", **kw)  # type: ignore[arg-type]
+    hybrid = tj.simulate_orbits(panel, orbit, 3, method="hybrid", **kw)  # type: ignore[arg-type]
+    assert hybrid.propagation["n_refused_orbits"] == 0
+    assert not gate_failures(full, hybrid, 3)
+    for name in ("jitter_rms", "jitter_peak"):
+        a, b = full.columns[name], hybrid.columns[name]
+        assert (abs(b - a) <= 0.1 * 0.02 * abs(a)).all(), (name, a, b)

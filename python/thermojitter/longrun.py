@@ -56,11 +56,33 @@ HYBRID_FALLBACK = (
 orbit, or with the N-node model (short orbits of the two-layer model run on slow time)."""
 
 SLOW_REFUSED = (
-    "{n} orbit(s) of this hybrid run were integrated in full with rk45 (the hybrid's fallback): "
-    "on slow time the ringing grew past {ring} rad, the thermal rates were not slow against the "
-    "hinge, or a summary lay too near 0 for the accuracy its closed form holds"
+    "{n} orbit(s) of this hybrid run were integrated in full with rk45 (the hybrid's fallback), "
+    "given back by slow time's guards: {reasons}"
 )
 """What a hybrid run says when its slow-time guards gave orbits back to the full integration."""
+
+SLOW_GUARDS = {
+    "n_refused_gate": "a summary too near 0 for the accuracy slow time vouches for",
+    "n_refused_separation": "thermal rates not slow against the hinge",
+    "n_refused_ringing": "a ringing past {ring} rad",
+    "n_refused_split": "a split of the state that did not converge",
+    "n_refused_limit": "|theta| near the run's limit",
+}
+"""Each slow-time guard's counter in ``propagation`` and what it says."""
+
+
+def slow_refused(counters: Mapping[str, Any]) -> str:
+    """The warning for a run whose slow-time guards gave orbits back, each guard with its count
+    (a run resumed from an older checkpoint may lack them: then all are named)."""
+    ring = _core.SLOW_RING_LIMIT
+    named = [
+        f"{text.format(ring=ring)} ({counters[key]})"
+        for key, text in SLOW_GUARDS.items()
+        if counters.get(key, 0) > 0
+    ]
+    if not named:
+        named = [text.format(ring=ring) for text in SLOW_GUARDS.values()]
+    return SLOW_REFUSED.format(n=counters["n_refused_orbits"], reasons="; ".join(named))
 
 
 def on_slow_time(period: float) -> bool:
@@ -85,11 +107,14 @@ DISTRIBUTED_ONLY = ("elements", "modes", "support", "damping_ratio")
 
 HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
-    "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits",
+    "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits", "n_refused_separation",
+    "n_refused_ringing", "n_refused_split", "n_refused_limit", "n_refused_gate",
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model, slow time (short orbits and varying loads) and the
-hinge-resolved fallback."""
+hinge-resolved fallback; ``n_refused_orbits`` of slow time's orbits given back to the full
+integration, and by which guard (``n_refused_separation``, ``_ringing``, ``_split``, ``_limit``,
+``_gate``)."""
 
 
 @dataclass
@@ -723,8 +748,7 @@ def simulate_orbits(
                     )
     warn_crossing(crossing, theta_limit, on_limit)
     if counters.get("n_refused_orbits", 0) > 0:
-        said = SLOW_REFUSED.format(n=counters["n_refused_orbits"], ring=_core.SLOW_RING_LIMIT)
-        warnings.warn(said, HybridFallbackWarning, stacklevel=2)
+        warnings.warn(slow_refused(counters), HybridFallbackWarning, stacklevel=2)
     if report:
         kept = f"kept {len(columns['index'])} of {n_orbits} orbits"
         if path is not None:

@@ -188,6 +188,11 @@ fn run_boom_orbits<'py>(
                 "n_reread_steps",
                 "n_slow_steps",
                 "n_refused_orbits",
+                "n_refused_separation",
+                "n_refused_ringing",
+                "n_refused_split",
+                "n_refused_limit",
+                "n_refused_gate",
             ] {
                 d.set_item(name, 0u64)?;
             }

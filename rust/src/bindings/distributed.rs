@@ -321,6 +321,11 @@ fn run_distributed_orbits<'py>(
                 ("n_reread_steps", 0),
                 ("n_slow_steps", 0),
                 ("n_refused_orbits", 0),
+                ("n_refused_separation", 0),
+                ("n_refused_ringing", 0),
+                ("n_refused_split", 0),
+                ("n_refused_limit", 0),
+                ("n_refused_gate", 0),
                 ("n_refused_arcs", split.n_refused),
             ] {
                 d.set_item(name, value)?;

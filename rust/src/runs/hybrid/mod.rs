@@ -112,6 +112,14 @@ pub struct HybridRun {
     pub n_slow_steps: u64,
     /// Orbits the slow-time guards gave back to the full integration.
     pub n_refused_orbits: u64,
+    /// Of those, how many each guard gave back: thermal rates not slow against the hinge, the
+    /// ringing past its limit, a split that did not converge, |θ| past the run's limit, and a
+    /// summary too near 0 for the accuracy the orbit's check vouches for.
+    pub n_refused_separation: u64,
+    pub n_refused_ringing: u64,
+    pub n_refused_split: u64,
+    pub n_refused_limit: u64,
+    pub n_refused_gate: u64,
 }
 
 /// What the state at a sunlit time allows.
@@ -208,6 +216,11 @@ pub(crate) fn counted_as_fallback(
         t_slow: 0.0,
         n_slow_steps: 0,
         n_refused_orbits: 0,
+        n_refused_separation: 0,
+        n_refused_ringing: 0,
+        n_refused_split: 0,
+        n_refused_limit: 0,
+        n_refused_gate: 0,
     }
 }
 
@@ -300,6 +313,11 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             t_slow: 0.0,
             n_slow_steps: 0,
             n_refused_orbits: 0,
+            n_refused_separation: 0,
+            n_refused_ringing: 0,
+            n_refused_split: 0,
+            n_refused_limit: 0,
+            n_refused_gate: 0,
         },
         judge: Judge {
             panel,

@@ -6,9 +6,12 @@
 //!
 //! - ȳ = (T̄, θ̄, θ̄') is the hinge's slow manifold over the temperatures T̄. With θ₀ = M_T(T̄)/K_el
 //!   and its derivatives along the thermal flow T̄' = g(t, T̄, θ̄),
-//!   θ̄ = θ₀ − (c_d θ₀' + I_eff θ₀'' + N)/K_el and θ̄' = θ₀' − (c_d/K_el) θ₀'': the hinge equation
-//!   balanced by the slow motion's own damping, inertia (I_B (1 + 3 sin²θ) for the non-linear
-//!   hinge) and, for the non-linear hinge, its velocity term N = 3 I_B θ₀'² sin θ₀ cos θ₀.
+//!   θ̄ = θ₀ − (c_d θ₀' + I_eff θ₀'' + N)/K_el and its rate along the flow
+//!   θ̄' = θ₀' − (c_d θ₀'' + I_eff θ₀''' + I_eff' θ₀'' + N')/K_el: the hinge equation balanced by
+//!   the slow motion's own damping, inertia (I_B (1 + 3 sin²θ) for the non-linear hinge) and, for
+//!   the non-linear hinge, its velocity term N = 3 I_B θ₀'² sin θ₀ cos θ₀. The inertia's term
+//!   I_eff θ₀''' is ε² of θ₀' (ε the thermal rates over the hinge's angular frequency): as large
+//!   as the ringing a penumbra excites, so a split without it misreads that ringing.
 //! - z is the ringing along the hinge eigenvector v (θ component 1) of the Jacobian at ȳ, λ its
 //!   eigenvalue and w the left eigenvector (wᵀv = 1): z' = (λ − wᵀv' + i Δω(|z|)) z, where Δω is the
 //!   non-linear hinge's frequency shift at amplitude |z| (from its conservative period, exact by
@@ -37,7 +40,7 @@ use crate::numerics::integrate::{
     solve, DenseStep, Method, Observer, OdeSystem, State, Tolerances,
 };
 use crate::numerics::quadrature::GAUSS_5;
-use crate::runs::hybrid::{counted_as_fallback, Propagated};
+use crate::runs::hybrid::{counted_as_fallback, HybridRun, Propagated};
 use crate::runs::orbits::STEPS_PER_HINGE_PERIOD;
 use crate::runs::orbits::{resolve_hinge, Collector, OrbitRunSpec, SummaryObserver, TwoLayerView};
 use nalgebra::{Complex, Matrix4, Vector2, Vector4, U2};
@@ -91,6 +94,22 @@ struct Manifold {
     y: Vector4<f64>,
     /// θ̄ − θ₀: the quasi-static deflection's lag, the slow part of the dynamic part.
     lag: f64,
+}
+
+/// The loads at `t` and at three times around it (one of them t) inside the segment.
+#[derive(Clone, Copy)]
+struct FlowLoads {
+    t: f64,
+    times: [f64; 3],
+    loads: [Loads; 3],
+    /// Which of `times` is t.
+    now: usize,
+}
+
+impl FlowLoads {
+    fn at_t(&self) -> Loads {
+        self.loads[self.now]
+    }
 }
 
 /// The hinge mode at a point of the slow manifold.
@@ -162,33 +181,92 @@ impl SlowModel {
         (self.theta0(&rates), rates)
     }
 
-    /// The slow manifold at (t, T̄).
-    fn manifold(&self, t: f64, temps: &Vector2<f64>) -> Manifold {
-        let th0 = self.theta0(temps);
-        let (th0_rate, rates0) = self.theta0_rate(t, temps);
-        // θ₀'' along the flow, by differences kept inside the segment.
+    /// The loads at t and at the two times next to it that the flow's derivatives read.
+    fn flow_loads(&self, t: f64) -> FlowLoads {
         let (a, b) = self.segment;
-        let (mut lo, mut hi) = ((t - FLOW_STEP).max(a), (t + FLOW_STEP).min(b));
-        if hi - lo < 1e-3 * FLOW_STEP {
-            (lo, hi) = (t, t + FLOW_STEP);
-        }
-        let at = |s: f64| self.theta0_rate(s, &(temps + rates0 * (s - t))).0;
-        let th0_accel = (at(hi) - at(lo)) / (hi - lo);
-        let (sin, cos) = th0.sin_cos();
-        let (inertia, velocity) = match self.model {
-            HingeModel::Linear => (self.inertia, 0.0),
-            HingeModel::Nonlinear => (
-                self.inertia * self.model.inertia_factor(sin),
-                3.0 * self.inertia * th0_rate * th0_rate * sin * cos,
-            ),
+        let h = FLOW_STEP;
+        let (times, now) = if t - h >= a && t + h <= b {
+            ([t - h, t, t + h], 1)
+        } else if t + 2.0 * h <= b || t - 2.0 * h < a {
+            ([t, t + h, t + 2.0 * h], 0)
+        } else {
+            ([t - 2.0 * h, t - h, t], 2)
         };
-        let lag = -(self.damping * th0_rate + inertia * th0_accel + velocity) / self.stiffness;
-        let theta = th0 + lag;
-        let theta_rate = th0_rate - self.damping / self.stiffness * th0_accel;
+        FlowLoads {
+            t,
+            times,
+            loads: times.map(|s| self.loads(s)),
+            now,
+        }
+    }
+
+    /// The slow manifold at (t, T̄), `flow` the loads around t.
+    fn manifold(&self, flow: &FlowLoads, temps: &Vector2<f64>) -> Manifold {
+        let th0 = self.theta0(temps);
+        let rates0 = self.thermal(flow.at_t(), temps, th0);
+        let th0_rate = self.theta0(&rates0);
+        let [accel, jerk] = self.flow_derivatives(flow, temps, th0_rate, &rates0);
+        let (sin, cos) = th0.sin_cos();
+        let (inertia, velocity, moving) = match self.model {
+            HingeModel::Linear => (self.inertia, 0.0, 0.0),
+            HingeModel::Nonlinear => {
+                // d/dt of I_eff θ₀'' + N beyond I_eff θ₀''': the inertia's and the velocity
+                // term's own change along the flow.
+                let (sc, cos2) = (sin * cos, cos * cos - sin * sin);
+                let moving = self.inertia
+                    * (6.0 * sc * th0_rate * accel
+                        + 3.0 * (2.0 * th0_rate * accel * sc + th0_rate.powi(3) * cos2));
+                (
+                    self.inertia * self.model.inertia_factor(sin),
+                    3.0 * self.inertia * th0_rate * th0_rate * sc,
+                    moving,
+                )
+            }
+        };
+        let lag = -(self.damping * th0_rate + inertia * accel + velocity) / self.stiffness;
+        // θ̄' = θ₀' + lag'. Its inertia term I θ₀'''/K_el is ε² of θ₀' (ε the thermal rates over
+        // the hinge's angular frequency): without it a split leaves that much in the ringing.
+        let theta_rate =
+            th0_rate - (self.damping * accel + inertia * jerk + moving) / self.stiffness;
         Manifold {
-            y: Vector4::new(temps[0], temps[1], theta, theta_rate),
+            y: Vector4::new(temps[0], temps[1], th0 + lag, theta_rate),
             lag,
         }
+    }
+
+    /// θ₀'' and θ₀''' along the thermal flow at t, by differences over three times
+    /// [`FLOW_STEP`] apart inside the segment: θ₀' along T + T' s (its slope is θ₀''), then along
+    /// T + T' s + T'' s²/2, T'' from the first pass (its curvature is θ₀''').
+    fn flow_derivatives(
+        &self,
+        flow: &FlowLoads,
+        temps: &Vector2<f64>,
+        th0_rate: f64,
+        rates0: &Vector2<f64>,
+    ) -> [f64; 2] {
+        let (t, times) = (flow.t, flow.times);
+        // θ₀' and T' at the three times, the temperatures along `curve` (of s = time − t).
+        let along = |curve: &dyn Fn(f64) -> Vector2<f64>| {
+            let mut values = [th0_rate; 3];
+            let mut rates = [*rates0; 3];
+            for k in 0..3 {
+                if k != flow.now {
+                    let at = temps + curve(times[k] - t);
+                    rates[k] = self.thermal(flow.loads[k], &at, self.theta0(&at));
+                    values[k] = self.theta0(&rates[k]);
+                }
+            }
+            (values, rates)
+        };
+        let (first, rates) = along(&|s| rates0 * s);
+        let accel = parabola_at(&times, &first, t).0;
+        let (d01, d12) = (
+            (rates[1] - rates[0]) / (times[1] - times[0]),
+            (rates[2] - rates[1]) / (times[2] - times[1]),
+        );
+        let t_accel = d01 + (d12 - d01) * ((2.0 * t - times[0] - times[1]) / (times[2] - times[0]));
+        let (second, _) = along(&|s| rates0 * s + t_accel * (0.5 * s * s));
+        [accel, parabola_at(&times, &second, t).1]
     }
 
     /// The Jacobian of the full model at (t, y), by central differences.
@@ -213,8 +291,8 @@ impl SlowModel {
 
     /// The hinge mode of the Jacobian at (t, y), its eigenvalue found by Newton's method on the
     /// characteristic polynomial from `guess`.
-    fn mode(&self, t: f64, y: &Vector4<f64>, guess: Complex<f64>) -> Option<Mode> {
-        let j = self.jacobian(self.loads(t), y);
+    fn mode(&self, loads: Loads, y: &Vector4<f64>, guess: Complex<f64>) -> Option<Mode> {
+        let j = self.jacobian(loads, y);
         let lambda = hinge_eigenvalue(&j, guess)?;
         let c = |r: usize, k: usize| Complex::new(j[(r, k)], 0.0);
         // v = (v0, v1, 1, λ): the two thermal rows.
@@ -282,9 +360,10 @@ impl SlowModel {
     ) -> Option<(Manifold, Mode, Complex<f64>)> {
         let mut temps = Vector2::new(y[0], y[1]);
         let mut lambda = guess;
+        let flow = self.flow_loads(t);
         for _ in 0..20 {
-            let m = self.manifold(t, &temps);
-            let mode = self.mode(t, &m.y, lambda)?;
+            let m = self.manifold(&flow, &temps);
+            let mode = self.mode(flow.at_t(), &m.y, lambda)?;
             lambda = mode.lambda;
             let d = y - m.y;
             let z: Complex<f64> = 2.0 * (0..4).map(|k| mode.w[k] * d[k]).sum::<Complex<f64>>();
@@ -292,8 +371,8 @@ impl SlowModel {
             let moved = (next - temps).abs().max();
             temps = next;
             if moved <= 1e-12 * temps.abs().max() {
-                let m = self.manifold(t, &temps);
-                let mode = self.mode(t, &m.y, lambda)?;
+                let m = self.manifold(&flow, &temps);
+                let mode = self.mode(flow.at_t(), &m.y, lambda)?;
                 let d = y - m.y;
                 let z = 2.0 * (0..4).map(|k| mode.w[k] * d[k]).sum::<Complex<f64>>();
                 return Some((m, mode, z));
@@ -301,6 +380,14 @@ impl SlowModel {
         }
         None
     }
+}
+
+/// The slope and curvature at t of the parabola through (xs, fs).
+fn parabola_at(xs: &[f64; 3], fs: &[f64; 3], t: f64) -> (f64, f64) {
+    let d01 = (fs[1] - fs[0]) / (xs[1] - xs[0]);
+    let d12 = (fs[2] - fs[1]) / (xs[2] - xs[1]);
+    let second = (d12 - d01) / (xs[2] - xs[0]);
+    (d01 + second * (2.0 * t - xs[0] - xs[1]), 2.0 * second)
 }
 
 /// The slow integration's state is the mean temperature and T_f − T_b, each over its absolute
@@ -371,6 +458,22 @@ enum Refusal {
     Ringing,
     Split,
     Limit,
+    /// A summary the orbit's accuracy check could not vouch for.
+    Gate,
+}
+
+impl Refusal {
+    /// Counts an orbit given back for this reason.
+    fn count(self, run: &mut HybridRun) {
+        run.n_refused_orbits += 1;
+        *match self {
+            Refusal::Separation => &mut run.n_refused_separation,
+            Refusal::Ringing => &mut run.n_refused_ringing,
+            Refusal::Split => &mut run.n_refused_split,
+            Refusal::Limit => &mut run.n_refused_limit,
+            Refusal::Gate => &mut run.n_refused_gate,
+        } += 1;
+    }
 }
 
 /// What the slow integration carries from step to step, and reads into the summaries.
@@ -436,8 +539,11 @@ impl Ringing<'_, '_> {
         let mut guess = self.mode.lambda;
         for k in 1..3 {
             let temps = m.temps(&if k == 2 { step.y1 } else { step.eval(ts[k]) });
-            points[k] = m.manifold(ts[k], &temps);
-            modes[k] = m.mode(ts[k], &points[k].y, guess).ok_or(Refusal::Split)?;
+            let flow = m.flow_loads(ts[k]);
+            points[k] = m.manifold(&flow, &temps);
+            modes[k] = m
+                .mode(flow.at_t(), &points[k].y, guess)
+                .ok_or(Refusal::Split)?;
             guess = modes[k].lambda;
         }
         if modes.iter().any(|md| md.separation > SEPARATION_LIMIT) {
@@ -533,12 +639,19 @@ impl Ringing<'_, '_> {
         if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
             return Err(Refusal::Ringing);
         }
-        let extremes = |a: f64, b: f64| (theta.smallest(a, b), theta.largest(a, b));
-        let (lo, hi) = extremes(t0, t1);
+        let (lo, hi) = (theta.smallest(t0, t1), theta.largest(t0, t1));
         let limit = self.obs.collector.options.theta_limit;
         if hi > limit || lo < -limit {
             return Err(Refusal::Limit);
         }
+        // The whole step's extremes are those just read; a window's part of it is read anew.
+        let extremes = |a: f64, b: f64| {
+            if (a, b) == (t0, t1) {
+                (lo, hi)
+            } else {
+                (theta.smallest(a, b), theta.largest(a, b))
+            }
+        };
         if let Err(e) = self
             .obs
             .collector
@@ -782,7 +895,7 @@ pub(crate) fn run_slow(
             orbit_end,
         ));
         cuts.push(orbit_end);
-        let mut refused = false;
+        let mut refused = None;
         let mut ring_max: f64 = 0.0;
         let (mut slow_steps, mut full_steps, mut slow_time) = (0, 0, 0.0);
         for pair in cuts.windows(2) {
@@ -819,11 +932,15 @@ pub(crate) fn run_slow(
             }
             model.enter(a, b);
             let Some((manifold, mode, z)) = model.split(a, &y, lambda) else {
-                refused = true;
+                refused = Some(Refusal::Split);
                 break;
             };
-            if mode.separation > SEPARATION_LIMIT || z.norm() > RING_LIMIT {
-                refused = true;
+            if mode.separation > SEPARATION_LIMIT {
+                refused = Some(Refusal::Separation);
+                break;
+            }
+            if z.norm() > RING_LIMIT {
+                refused = Some(Refusal::Ringing);
                 break;
             }
             let mut ring = Ringing {
@@ -844,7 +961,7 @@ pub(crate) fn run_slow(
                 return Err(e);
             }
             if ring.refusal.is_some() {
-                refused = true;
+                refused = ring.refusal;
                 break;
             }
             stats.n_rhs += st.n_rhs;
@@ -860,10 +977,10 @@ pub(crate) fn run_slow(
             let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
             y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
         }
-        if !refused && !within_gate(&obs.collector, ring_max) {
-            refused = true;
+        if refused.is_none() && !within_gate(&obs.collector, ring_max) {
+            refused = Some(Refusal::Gate);
         }
-        if refused {
+        if let Some(reason) = refused {
             // This orbit in full, from its start; the next one tries slow time again.
             obs.collector.rewind(mark);
             check_budget(stats.n_steps + stats.n_rejected, orbit_start)?;
@@ -878,7 +995,7 @@ pub(crate) fn run_slow(
             if let Some(e) = obs.error.take() {
                 return Err(e);
             }
-            split.n_refused_orbits += 1;
+            reason.count(&mut split);
             split.n_fallback_steps += st.n_steps;
             stats.n_rejected += st.n_rejected;
             split.t_fallback += st.t_end - orbit_start;
@@ -1027,10 +1144,10 @@ mod tests {
         let mut model = SlowModel::new(&s);
         model.enter(0.0, 100.0);
         let y = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
-        let m = model.manifold(0.0, &Vector2::new(y[0], y[1]));
+        let m = model.manifold(&model.flow_loads(0.0), &Vector2::new(y[0], y[1]));
         let mode = model
             .mode(
-                0.0,
+                model.loads(0.0),
                 &m.y,
                 Complex::new(0.0, panel.natural_angular_frequency()),
             )
@@ -1067,6 +1184,59 @@ mod tests {
         let back = m.y + Vector4::from_fn(|i, _| (z * mode.v[i]).re);
         assert!((back - y).abs().max() < 1e-9, "{back} vs {y}");
         assert!(z.norm() > 1e-3);
+    }
+
+    #[test]
+    fn the_manifold_velocity_is_the_rate_of_its_angle_along_the_flow() {
+        // Just inside the umbra the temperatures fall fastest: θ̄' must be dθ̄/dt along the
+        // thermal flow, read here by central differences of θ̄ over a trajectory integrated by
+        // RK4 at a small step. Without the inertia's term I θ₀'''/K_el (ε² of θ₀') it is not.
+        for hinge in [HingeModel::Linear, HingeModel::Nonlinear] {
+            let panel = Panel {
+                specific_heat: 450.0,
+                ..Panel::paper()
+            };
+            let orbit = Orbit::leo(540e3);
+            let mut model = SlowModel::new(&spec(panel, orbit, hinge, 1));
+            model.enter(1900.0, 3000.0);
+            let y = start_state(&panel, &orbit, Coupling::ProjectedArea, 0.0).unwrap();
+            let flow = |t: f64, temps: &Vector2<f64>| model.theta0_rate(t, temps).1;
+            let dt = 1e-3;
+            let (mut t, mut temps) = (1900.0, Vector2::new(y[0], y[1]));
+            let mut points = Vec::new();
+            for n in 0..60_005 {
+                if n >= 60_000 {
+                    points.push((t, temps));
+                }
+                let k1 = flow(t, &temps);
+                let k2 = flow(t + 0.5 * dt, &(temps + k1 * (0.5 * dt)));
+                let k3 = flow(t + 0.5 * dt, &(temps + k2 * (0.5 * dt)));
+                let k4 = flow(t + dt, &(temps + k3 * dt));
+                temps += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
+                t = 1900.0 + (n + 1) as f64 * dt;
+            }
+            let angle = |k: usize| {
+                model
+                    .manifold(&model.flow_loads(points[k].0), &points[k].1)
+                    .y[2]
+            };
+            // The fourth-order central difference at the middle point (t = 1960.002).
+            let d = (angle(0) - 8.0 * angle(1) + 8.0 * angle(3) - angle(4)) / (12.0 * dt);
+            let (t_mid, temps_mid) = points[2];
+            let m = model.manifold(&model.flow_loads(t_mid), &temps_mid);
+            let rate = model.theta0_rate(t_mid, &temps_mid).0;
+            // θ₀' − θ̄': the lag's rate, mostly the inertia's term.
+            let lag_rate = (rate - m.y[3]).abs();
+            assert!(
+                lag_rate > 1e-3 * rate.abs(),
+                "{hinge:?}: {lag_rate} vs {rate}"
+            );
+            assert!(
+                (m.y[3] - d).abs() < 0.05 * lag_rate,
+                "{hinge:?}: θ̄' {} vs dθ̄/dt {d} (the lag's rate {lag_rate})",
+                m.y[3]
+            );
+        }
     }
 
     #[test]
