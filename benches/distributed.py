@@ -101,9 +101,10 @@ def long_run(
 def split(run: tj.OrbitSummaries) -> str:
     p = run.propagation
     return (
-        f"linear arcs {p['t_linear'] / 86400:.2f} d in {p['n_arcs']} arcs, full integration "
-        f"{p['t_fallback'] / 3600:.2f} h ({run.nonlinear_fraction:.2%}; {p['n_fallback_steps']} "
-        f"steps), arcs refused by their checks {p['n_refused_arcs']}"
+        f"linear arcs {p['t_linear'] / 86400:.2f} d in {p['n_arcs']} arcs, umbra (temperatures "
+        f"alone, modes exact) {p['t_exponential'] / 3600:.2f} h in {p['n_exp_steps']} steps, "
+        f"full integration {p['t_fallback'] / 3600:.2f} h ({p['n_fallback_steps']} steps), "
+        f"arcs refused by their checks {p['n_refused_arcs']}"
     )
 
 

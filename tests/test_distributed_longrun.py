@@ -75,7 +75,12 @@ def test_linear_arcs_match_the_full_integration(
         within_gate(name, full.columns[name], fast.columns[name])
     p = fast.propagation
     assert p["t_linear"] > 0.5 * n_orbits * o.period, p
-    assert p["t_linear"] + p["t_fallback"] == pytest.approx(n_orbits * o.period)
+    total = p["t_linear"] + p["t_exponential"] + p["t_fallback"]
+    assert total == pytest.approx(n_orbits * o.period)
+    # The umbra: its temperatures integrated alone, the modes exactly (none between the seasons).
+    umbra = np.nansum(full.t_exit - full.t_entry)
+    assert (p["t_exponential"] > 0.0) == (umbra > 0.0), p
+    assert p["t_exponential"] <= umbra + 1e-6 * o.period
     assert fast.n_steps < full.n_steps
     assert np.allclose(fast.y_end[: elements * 2], full.y_end[: elements * 2], rtol=1e-4)
 

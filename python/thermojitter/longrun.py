@@ -146,9 +146,11 @@ class OrbitSummaries(Persistent):
     settings: dict[str, Any] = field(default_factory=dict)
     propagation: dict[str, float] = field(default_factory=dict)
     """Hybrid runs: simulated time (s) by linear arcs (``t_linear``), by the non-linear model
-    (``t_exponential`` with the exponential integrator, ``t_fallback`` with the hinge-resolved
-    full integration), and the work (``n_arcs``, ``n_exp_steps``, ``n_fallback_steps``, and
-    ``n_reread_steps``: exponential steps whose band of θ failed its check and were read again)."""
+    (``t_exponential`` with the exponential integrator — the distributed panel's umbra, its
+    temperatures integrated alone and its modes exactly —, ``t_fallback`` with the
+    hinge-resolved full integration), and the work (``n_arcs``, ``n_exp_steps``,
+    ``n_fallback_steps``, and ``n_reread_steps``: exponential steps whose band of θ failed its
+    check and were read again)."""
     fallback: str | None = None
     """Why a run asked for ``method="hybrid"`` ran the full integration instead (a boom), or
     None."""
@@ -503,13 +505,16 @@ def simulate_orbits(
     T₁/``steps_per_period``, T₁ the first kept mode's period; every step read at eight points);
     ``"hybrid"`` (default) propagates the sunlit arcs near the equilibrium exactly in the
     linearised system's modal form (the structural pairs in closed form, the thermal part by the
-    matrix exponential) and integrates the shadow crossings and their recovery in full with rk45.
-    An arc is taken only where its checks hold (the non-linear remainder at its start below
-    ``hybrid.linear_tolerance`` as a static θ_f error, the oscillation below
-    ``hybrid.linear_amplitude``, the drift of the dropped non-linear terms within half the
-    accuracy gate, the reads' interpolation error); elsewhere the run goes on in full. The
-    split is in ``result.propagation`` (``t_linear``, ``t_fallback`` the full integration,
-    ``n_arcs``, ``n_refused_arcs``).
+    matrix exponential); in the umbra, where the elements' heat balances do not depend on the
+    structure, it integrates the temperatures alone with rk45 (steps of the thermal time scales)
+    and propagates the modes exactly over each step; the penumbra and the recovery after the
+    exit are integrated in full with rk45. An arc is taken only where its checks hold (the
+    non-linear remainder at its start below ``hybrid.linear_tolerance`` as a static θ_f error,
+    the oscillation below ``hybrid.linear_amplitude``, the drift of the dropped non-linear terms
+    within half the accuracy gate, the reads' interpolation error); elsewhere the run goes on in
+    full. The split is in ``result.propagation`` (``t_linear``, ``t_exponential`` the umbra and
+    ``n_exp_steps`` its steps, ``t_fallback`` the full integration, ``n_arcs``,
+    ``n_refused_arcs``).
     """
     given = {
         "elements": elements,

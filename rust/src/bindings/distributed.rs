@@ -305,10 +305,12 @@ fn run_distributed_orbits<'py>(
         d.set_item("tip_max", PyArray1::from_vec(py, out.tip_max))?;
         d.set_item("tip_min", PyArray1::from_vec(py, out.tip_min))?;
         if let Some(split) = out.split {
-            // Named as the hybrid runs' counters: its full integration is their fallback.
+            // Named as the hybrid runs' counters: its full integration is their fallback, the
+            // umbra (the temperatures integrated alone, the modes exactly) their exponential
+            // steps.
             for (name, value) in [
                 ("t_linear", split.t_linear),
-                ("t_exponential", 0.0),
+                ("t_exponential", split.t_umbra),
                 ("t_slow", 0.0),
                 ("t_fallback", split.t_full),
             ] {
@@ -316,7 +318,7 @@ fn run_distributed_orbits<'py>(
             }
             for (name, value) in [
                 ("n_arcs", split.n_arcs),
-                ("n_exp_steps", 0),
+                ("n_exp_steps", split.n_umbra_steps),
                 ("n_fallback_steps", split.n_full_steps),
                 ("n_reread_steps", 0),
                 ("n_slow_steps", 0),

@@ -76,6 +76,14 @@ pub trait ThermalModel {
         self.moment_per_kelvin() * self.gradient(temps)
     }
 
+    /// The thermal moment of each of a row of plates (`temps` holds their temperatures one plate
+    /// after another), into `out`: one call for a whole panel of elements.
+    fn moments_of(&self, temps: &[f64], out: &mut [f64]) {
+        for (t, m) in temps.chunks_exact(self.size()).zip(out) {
+            *m = self.moment(t);
+        }
+    }
+
     /// A starting point for the steady state under `flux`: every temperature at the isothermal
     /// plate's equilibrium.
     fn initial_guess(&self, flux: f64, out: &mut [f64]);
@@ -133,6 +141,9 @@ impl<M: ThermalModel + ?Sized> ThermalModel for Box<M> {
     }
     fn gradient(&self, temps: &[f64]) -> f64 {
         (**self).gradient(temps)
+    }
+    fn moments_of(&self, temps: &[f64], out: &mut [f64]) {
+        (**self).moments_of(temps, out)
     }
     fn moment_per_kelvin(&self) -> f64 {
         (**self).moment_per_kelvin()

@@ -14,8 +14,10 @@
 //!   cap theirs at the hinge's).
 //! - **Linear arcs** (with hybrid settings): on sunlit arcs near the equilibrium, past the last
 //!   shadow exit by the summary window, the linearised system is propagated exactly
-//!   ([`crate::runs::distributed_arc`]) and the summaries read off it; the shadow crossings and
-//!   their thermal recovery are integrated in full. An arc is taken only where its own checks
+//!   ([`crate::runs::distributed_arc`]) and the summaries read off it; in the umbra the
+//!   temperatures are integrated alone and the modes propagated exactly
+//!   ([`crate::runs::distributed_umbra`]); the penumbra and the thermal recovery after the exit
+//!   are integrated in full. An arc is taken only where its own checks
 //!   hold: the non-linear remainder at its start as a static θ_f error below
 //!   `linear_tolerance`, the oscillation below `linear_amplitude`, the structural pairs and
 //!   their eigenvectors found to rounding, the reads' interpolation error within their
@@ -31,6 +33,7 @@ use crate::models::distributed::{DistributedPanel, ElementHeat};
 use crate::numerics::integrate::{solve, DenseStep, Method, Observer, Stats};
 use crate::runs::distributed::DistributedSystem;
 use crate::runs::distributed_arc::{structural_pairs, LinearArc};
+use crate::runs::distributed_umbra::{ShadowedThermal, Umbra, UmbraStep};
 use crate::runs::hybrid::{gate_scale, HybridSettings, DRIFT_ATOL, DRIFT_RTOL};
 use crate::runs::orbits::{Collector, LimitCrossing, OrbitRunSpec, OrbitSummary, SummaryView};
 use nalgebra::{DVector, Dyn as D};
@@ -47,6 +50,12 @@ const CHECK_EVERY: f64 = 60.0;
 /// envelopes and the thermal part's range): a fiftieth of the 2 % gate on the smallest column
 /// they feed (the amplitude, the jitter peak).
 const READ_RTOL: f64 = 4e-4;
+
+/// The reads' absolute floor: READ_RTOL of the gate's absolute 1e-6 rad as a rise (m) at the
+/// arm `arm`.
+fn read_floor(arm: f64) -> f64 {
+    READ_RTOL * 1e-6 * arm
+}
 
 /// Largest spread of asin's slope over an arc, relative: the jitter (a difference of two θ_f)
 /// is read as the difference of the tip rises times that slope.
@@ -78,7 +87,7 @@ impl Affine {
 
     /// The functional a·q + b·M of the modal coordinates q and the element moments M, as one of
     /// the state (the moments are affine in the temperatures).
-    fn of(model: &DistributedPanel, a: &[f64], b: &[f64]) -> Affine {
+    pub(crate) fn of(model: &DistributedPanel, a: &[f64], b: &[f64]) -> Affine {
         let s = model.layers();
         let zero = vec![0.0; s];
         let m0 = model.thermal.moment(&zero);
@@ -148,6 +157,27 @@ impl Readers {
         }
     }
 
+    /// The tip rise, the static state's rise and the tip deflection of the state `y`, in one
+    /// pass (each sum in the order and from the -0.0 of [`Affine::at`]'s: the same bits).
+    pub fn values(&self, y: &[f64]) -> (f64, f64, f64) {
+        let (mut rise, mut rise_static, mut tip) = (-0.0, -0.0, -0.0);
+        let (a, b, c) = (
+            self.rise.w.as_slice(),
+            self.rise_static.w.as_slice(),
+            self.tip.w.as_slice(),
+        );
+        for (i, v) in y.iter().enumerate().take(a.len()) {
+            rise += a[i] * v;
+            rise_static += b[i] * v;
+            tip += c[i] * v;
+        }
+        (
+            rise + self.rise.c,
+            rise_static + self.rise_static.c,
+            tip + self.tip.c,
+        )
+    }
+
     /// asin(rise/arm), the rise clamped to the arm (runs refuse a rise beyond it first).
     #[inline]
     pub fn angle(&self, rise: f64) -> f64 {
@@ -197,6 +227,10 @@ pub struct DistributedSplit {
     pub n_full_steps: u64,
     /// Attempts at an arc refused by its checks (the run went on in full).
     pub n_refused: u64,
+    /// Simulated time through the umbra (the temperatures integrated alone, the modes exact),
+    /// s, and the steps of that integration.
+    pub t_umbra: f64,
+    pub n_umbra_steps: u64,
 }
 
 /// A summarised run of the distributed panel over whole orbits.
@@ -238,7 +272,20 @@ impl Reads<'_> {
 
     /// One point (t, y) of the solution standing for the interval dt before it.
     fn read(&mut self, t: f64, y: &[f64], dt: f64) -> Result<()> {
-        let rise = self.readers.rise.at(y);
+        let (rise, rise_static, tip) = self.readers.values(y);
+        self.read_values(t, rise, rise_static, tip, dt)
+    }
+
+    /// One point at t, given by its tip rise, its static state's rise and its tip deflection,
+    /// standing for the interval dt before it.
+    fn read_values(
+        &mut self,
+        t: f64,
+        rise: f64,
+        rise_static: f64,
+        tip: f64,
+        dt: f64,
+    ) -> Result<()> {
         if rise.is_nan() || rise.abs() > self.readers.arm {
             return Err(Error::Integration {
                 t,
@@ -248,8 +295,10 @@ impl Reads<'_> {
                 ),
             });
         }
-        self.collector.read(t, y, dt)?;
-        let tip = self.readers.tip.at(y);
+        let (theta, quasi_static) = (self.readers.angle(rise), self.readers.angle(rise_static));
+        let dynamic = theta - quasi_static;
+        self.collector
+            .record(t, theta, theta, dynamic.abs(), dynamic * dynamic * dt, dt)?;
         self.tip(tip, tip);
         Ok(())
     }
@@ -330,6 +379,12 @@ pub fn run_distributed_orbits(
     let tip0 = readers.tip.at(y0);
     let mut tips = vec![(f64::INFINITY, f64::NEG_INFINITY); spec.n_orbits as usize];
     tips[0] = (tip0, tip0);
+    let umbra = Umbra::new(
+        model,
+        [&readers.rise, &readers.rise_static, &readers.tip],
+        READ_RTOL,
+        read_floor(readers.arm),
+    );
     let mut reads = Reads {
         collector: Collector::new(view, spec, theta0)?,
         readers,
@@ -343,6 +398,8 @@ pub fn run_distributed_orbits(
         model,
         orbit: spec.orbit,
         method,
+        shadow_method: spec.method,
+        umbra,
         system: DistributedSystem::new(model.clone(), spec.orbit),
         reads: &mut reads,
         t_end: spec.t_end(),
@@ -421,6 +478,10 @@ struct Driver<'a, 'c> {
     model: &'a DistributedPanel,
     orbit: Orbit,
     method: Method,
+    /// The method of the temperatures alone in the umbra: the run's, its step not capped by the
+    /// modes (they are propagated exactly).
+    shadow_method: Method,
+    umbra: Umbra,
     system: DistributedSystem,
     reads: &'a mut Reads<'c>,
     t_end: f64,
@@ -477,12 +538,61 @@ impl Driver<'_, '_> {
         let reached = if done.stopped { done.t_end } else { end };
         self.split.t_full += reached - self.t;
         self.split.n_full_steps += done.n_steps;
+        self.add_work(&done);
+        (self.t, self.y) = (reached, y);
+        Ok(())
+    }
+
+    /// Adds the steps and evaluations of a finished integration to the run's.
+    fn add_work(&mut self, done: &Stats) {
         let s = &mut self.stats;
         (s.n_steps, s.n_rejected, s.n_rhs) = (
             s.n_steps + done.n_steps,
             s.n_rejected + done.n_rejected,
             s.n_rhs + done.n_rhs,
         );
+    }
+
+    /// From t to `end` inside the umbra: the temperatures integrated alone, the modes propagated
+    /// exactly over each of their steps, and the reads evenly spaced in each step at the spacing
+    /// [`UmbraStep::spacing`] allows (or to where they stopped the run).
+    fn through_umbra(&mut self, end: f64) -> Result<()> {
+        let (nt, k) = (self.model.temps(), self.model.k());
+        let y = self.y.as_slice();
+        let mut observer = UmbraReads {
+            umbra: &self.umbra,
+            reads: &mut *self.reads,
+            q: y[nt..nt + k].to_vec(),
+            v: y[nt + k..].to_vec(),
+            stop: None,
+            error: None,
+        };
+        let mut system = ShadowedThermal { model: self.model };
+        let temps = DVector::from_column_slice(&y[..nt]);
+        let outcome = solve(
+            &mut system,
+            &self.shadow_method,
+            self.t,
+            temps,
+            end,
+            &mut observer,
+        );
+        let (done, temps) = match (outcome, observer.error.take()) {
+            (_, Some(e)) | (Err(e), None) => return Err(e),
+            (Ok(run), None) => run,
+        };
+        let (reached, y) = match observer.stop.take() {
+            Some(stop) => stop,
+            None => {
+                let mut y = temps.as_slice().to_vec();
+                y.extend_from_slice(&observer.q);
+                y.extend_from_slice(&observer.v);
+                (end, DVector::from_vec(y))
+            }
+        };
+        self.split.t_umbra += reached - self.t;
+        self.split.n_umbra_steps += done.n_steps;
+        self.add_work(&done);
         (self.t, self.y) = (reached, y);
         Ok(())
     }
@@ -520,7 +630,18 @@ impl Driver<'_, '_> {
                 .map(|e| e.outer.1 + window)
                 .fold(f64::NEG_INFINITY, f64::max);
             let next = if let Some(e) = shadow {
-                e.outer.1 + window
+                match e.umbra {
+                    // The umbra, the temperatures alone: first the penumbra before it in full.
+                    Some((u0, u1)) if t < u1 && matches!(self.shadow_method, Method::Dopri5(_)) => {
+                        if t < u0 {
+                            u0
+                        } else {
+                            self.through_umbra(u1.min(self.t_end))?;
+                            continue;
+                        }
+                    }
+                    _ => e.outer.1 + window,
+                }
             } else if t < release {
                 release
             } else {
@@ -560,8 +681,7 @@ impl Driver<'_, '_> {
         let rise_static = arc.signal(&r.rise_static.w, r.rise_static.c);
         let tip = arc.signal(&r.tip.w, r.tip.c);
         let length = end - t0;
-        // With a floor of READ_RTOL of the gate's absolute 1e-6 rad as a rise (m) at the arm.
-        let floor = READ_RTOL * 1e-6 * r.arm;
+        let floor = read_floor(r.arm);
         let tol = |s: &crate::runs::distributed_arc::ArcSignal| READ_RTOL * s.variation() + floor;
         let signals = [&rise, &dynamic, &rise_static, &tip];
         if signals.iter().any(|s| s.max_interpolation_error() > tol(s)) {
@@ -794,5 +914,65 @@ impl Driver<'_, '_> {
             at_end,
             if slowest.is_finite() { slowest } else { 0.0 },
         )
+    }
+}
+
+/// The reads of a span through the umbra: evenly spaced in each step of the temperatures (the
+/// last at its end), the modes carried from step to step.
+struct UmbraReads<'r, 'c> {
+    umbra: &'r Umbra,
+    reads: &'r mut Reads<'c>,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    /// Where the reads stopped the run (the limit), and the state there.
+    stop: Option<(f64, DVector<f64>)>,
+    error: Option<Error>,
+}
+
+impl Observer<D> for UmbraReads<'_, '_> {
+    fn on_step(&mut self, step: &DenseStep<D>) -> ControlFlow<()> {
+        if let Err(e) = self.reads.cancel.check() {
+            self.error = Some(e);
+            return ControlFlow::Break(());
+        }
+        let arc = UmbraStep::new(self.umbra, step, &self.q, &self.v);
+        let h = step.t1 - step.t0;
+        let count = (h / arc.spacing(self.umbra)).ceil().clamp(1.0, 1e9) as usize;
+        let dt = h / count as f64;
+        let time = |j: usize| {
+            if j == count {
+                step.t1
+            } else {
+                step.t0 + j as f64 * dt
+            }
+        };
+        let mut stopped = None;
+        let reads = &mut *self.reads;
+        let error = &mut self.error;
+        arc.read_uniform(time(1), dt, count, |i, [rise, rs, tip]| {
+            let t = time(i + 1);
+            if let Err(e) = reads.read_values(t, rise, rs, tip, dt) {
+                *error = Some(e);
+                return false;
+            }
+            if reads.stopped() {
+                stopped = Some(t);
+                return false;
+            }
+            true
+        });
+        if self.error.is_some() {
+            return ControlFlow::Break(());
+        }
+        if let Some(t) = stopped {
+            let (q, v) = arc.modes_at(t);
+            let mut y = step.eval(t).as_slice().to_vec();
+            y.extend_from_slice(&q);
+            y.extend_from_slice(&v);
+            self.stop = Some((t, DVector::from_vec(y)));
+            return ControlFlow::Break(());
+        }
+        (self.q, self.v) = arc.modes_at(step.t1);
+        ControlFlow::Continue(())
     }
 }

@@ -6,6 +6,7 @@ pub mod boom;
 pub mod distributed;
 pub mod distributed_arc;
 pub mod distributed_orbits;
+pub(crate) mod distributed_umbra;
 pub mod ensemble;
 pub mod hybrid;
 pub mod layered;

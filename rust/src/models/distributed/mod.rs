@@ -239,18 +239,24 @@ impl DistributedPanel {
 
     /// Element moments from the state, N m.
     pub fn moments(&self, y: &[f64]) -> Vec<f64> {
-        (0..self.n())
-            .map(|e| self.thermal.moment(self.element(y, e)))
-            .collect()
+        let mut m = vec![0.0; self.n()];
+        self.thermal.moments_of(&y[..self.temps()], &mut m);
+        m
     }
 
     /// Per-element chord slopes ρ = D Φ q + D R M, written as D S M + D Φ (q − Ω⁻² G M) so that
     /// the static part is integrated in O(n) ([`Reduction::static_slopes`]); `gm` is G M.
     fn slopes_with(&self, q: &[f64], moments: &[f64], gm: &[f64]) -> Vec<f64> {
+        let mut rho = vec![0.0; self.n()];
+        self.slopes_into(q, moments, gm, &mut rho);
+        rho
+    }
+
+    /// [`Self::slopes_with`] into `rho`.
+    fn slopes_into(&self, q: &[f64], moments: &[f64], gm: &[f64], rho: &mut [f64]) {
         let r = &self.reduction;
         let n = self.n();
-        let mut rho = vec![0.0; n];
-        r.static_slopes(moments, &mut rho);
+        r.static_slopes(moments, rho);
         // Column by column (column-major): each pass is a contiguous axpy.
         for (i, col) in r.slope_modal.as_slice().chunks_exact(n).enumerate() {
             let w = r.omega[i];
@@ -259,21 +265,26 @@ impl DistributedPanel {
                 *out += a * x;
             }
         }
-        rho
     }
 
     /// G M: the modal forces of the element moments.
     fn modal_forces(&self, moments: &[f64]) -> Vec<f64> {
-        let r = &self.reduction;
-        (0..self.k())
-            .map(|i| {
-                moments
-                    .iter()
-                    .enumerate()
-                    .map(|(e, m)| r.force[(i, e)] * m)
-                    .sum()
-            })
-            .collect()
+        let mut gm = vec![0.0; self.k()];
+        self.modal_forces_into(moments, &mut gm);
+        gm
+    }
+
+    /// [`Self::modal_forces`] into `gm`.
+    fn modal_forces_into(&self, moments: &[f64], gm: &mut [f64]) {
+        // Every mode's sum over the elements in their order, the modes side by side (from -0.0,
+        // the neutral element of f64's `Sum`: each the same bits as summed alone).
+        gm.fill(-0.0);
+        let columns = self.reduction.force.as_slice().chunks_exact(gm.len());
+        for (column, m) in columns.zip(moments) {
+            for (g, f) in gm.iter_mut().zip(column) {
+                *g += f * m;
+            }
+        }
     }
 
     /// Per-element chord slopes ρ.
@@ -300,6 +311,16 @@ impl DistributedPanel {
         });
     }
 
+    /// The temperatures' rates of every element in the umbra (`temps` and `out`: the
+    /// temperatures alone): without sunlight the structure does not enter them, and each element
+    /// cools on its own, as [`Self::rhs_at_flux`] at flux 0 has it.
+    pub fn rates_in_shadow(&self, temps: &[f64], out: &mut [f64]) {
+        let s = self.layers();
+        for (t, o) in temps.chunks_exact(s).zip(out.chunks_exact_mut(s)) {
+            self.thermal.rates(0.0, t, o);
+        }
+    }
+
     /// The right-hand side under the orbit's `heat` (each element at its own orientation).
     pub fn rhs_loaded(&self, heat: &ElementHeat, y: &[f64], dy: &mut [f64]) {
         self.rhs_with(y, dy, |slope, temps, out| {
@@ -315,16 +336,23 @@ impl DistributedPanel {
     fn rhs_with(&self, y: &[f64], dy: &mut [f64], heat: impl Fn(f64, &[f64], &mut [f64])) {
         let (n, k, s, nt) = (self.n(), self.k(), self.layers(), self.temps());
         let r = &self.reduction;
-        let moments = self.moments(y);
+        // The moments, G M and the chord slopes in one buffer.
+        let mut scratch = vec![0.0; 2 * n + k];
+        let (moments, rest) = scratch.split_at_mut(n);
+        let (gm, slopes) = rest.split_at_mut(k);
+        self.thermal.moments_of(&y[..nt], moments);
         let q = self.modal(y);
         let v = &y[nt + k..];
-        let gm = self.modal_forces(&moments);
-        let slopes = match self.settings.coupling {
-            Coupling::ProjectedArea => self.slopes_with(q, &moments, &gm),
-            Coupling::Frozen => vec![0.0; n],
-        };
-        for (e, &slope) in slopes.iter().enumerate() {
-            heat(slope, self.element(y, e), &mut dy[e * s..(e + 1) * s]);
+        self.modal_forces_into(moments, gm);
+        if self.settings.coupling == Coupling::ProjectedArea {
+            self.slopes_into(q, moments, gm, slopes);
+        }
+        for ((&slope, temps), out) in slopes
+            .iter()
+            .zip(y[..nt].chunks_exact(s))
+            .zip(dy[..nt].chunks_exact_mut(s))
+        {
+            heat(slope, temps, out);
         }
         let zeta = self.settings.damping_ratio;
         for i in 0..k {

@@ -199,6 +199,13 @@ where
         }
     }
 
+    /// The interpolant's coefficients r1..r5 along the weights `w` (each w·r_i): the
+    /// interpolant of the scalar w·y, of the same form in θ.
+    pub(crate) fn coefficients_along(&self, w: &[f64]) -> [f64; 5] {
+        let r = self.r.get_or_init(|| self.coefficients());
+        std::array::from_fn(|i| r[i].iter().zip(w).map(|(a, b)| a * b).sum())
+    }
+
     /// Value of the interpolant at t in [t0, t1].
     pub fn eval(&self, t: f64) -> State<D> {
         if t == self.t1 {
