@@ -127,7 +127,8 @@ impl Sunlight {
         let s = self.illumination(t);
         // At 1 au the scale is exactly 1: no multiplication, no division on the right-hand
         // side's path (with the multiplication the compiler merged both paths into a division).
-        if self.orbit.eccentric_sun {
+        // In the umbra s = 0 is the flux whatever the scale (s × scale is s, its sign too).
+        if self.orbit.eccentric_sun && s != 0.0 {
             s * self.orbit.flux_scale(t)
         } else {
             s

@@ -1,6 +1,7 @@
 //! Numerical methods that know no physics: SIMD number types, the processor and the kernel
-//! chosen on it, and the ODE integrators with their output.
+//! chosen on it, the ODE integrators with their output, and interpolation.
 
+pub mod chebyshev;
 pub mod cpu;
 pub mod integrate;
 pub mod newton;
