@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import hypothesis.strategies as st
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, Phase, given, note, reject, settings
 from test_hybrid import METRICS
 
@@ -206,3 +207,35 @@ def test_hybrid_holds_the_gate_of_the_full_run(case: Case) -> None:
         f"{case.describe()}: {len(failures)} outside the gate in {m} compared orbits; "
         + "; ".join(failures[:5])
     )
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known defect of the hybrid on GEO: a non-linear hinge near flutter (front emissivity "
+    "0.15, θ_eq 15°) reads orbit 0's jitter_peak and jitter_rms 4 % high, 1.97 x the gate, and no "
+    "check catches it; the error comes from the exponential integrator's stretch through the "
+    "eclipse (the run matches rk45 to 2e-4 when that stretch is left to the full integration, "
+    "hybrid={'resolved_amplitude': 1e-5}), and a tighter rtol there makes it larger; cause not "
+    "found yet",
+)
+def test_the_known_fluttering_case_on_geo_holds_the_gate() -> None:
+    # Drawn by the property test above (dev profile).
+    panel = tj.Panel.paper().replace(
+        emissivity_front=0.15132300635607948,
+        emissivity_back=0.95,
+        absorptivity=0.7066896092458339,
+        specific_heat=827.0431581700932,
+        mass_per_length=5.881868280083421,
+        expansion_coeff=2.2619963073516082e-05,
+        length=57.630225184976425,
+        youngs_modulus=58310644833.52782,
+        conductance=24.831180402000104,
+        hinge_stiffness=3818.0692800791876,
+        bending_inertia=8.323818110026694e-07,
+        damping=9.502121727292856,
+        solar_constant=1633.2,
+    )
+    orbit = tj.Orbit.geo_year("2026-03-03")
+    full = tj.simulate_orbits(panel, orbit, 1, method="rk45", progress=False)
+    hybrid = tj.simulate_orbits(panel, orbit, 1, method="hybrid", progress=False)
+    assert not gate_failures(full, hybrid, 1)
