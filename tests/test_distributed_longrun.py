@@ -258,7 +258,7 @@ def test_the_validity_limit_stops_the_run_at_the_crossing() -> None:
     # θ_f overshoots its equilibrium after the shadow exit (about 0.157 rad on Table 1): a limit
     # of 0.12 rad is crossed there, in the first orbit, where the series crosses it.
     kw = {"model": "distributed", "solver": SOLVER, "progress": False, **SMALL}
-    with pytest.warns(tj.ValidityLimitWarning):
+    with pytest.warns(tj.ValidityLimitWarning, match="θ_f passed .* the distributed panel's range"):
         run = tj.simulate_orbits(PAPER, GEO, 3, theta_limit=0.12, **kw)
     crossing = run.limit_crossing
     assert crossing is not None and crossing.orbit == 0 and len(run) == 1

@@ -131,15 +131,17 @@ def warn_crossing(
     angle: str = "θ",
     *,
     stacklevel: int = 3,
+    model: str = "the hinge model",
 ) -> None:
-    """The one :class:`ValidityLimitWarning` of a call whose run passed ``theta_limit``."""
+    """The one :class:`ValidityLimitWarning` of a call whose run passed ``theta_limit``
+    (``angle`` as the model names it, ``model`` whose range of validity it left)."""
     if crossing is None:
         return
     then = "the run stopped there" if on_limit == "stop" else "the result beyond means nothing"
     warnings.warn(
         f"{angle} passed theta_limit = {math.degrees(theta_limit):.4g}° at "
         f"t = {crossing.t:.6g} s (orbit {crossing.orbit}): {angle} = "
-        f"{crossing.theta_deg:.4g}°, beyond the hinge model's range of validity; {then} "
+        f"{crossing.theta_deg:.4g}°, beyond {model}'s range of validity; {then} "
         "(result.limit_crossing; on_limit='ignore' silences this)",
         ValidityLimitWarning,
         stacklevel=stacklevel,

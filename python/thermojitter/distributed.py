@@ -276,7 +276,13 @@ def simulate_distributed(
         _core.simulate_distributed, panel.as_dict(), engine_orbit_args, settings, run
     )
     limit = limit_record(raw)
-    warn_crossing(limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, "θ_f")
+    warn_crossing(
+        limit["limit_crossing"],
+        run["limit"]["theta_limit"],
+        on_limit,
+        "θ_f",
+        model="the distributed panel",
+    )
     return DistributedSolution(
         **run_record(raw, used),
         settings={

@@ -751,7 +751,10 @@ def simulate_orbits(
                     _save_checkpoint(
                         path, settings, n_orbits, columns, y, next_index, counters, crossing
                     )
-    warn_crossing(crossing, theta_limit, on_limit)
+    if model == "distributed":
+        warn_crossing(crossing, theta_limit, on_limit, "θ_f", model="the distributed panel")
+    else:
+        warn_crossing(crossing, theta_limit, on_limit)
     if counters.get("n_refused_orbits", 0) > 0:
         warnings.warn(slow_refused(counters), HybridFallbackWarning, stacklevel=2)
     if report:
