@@ -124,6 +124,10 @@ def limit_args(theta_limit: Any, on_limit: Any) -> dict[str, Any]:
     }
 
 
+DISTRIBUTED_LIMIT = ("θ_f", "the distributed panel")
+"""The angle a distributed run's limit is read on, and the model whose validity it bounds."""
+
+
 def warn_crossing(
     crossing: LimitCrossing | None,
     theta_limit: float,

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from thermojitter import _core
+from thermojitter._runs import DISTRIBUTED_LIMIT
 from thermojitter.attitude import Attitude, engine_orbit
 from thermojitter.errors import ParameterError, flag, real, wrong_type
 from thermojitter.orbit import Orbit, eclipse_window
@@ -276,12 +277,9 @@ def simulate_distributed(
         _core.simulate_distributed, panel.as_dict(), engine_orbit_args, settings, run
     )
     limit = limit_record(raw)
+    angle, validity = DISTRIBUTED_LIMIT
     warn_crossing(
-        limit["limit_crossing"],
-        run["limit"]["theta_limit"],
-        on_limit,
-        "θ_f",
-        model="the distributed panel",
+        limit["limit_crossing"], run["limit"]["theta_limit"], on_limit, angle, model=validity
     )
     return DistributedSolution(
         **run_record(raw, used),

@@ -22,6 +22,7 @@ from thermojitter import _core
 from thermojitter import boom as boom_module
 from thermojitter import checkpoint as checkpoints
 from thermojitter import errors as checks
+from thermojitter._runs import DISTRIBUTED_LIMIT
 from thermojitter.attitude import Attitude, engine_orbit, has_face_loads
 from thermojitter.boom import Boom
 from thermojitter.errors import HybridFallbackWarning
@@ -751,10 +752,8 @@ def simulate_orbits(
                     _save_checkpoint(
                         path, settings, n_orbits, columns, y, next_index, counters, crossing
                     )
-    if model == "distributed":
-        warn_crossing(crossing, theta_limit, on_limit, "θ_f", model="the distributed panel")
-    else:
-        warn_crossing(crossing, theta_limit, on_limit)
+    angle, validity = DISTRIBUTED_LIMIT if model == "distributed" else ("θ", "the hinge model")
+    warn_crossing(crossing, theta_limit, on_limit, angle, model=validity)
     if counters.get("n_refused_orbits", 0) > 0:
         warnings.warn(slow_refused(counters), HybridFallbackWarning, stacklevel=2)
     if report:

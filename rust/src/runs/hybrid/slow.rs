@@ -260,11 +260,7 @@ impl SlowModel {
         };
         let (first, rates) = along(&|s| rates0 * s);
         let accel = parabola_at(&times, &first, t).0;
-        let (d01, d12) = (
-            (rates[1] - rates[0]) / (times[1] - times[0]),
-            (rates[2] - rates[1]) / (times[2] - times[1]),
-        );
-        let t_accel = d01 + (d12 - d01) * ((2.0 * t - times[0] - times[1]) / (times[2] - times[0]));
+        let t_accel = parabola_at(&times, &rates, t).0;
         let (second, _) = along(&|s| rates0 * s + t_accel * (0.5 * s * s));
         [accel, parabola_at(&times, &second, t).1]
     }
@@ -383,11 +379,18 @@ impl SlowModel {
 }
 
 /// The slope and curvature at t of the parabola through (xs, fs).
-fn parabola_at(xs: &[f64; 3], fs: &[f64; 3], t: f64) -> (f64, f64) {
+fn parabola_at<T>(xs: &[f64; 3], fs: &[T; 3], t: f64) -> (T, T)
+where
+    T: Copy
+        + std::ops::Add<Output = T>
+        + std::ops::Sub<Output = T>
+        + std::ops::Mul<f64, Output = T>
+        + std::ops::Div<f64, Output = T>,
+{
     let d01 = (fs[1] - fs[0]) / (xs[1] - xs[0]);
     let d12 = (fs[2] - fs[1]) / (xs[2] - xs[1]);
     let second = (d12 - d01) / (xs[2] - xs[0]);
-    (d01 + second * (2.0 * t - xs[0] - xs[1]), 2.0 * second)
+    (d01 + second * (2.0 * t - xs[0] - xs[1]), second * 2.0)
 }
 
 /// The slow integration's state is the mean temperature and T_f − T_b, each over its absolute
