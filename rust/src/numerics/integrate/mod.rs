@@ -7,6 +7,7 @@
 //! delivered to an [`Observer`] one accepted step at a time, with an interpolant over the step, so
 //! callers keep only what they need (samples, per-orbit summaries) and never every step.
 
+pub mod dop853;
 pub mod dopri5;
 pub mod output;
 pub mod rk4;

@@ -2,6 +2,7 @@
 //! linearises about the current state, not only about the sunlit equilibrium
 //! ([`crate::analysis::flutter::jacobian`] is this matrix's value there).
 
+use crate::inputs::heating::Loads;
 use crate::inputs::panel::Panel;
 use crate::models::coupled::{jacobian_from_rows, Coupling};
 use crate::models::hinge::{generalised_moment, HingeModel};
@@ -17,6 +18,8 @@ pub struct Linearisation {
     heating: f64,
     /// K / (m c / 2), 1/s.
     conduction: f64,
+    /// 1 / (m c / 2): a load absorbed on a face (W/m²) to its layer's rate, K/s.
+    per_capacity: f64,
     /// σ ε / (m c / 2) of the front and back faces, 1/(s K³).
     radiation_front: f64,
     radiation_back: f64,
@@ -35,6 +38,7 @@ impl Linearisation {
             coupling,
             heating: panel.absorptivity * panel.solar_constant / half_capacity,
             conduction: panel.conductance / half_capacity,
+            per_capacity: 1.0 / half_capacity,
             radiation_front: STEFAN_BOLTZMANN * panel.emissivity_front / half_capacity,
             radiation_back: STEFAN_BOLTZMANN * panel.emissivity_back / half_capacity,
             moment: panel.moment_per_kelvin() / inertia,
@@ -88,6 +92,18 @@ impl Linearisation {
         )
     }
 
+    /// ∂f/∂y at state y under `loads`: sunlight on the front and loads on each face (the
+    /// Earth's, an attitude's), all on the projected area.
+    pub fn jacobian_at_loads(&self, loads: Loads, y: &Vector4<f64>) -> Matrix4<f64> {
+        let mut j = self.jacobian(loads.sun, y);
+        if loads.has_face_loads() && self.coupling == Coupling::ProjectedArea {
+            let sin = y[2].sin();
+            j[(0, 2)] -= self.per_capacity * loads.front * sin;
+            j[(1, 2)] -= self.per_capacity * loads.back * sin;
+        }
+        j
+    }
+
     /// ∂f/∂(flux) at state y: the absorbed flux enters the front layer's balance only.
     pub fn flux_sensitivity(&self, y: &Vector4<f64>) -> Vector4<f64> {
         let area = match self.coupling {
@@ -126,6 +142,14 @@ mod tests {
                     let dflux =
                         (sys.rhs_at_flux(0.9 + 1e-6, y) - sys.rhs_at_flux(0.9 - 1e-6, y)) / 2e-6;
                     assert!((dflux - lin.flux_sensitivity(y)).amax() < 1e-6 * dflux.amax());
+                    // With loads on both faces (W/m²).
+                    let loads = Loads {
+                        sun: 0.9,
+                        front: 180.0,
+                        back: 95.0,
+                    };
+                    let f = |y: &Vector4<f64>| sys.rhs_at_loads(loads, y);
+                    assert_jacobian(&lin.jacobian_at_loads(loads, y), f, y, 1e-9, &case);
                 }
             }
         }

@@ -17,7 +17,9 @@
 //!   non-linear hinge's frequency shift at amplitude |z| (from its conservative period, exact by
 //!   quadrature). The thermal coupling, and with it flutter, is in λ.
 //!
-//! T̄ is integrated on the thermal time scale (Dormand–Prince on two states); z is carried in
+//! T̄ is integrated on the thermal time scale (Dormand–Prince 8(5,3) on two states, its
+//! continuous extension held to the tolerance inside each step: the reads are made there); z is
+//! carried in
 //! closed form over each step (the exponent's rate a quadratic through three Gauss nodes). Where
 //! the loads change on the hinge's time scale, the penumbra, the full model is integrated with
 //! the hinge resolved, and the state is split again after it; at a cylindrical shadow's jump the
@@ -36,10 +38,10 @@ use crate::inputs::heating::Loads;
 use crate::inputs::orbit::{breakpoints_of, EclipseTable, Shadow};
 use crate::models::coupled::Coupled;
 use crate::models::hinge::{quasi_static, HingeModel};
-use crate::numerics::integrate::{
-    solve, DenseStep, Method, Observer, OdeSystem, State, Tolerances,
-};
+use crate::numerics::integrate::dop853::{self, Dop853Step};
+use crate::numerics::integrate::{solve, OdeSystem, State, Tolerances};
 use crate::numerics::quadrature::GAUSS_5;
+use crate::runs::hybrid::jacobian::Linearisation;
 use crate::runs::hybrid::{counted_as_fallback, HybridRun, Propagated};
 use crate::runs::orbits::STEPS_PER_HINGE_PERIOD;
 use crate::runs::orbits::{resolve_hinge, Collector, OrbitRunSpec, SummaryObserver, TwoLayerView};
@@ -76,6 +78,8 @@ const MEAN_TOLERANCE: f64 = 1e-3;
 #[derive(Clone)]
 struct SlowModel {
     system: Coupled,
+    /// The system's Jacobian in closed form.
+    linear: Linearisation,
     model: HingeModel,
     stiffness: f64,
     damping: f64,
@@ -127,6 +131,7 @@ impl SlowModel {
         let p = &spec.panel;
         SlowModel {
             system: Coupled::new(spec.panel, spec.orbit, spec.model, spec.coupling),
+            linear: Linearisation::new(&spec.panel, spec.model, spec.coupling),
             model: spec.model,
             stiffness: p.hinge_stiffness,
             damping: p.damping,
@@ -265,30 +270,10 @@ impl SlowModel {
         [accel, parabola_at(&times, &second, t).1]
     }
 
-    /// The Jacobian of the full model at (t, y), by central differences.
-    fn jacobian(&self, loads: Loads, y: &Vector4<f64>) -> Matrix4<f64> {
-        let mut j = Matrix4::zeros();
-        for k in 0..4 {
-            let h = if k < 2 {
-                1e-6 * y[k].abs().max(1.0)
-            } else {
-                1e-7
-            };
-            let (mut plus, mut minus) = (*y, *y);
-            plus[k] += h;
-            minus[k] -= h;
-            let d = (self.system.rhs_at_loads(loads, &plus)
-                - self.system.rhs_at_loads(loads, &minus))
-                / (plus[k] - minus[k]);
-            j.set_column(k, &d);
-        }
-        j
-    }
-
     /// The hinge mode of the Jacobian at (t, y), its eigenvalue found by Newton's method on the
     /// characteristic polynomial from `guess`.
     fn mode(&self, loads: Loads, y: &Vector4<f64>, guess: Complex<f64>) -> Option<Mode> {
-        let j = self.jacobian(loads, y);
+        let j = self.linear.jacobian_at_loads(loads, y);
         let lambda = hinge_eigenvalue(&j, guess)?;
         let c = |r: usize, k: usize| Complex::new(j[(r, k)], 0.0);
         // v = (v0, v1, 1, λ): the two thermal rows.
@@ -531,7 +516,7 @@ where
 
 impl Ringing<'_, '_> {
     /// Carries z over the accepted step and reads the step into the summaries.
-    fn take(&mut self, step: &DenseStep<U2>) -> std::result::Result<(), Refusal> {
+    fn take(&mut self, step: &Dop853Step<U2>) -> std::result::Result<(), Refusal> {
         let (t0, t1) = (step.t0, step.t1);
         let h = t1 - t0;
         let m = self.model;
@@ -766,8 +751,10 @@ fn refined(f: &dyn Fn(f64) -> f64, t: f64, d: f64, a: f64, b: f64) -> f64 {
 /// Points at which a span's envelope is read to find its largest.
 const ENVELOPE_READS: usize = 8;
 
-impl Observer<U2> for Ringing<'_, '_> {
-    fn on_step(&mut self, step: &DenseStep<U2>) -> ControlFlow<()> {
+impl Ringing<'_, '_> {
+    /// Takes one accepted step of the slow integration; stops it on cancellation, an error or a
+    /// guard's refusal.
+    fn on_step(&mut self, step: &Dop853Step<U2>) -> ControlFlow<()> {
         if let Err(e) = self.obs.cancel.check() {
             self.error = Some(e);
             return ControlFlow::Break(());
@@ -867,7 +854,6 @@ pub(crate) fn run_slow(
     let mut y = y0;
     let mut t = spec.t_start;
     let mut lambda = Complex::new(0.0, spec.panel.natural_angular_frequency());
-    let slow_method = Method::Dopri5(SLOW_TOLERANCES);
     // The full integration's step budget holds for the whole run, every kind of step counted
     // (as the hybrid's): each full stretch alone stops at it, and a run of one stretch an orbit
     // would otherwise take that many steps an orbit.
@@ -957,9 +943,16 @@ pub(crate) fn run_slow(
                 steps: 0,
                 largest: 0.0,
             };
-            let mut flow = SlowFlow { model: &model };
+            let flow = SlowFlow { model: &model };
             let temps = model.scaled(&Vector2::new(manifold.y[0], manifold.y[1]));
-            let (st, _) = solve(&mut flow, &slow_method, a, temps, b, &mut ring)?;
+            let mut tolx = SLOW_TOLERANCES;
+            if let Ok(v) = std::env::var("TJ_MAXSTEP") {
+                tolx.max_step = v.parse().unwrap();
+            }
+            if let Ok(v) = std::env::var("TJ_RTOL") {
+                tolx.rtol = v.parse().unwrap();
+            }
+            let (st, _) = dop853::solve(&flow, &tolx, a, temps, b, &mut |step| ring.on_step(step))?;
             if let Some(e) = ring.error.take() {
                 return Err(e);
             }
@@ -970,6 +963,16 @@ pub(crate) fn run_slow(
             stats.n_rhs += st.n_rhs;
             stats.n_rejected += st.n_rejected;
             slow_steps += ring.steps;
+            if std::env::var("TJ_DBG").is_ok() {
+                eprintln!(
+                    "seg {:.1} {:.1} len {:.0} steps {} ill {:.2}",
+                    a,
+                    b,
+                    b - a,
+                    ring.steps,
+                    mid
+                );
+            }
             check_budget(
                 stats.n_steps + stats.n_rejected + slow_steps + full_steps,
                 b,
@@ -1044,7 +1047,7 @@ mod tests {
             orbit,
             model,
             coupling: Coupling::ProjectedArea,
-            method: Method::Dopri5(Tolerances::default()),
+            method: crate::numerics::integrate::Method::Dopri5(Tolerances::default()),
             t_start: 0.0,
             first_index: 0,
             n_orbits: n,
@@ -1155,7 +1158,7 @@ mod tests {
                 Complex::new(0.0, panel.natural_angular_frequency()),
             )
             .unwrap();
-        let j = model.jacobian(model.loads(0.0), &m.y);
+        let j = model.linear.jacobian_at_loads(model.loads(0.0), &m.y);
         let nearest = j
             .complex_eigenvalues()
             .iter()
