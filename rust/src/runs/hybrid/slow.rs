@@ -607,7 +607,23 @@ impl Ringing<'_, '_> {
             speed: &speed,
             period,
         };
-        let dyn_abs = dynamic.largest(t0, t1).max(-dynamic.smallest(t0, t1));
+        // |dynamic| ≤ max |lag| + max |κ| A over the step, each of the three read exactly off its
+        // polynomial: where that bound cannot raise the orbit's peak so far, the peak is not read.
+        let log_amp_max = log_z0 + 0.5 * h * cubic_max(q0.re, q1.re, q2.re);
+        let bound = largest_magnitude(&lags, t0, t1)
+            + (log_amp_max + parabola_range(&log_kappa, t0, t1).1).exp();
+        let current = &self.obs.collector.current;
+        let peak_so_far = if current.t_start <= t0 && t1 <= current.t_end {
+            current.jitter_peak
+        } else {
+            f64::NEG_INFINITY
+        };
+        let dyn_abs = if bound <= peak_so_far {
+            bound
+        } else {
+            let (lo, hi) = dynamic.range(t0, t1);
+            hi.max(-lo)
+        };
         // ∫ (dynamic)²: lag² + |κz|²/2 by Gauss–Legendre, and the oscillating terms
         // 2 lag Re(κz) + Re((κz)²)/2 by their leading term [F/L']: they swing at the hinge's
         // frequency, L' the exponent's rate.
@@ -627,7 +643,7 @@ impl Ringing<'_, '_> {
         if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
             return Err(Refusal::Ringing);
         }
-        let (lo, hi) = (theta.smallest(t0, t1), theta.largest(t0, t1));
+        let (lo, hi) = theta.range(t0, t1);
         let limit = self.obs.collector.options.theta_limit;
         if hi > limit || lo < -limit {
             return Err(Refusal::Limit);
@@ -637,7 +653,7 @@ impl Ringing<'_, '_> {
             if (a, b) == (t0, t1) {
                 (lo, hi)
             } else {
-                (theta.smallest(a, b), theta.largest(a, b))
+                theta.range(a, b)
             }
         };
         if let Err(e) = self
@@ -669,16 +685,34 @@ struct Wave<'f> {
 }
 
 impl Wave<'_> {
-    fn largest(&self, a: f64, b: f64) -> f64 {
-        self.extreme(a, b, 1.0)
+    /// The smallest and largest of s + A cos φ over [a, b]: the envelope's samples shared.
+    fn range(&self, a: f64, b: f64) -> (f64, f64) {
+        if b - a <= self.period {
+            return (
+                -self.extreme(a, b, -1.0, None),
+                self.extreme(a, b, 1.0, None),
+            );
+        }
+        let samples: [(f64, f64, f64); ENVELOPE_READS + 1] = std::array::from_fn(|i| {
+            let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
+            (t, (self.slow)(t), (self.amplitude)(t))
+        });
+        (
+            -self.extreme(a, b, -1.0, Some(&samples)),
+            self.extreme(a, b, 1.0, Some(&samples)),
+        )
     }
 
-    fn smallest(&self, a: f64, b: f64) -> f64 {
-        -self.extreme(a, b, -1.0)
-    }
-
-    /// The largest of `sign` (s + A cos φ) over [a, b].
-    fn extreme(&self, a: f64, b: f64, sign: f64) -> f64 {
+    /// The largest of `sign` (s + A cos φ) over [a, b]; `samples` (t, s, A) at the
+    /// [`ENVELOPE_READS`] + 1 points that find the envelope's largest on a span longer than a
+    /// period.
+    fn extreme(
+        &self,
+        a: f64,
+        b: f64,
+        sign: f64,
+        samples: Option<&[(f64, f64, f64); ENVELOPE_READS + 1]>,
+    ) -> f64 {
         let f = |t: f64| sign * ((self.slow)(t) + (self.amplitude)(t) * (self.phase)(t).cos());
         let envelope = |t: f64| sign * (self.slow)(t) + (self.amplitude)(t);
         // The peaks of −(s + A cos φ) are those of cos(φ + π).
@@ -688,19 +722,25 @@ impl Wave<'_> {
             return best;
         }
         let d = self.period / READS_PER_PERIOD;
-        if b - a <= self.period {
+        let Some(samples) = samples else {
             let n = ((b - a) / d).ceil().max(1.0) as usize;
             for i in 1..n {
-                best = best.max(refined(&f, a + (b - a) * i as f64 / n as f64, d, a, b));
+                best = best.max(refined(
+                    &f,
+                    a + (b - a) * i as f64 / n as f64,
+                    None,
+                    d,
+                    a,
+                    b,
+                ));
             }
             return best;
-        }
+        };
         // The envelope's largest on a few points, then the peaks around it.
         let mut t_star = a;
         let mut e_best = f64::NEG_INFINITY;
-        for i in 0..=ENVELOPE_READS {
-            let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
-            let e = envelope(t);
+        for &(t, slow, amplitude) in samples {
+            let e = sign * slow + amplitude;
             if e > e_best {
                 (e_best, t_star) = (e, t);
             }
@@ -719,6 +759,9 @@ impl Wave<'_> {
         let phase = |t: f64| (self.phase)(t) + turn;
         let ph = phase(t_star);
         let m0 = (ph / (2.0 * PI)).round();
+        // The three peaks around t*; the highest refined (the refinement moves a peak's value
+        // by far less than the gap between two peaks of a moving envelope).
+        let mut top: Option<(f64, f64)> = None;
         for dm in [-1.0, 0.0, 1.0] {
             let target = 2.0 * PI * (m0 + dm);
             let mut t = t_star + (target - ph) / (self.speed)(t_star);
@@ -726,17 +769,24 @@ impl Wave<'_> {
                 t -= (phase(t) - target) / (self.speed)(t);
             }
             if t >= a && t <= b {
-                best = best.max(refined(&f, t, d, a, b));
+                let v = f(t);
+                if top.is_none_or(|(_, w)| v > w) {
+                    top = Some((t, v));
+                }
             }
+        }
+        if let Some((t, v)) = top {
+            best = best.max(refined(&f, t, Some(v), d, a, b));
         }
         best
     }
 }
 
-/// f near t, refined by the parabola through t ± d (kept within [a, b]).
-fn refined(f: &dyn Fn(f64) -> f64, t: f64, d: f64, a: f64, b: f64) -> f64 {
+/// f near t, refined by the parabola through t ± d (kept within [a, b]); `at` is f(t) when
+/// known.
+fn refined(f: &dyn Fn(f64) -> f64, t: f64, at: Option<f64>, d: f64, a: f64, b: f64) -> f64 {
     let (lo, hi) = ((t - d).max(a), (t + d).min(b));
-    let (p, c, q) = (f(lo), f(t), f(hi));
+    let (p, c, q) = (f(lo), at.unwrap_or_else(|| f(t)), f(hi));
     let mut best = c.max(p).max(q);
     if hi - t == t - lo && t > lo {
         let curv = p - 2.0 * c + q;
@@ -746,6 +796,54 @@ fn refined(f: &dyn Fn(f64) -> f64, t: f64, d: f64, a: f64, b: f64) -> f64 {
         }
     }
     best
+}
+
+/// The largest of the cubic ∫₋₁ˣ (r0 + r1 u + r2 u²) du over x in [−1, 1]: at an end or where
+/// its rate vanishes.
+fn cubic_max(r0: f64, r1: f64, r2: f64) -> f64 {
+    let value = |x: f64| r0 * (x + 1.0) + r1 * 0.5 * (x * x - 1.0) + r2 * (x * x * x + 1.0) / 3.0;
+    let mut best = value(-1.0).max(value(1.0));
+    let roots = if r2 != 0.0 {
+        let disc = r1 * r1 - 4.0 * r2 * r0;
+        if disc >= 0.0 {
+            let sq = disc.sqrt();
+            [(-r1 - sq) / (2.0 * r2), (-r1 + sq) / (2.0 * r2)]
+        } else {
+            [f64::NAN; 2]
+        }
+    } else if r1 != 0.0 {
+        [-r0 / r1, f64::NAN]
+    } else {
+        [f64::NAN; 2]
+    };
+    for x in roots {
+        if x > -1.0 && x < 1.0 {
+            best = best.max(value(x));
+        }
+    }
+    best
+}
+
+/// The smallest and largest of the parabola `p` over [a, b]: at an end or its vertex.
+fn parabola_range(p: &Newton<f64, 3>, a: f64, b: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (p.at(a).min(p.at(b)), p.at(a).max(p.at(b)));
+    let [x0, x1, _] = p.xs;
+    let [_, c1, c2] = p.cs;
+    if c2 != 0.0 {
+        // p' = c1 + c2 (2t − x0 − x1).
+        let vertex = 0.5 * (x0 + x1) - c1 / (2.0 * c2);
+        if vertex > a && vertex < b {
+            let v = p.at(vertex);
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+    }
+    (lo, hi)
+}
+
+/// The largest |p| of the parabola `p` over [a, b].
+fn largest_magnitude(p: &Newton<f64, 3>, a: f64, b: f64) -> f64 {
+    let (lo, hi) = parabola_range(p, a, b);
+    hi.max(-lo)
 }
 
 /// Points at which a span's envelope is read to find its largest.
@@ -1242,6 +1340,46 @@ mod tests {
                 "{hinge:?}: θ̄' {} vs dθ̄/dt {d} (the lag's rate {lag_rate})",
                 m.y[3]
             );
+        }
+    }
+
+    #[test]
+    fn the_bounds_of_the_reads_are_their_polynomials_extremes() {
+        // Drawn cubics and parabolas against a fine sampling: the closed forms are the extremes
+        // (no larger: a bound that is too high only reads more; no smaller: it would skip one).
+        let mut seed = 12345u64;
+        let mut draw = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            let (r0, r1, r2) = (draw(), draw(), draw());
+            let value =
+                |x: f64| r0 * (x + 1.0) + r1 * 0.5 * (x * x - 1.0) + r2 * (x * x * x + 1.0) / 3.0;
+            let sampled = (0..=20_000)
+                .map(|i| value(-1.0 + i as f64 / 10_000.0))
+                .fold(f64::NEG_INFINITY, f64::max);
+            let got = cubic_max(r0, r1, r2);
+            assert!(
+                got >= sampled - 1e-12 && got <= sampled + 1e-7,
+                "{got} {sampled}"
+            );
+            let xs = [0.0, 0.5 + 0.5 * draw(), 2.0];
+            let p = Newton::new(&xs, &[draw(), draw(), draw()]);
+            let (a, b) = (0.3 * draw().abs(), 2.0 - 0.3 * draw().abs());
+            let (lo, hi) = (0..=20_000)
+                .map(|i| p.at(a + (b - a) * i as f64 / 20_000.0))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    (l.min(v), h.max(v))
+                });
+            let (glo, ghi) = parabola_range(&p, a, b);
+            // The sampling misses a vertex by up to c2 (spacing)²/4.
+            let miss = 1e-8 * (1.0 + p.cs[2].abs());
+            assert!(glo <= lo + 1e-12 && glo >= lo - miss, "{glo} {lo}");
+            assert!(ghi >= hi - 1e-12 && ghi <= hi + miss, "{ghi} {hi}");
+            assert_eq!(largest_magnitude(&p, a, b), ghi.max(-glo));
         }
     }
 
