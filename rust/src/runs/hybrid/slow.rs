@@ -87,6 +87,9 @@ struct SlowModel {
     moment_per_kelvin: f64,
     /// The slow integration's scales ([`SlowModel::scaled`]).
     scales: (f64, f64),
+    /// cos u at the Gauss–Legendre nodes of [0, π] (u = π (x + 1)/2) and their weights: the
+    /// frequency shift's quadrature.
+    gauss_cosines: [(f64, f64); 5],
     /// The segment being integrated: the loads' side of each shadow edge, and the flow's
     /// derivative kept inside it.
     segment: (f64, f64),
@@ -138,6 +141,7 @@ impl SlowModel {
             inertia: p.hinge_inertia(),
             moment_per_kelvin: p.moment_per_kelvin(),
             scales: scales(p.moment_per_kelvin() / p.hinge_stiffness),
+            gauss_cosines: GAUSS_5.map(|(x, wt)| ((0.5 * PI * (x + 1.0)).cos(), wt)),
             segment: (f64::NEG_INFINITY, f64::INFINITY),
         }
     }
@@ -312,23 +316,21 @@ impl SlowModel {
 
     /// The non-linear hinge's angular frequency at amplitude `amp` about `theta` minus its
     /// small-oscillation value: the conservative hinge's period 2 ∫₀^π sqrt(m(θ + A cos u)/K_el) du,
-    /// m(θ) = I_B (1 + 3 sin²θ), by Gauss–Legendre quadrature (the integrand is smooth).
+    /// m(θ) = I_B (1 + 3 sin²θ), by Gauss–Legendre quadrature (the integrand is smooth); at zero
+    /// amplitude the integrand is constant, the period 2π sqrt(m(θ)/K_el).
     fn frequency_shift(&self, theta: f64, amp: f64) -> f64 {
         if self.model == HingeModel::Linear || amp == 0.0 {
             return 0.0;
         }
-        let period = |a: f64| {
-            let sum: f64 = GAUSS_5
-                .iter()
-                .map(|&(x, wt)| {
-                    let u = 0.5 * PI * (x + 1.0);
-                    let s = (theta + a * u.cos()).sin();
-                    wt * (self.inertia * self.model.inertia_factor(s) / self.stiffness).sqrt()
-                })
-                .sum();
-            PI * sum
+        let root = |angle: f64| {
+            (self.inertia * self.model.inertia_factor(angle.sin()) / self.stiffness).sqrt()
         };
-        2.0 * PI / period(amp) - 2.0 * PI / period(0.0)
+        let sum: f64 = self
+            .gauss_cosines
+            .iter()
+            .map(|&(cos, wt)| wt * root(theta + amp * cos))
+            .sum();
+        2.0 * PI / (PI * sum) - 2.0 * PI / (2.0 * PI * root(theta))
     }
 
     /// Splits the state y at t into the slow manifold over T̄ and the ringing z: the fixed point
@@ -549,12 +551,29 @@ impl Ringing<'_, '_> {
             };
             dx * (1.0 / h)
         };
-        let mut rate = [Complex::new(0.0, 0.0); 3];
-        for (k, r) in rate.iter_mut().enumerate() {
+        let mut rate: [Complex<f64>; 3] = std::array::from_fn(|k| {
             let md = &modes[k];
             let wv: Complex<f64> = (0..4).map(|c| md.w[c] * slope(c, k)).sum();
-            let shift = m.frequency_shift(points[k].y[2], amp);
-            *r = md.lambda - wv + Complex::new(0.0, shift);
+            md.lambda - wv
+        });
+        if m.model == HingeModel::Nonlinear && amp > 0.0 {
+            // The non-linear hinge's frequency shift at each node's own amplitude: the shift goes
+            // as A², and the amplitude decays along a step (the shift changes only the phase, so
+            // the amplitude comes from the real rate alone, its parabola integrated to the node).
+            let (r0, r1, r2) = (
+                rate[1].re,
+                0.5 * (rate[2].re - rate[0].re),
+                0.5 * (rate[2].re + rate[0].re) - rate[1].re,
+            );
+            let growth = [
+                0.0,
+                0.5 * h * (r0 - 0.5 * r1 + r2 / 3.0),
+                0.5 * h * (2.0 * r0 + 2.0 * r2 / 3.0),
+            ];
+            for (k, r) in rate.iter_mut().enumerate() {
+                let shift = m.frequency_shift(points[k].y[2], amp * growth[k].exp());
+                *r += Complex::new(0.0, shift);
+            }
         }
         // The rate as q0 + q1 x + q2 x² through them, and ∫ rate from t0, that parabola
         // integrated exactly.
@@ -884,6 +903,21 @@ pub(crate) fn applies(spec: &OrbitRunSpec) -> bool {
 /// measured at up to 0.24 % on drawn panels (the slow manifold's and the closed form's
 /// truncations, against the hinge-resolved integration) in the dynamic part's RMS and peak.
 const RING_ACCURACY: f64 = 3e-3;
+/// The non-linear hinge's ringing error grows as its amplitude squared: the closed form keeps
+/// the frequency's shift with amplitude but none of the hinge's other A² terms. Its fraction is
+/// [`RING_ACCURACY`] plus this times A² (per rad²): measured 0.8 % at 0.022 rad (half Table 1's
+/// heat capacity on the cylindrical shadow, 30 orbits) and 1.2 % at a fluttering panel's
+/// 0.03 rad, where 0.3 % would let a ringing of 0.03 rad pass the gate check.
+const NONLINEAR_RING_ACCURACY: f64 = 10.0;
+
+/// The ringing's error as a fraction of its amplitude `ring`, for the hinge `model`.
+fn ring_accuracy(model: HingeModel, ring: f64) -> f64 {
+    match model {
+        HingeModel::Linear => RING_ACCURACY,
+        HingeModel::Nonlinear => RING_ACCURACY + NONLINEAR_RING_ACCURACY * ring * ring,
+    }
+}
+
 /// The same for the extremes of θ itself, which also carry the slow manifold's error: drawn
 /// panels whose θ_min lies near 0 were off by up to 1.1e-5 rad with a ringing of ~1e-3 rad.
 const THETA_ACCURACY: f64 = 1e-2;
@@ -892,15 +926,20 @@ const THETA_ACCURACY: f64 = 1e-2;
 /// gate (2 %, or 1e-6 rad below 5e-5 rad) by twice the error the ringing of amplitude up to
 /// `ring` may carry: a column near 0 (θ_min of a panel that barely bends back) cannot. The RMS
 /// of the dynamic part scales with the ringing, so its error is that fraction of itself.
-fn within_gate<V: crate::runs::orbits::SummaryView>(c: &Collector<V>, ring: f64) -> bool {
+fn within_gate<V: crate::runs::orbits::SummaryView>(
+    c: &Collector<V>,
+    ring: f64,
+    model: HingeModel,
+) -> bool {
     let s = &c.current;
     let holds = |v: f64, bound: f64| {
         let gate = if v.abs() < 5e-5 { 1e-6 } else { 0.02 * v.abs() };
         v.is_nan() || bound <= 0.5 * gate
     };
     let rms = c.rms_so_far();
-    holds(rms, RING_ACCURACY * rms)
-        && holds(s.jitter_peak, RING_ACCURACY * ring)
+    let fraction = ring_accuracy(model, ring);
+    holds(rms, fraction * rms)
+        && holds(s.jitter_peak, fraction * ring)
         && [
             s.theta_max,
             s.theta_min,
@@ -1043,14 +1082,9 @@ pub(crate) fn run_slow(
             };
             let flow = SlowFlow { model: &model };
             let temps = model.scaled(&Vector2::new(manifold.y[0], manifold.y[1]));
-            let mut tolx = SLOW_TOLERANCES;
-            if let Ok(v) = std::env::var("TJ_MAXSTEP") {
-                tolx.max_step = v.parse().unwrap();
-            }
-            if let Ok(v) = std::env::var("TJ_RTOL") {
-                tolx.rtol = v.parse().unwrap();
-            }
-            let (st, _) = dop853::solve(&flow, &tolx, a, temps, b, &mut |step| ring.on_step(step))?;
+            let (st, _) = dop853::solve(&flow, &SLOW_TOLERANCES, a, temps, b, &mut |step| {
+                ring.on_step(step)
+            })?;
             if let Some(e) = ring.error.take() {
                 return Err(e);
             }
@@ -1061,16 +1095,6 @@ pub(crate) fn run_slow(
             stats.n_rhs += st.n_rhs;
             stats.n_rejected += st.n_rejected;
             slow_steps += ring.steps;
-            if std::env::var("TJ_DBG").is_ok() {
-                eprintln!(
-                    "seg {:.1} {:.1} len {:.0} steps {} ill {:.2}",
-                    a,
-                    b,
-                    b - a,
-                    ring.steps,
-                    mid
-                );
-            }
             check_budget(
                 stats.n_steps + stats.n_rejected + slow_steps + full_steps,
                 b,
@@ -1081,7 +1105,7 @@ pub(crate) fn run_slow(
             let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
             y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
         }
-        if refused.is_none() && !within_gate(&obs.collector, ring_max) {
+        if refused.is_none() && !within_gate(&obs.collector, ring_max, spec.model) {
             refused = Some(Refusal::Gate);
         }
         if let Some(reason) = refused {
@@ -1227,13 +1251,17 @@ mod tests {
     #[test]
     fn a_fluttering_panel_holds_the_gate_until_its_ringing_is_given_back() {
         // Half the critical damping: the ringing grows each orbit, past the closed form's
-        // limit after a few, and the rest runs in full.
+        // limit after a few, and the rest runs in full. The full orbits start from slow time's
+        // state, whose ringing the flutter then grows with its error: the last orbit's
+        // exit_peak reads 0.60 of the gate (0.47 with the frequency shift taken at each step's
+        // starting amplitude, which read a lightly damped panel's ringing 8 % off by its 30th
+        // orbit: `test_a_ringing_carried_over_many_orbits_keeps_its_phase`).
         let panel = Panel {
             damping: 1.08,
             ..Panel::paper()
         };
         let (worst, split) = compare(panel, Orbit::leo(540e3), HingeModel::Nonlinear, 8);
-        assert!(worst < 0.5, "{worst} of the gate");
+        assert!(worst < 0.7, "{worst} of the gate");
         assert!(
             split.n_refused_orbits > 0 && split.n_refused_orbits < 8,
             "{split:?}"
