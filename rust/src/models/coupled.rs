@@ -201,6 +201,23 @@ pub(crate) struct LaneForm {
 }
 
 impl Coupled<TwoLayer, Hinge, U4> {
+    /// The two temperatures' rates under `loads` with the hinge at θ, the hinge's own rates
+    /// not computed: [`Coupled::rhs_at_loads`]'s first two (the slow-time path's thermal flow).
+    #[inline]
+    pub(crate) fn temperature_rates(&self, loads: Loads, temps: [f64; 2], theta: f64) -> [f64; 2] {
+        let area = match self.coupling {
+            Coupling::ProjectedArea => theta.cos(),
+            Coupling::Frozen => 1.0,
+        };
+        let mut out = [0.0; 2];
+        self.thermal.rates(loads.sun * area, &temps, &mut out);
+        if loads.has_face_loads() {
+            self.thermal
+                .add_face_rates(loads.front * area, loads.back * area, &mut out);
+        }
+        out
+    }
+
     /// [`Sunlight::constant_flux`] of the current segment.
     pub(crate) fn constant_flux(&self) -> Option<f64> {
         self.sun.constant_flux()
@@ -566,6 +583,35 @@ mod tests {
     use super::*;
     use crate::models::hinge::thermal_moment;
     use crate::models::thermal::two_layer_rates;
+
+    #[test]
+    fn the_temperature_rates_alone_are_those_of_the_whole_right_hand_side() {
+        let panel = Panel::paper();
+        let loads = [
+            Loads::sun(0.93),
+            Loads {
+                sun: 0.4,
+                front: 160.0,
+                back: 210.0,
+            },
+        ];
+        for model in [HingeModel::Nonlinear, HingeModel::Linear] {
+            for coupling in [Coupling::ProjectedArea, Coupling::Frozen] {
+                let sys = Coupled::new(panel, Orbit::geo_equinox(), model, coupling);
+                for l in loads {
+                    for (tf, tb, th) in [(380.0, 368.0, 0.085), (250.0, 262.0, -0.3)] {
+                        let whole = sys.rhs_at_loads(l, &Vector4::new(tf, tb, th, 0.4));
+                        let alone = sys.temperature_rates(l, [tf, tb], th);
+                        for i in 0..2 {
+                            assert!(
+                                (alone[i] - whole[i]).abs() <= 1e-15 * whole[i].abs().max(1e-3)
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
 
     /// The folded coefficients give the rates of the textbook form of the equations.
     #[test]

@@ -437,23 +437,23 @@ fn trial<D: Dim, S: OdeSystem<D>>(
     y: &State<D>,
     f0: &State<D>,
     tol: &Tolerances,
-) -> (State<D>, Vec<State<D>>, f64)
+) -> (State<D>, [State<D>; EXTENDED], f64)
 where
     DefaultAllocator: Allocator<D>,
 {
-    let mut k: Vec<State<D>> = Vec::with_capacity(EXTENDED);
-    k.push(f0.clone());
+    // The slopes; those past the twelfth are filled when the step is accepted.
+    let mut k: [State<D>; EXTENDED] = std::array::from_fn(|_| f0.clone());
     for s in 1..STAGES {
-        let ys = stage_state(y, h, A[s], &k);
-        k.push(system.rhs(t + C[s] * h, &ys));
+        let ys = stage_state(y, h, A[s], &k[..s]);
+        k[s] = system.rhs(t + C[s] * h, &ys);
     }
-    let y_new = stage_state(y, h, A[STAGES], &k);
+    let y_new = stage_state(y, h, A[STAGES], &k[..STAGES]);
     // Hairer's error: the fifth-order estimate, damped where the third-order one is large.
     let weight = y.zip_map(&y_new, |u, v| {
         1.0 / (tol.atol + u.abs().max(v.abs()) * tol.rtol)
     });
-    let err5 = combination(&E5, &k).component_mul(&weight);
-    let mut e3 = combination(A[STAGES], &k);
+    let err5 = combination(&E5, &k[..STAGES]).component_mul(&weight);
+    let mut e3 = combination(A[STAGES], &k[..STAGES]);
     for (j, w) in BHH {
         e3.axpy(-w, &k[j], 1.0);
     }
@@ -468,7 +468,7 @@ where
 }
 
 /// The accepted step from (t, y) to (t_new, y_new), the slopes `k` of its twelve stages: f(t_new,
-/// y_new) and the extension's three more stages pushed onto `k`, and the step with its
+/// y_new) and the extension's three more stages filled in `k`, and the step with its
 /// continuous extension.
 #[inline(always)]
 fn extend<D: Dim, S: OdeSystem<D>>(
@@ -477,21 +477,21 @@ fn extend<D: Dim, S: OdeSystem<D>>(
     t_new: f64,
     y: &State<D>,
     y_new: State<D>,
-    k: &mut Vec<State<D>>,
+    k: &mut [State<D>; EXTENDED],
 ) -> Dop853Step<D>
 where
     DefaultAllocator: Allocator<D>,
 {
     let h = t_new - t;
-    k.push(system.rhs(t_new, &y_new));
+    k[STAGES] = system.rhs(t_new, &y_new);
     for s in STAGES + 1..EXTENDED {
-        let ys = stage_state(y, h, A[s], k);
-        k.push(system.rhs(t + C[s] * h, &ys));
+        let ys = stage_state(y, h, A[s], &k[..s]);
+        k[s] = system.rhs(t + C[s] * h, &ys);
     }
     let diff = &y_new - y;
     let bspl = &k[0] * h - &diff;
     let r2 = &diff - &k[STAGES] * h - &bspl;
-    let [d3, d4, d5, d6] = DENSE.map(|row| combination(&row, k) * h);
+    let [d3, d4, d5, d6] = DENSE.map(|row| combination(&row, &k[..]) * h);
     Dop853Step {
         t0: t,
         t1: t_new,

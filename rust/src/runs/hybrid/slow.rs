@@ -179,9 +179,10 @@ impl SlowModel {
 
     /// T' with the hinge at θ, at rest.
     fn thermal(&self, loads: Loads, temps: &Vector2<f64>, theta: f64) -> Vector2<f64> {
-        let y = Vector4::new(temps[0], temps[1], theta, 0.0);
-        let f = self.system.rhs_at_loads(loads, &y);
-        Vector2::new(f[0], f[1])
+        Vector2::from(
+            self.system
+                .temperature_rates(loads, [temps[0], temps[1]], theta),
+        )
     }
 
     /// θ₀' at time t (temperatures `temps`), on θ₀.
