@@ -13,7 +13,7 @@
 // The tableau's coefficients as published, to 30 digits: rounding is the compiler's.
 #![allow(clippy::excessive_precision)]
 
-use super::dopri5::next_up;
+use super::dopri5::{initial_step_of_order, next_up};
 use super::{rms_scaled, OdeSystem, State, Stats, Tolerances};
 use crate::error::{Error, Result};
 use nalgebra::allocator::Allocator;
@@ -394,39 +394,6 @@ where
     out
 }
 
-/// Hairer's estimate of a first step for an eighth-order method.
-fn initial_step<D: Dim, S: OdeSystem<D>>(
-    system: &S,
-    t0: f64,
-    y0: &State<D>,
-    f0: &State<D>,
-    interval: f64,
-    tol: &Tolerances,
-    stats: &mut Stats,
-) -> f64
-where
-    DefaultAllocator: Allocator<D>,
-{
-    let scale = y0.map(|v| tol.atol + v.abs() * tol.rtol);
-    let d0 = rms_scaled(y0, &scale);
-    let d1 = rms_scaled(f0, &scale);
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6
-    } else {
-        0.01 * d0 / d1
-    };
-    let h0 = h0.min(interval);
-    let f1 = system.rhs(t0 + h0, &(y0 + f0 * h0));
-    stats.n_rhs += 1;
-    let d2 = rms_scaled(&(f1 - f0), &scale) / h0;
-    let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
-        (h0 * 1e-3).max(1e-6)
-    } else {
-        (0.01 / d1.max(d2)).powf(1.0 / 8.0)
-    };
-    (100.0 * h0).min(h1).min(interval).min(tol.max_step)
-}
-
 /// The twelve stages of a trial step of size h from (t, y), f0 = f(t, y): the new state, the
 /// slopes and the error norm (< 1 to accept).
 #[inline(always)]
@@ -558,7 +525,10 @@ where
     let mut t = t0;
     let mut f0 = system.rhs(t, &y);
     stats.n_rhs += 1;
-    let mut h_abs = initial_step(system, t, &y, &f0, t1 - t0, tol, &mut stats);
+    // The fifth-order estimator's error goes as h⁶ but the steps' as h⁸: the eighth order's
+    // first step, as Hairer's DOP853 takes it.
+    let mut h_abs =
+        initial_step_of_order(7, system, t, &y, &f0, t1 - t0, tol, &mut stats).min(tol.max_step);
     while t < t1 {
         let min_step = 10.0 * (next_up(t) - t);
         h_abs = h_abs.max(min_step);

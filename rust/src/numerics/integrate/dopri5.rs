@@ -79,6 +79,25 @@ pub(crate) fn initial_step<D: Dim, S: OdeSystem<D>>(
 where
     DefaultAllocator: Allocator<D>,
 {
+    initial_step_of_order(4, system, t0, y0, f0, interval, tol, stats)
+}
+
+/// Hairer's estimate of a first step for an error estimator of order `order` (the step's local
+/// error goes as h^(order + 1)).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn initial_step_of_order<D: Dim, S: OdeSystem<D>>(
+    order: i32,
+    system: &S,
+    t0: f64,
+    y0: &State<D>,
+    f0: &State<D>,
+    interval: f64,
+    tol: &Tolerances,
+    stats: &mut Stats,
+) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+{
     let scale = y0.map(|v| tol.atol + v.abs() * tol.rtol);
     let d0 = rms_scaled(y0, &scale);
     let d1 = rms_scaled(f0, &scale);
@@ -95,7 +114,7 @@ where
     let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
         (h0 * 1e-3).max(1e-6)
     } else {
-        (0.01 / d1.max(d2)).powf(1.0 / 5.0)
+        (0.01 / d1.max(d2)).powf(1.0 / f64::from(order + 1))
     };
     (100.0 * h0).min(h1).min(interval)
 }
