@@ -29,7 +29,7 @@ use crate::models::hinge::{angular_acceleration, generalised_moment, sin_cos_ker
 use crate::models::thermal::Balance;
 use crate::numerics::cpu::{Kernel, ScalarKernel};
 use crate::numerics::integrate::dopri5::{
-    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT, MIN_FACTOR, SAFETY,
+    self, A21, A3, A4, A5, A6, B, B_HAT, C, DENSE, ERROR_EXPONENT,
 };
 use crate::numerics::integrate::{
     check_span, solve_on, DenseStep, FusedRhs, Method, Observer, OdeSystem, Span, Stats, Tolerances,
@@ -697,23 +697,14 @@ impl<O: LaneObserver> Lane<O> {
         }
         self.stats.n_rejected += 1;
         let err_norm = mean_square.sqrt();
-        let shrink = if err_norm.is_finite() {
-            MIN_FACTOR.max(SAFETY * err_norm.powf(ERROR_EXPONENT))
-        } else {
-            MIN_FACTOR
-        };
-        self.h_abs = h * shrink;
+        self.h_abs = dopri5::shrunk_step(h, err_norm, ERROR_EXPONENT);
         self.rejected = true;
         if self.h_abs < self.min_step {
-            return Some(Err(Error::Integration {
+            return Some(Err(dopri5::step_too_small(
                 t,
-                reason: format!(
-                    "step size {:e} s fell below the smallest resolvable step \
-                     (state {:?}); the solution is not finite or the problem is too stiff",
-                    self.h_abs,
-                    self.y.as_slice()
-                ),
-            }));
+                self.h_abs,
+                self.y.as_slice(),
+            )));
         }
         None
     }

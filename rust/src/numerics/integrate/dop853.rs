@@ -13,7 +13,7 @@
 // The tableau's coefficients as published, to 30 digits: rounding is the compiler's.
 #![allow(clippy::excessive_precision)]
 
-use super::dopri5::{initial_step_of_order, next_up};
+use super::dopri5::{initial_step_of_order, next_up, shrunk_step, step_too_small};
 use super::{rms_scaled, OdeSystem, State, Stats, Tolerances};
 use crate::error::{Error, Result};
 use nalgebra::allocator::Allocator;
@@ -297,7 +297,6 @@ const DENSE: [[f64; EXTENDED]; 4] = [
 ];
 
 const SAFETY: f64 = 0.9;
-const MIN_FACTOR: f64 = 0.2;
 const MAX_FACTOR: f64 = 10.0;
 const ERROR_EXPONENT: f64 = -1.0 / 8.0;
 
@@ -578,22 +577,10 @@ where
                 break;
             }
             stats.n_rejected += 1;
-            let shrink = if err.is_finite() {
-                MIN_FACTOR.max(SAFETY * err.powf(ERROR_EXPONENT))
-            } else {
-                MIN_FACTOR
-            };
-            h_abs = h * shrink;
+            h_abs = shrunk_step(h, err, ERROR_EXPONENT);
             rejected = true;
             if h_abs < min_step {
-                return Err(Error::Integration {
-                    t,
-                    reason: format!(
-                        "step size {h_abs:e} s fell below the smallest resolvable step \
-                         (state {:?}); the solution is not finite or the problem is too stiff",
-                        y.as_slice()
-                    ),
-                });
+                return Err(step_too_small(t, h_abs, y.as_slice()));
             }
         }
     }

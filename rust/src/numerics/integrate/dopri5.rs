@@ -246,23 +246,10 @@ where
                 break;
             }
             run.stats.n_rejected += 1;
-            let err_norm = mean_square.sqrt();
-            let shrink = if err_norm.is_finite() {
-                MIN_FACTOR.max(SAFETY * err_norm.powf(ERROR_EXPONENT))
-            } else {
-                MIN_FACTOR
-            };
-            h_abs = h * shrink;
+            h_abs = shrunk_step(h, mean_square.sqrt(), ERROR_EXPONENT);
             rejected = true;
             if h_abs < min_step {
-                return Err(Error::Integration {
-                    t,
-                    reason: format!(
-                        "step size {h_abs:e} s fell below the smallest resolvable step \
-                         (state {:?}); the solution is not finite or the problem is too stiff",
-                        y0.as_slice()
-                    ),
-                });
+                return Err(step_too_small(t, h_abs, y0.as_slice()));
             }
         }
     }
@@ -323,6 +310,30 @@ where
         + k7 * DENSE[6])
         * h;
     [y0.clone(), diff, bspl, r4, r5]
+}
+
+/// The step after a rejected step of size h whose error norm is `err_norm`:
+/// h·max(0.2, 0.9·err_norm^exponent), 0.2 h for a non-finite error.
+#[inline]
+pub(crate) fn shrunk_step(h: f64, err_norm: f64, exponent: f64) -> f64 {
+    let shrink = if err_norm.is_finite() {
+        MIN_FACTOR.max(SAFETY * err_norm.powf(exponent))
+    } else {
+        MIN_FACTOR
+    };
+    h * shrink
+}
+
+/// The error of an integration whose step, shrunk to `h_abs` at t (the state `y`), fell below
+/// the smallest resolvable one.
+pub(crate) fn step_too_small(t: f64, h_abs: f64, y: &[f64]) -> Error {
+    Error::Integration {
+        t,
+        reason: format!(
+            "step size {h_abs:e} s fell below the smallest resolvable step \
+             (state {y:?}); the solution is not finite or the problem is too stiff"
+        ),
+    }
 }
 
 /// The next representable f64 above x (x finite).
