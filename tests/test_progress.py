@@ -165,6 +165,58 @@ def test_the_command_stops_on_ctrl_c_in_one_line(tmp_path: Path) -> None:
     assert (out / "checkpoint.json").exists()
 
 
+def test_short_orbits_stop_on_ctrl_c_and_keep_every_finished_one() -> None:
+    """A hybrid GEO orbit is a call of ~0.2 ms, which runs in the calling thread
+    (Interruptible.runs_here): Ctrl-C comes at a call's end, and every orbit finished before it
+    is kept, each the same as in a run that was not interrupted."""
+    child = Child(
+        python("""
+            import numpy as np
+            import thermojitter as tj
+            orbit = tj.Orbit.geo_year("2026-01-01")
+            runs = tj.simulate_orbits(tj.Panel.paper(), orbit, 200_000, method="hybrid")
+            print(len(runs), runs.interrupted, flush=True)
+            again = tj.simulate_orbits(tj.Panel.paper(), orbit, len(runs), method="hybrid",
+                                       progress=False)
+            same = all(np.array_equal(runs.columns[k], again.columns[k], equal_nan=True)
+                       for k in again.columns)
+            print(same)
+        """)
+    )
+    child.wait_for(r"[1-9]\d{3,}/200000 orbit")
+    cpu, out = child.interrupt()
+    assert child.proc.returncode == 0, child.err[-500:]
+    assert "Traceback" not in child.err
+    done, interrupted, same = out.split()
+    assert interrupted == "True" and 1000 <= int(done) < 200_000
+    assert same == "True"
+    # Stopping took no more than the run of the kept orbits again (~0.2 ms each) and its start.
+    assert cpu < 2.0 + 1e-3 * int(done)
+
+
+def test_a_call_after_a_short_one_runs_in_the_calling_thread() -> None:
+    seen: list[int] = []
+
+    def short(*, cancel: object) -> int:
+        seen.append(threading.get_ident())
+        return len(seen)
+
+    def long(*, cancel: object) -> int:
+        time.sleep(0.05)  # longer than SHORT_CALL
+        return short(cancel=cancel)
+
+    with Interruptible() as engine:
+        assert not engine.runs_here
+        assert engine.call(short) == 1  # the first in the worker
+        assert engine.runs_here
+        assert engine.call(short) == 2  # then here
+        assert engine.call(long) == 3  # here too; a long call sends the next to the worker
+        assert not engine.runs_here
+        assert engine.call(short) == 4
+    main = threading.get_ident()
+    assert seen[0] != main and seen[1] == main and seen[2] == main and seen[3] != main
+
+
 def test_interruptible_cancels_the_engine_call() -> None:
     """The token handed to the engine stops a long batch from another thread."""
     pool = _core.MonteCarloPool(1)

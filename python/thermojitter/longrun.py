@@ -7,6 +7,7 @@ run resumed from a checkpoint gives the very same summaries as one that was neve
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 import warnings
@@ -696,48 +697,52 @@ def simulate_orbits(
                     if boom
                     else _core.run_orbits
                 )
-                raw = engine.call(
-                    call,
-                    panel.as_dict(),
-                    engine_orbit_args,
-                    orbits_args(run, count),
-                    t_start=t0,
-                    first_index=next_index,
-                    y0=y,
-                    **watch,
-                )
-                with ctrl_c.hold():
-                    for name in fields:
-                        columns[name].extend(np.asarray(raw[name]).tolist())
-                    y = list(raw["y_end"])
-                    ran_with = raw["solver"]
-                    fallback = raw.get("fallback", fallback)
-                    counters["n_steps"] += int(raw["n_steps"])
-                    counters["n_rhs"] += int(raw["n_rhs"])
-                    for name in HYBRID_COUNTERS if method == "hybrid" else ():
-                        counters[name] = counters.get(name, 0) + raw[name]
-                    if "n_refused_arcs" in counters:
-                        counters["n_refused_arcs"] += raw["n_refused_arcs"]
-                    if crossing is None and on_limit != "ignore":
-                        crossing = LimitCrossing.of(raw["crossing"])
-                    if raw["stopped"]:
-                        stopped = True
-                        next_index = int(columns["index"][-1]) + 1
-                    else:
-                        next_index += count
-                    if counters["n_steps"] >= budget and next_index < n_orbits and not stopped:
-                        raise _core.IntegrationError(
-                            f"max_steps = {budget} reached after {next_index} of {n_orbits} "
-                            f"orbits ({counters['n_steps']} steps; the budget holds for the whole "
-                            "run): pass a larger max_steps or fewer orbits"
-                        )
-                    if bar is not None:
-                        bar.update(count)
-                    if path is not None and time.monotonic() - last_save > checkpoint_every:
-                        _save_checkpoint(
-                            path, settings, n_orbits, columns, y, next_index, counters, crossing
-                        )
-                        last_save = time.monotonic()
+                # A call in this thread holds Ctrl-C until its chunk is kept (Interruptible).
+                here = ctrl_c.hold() if engine.runs_here else contextlib.nullcontext()
+                with here:
+                    raw = engine.call(
+                        call,
+                        panel.as_dict(),
+                        engine_orbit_args,
+                        orbits_args(run, count),
+                        t_start=t0,
+                        first_index=next_index,
+                        y0=y,
+                        **watch,
+                    )
+                    with ctrl_c.hold():
+                        for name in fields:
+                            columns[name].extend(np.asarray(raw[name]).tolist())
+                        y = list(raw["y_end"])
+                        ran_with = raw["solver"]
+                        fallback = raw.get("fallback", fallback)
+                        counters["n_steps"] += int(raw["n_steps"])
+                        counters["n_rhs"] += int(raw["n_rhs"])
+                        for name in HYBRID_COUNTERS if method == "hybrid" else ():
+                            counters[name] = counters.get(name, 0) + raw[name]
+                        if "n_refused_arcs" in counters:
+                            counters["n_refused_arcs"] += raw["n_refused_arcs"]
+                        if crossing is None and on_limit != "ignore":
+                            crossing = LimitCrossing.of(raw["crossing"])
+                        if raw["stopped"]:
+                            stopped = True
+                            next_index = int(columns["index"][-1]) + 1
+                        else:
+                            next_index += count
+                        if counters["n_steps"] >= budget and next_index < n_orbits and not stopped:
+                            raise _core.IntegrationError(
+                                f"max_steps = {budget} reached after {next_index} of "
+                                f"{n_orbits} orbits ({counters['n_steps']} steps; the budget "
+                                "holds for the whole run): pass a larger max_steps or fewer "
+                                "orbits"
+                            )
+                        if bar is not None:
+                            bar.update(count)
+                        if path is not None and time.monotonic() - last_save > checkpoint_every:
+                            _save_checkpoint(
+                                path, settings, n_orbits, columns, y, next_index, counters, crossing
+                            )
+                            last_save = time.monotonic()
                 if stop is not None and stop() and next_index < n_orbits and not stopped:
                     interrupted = True  # the caller asked, and reports it
                     break

@@ -22,6 +22,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from typing import Any, TypeVar
 
@@ -75,26 +76,43 @@ def report_interrupted(kept: str, resume: str) -> None:
     print(f"thermojitter: interrupted; {kept}; {resume}", file=sys.stderr, flush=True)
 
 
+SHORT_CALL = 2e-3
+"""Seconds: an engine call that follows one shorter than this runs in the calling thread
+(:attr:`Interruptible.runs_here`), where handing it to the worker and back (~0.1 ms on a
+2-core machine) would cost about what the call does (a hybrid GEO orbit: ~0.2 ms)."""
+
+
 class Interruptible:
     """Runs engine calls in one worker thread, each given ``cancel=`` a shared token.
 
     The calling thread waits on the result, which Ctrl-C interrupts at once (a thread inside the
     engine, with the GIL released, would only notice at the end of the call). On Ctrl-C the token
     is cancelled, the engine stops within one integration step, and :meth:`call` re-raises
-    ``KeyboardInterrupt`` once the worker is idle again. Use as a context manager."""
+    ``KeyboardInterrupt`` once the worker is idle again. Use as a context manager.
+
+    A call that follows a short one (``SHORT_CALL``) runs in the calling thread instead
+    (:attr:`runs_here` says so before it): Ctrl-C then comes at its end, so the caller holds it
+    back over the call and the keeping of its result (nothing finished is lost)."""
 
     def __init__(self) -> None:
         self.token = _core.CancelToken()
         self._executor = cf.ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermojitter")
+        self.runs_here = False
 
     def call(self, fn: Callable[..., T], /, *args: Any, **kwargs: Any) -> T:
-        future = self._executor.submit(fn, *args, cancel=self.token, **kwargs)
-        try:
-            return future.result()
-        except KeyboardInterrupt:
-            self.token.cancel()
-            cf.wait([future])
-            raise
+        start = time.perf_counter()
+        if self.runs_here:
+            out = fn(*args, cancel=self.token, **kwargs)
+        else:
+            future = self._executor.submit(fn, *args, cancel=self.token, **kwargs)
+            try:
+                out = future.result()
+            except KeyboardInterrupt:
+                self.token.cancel()
+                cf.wait([future])
+                raise
+        self.runs_here = time.perf_counter() - start < SHORT_CALL
+        return out
 
     def __enter__(self) -> Interruptible:
         return self
