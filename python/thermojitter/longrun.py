@@ -69,6 +69,7 @@ SLOW_GUARDS = {
     "n_refused_ringing": "a ringing past {ring} rad",
     "n_refused_split": "a split of the state that did not converge",
     "n_refused_limit": "|theta| near the run's limit",
+    "n_refused_growth": "a ringing that grows over the orbit (flutter)",
 }
 """Each slow-time guard's counter in ``propagation`` and what it says."""
 
@@ -111,12 +112,13 @@ HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
     "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits", "n_refused_separation",
     "n_refused_ringing", "n_refused_split", "n_refused_limit", "n_refused_gate",
+    "n_refused_growth",
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model, slow time (short orbits and varying loads) and the
 hinge-resolved fallback; ``n_refused_orbits`` of slow time's orbits given back to the full
 integration, and by which guard (``n_refused_separation``, ``_ringing``, ``_split``, ``_limit``,
-``_gate``)."""
+``_gate``, ``_growth``)."""
 
 
 @dataclass

@@ -193,6 +193,7 @@ fn run_boom_orbits<'py>(
                 "n_refused_split",
                 "n_refused_limit",
                 "n_refused_gate",
+                "n_refused_growth",
             ] {
                 d.set_item(name, 0u64)?;
             }

@@ -328,6 +328,7 @@ fn run_distributed_orbits<'py>(
                 ("n_refused_split", 0),
                 ("n_refused_limit", 0),
                 ("n_refused_gate", 0),
+                ("n_refused_growth", 0),
                 ("n_refused_arcs", split.n_refused),
             ] {
                 d.set_item(name, value)?;

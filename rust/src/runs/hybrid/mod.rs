@@ -113,13 +113,15 @@ pub struct HybridRun {
     /// Orbits the slow-time guards gave back to the full integration.
     pub n_refused_orbits: u64,
     /// Of those, how many each guard gave back: thermal rates not slow against the hinge, the
-    /// ringing past its limit, a split that did not converge, |θ| past the run's limit, and a
-    /// summary too near 0 for the accuracy the orbit's check vouches for.
+    /// ringing past its limit, a split that did not converge, |θ| past the run's limit, a
+    /// summary too near 0 for the accuracy the orbit's check vouches for, and a ringing that
+    /// grows over the orbit (flutter).
     pub n_refused_separation: u64,
     pub n_refused_ringing: u64,
     pub n_refused_split: u64,
     pub n_refused_limit: u64,
     pub n_refused_gate: u64,
+    pub n_refused_growth: u64,
 }
 
 /// What the state at a sunlit time allows.
@@ -221,6 +223,7 @@ pub(crate) fn counted_as_fallback(
         n_refused_split: 0,
         n_refused_limit: 0,
         n_refused_gate: 0,
+        n_refused_growth: 0,
     }
 }
 
@@ -318,6 +321,7 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             n_refused_split: 0,
             n_refused_limit: 0,
             n_refused_gate: 0,
+            n_refused_growth: 0,
         },
         judge: Judge {
             panel,

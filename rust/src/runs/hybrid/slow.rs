@@ -453,6 +453,9 @@ enum Refusal {
     Limit,
     /// A summary the orbit's accuracy check could not vouch for.
     Gate,
+    /// A ringing that grows over the orbit (flutter): its error, a fraction of it, would grow
+    /// into the later orbits, where no check of this orbit sees it.
+    Growth,
 }
 
 impl Refusal {
@@ -465,6 +468,7 @@ impl Refusal {
             Refusal::Split => &mut run.n_refused_split,
             Refusal::Limit => &mut run.n_refused_limit,
             Refusal::Gate => &mut run.n_refused_gate,
+            Refusal::Growth => &mut run.n_refused_growth,
         } += 1;
     }
 }
@@ -482,6 +486,8 @@ struct Ringing<'a, 'c> {
     steps: u64,
     /// The largest |z| of the segment.
     largest: f64,
+    /// log |z| gained over the segment by the ringing's own rate (not by the splits).
+    growth: f64,
 }
 
 /// The polynomial through N points in Newton's form (divided differences once, then N − 1
@@ -693,6 +699,7 @@ impl Ringing<'_, '_> {
         {
             self.error = Some(e);
         }
+        self.growth += exponent(t1).re;
         self.z = z1;
         self.mode = modes[2];
         self.manifold = points[2];
@@ -1046,6 +1053,8 @@ pub(crate) fn run_slow(
         cuts.push(orbit_end);
         let mut refused = None;
         let mut ring_max: f64 = 0.0;
+        // log |z| the ringing gains over the orbit's slow time.
+        let mut growth = 0.0;
         let (mut slow_steps, mut full_steps, mut slow_time) = (0, 0, 0.0);
         for pair in cuts.windows(2) {
             let (a, b) = (pair[0], pair[1]);
@@ -1102,6 +1111,7 @@ pub(crate) fn run_slow(
                 error: None,
                 steps: 0,
                 largest: 0.0,
+                growth: 0.0,
             };
             let flow = SlowFlow { model: &model };
             let temps = model.scaled(&Vector2::new(manifold.y[0], manifold.y[1]));
@@ -1123,10 +1133,16 @@ pub(crate) fn run_slow(
                 b,
             )?;
             ring_max = ring_max.max(ring.largest);
+            growth += ring.growth;
             slow_time += b - a;
             lambda = ring.mode.lambda;
             let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
             y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
+        }
+        // A ringing that grows over the orbit carries this orbit's error, a fraction of the
+        // ringing, into the next ones, grown with it: flutter goes to the full integration.
+        if refused.is_none() && growth > 0.0 {
+            refused = Some(Refusal::Growth);
         }
         if refused.is_none() && !within_gate(&obs.collector, ring_max, spec.model) {
             refused = Some(Refusal::Gate);
@@ -1272,23 +1288,23 @@ mod tests {
     }
 
     #[test]
-    fn a_fluttering_panel_holds_the_gate_until_its_ringing_is_given_back() {
-        // Half the critical damping: the ringing grows each orbit, past the closed form's
-        // limit after a few, and the rest runs in full. The full orbits start from slow time's
-        // state, whose ringing the flutter then grows with its error: the last orbit's
-        // exit_peak reads 0.60 of the gate (0.47 with the frequency shift taken at each step's
-        // starting amplitude, which read a lightly damped panel's ringing 8 % off by its 30th
-        // orbit: `test_a_ringing_carried_over_many_orbits_keeps_its_phase`).
+    fn a_fluttering_panel_is_given_back_to_the_full_integration() {
+        // Half the critical damping: the ringing grows over each orbit. Slow time's error, a
+        // fraction of the ringing, would grow with it into the later orbits (given back to the
+        // full integration once the ringing passes its limit, from slow time's state): the
+        // last orbit's exit_peak read 0.60 of the gate here, and a drawn light panel at 400 km
+        // 1.71 x the gate (`test_a_fluttering_panel_on_a_low_orbit_holds_the_gate`). Every
+        // orbit goes to the full integration from the first, each from the full integration's
+        // state (the reference integrates the 8 orbits in one stretch: its steps across the
+        // orbits' ends differ, 8e-4 of the gate).
         let panel = Panel {
             damping: 1.08,
             ..Panel::paper()
         };
         let (worst, split) = compare(panel, Orbit::leo(540e3), HingeModel::Nonlinear, 8);
-        assert!(worst < 0.7, "{worst} of the gate");
-        assert!(
-            split.n_refused_orbits > 0 && split.n_refused_orbits < 8,
-            "{split:?}"
-        );
+        assert!(worst < 0.01, "{worst} of the gate");
+        assert_eq!(split.n_refused_orbits, 8, "{split:?}");
+        assert!(split.n_refused_growth > 0, "{split:?}");
     }
 
     #[test]
