@@ -488,7 +488,7 @@ fn first_step<S: OdeSystem<nalgebra::U4>>(
     stats: &mut Stats,
 ) -> (Vector4<f64>, f64) {
     let k1 = system.rhs(a, y);
-    let h0 = dopri5::initial_step(system, a, y, &k1, b - a, tol, stats);
+    let h0 = dopri5::initial_step(4, system, a, y, &k1, b - a, tol, stats);
     (k1, h0)
 }
 

@@ -13,7 +13,7 @@
 // The tableau's coefficients as published, to 30 digits: rounding is the compiler's.
 #![allow(clippy::excessive_precision)]
 
-use super::dopri5::{initial_step_of_order, next_up, shrunk_step, step_too_small};
+use super::dopri5::{initial_step, next_up, shrunk_step, step_too_small};
 use super::{rms_scaled, OdeSystem, State, Stats, Tolerances};
 use crate::error::{Error, Result};
 use nalgebra::allocator::Allocator;
@@ -526,8 +526,7 @@ where
     stats.n_rhs += 1;
     // The fifth-order estimator's error goes as h⁶ but the steps' as h⁸: the eighth order's
     // first step, as Hairer's DOP853 takes it.
-    let mut h_abs =
-        initial_step_of_order(7, system, t, &y, &f0, t1 - t0, tol, &mut stats).min(tol.max_step);
+    let mut h_abs = initial_step(7, system, t, &y, &f0, t1 - t0, tol, &mut stats).min(tol.max_step);
     while t < t1 {
         let min_step = 10.0 * (next_up(t) - t);
         h_abs = h_abs.max(min_step);

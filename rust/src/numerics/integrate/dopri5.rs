@@ -66,26 +66,10 @@ pub(crate) const MIN_FACTOR: f64 = 0.2;
 pub(crate) const MAX_FACTOR: f64 = 10.0;
 pub(crate) const ERROR_EXPONENT: f64 = -1.0 / 5.0;
 
-/// Hairer's estimate of a first step for an order-4 error estimator.
-pub(crate) fn initial_step<D: Dim, S: OdeSystem<D>>(
-    system: &S,
-    t0: f64,
-    y0: &State<D>,
-    f0: &State<D>,
-    interval: f64,
-    tol: &Tolerances,
-    stats: &mut Stats,
-) -> f64
-where
-    DefaultAllocator: Allocator<D>,
-{
-    initial_step_of_order(4, system, t0, y0, f0, interval, tol, stats)
-}
-
 /// Hairer's estimate of a first step for an error estimator of order `order` (the step's local
 /// error goes as h^(order + 1)).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn initial_step_of_order<D: Dim, S: OdeSystem<D>>(
+pub(crate) fn initial_step<D: Dim, S: OdeSystem<D>>(
     order: i32,
     system: &S,
     t0: f64,
@@ -199,7 +183,7 @@ where
     let mut k1 = system.rhs(t, &run.y);
     run.stats.n_rhs += 1;
     let mut h_abs =
-        initial_step(system, t, &run.y, &k1, b - a, tol, &mut run.stats).min(tol.max_step);
+        initial_step(4, system, t, &run.y, &k1, b - a, tol, &mut run.stats).min(tol.max_step);
 
     while t < b {
         let min_step = 10.0 * (next_up(t) - t);
