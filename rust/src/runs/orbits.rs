@@ -526,6 +526,27 @@ impl<V: SummaryView> Collector<V> {
         Ok(())
     }
 
+    /// The edges of the current orbit's windows after entry and exit strictly inside (t0, t1)
+    /// and within the orbit, as (their times, how many): where a window's extreme lies while θ
+    /// still moves, which a step's middle and end miss by up to half a step.
+    pub(crate) fn window_edges_in(&self, t0: f64, t1: f64) -> ([f64; 4], usize) {
+        let mut edges = [0.0; 4];
+        let mut n = 0;
+        let calm = self.calm;
+        if t0 > calm.from && t1 < calm.to {
+            return (edges, 0); // inside the calm span: no edge
+        }
+        let s = &self.current;
+        let w = self.options.window;
+        for edge in [s.t_entry, s.t_entry + w, s.t_exit, s.t_exit + w] {
+            if edge > t0 && edge < t1 && edge <= s.t_end {
+                edges[n] = edge;
+                n += 1;
+            }
+        }
+        (edges, n)
+    }
+
     /// The span of the current orbit around t between the edges of its windows (and its end),
     /// where being inside a window or not cannot change.
     fn calm_around(&self, t: f64) -> Calm {
@@ -733,6 +754,18 @@ where
         }
         let c = &mut self.collector;
         let (t0, t1) = (step.t0, step.t1);
+        // A window's edge inside the step: θ read there too (no share of ∫(dynamic)²).
+        let (edges, n_edges) = c.window_edges_in(t0, t1);
+        for &edge in &edges[..n_edges] {
+            let p = c.inside_point(step, edge, step.eval(edge).as_slice());
+            // Past the limit the step's own reads mark the crossing.
+            if p.theta.abs() <= c.options.theta_limit {
+                if let Err(e) = c.record(edge, p.theta, p.theta, p.dynamic.abs(), 0.0, 0.0) {
+                    return self.after(Err(e));
+                }
+            }
+        }
+        let c = &mut self.collector;
         let end_point = |c: &Collector<V>| match step.end_slope() {
             Some(dy) => c.end_point(t1, step.y1.as_slice(), dy.as_slice()),
             None => c.point(t1, step.y1.as_slice()),
@@ -812,7 +845,7 @@ impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
     fn on_reads(&mut self, r: &StepReads) -> Option<ControlFlow<()>> {
         let c = &mut self.collector;
         let [r0, r_mid, r1] = r.rising;
-        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0) {
+        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0) || c.window_edges_in(r.t0, r.t1).1 > 0 {
             return None;
         }
         if let Err(e) = self.cancel.check() {
