@@ -34,40 +34,57 @@ def test_summaries_agree_with_the_sampled_solution() -> None:
     assert runs.jitter_rms[0] == pytest.approx(np.sqrt(np.mean(dynamic**2)), rel=1e-2)
 
 
-@settings(max_examples=6, deadline=None)
+@settings(max_examples=4, deadline=None)
 @given(
     window=st.floats(60.0, 900.0),
     absorptivity=st.floats(0.6, 0.95),
-    altitude=st.floats(400e3, 1200e3),
+    altitude=st.floats(300e3, 800e3),
     inclination=st.floats(0.0, 1.2),
+    into_eclipse=st.floats(0.0, 1.0),
 )
-def test_a_window_is_read_to_its_edge(
-    window: float, absorptivity: float, altitude: float, inclination: float
+def test_every_orbit_is_read_to_its_edges(
+    window: float, absorptivity: float, altitude: float, inclination: float, into_eclipse: float
 ) -> None:
     # θ still moves where a window ends: the full integration reads its extreme at the edge, not
     # at the last step's middle or end before it (up to half a step early: 1.2e-5 rad on
-    # Table 1's low orbit at a 150 s window).
+    # Table 1's low orbit at a 150 s window). Starting inside an eclipse, every orbit opens in
+    # one carried over: its window starts with the orbit, θ at its start included (the orbit
+    # after the first read it 2.5e-4 rad off on the heated 540 km orbit).
     panel = PAPER.replace(absorptivity=absorptivity)
     orbit = tj.Orbit.circular(altitude, inclination)
+    first = tj.simulate_orbits(panel, orbit, 1, method="rk45", progress=False)
+    t_start = first.t_entry[0] + into_eclipse * (first.t_exit[0] - first.t_entry[0])
+    if not np.isfinite(t_start):
+        t_start = into_eclipse * orbit.period  # no eclipse on this orbit
     kick = tj.steady_state(panel)
     y0 = (kick.T_front, kick.T_back, kick.theta, 0.0)
-    runs = tj.simulate_orbits(panel, orbit, 1, window=window, method="rk45", y0=y0, progress=False)
-    columns = {"entry_theta_min": runs.t_entry[0], "exit_theta_max": runs.t_exit[0]}
-    starts = [t for t in columns.values() if np.isfinite(t)]
-    times = np.concatenate([np.linspace(t, t + window, int(window / 0.01) + 1) for t in starts])
-    times = np.sort(times[times <= orbit.period])
-    fine = tj.simulate(
-        panel, orbit, (0.0, orbit.period), t_eval=times, y0=y0, rtol=1e-11, atol=1e-13
+    n = 2
+    runs = tj.simulate_orbits(
+        panel, orbit, n, t_start=t_start, window=window, method="rk45", y0=y0, progress=False
     )
-    for name, start in columns.items():
-        if not np.isfinite(start):
-            continue
-        inside = (fine.t >= start) & (fine.t <= min(start + window, orbit.period))
-        theta = fine.theta[inside]
-        want = theta.min() if name == "entry_theta_min" else theta.max()
-        # Between samples θ can pass the sampled extreme only at an interior turn: every 0.01 s
-        # bounds that by ~2e-8 rad under the hinge's ringing.
-        assert getattr(runs, name)[0] == pytest.approx(want, abs=2e-7), name
+    t_end = t_start + n * orbit.period
+    # Every 0.01 s, and every orbit's and window's edge exactly.
+    starts, ends = runs.columns["t_start"], runs.columns["t_end"]
+    edges = [starts, runs.t_entry, runs.t_entry + window, runs.t_exit, runs.t_exit + window]
+    times = np.concatenate([np.arange(t_start, t_end, 0.01), [t_end], *edges])
+    times = np.unique(times[np.isfinite(times) & (times <= t_end)])
+    fine = tj.simulate(panel, orbit, (t_start, t_end), t_eval=times, y0=y0, rtol=1e-11, atol=1e-13)
+    for k in range(n):
+        t0, t1 = starts[k], ends[k]
+
+        def over(a: float, b: float) -> np.ndarray:
+            return np.asarray(fine.theta[(fine.t >= a - 1e-9) & (fine.t <= b + 1e-9)])
+
+        want = {"theta_max": over(t0, t1).max(), "theta_min": over(t0, t1).min()}
+        if np.isfinite(runs.t_entry[k]):
+            want["entry_theta_min"] = over(runs.t_entry[k], min(runs.t_entry[k] + window, t1)).min()
+        if np.isfinite(runs.t_exit[k]):
+            want["exit_theta_max"] = over(runs.t_exit[k], min(runs.t_exit[k] + window, t1)).max()
+        # Within the accuracy gate's 1e-6 rad (the integration's own error at an interior turn
+        # reaches 3e-7; sampling every 0.01 s misses ~2e-8 there), where the reads that missed
+        # an edge were 4e-6 to 2.5e-4 off.
+        for name, value in want.items():
+            assert getattr(runs, name)[k] == pytest.approx(value, abs=1e-6), (k, name)
 
 
 def test_undamped_panel_is_stopped_at_the_validity_limit() -> None:

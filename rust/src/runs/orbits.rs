@@ -258,6 +258,9 @@ pub(crate) struct Collector<V> {
     /// Where the next steps' points are known to lie inside one orbit and on one side of each
     /// window's edges.
     calm: Calm,
+    /// θ where the current orbit ends, once read: the next orbit starts there
+    /// ([`Collector::orbit_starts`]).
+    next_start: Option<f64>,
     /// The orbit's eclipses, searched a stretch of orbits at a time.
     eclipses: EclipseTable,
 }
@@ -273,6 +276,7 @@ pub(crate) struct Mark {
     crossing: Option<LimitCrossing>,
     end: (f64, f64),
     calm: Calm,
+    next_start: Option<f64>,
 }
 
 impl<V: SummaryView> Collector<V> {
@@ -320,11 +324,11 @@ impl<V: SummaryView> Collector<V> {
                 in_entry: false,
                 in_exit: false,
             },
+            next_start: None,
             eclipses: EclipseTable::until(orbit, t_end),
         };
         collector.current = collector.open(first_index)?;
-        collector.current.theta_max = theta0;
-        collector.current.theta_min = theta0;
+        collector.starts_with(theta0);
         Ok(collector)
     }
 
@@ -350,6 +354,23 @@ impl<V: SummaryView> Collector<V> {
         Ok(OrbitSummary::new(index, t0, t1, theta_eq, eclipse))
     }
 
+    /// The current orbit, just opened, starts with hinge angle θ: its extremes start there, and
+    /// so do its windows when it opens in an eclipse carried over from the last orbit (or
+    /// leaves it at once).
+    fn starts_with(&mut self, theta: f64) {
+        let s = &self.current;
+        let (t0, in_entry, in_exit) = (s.t_start, s.t_entry, s.t_exit);
+        self.take(theta, theta, 0.0, 0.0, 0.0, in_entry == t0, in_exit == t0);
+    }
+
+    /// θ at t, where a reader has reached the current orbit's end (its last read): the next
+    /// orbit starts with it. Elsewhere nothing.
+    pub(crate) fn orbit_starts(&mut self, t: f64, theta: f64) {
+        if t == self.current.t_end && self.current.index < self.last_index {
+            self.next_start = Some(theta);
+        }
+    }
+
     pub(crate) fn mark(&self) -> Mark {
         Mark {
             done: self.done.len(),
@@ -359,6 +380,7 @@ impl<V: SummaryView> Collector<V> {
             crossing: self.crossing,
             end: self.end,
             calm: self.calm,
+            next_start: self.next_start,
         }
     }
 
@@ -371,6 +393,7 @@ impl<V: SummaryView> Collector<V> {
         self.crossing = mark.crossing;
         self.end = mark.end;
         self.calm = mark.calm;
+        self.next_start = mark.next_start;
     }
 
     /// The run's summaries, with its counters and end state: the last orbit closed.
@@ -610,9 +633,13 @@ impl<V: SummaryView> Collector<V> {
     /// t_start + n P, which can round above the last orbit's t0 + P: no orbit opens past it.
     pub(crate) fn advance(&mut self, t: f64) -> Result<()> {
         while t > self.current.t_end && self.current.index < self.last_index {
+            let start = self.next_start.take();
             self.close();
             let next = self.current.index + 1;
             self.current = self.open(next)?;
+            if let Some(theta) = start {
+                self.starts_with(theta);
+            }
         }
         Ok(())
     }
@@ -770,6 +797,25 @@ where
             Some(dy) => c.end_point(t1, step.y1.as_slice(), dy.as_slice()),
             None => c.point(t1, step.y1.as_slice()),
         };
+        // The orbit's end inside the step (read there too) or at its end: the next orbit
+        // starts with θ there.
+        let orbit_end = c.current.t_end;
+        if t0 < orbit_end && orbit_end <= t1 {
+            let p = if orbit_end == t1 {
+                end_point(c)
+            } else {
+                c.inside_point(step, orbit_end, step.eval(orbit_end).as_slice())
+            };
+            if orbit_end < t1 && p.theta.abs() <= c.options.theta_limit {
+                let read = c.record(orbit_end, p.theta, p.theta, p.dynamic.abs(), 0.0, 0.0);
+                if let Err(e) = read {
+                    return self.after(Err(e));
+                }
+            }
+            let c = &mut self.collector;
+            c.orbit_starts(orbit_end, p.theta);
+        }
+        let c = &mut self.collector;
         let (t_mid, y_mid) = step.midpoint();
         let rate = |y: &State<D>| c.view.rate(y.as_slice()) > 0.0;
         let (r0, r_mid, r1) = (rate(&step.y0), rate(&y_mid), rate(&step.y1));
@@ -845,7 +891,11 @@ impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
     fn on_reads(&mut self, r: &StepReads) -> Option<ControlFlow<()>> {
         let c = &mut self.collector;
         let [r0, r_mid, r1] = r.rising;
-        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0) || c.window_edges_in(r.t0, r.t1).1 > 0 {
+        // A window's edge or the orbit's end in the step: read from the dense step.
+        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0)
+            || c.window_edges_in(r.t0, r.t1).1 > 0
+            || r.t1 >= c.current.t_end
+        {
             return None;
         }
         if let Err(e) = self.cancel.check() {

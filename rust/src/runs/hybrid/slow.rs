@@ -1042,6 +1042,7 @@ pub(crate) fn run_slow(
         } else {
             spec.t_start + (k + 1) as f64 * spec.orbit.period
         };
+        obs.collector.orbit_starts(orbit_start, y[2]);
         let mark = obs.collector.mark();
         let y_start = y;
         let mut cuts = vec![orbit_start];
