@@ -47,3 +47,14 @@ pub(crate) fn central_difference(
     f(&ym, &mut fm);
     (0..n).map(|i| (fp[i] - fm[i]) / (2.0 * h)).collect()
 }
+
+/// Uniform draws in [0, 1) from `seed`, the same on every machine: a linear congruential
+/// generator (Knuth's MMIX constants), its top 53 bits.
+pub(crate) fn uniform_draws(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

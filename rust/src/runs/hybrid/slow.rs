@@ -1432,13 +1432,8 @@ mod tests {
     fn the_bounds_of_the_reads_are_their_polynomials_extremes() {
         // Drawn cubics and parabolas against a fine sampling: the closed forms are the extremes
         // (no larger: a bound that is too high only reads more; no smaller: it would skip one).
-        let mut seed = 12345u64;
-        let mut draw = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut uniform = crate::numerics::testing::uniform_draws(12345);
+        let mut draw = || uniform() * 2.0 - 1.0;
         for _ in 0..2000 {
             let (r0, r1, r2) = (draw(), draw(), draw());
             let value =
@@ -1473,13 +1468,7 @@ mod tests {
         // Drawn ringings on a slow ramp over spans up to a period, their peaks anywhere (just
         // after the span's start, as the first trough of a ringing split there, or inside a
         // span shorter than the reads' spacing): the range that of a fine sampling.
-        let mut seed = 777u64;
-        let mut draw = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut draw = crate::numerics::testing::uniform_draws(777);
         let period = 6.4;
         let omega = 2.0 * PI / period;
         for _ in 0..2000 {
