@@ -26,7 +26,7 @@
 
 use crate::error::{Error, Result};
 use crate::inputs::attitude::Attitude;
-use crate::inputs::orbit::Orbit;
+use crate::inputs::orbit::{Frame, Orbit};
 use crate::inputs::panel::Panel;
 use crate::numerics::vector::{cross, dot, norm};
 use std::f64::consts::PI;
@@ -226,8 +226,13 @@ impl Orbit {
 
     /// The front normal at time t, with the Sun's and the satellite's directions.
     pub fn geometry(&self, t: f64) -> Geometry {
+        self.geometry_in(&self.frame(), t)
+    }
+
+    /// [`Orbit::geometry`] with the orbit's constants from `frame`.
+    pub fn geometry_in(&self, frame: &Frame, t: f64) -> Geometry {
         let sun = self.sun_direction(t);
-        let position = self.position(t);
+        let position = self.position_in(frame, t);
         let normal = match self.attitude {
             Attitude::SunPointing => sun,
             Attitude::Nadir => position.map(|c| -c),
@@ -258,8 +263,12 @@ impl Orbit {
     /// Incident fluxes on each face at time t for the illuminated fraction `s` of the Sun and a
     /// solar constant C (W/m²), before the structure's area factor.
     pub fn face_fluxes(&self, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
-        let g = self.geometry(t);
-        self.sources(&g, t, s, solar_constant)
+        self.face_fluxes_of(&self.geometry(t), t, s, solar_constant)
+    }
+
+    /// [`Orbit::face_fluxes`] of the geometry `g` at time t ([`Orbit::geometry_in`]).
+    pub fn face_fluxes_of(&self, g: &Geometry, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
+        self.sources(g, t, s, solar_constant)
             .fluxes(g.normal, self.attitude == Attitude::SunPointing)
     }
 
@@ -282,6 +291,13 @@ impl Orbit {
     /// front's sunlight as a flux factor (the paper's form) and the rest absorbed, W/m².
     pub fn loads(&self, t: f64, s: f64, optics: &Optics) -> Loads {
         self.face_fluxes(t, s, optics.solar_constant)
+            .absorbed(optics)
+    }
+
+    /// The loads at time t of the geometry `g` there ([`Orbit::geometry_in`]) for the
+    /// illuminated fraction `s`: [`Orbit::loads`] without computing the geometry again.
+    pub fn loads_of(&self, g: &Geometry, t: f64, s: f64, optics: &Optics) -> Loads {
+        self.face_fluxes_of(g, t, s, optics.solar_constant)
             .absorbed(optics)
     }
 

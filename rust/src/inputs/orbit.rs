@@ -177,6 +177,24 @@ pub struct Orbit {
     pub attitude: Attitude,
 }
 
+/// An inclined orbit's constants that its geometry reads at every time ([`Orbit::frame`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Argument of latitude at t = 0: the noon's plus the phase from it, rad.
+    u0: f64,
+    /// [`Orbit::nodal_rate`], rad/s.
+    node_rate: f64,
+    /// Sine and cosine of the inclination.
+    inclination: (f64, f64),
+}
+
+/// Angle between the satellite's direction `sat` and the anti-Sun direction (`sun` the Sun's),
+/// both unit and from the Earth's centre, rad in [0, π]: the atan2 of |sat × S| and −sat·S,
+/// accurate at both ends, unlike acos.
+fn anti_sun_angle_between(sat: [f64; 3], sun: [f64; 3]) -> f64 {
+    norm(cross(sat, sun)).atan2(-dot(sat, sun))
+}
+
 impl Orbit {
     /// The paper's scenario: GEO at equinox, cylindrical shadow, t = 0 at the subsolar point.
     pub fn geo_equinox() -> Self {
@@ -415,12 +433,41 @@ impl Orbit {
         [cl, ce * sl, se * sl]
     }
 
+    /// What the geometry of an inclined orbit takes at every time but that does not change with
+    /// it, computed once for the many times a run reads its loads (the same bits as computing
+    /// them at each time).
+    pub fn frame(&self) -> Frame {
+        if self.equatorial() {
+            // Unread: the equatorial orbit keeps its own arithmetic.
+            return Frame {
+                u0: 0.0,
+                node_rate: 0.0,
+                inclination: (0.0, 1.0),
+            };
+        }
+        Frame {
+            u0: self.noon(0.0) + self.phase0,
+            node_rate: self.nodal_rate(),
+            inclination: self.inclination.sin_cos(),
+        }
+    }
+
     /// The orbit plane at time t: the node direction P, the direction Q a quarter orbit on, and
     /// the normal h (u = 0 at P, u = π/2 at Q).
     fn plane(&self, t: f64) -> [[f64; 3]; 3] {
-        let node = self.raan + self.nodal_rate() * t;
+        let frame = Frame {
+            u0: 0.0, // unread
+            node_rate: self.nodal_rate(),
+            inclination: self.inclination.sin_cos(),
+        };
+        self.plane_in(&frame, t)
+    }
+
+    /// [`Orbit::plane`] with the orbit's constants from `frame`.
+    fn plane_in(&self, frame: &Frame, t: f64) -> [[f64; 3]; 3] {
+        let node = self.raan + frame.node_rate * t;
         let (so, co) = node.sin_cos();
-        let (si, ci) = self.inclination.sin_cos();
+        let (si, ci) = frame.inclination;
         [
             [co, so, 0.0],
             [-ci * so, ci * co, si],
@@ -448,9 +495,14 @@ impl Orbit {
     /// [`Orbit::sun_direction`]. On the equatorial orbit the satellite is the orbit phase past
     /// the Sun's meridian (its right ascension plus the phase), as the shadow sees it.
     pub fn position(&self, t: f64) -> [f64; 3] {
+        self.position_in(&self.frame(), t)
+    }
+
+    /// [`Orbit::position`] with the orbit's constants from `frame`.
+    pub fn position_in(&self, frame: &Frame, t: f64) -> [f64; 3] {
         if !self.equatorial() {
-            let [p, q, _] = self.plane(t);
-            let (su, cu) = self.latitude_argument(t).sin_cos();
+            let [p, q, _] = self.plane_in(frame, t);
+            let (su, cu) = (frame.u0 + 2.0 * PI / self.period * t).sin_cos();
             return [0, 1, 2].map(|k| cu * p[k] + su * q[k]);
         }
         let phase = if self.season {
@@ -472,7 +524,7 @@ impl Orbit {
 
     /// Argument of latitude of the satellite, u(t) = u₀ + n t, rad.
     fn latitude_argument(&self, t: f64) -> f64 {
-        self.noon(0.0) + self.phase0 + 2.0 * PI / self.period * t
+        self.frame().u0 + 2.0 * PI / self.period * t
     }
 
     /// The Sun's angle to the orbit plane at time t, rad in [−π/2, π/2], positive on the side of
@@ -485,14 +537,11 @@ impl Orbit {
         dot(self.sun_direction(t), h).clamp(-1.0, 1.0).asin()
     }
 
-    /// Angle between the satellite's direction and the anti-Sun direction, both from the
-    /// Earth's centre, rad in [0, π].
-    fn anti_sun_angle(&self, t: f64) -> f64 {
+    /// Angle between the satellite's direction and the anti-Sun direction at time t, both from
+    /// the Earth's centre, rad in [0, π]; `frame` the orbit's constants ([`Orbit::frame`]).
+    fn anti_sun_angle_in(&self, frame: &Frame, t: f64) -> f64 {
         if !self.equatorial() {
-            let sat = self.position(t);
-            let s = self.sun_direction(t);
-            // atan2 of |sat × S| and −sat·S: accurate at both ends, unlike acos.
-            return norm(cross(sat, s)).atan2(-dot(sat, s));
+            return anti_sun_angle_between(self.position_in(frame, t), self.sun_direction(t));
         }
         if !self.season {
             let beta = 2.0 * PI * t / self.period + self.phase0;
@@ -505,10 +554,10 @@ impl Orbit {
         (sd * sd + cd * cd * sb * sb).sqrt().atan2(-cd * cb)
     }
 
-    /// Seen from the satellite: the angle between the Earth's and the Sun's centres and the Sun's
-    /// angular radius, rad. For the cylinder the Sun is a point at infinity.
-    fn sky(&self, t: f64) -> (f64, f64) {
-        let psi = self.anti_sun_angle(t);
+    /// Seen from the satellite at time t, `psi` from the anti-Sun direction
+    /// ([`Orbit::anti_sun_angle_in`]): the angle between the Earth's and the Sun's centres and
+    /// the Sun's angular radius, rad. For the cylinder the Sun is a point at infinity.
+    fn sky_at(&self, psi: f64, t: f64) -> (f64, f64) {
         if self.shadow != Shadow::Penumbra {
             return (psi, 0.0);
         }
@@ -523,20 +572,48 @@ impl Orbit {
     /// Illuminated fraction of the Sun seen from the plate at time t: 1 in sunlight, 0 in umbra,
     /// in between in the penumbra.
     pub fn illumination(&self, t: f64) -> f64 {
+        self.illumination_in(&self.frame(), t)
+    }
+
+    /// [`Orbit::illumination`] with the orbit's constants from `frame`.
+    pub fn illumination_in(&self, frame: &Frame, t: f64) -> f64 {
+        match self.shadow {
+            Shadow::None => 1.0,
+            _ => self.illumination_seen(self.anti_sun_angle_in(frame, t), t),
+        }
+    }
+
+    /// The illuminated fraction at time t where the satellite is `psi` from the anti-Sun
+    /// direction.
+    fn illumination_seen(&self, psi: f64, t: f64) -> f64 {
         match self.shadow {
             Shadow::None => 1.0,
             Shadow::Cylindrical => {
-                if self.anti_sun_angle(t) < self.shadow_half_angle() {
+                if psi < self.shadow_half_angle() {
                     0.0
                 } else {
                     1.0
                 }
             }
             Shadow::Penumbra => {
-                let (sep, rho_s) = self.sky(t);
+                let (sep, rho_s) = self.sky_at(psi, t);
                 visible_fraction(rho_s, self.earth_angular_radius(), sep)
             }
         }
+    }
+
+    /// The illuminated fraction at time t of the geometry `g` there ([`Orbit::geometry_in`]):
+    /// on an inclined orbit from its directions to the satellite and the Sun.
+    pub fn illumination_of(
+        &self,
+        frame: &Frame,
+        g: &crate::inputs::heating::Geometry,
+        t: f64,
+    ) -> f64 {
+        if self.equatorial() || self.shadow == Shadow::None {
+            return self.illumination_in(frame, t);
+        }
+        self.illumination_seen(anti_sun_angle_between(g.position, g.sun), t)
     }
 
     /// Illumination to use inside the segment [a, b] between two breakpoints. With the cylinder
@@ -544,10 +621,15 @@ impl Orbit {
     /// value at the ends, where the integrator evaluates the right-hand side exactly on a
     /// discontinuity. With the penumbra s(t) is continuous and is evaluated at t.
     pub fn illumination_on(&self, t: f64, a: f64, b: f64) -> f64 {
+        self.illumination_on_in(&self.frame(), t, a, b)
+    }
+
+    /// [`Orbit::illumination_on`] with the orbit's constants from `frame`.
+    pub fn illumination_on_in(&self, frame: &Frame, t: f64, a: f64, b: f64) -> f64 {
         match self.shadow {
             Shadow::None => 1.0,
-            Shadow::Cylindrical => self.illumination(0.5 * (a + b)),
-            Shadow::Penumbra => self.illumination(t),
+            Shadow::Cylindrical => self.illumination_in(frame, 0.5 * (a + b)),
+            Shadow::Penumbra => self.illumination_in(frame, t),
         }
     }
 
@@ -683,12 +765,14 @@ impl Orbit {
     fn searched_eclipses(&self, t0: f64, t1: f64, prefilter: bool) -> Vec<Eclipse> {
         let quarter = 0.25 * self.synodic_period();
         let rho_e = self.earth_angular_radius();
+        let frame = self.frame();
+        let sky = |t: f64| self.sky_at(self.anti_sun_angle_in(&frame, t), t);
         let outer = |t: f64| {
-            let (sep, rho_s) = self.sky(t);
+            let (sep, rho_s) = sky(t);
             sep - rho_e - rho_s
         };
         let inner = |t: f64| {
-            let (sep, rho_s) = self.sky(t);
+            let (sep, rho_s) = sky(t);
             sep - rho_e + rho_s
         };
         // Passage centres: closed form on the equator, found one from the last when inclined.

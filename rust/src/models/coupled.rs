@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::inputs::heating::{Loads, Optics};
-use crate::inputs::orbit::{Orbit, Shadow};
+use crate::inputs::orbit::{Frame, Orbit, Shadow};
 use crate::inputs::panel::Panel;
 use crate::models::hinge::{
     hinge_acceleration, sin_cos_as, Hinge, HingeModel, Rigid, StructuralModel,
@@ -37,6 +37,8 @@ pub(crate) struct Sunlight {
     /// The panel's optics, which turn the Earth's heat and sunlight on the back into absorbed
     /// loads; None for a system that takes the front's sunlight only.
     optics: Option<Optics>,
+    /// The orbit's constants its geometry reads at every time.
+    frame: Frame,
     /// The orbit heats more than the front's sunlight and the optics are known: the right-hand
     /// side takes [`Sunlight::loads`] instead of [`Sunlight::flux`].
     pub(crate) face_loads: bool,
@@ -51,6 +53,7 @@ impl Sunlight {
             segment: (0.0, 0.0),
             constant_s: None,
             optics: None,
+            frame: orbit.frame(),
             face_loads: false,
         }
     }
@@ -85,7 +88,7 @@ impl Sunlight {
             Some(s) => s,
             None => {
                 let (a, b) = self.segment;
-                self.orbit.illumination_on(t, a, b)
+                self.orbit.illumination_on_in(&self.frame, t, a, b)
             }
         }
     }
@@ -94,7 +97,17 @@ impl Sunlight {
     /// without optics).
     pub(crate) fn loads(&self, t: f64) -> Loads {
         match &self.optics {
-            Some(optics) if self.face_loads => self.orbit.loads(t, self.illumination(t), optics),
+            Some(optics) if self.face_loads => {
+                // One geometry for the loads and, inside a penumbra, the illumination.
+                let g = self.orbit.geometry_in(&self.frame, t);
+                let s = match self.constant_s {
+                    None if self.orbit.shadow == Shadow::Penumbra => {
+                        self.orbit.illumination_of(&self.frame, &g, t)
+                    }
+                    _ => self.illumination(t),
+                };
+                self.orbit.loads_of(&g, t, s, optics)
+            }
             _ => Loads::sun(self.flux(t)),
         }
     }
@@ -110,7 +123,9 @@ impl Sunlight {
 
     pub(crate) fn enter(&mut self, a: f64, b: f64) {
         self.segment = (a, b);
-        let mid = self.orbit.illumination_on(0.5 * (a + b), a, b);
+        let mid = self
+            .orbit
+            .illumination_on_in(&self.frame, 0.5 * (a + b), a, b);
         let varies = matches!(self.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
         self.constant_s = if varies { None } else { Some(mid) };
     }
@@ -608,6 +623,50 @@ mod tests {
                         let whole = sys.rhs_at_loads(l, &Vector4::new(tf, tb, th, 0.4));
                         let alone = sys.temperature_rates(l, [tf, tb], th);
                         assert_eq!(alone, [whole[0], whole[1]]);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn one_geometry_for_loads_and_penumbra_gives_the_same_bits() {
+        // Drawn inclined orbits under the Earth's heat, at times in and around each penumbra:
+        // the loads a system reads with the orbit's constants computed once and one geometry
+        // for the loads and the illumination are, bit for bit, those of the orbit alone.
+        let mut draw = crate::numerics::testing::uniform_draws(2024);
+        let optics = Optics::of(&Panel::paper());
+        for _ in 0..40 {
+            let orbit = Orbit {
+                inclination: 1.5 * draw() + 0.01,
+                raan: 6.0 * draw(),
+                epoch_day: 365.0 * draw(),
+                phase0: draw() - 0.5,
+                season: true,
+                eccentric_sun: true,
+                j2: true,
+                shadow: Shadow::Penumbra,
+                albedo: 0.3,
+                earth_ir: 237.0,
+                ..Orbit::leo(400e3 + 800e3 * draw())
+            };
+            let sun = Sunlight::with_optics(orbit, optics);
+            let frame = orbit.frame();
+            for e in orbit.eclipses(0.0, 3.0 * orbit.period) {
+                let (a, b) = e.outer;
+                let (ua, ub) = e.umbra.unwrap_or((b, b));
+                for (from, to) in [(a - 30.0, a), (a, ua), (ua, ub), (ub, b), (b, b + 30.0)] {
+                    let mut seg = sun;
+                    seg.enter(from, to);
+                    for k in 0..=8 {
+                        let t = from + (to - from) * k as f64 / 8.0;
+                        // The segment's s: constant outside a penumbra, the orbit's inside.
+                        let s = seg.illumination(t);
+                        if seg.constant_s.is_none() {
+                            assert_eq!(s, orbit.illumination(t));
+                        }
+                        assert_eq!(seg.loads(t), orbit.loads(t, s, &optics), "t = {t}");
+                        assert_eq!(orbit.position_in(&frame, t), orbit.position(t));
                     }
                 }
             }
