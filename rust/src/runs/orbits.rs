@@ -570,6 +570,13 @@ impl<V: SummaryView> Collector<V> {
         (edges, n)
     }
 
+    /// Whether a window's edge lies strictly inside (t0, t1) or the current orbit ends by t1.
+    #[cold]
+    #[inline(never)]
+    fn edge_or_end_in(&self, t0: f64, t1: f64) -> bool {
+        self.window_edges_in(t0, t1).1 > 0 || t1 >= self.current.t_end
+    }
+
     /// The span of the current orbit around t between the edges of its windows (and its end),
     /// where being inside a window or not cannot change.
     fn calm_around(&self, t: f64) -> Calm {
@@ -891,11 +898,14 @@ impl LaneObserver for SummaryObserver<'_, TwoLayerView> {
     fn on_reads(&mut self, r: &StepReads) -> Option<ControlFlow<()>> {
         let c = &mut self.collector;
         let [r0, r_mid, r1] = r.rising;
-        // A window's edge or the orbit's end in the step: read from the dense step.
-        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0)
-            || c.window_edges_in(r.t0, r.t1).1 > 0
-            || r.t1 >= c.current.t_end
-        {
+        if !(r0 == r_mid && r_mid == r1 && c.end.0 == r.t0) {
+            return None;
+        }
+        // A window's edge or the orbit's end in the step: read from the dense step. A step that
+        // ends inside the calm span (nearly every step; it starts where the last one read,
+        // past the span's start) holds neither.
+        let in_calm = r.t1 < c.calm.to; // false before any calm span (NaN)
+        if !in_calm && c.edge_or_end_in(r.t0, r.t1) {
             return None;
         }
         if let Err(e) = self.cancel.check() {
