@@ -602,18 +602,14 @@ impl Orbit {
         }
     }
 
-    /// The illuminated fraction at time t of the geometry `g` there ([`Orbit::geometry_in`]):
-    /// on an inclined orbit from its directions to the satellite and the Sun.
-    pub fn illumination_of(
-        &self,
-        frame: &Frame,
-        g: &crate::inputs::heating::Geometry,
-        t: f64,
-    ) -> f64 {
+    /// The illuminated fraction at time t with the satellite's and the Sun's directions `sat` and
+    /// `sun` there (unit, from the Earth's centre: a geometry's, [`Orbit::geometry_in`]): on an
+    /// inclined orbit from them, else as [`Orbit::illumination_in`].
+    pub fn illumination_between(&self, frame: &Frame, sat: [f64; 3], sun: [f64; 3], t: f64) -> f64 {
         if self.equatorial() || self.shadow == Shadow::None {
             return self.illumination_in(frame, t);
         }
-        self.illumination_seen(anti_sun_angle_between(g.position, g.sun), t)
+        self.illumination_seen(anti_sun_angle_between(sat, sun), t)
     }
 
     /// Illumination to use inside the segment [a, b] between two breakpoints. With the cylinder

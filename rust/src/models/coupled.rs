@@ -101,9 +101,9 @@ impl Sunlight {
                 // One geometry for the loads and, inside a penumbra, the illumination.
                 let g = self.orbit.geometry_in(&self.frame, t);
                 let s = match self.constant_s {
-                    None if self.orbit.shadow == Shadow::Penumbra => {
-                        self.orbit.illumination_of(&self.frame, &g, t)
-                    }
+                    None if self.orbit.shadow == Shadow::Penumbra => self
+                        .orbit
+                        .illumination_between(&self.frame, g.position, g.sun, t),
                     _ => self.illumination(t),
                 };
                 self.orbit.loads_of(&g, t, s, optics)
