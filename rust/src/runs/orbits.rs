@@ -475,6 +475,20 @@ impl<V: SummaryView> Collector<V> {
         }
     }
 
+    /// θ at t strictly inside `step` read beside the step's own points (no share of
+    /// ∫(dynamic)²): a window's edge or the orbit's end. Past the limit the step's own reads
+    /// mark the crossing. Returns θ there.
+    pub(crate) fn read_inside<D: Dim>(&mut self, step: &DenseStep<D>, t: f64) -> Result<f64>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let p = self.inside_point(step, t, step.eval(t).as_slice());
+        if p.theta.abs() <= self.options.theta_limit {
+            self.record(t, p.theta, p.theta, p.dynamic.abs(), 0.0, 0.0)?;
+        }
+        Ok(p.theta)
+    }
+
     /// The end (t, y) of a step with its slope `dy` there, as the summaries read it.
     #[inline]
     pub(crate) fn end_point(&self, t: f64, y: &[f64], dy: &[f64]) -> Point {
@@ -549,9 +563,10 @@ impl<V: SummaryView> Collector<V> {
         Ok(())
     }
 
-    /// The edges of the current orbit's windows after entry and exit strictly inside (t0, t1)
-    /// and within the orbit, as (their times, how many): where a window's extreme lies while θ
-    /// still moves, which a step's middle and end miss by up to half a step.
+    /// The edges of the current orbit's windows after entry and exit strictly inside (t0, t1),
+    /// in the order entry, entry + window, exit, exit + window, as (their times, how many):
+    /// where a window's extreme lies while θ still moves, which a step's middle and end miss by
+    /// up to half a step.
     pub(crate) fn window_edges_in(&self, t0: f64, t1: f64) -> ([f64; 4], usize) {
         let mut edges = [0.0; 4];
         let mut n = 0;
@@ -562,7 +577,7 @@ impl<V: SummaryView> Collector<V> {
         let s = &self.current;
         let w = self.options.window;
         for edge in [s.t_entry, s.t_entry + w, s.t_exit, s.t_exit + w] {
-            if edge > t0 && edge < t1 && edge <= s.t_end {
+            if edge > t0 && edge < t1 {
                 edges[n] = edge;
                 n += 1;
             }
@@ -570,7 +585,8 @@ impl<V: SummaryView> Collector<V> {
         (edges, n)
     }
 
-    /// Whether a window's edge lies strictly inside (t0, t1) or the current orbit ends by t1.
+    /// Whether a window's edge lies strictly inside (t0, t1) or the current orbit ends by t1 (an
+    /// edge past the orbit's end is then in the step too).
     #[cold]
     #[inline(never)]
     fn edge_or_end_in(&self, t0: f64, t1: f64) -> bool {
@@ -788,41 +804,30 @@ where
         }
         let c = &mut self.collector;
         let (t0, t1) = (step.t0, step.t1);
-        // A window's edge inside the step: θ read there too (no share of ∫(dynamic)²).
-        let (edges, n_edges) = c.window_edges_in(t0, t1);
-        for &edge in &edges[..n_edges] {
-            let p = c.inside_point(step, edge, step.eval(edge).as_slice());
-            // Past the limit the step's own reads mark the crossing.
-            if p.theta.abs() <= c.options.theta_limit {
-                if let Err(e) = c.record(edge, p.theta, p.theta, p.dynamic.abs(), 0.0, 0.0) {
-                    return self.after(Err(e));
-                }
-            }
-        }
-        let c = &mut self.collector;
         let end_point = |c: &Collector<V>| match step.end_slope() {
             Some(dy) => c.end_point(t1, step.y1.as_slice(), dy.as_slice()),
             None => c.point(t1, step.y1.as_slice()),
         };
-        // The orbit's end inside the step (read there too) or at its end: the next orbit
-        // starts with θ there.
+        // The edges of the current orbit's windows inside the step, then its end inside the
+        // step, read there too; the next orbit starts with θ at that end.
         let orbit_end = c.current.t_end;
-        if t0 < orbit_end && orbit_end <= t1 {
-            let p = if orbit_end == t1 {
-                end_point(c)
-            } else {
-                c.inside_point(step, orbit_end, step.eval(orbit_end).as_slice())
-            };
-            if orbit_end < t1 && p.theta.abs() <= c.options.theta_limit {
-                let read = c.record(orbit_end, p.theta, p.theta, p.dynamic.abs(), 0.0, 0.0);
-                if let Err(e) = read {
-                    return self.after(Err(e));
-                }
+        let (edges, n_edges) = c.window_edges_in(t0, t1);
+        for &edge in edges[..n_edges].iter().filter(|&&e| e <= orbit_end) {
+            if let Err(e) = c.read_inside(step, edge) {
+                return self.after(Err(e));
             }
-            let c = &mut self.collector;
-            c.orbit_starts(orbit_end, p.theta);
         }
-        let c = &mut self.collector;
+        if t0 < orbit_end && orbit_end <= t1 {
+            let theta = if orbit_end == t1 {
+                end_point(c).theta
+            } else {
+                match c.read_inside(step, orbit_end) {
+                    Ok(theta) => theta,
+                    Err(e) => return self.after(Err(e)),
+                }
+            };
+            c.orbit_starts(orbit_end, theta);
+        }
         let (t_mid, y_mid) = step.midpoint();
         let rate = |y: &State<D>| c.view.rate(y.as_slice()) > 0.0;
         let (r0, r_mid, r1) = (rate(&step.y0), rate(&y_mid), rate(&step.y1));

@@ -1172,8 +1172,6 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
     /// times: a window's extreme is read where it ends, not at the nearest quarter (θ still
     /// falls there as the panel cools).
     fn with_window_edges(&self, base: &[f64], t0: f64, t1: f64) -> Vec<(f64, f64)> {
-        let s = &self.obs.collector.current;
-        let w = self.obs.collector.options.window;
         let at = |frac: f64| {
             if frac == 1.0 {
                 t1
@@ -1182,10 +1180,9 @@ impl<const N: usize, M: HybridModel<N>> Driver<'_, N, M> {
             }
         };
         let mut points: Vec<(f64, f64)> = base.iter().map(|&f| (f, at(f))).collect();
-        for edge in [s.t_entry, s.t_entry + w, s.t_exit, s.t_exit + w] {
-            if edge > t0 && edge < t1 {
-                points.push(((edge - t0) / (t1 - t0), edge));
-            }
+        let (edges, n) = self.obs.collector.window_edges_in(t0, t1);
+        for &edge in &edges[..n] {
+            points.push(((edge - t0) / (t1 - t0), edge));
         }
         points.sort_by(|a, b| a.1.total_cmp(&b.1));
         points.dedup_by(|a, b| a.1 == b.1);
