@@ -38,22 +38,29 @@ use std::f64::consts::PI;
 /// (the plate's plane cuts the sphere), with x = sqrt(H² − 1):
 /// F = 1/2 − asin(x / (H sin λ))/π + [cos λ acos(−x cot λ) − x sqrt(1 − H² cos²λ)] / (π H²).
 pub fn earth_view_factor(cos_lambda: f64, h: f64) -> f64 {
+    earth_view_factors(cos_lambda, h).0
+}
+
+/// [`earth_view_factor`] of a plate's two faces, the front's normal at `cos_lambda` to the
+/// direction of the sphere and the back's opposite: (front, back). Where the plate's plane cuts
+/// the sphere both faces share the arcsine, and the back's arccosine is π less the front's.
+pub fn earth_view_factors(cos_lambda: f64, h: f64) -> (f64, f64) {
     let c = cos_lambda.clamp(-1.0, 1.0);
     let h2 = h * h;
     if c * h >= 1.0 {
-        return c / h2;
+        return (c / h2, 0.0);
     }
     if c * h <= -1.0 {
-        return 0.0;
+        return (0.0, -c / h2);
     }
     let x = (h2 - 1.0).sqrt();
     let s = (1.0 - c * c).sqrt();
-    // s > 0 here: |c| < 1/H < 1.
     let first = 0.5 - (x / (h * s)).min(1.0).asin() / PI;
-    let cot = c / s;
-    let second = (c * (-x * cot).clamp(-1.0, 1.0).acos() - x * (1.0 - h2 * c * c).max(0.0).sqrt())
-        / (PI * h2);
-    (first + second).max(0.0)
+    let arc = (-x * (c / s)).clamp(-1.0, 1.0).acos();
+    let chord = x * (1.0 - h2 * c * c).max(0.0).sqrt();
+    let front = first + (c * arc - chord) / (PI * h2);
+    let back = first + (-c * (PI - arc) - chord) / (PI * h2);
+    (front.max(0.0), back.max(0.0))
 }
 
 /// The panel's optical properties that turn incident fluxes into absorbed ones.
@@ -191,10 +198,7 @@ impl Sources {
         let h = self.height_ratio;
         // The direction to the Earth's centre is −position.
         let cos_front = -dot(normal, self.position);
-        let (view_front, view_back) = (
-            earth_view_factor(cos_front, h),
-            earth_view_factor(-cos_front, h),
-        );
+        let (view_front, view_back) = earth_view_factors(cos_front, h);
         FaceFluxes {
             sun_front: self.direct * cos_sun.max(0.0),
             sun_back: self.direct * (-cos_sun).max(0.0),
@@ -213,6 +217,8 @@ pub struct Geometry {
     pub sun: [f64; 3],
     pub position: [f64; 3],
     pub normal: [f64; 3],
+    /// The Sun's flux there relative to 1 au ([`Orbit::flux_scale`]).
+    pub flux_scale: f64,
 }
 
 impl Orbit {
@@ -231,7 +237,7 @@ impl Orbit {
 
     /// [`Orbit::geometry`] with the orbit's constants from `frame`.
     pub fn geometry_in(&self, frame: &Frame, t: f64) -> Geometry {
-        let sun = self.sun_direction(t);
+        let sun = self.sun_direction_in(frame, t);
         let position = self.position_in(frame, t);
         let normal = match self.attitude {
             Attitude::SunPointing => sun,
@@ -257,26 +263,27 @@ impl Orbit {
             sun,
             position,
             normal,
+            flux_scale: self.flux_scale_in(frame, t),
         }
     }
 
     /// Incident fluxes on each face at time t for the illuminated fraction `s` of the Sun and a
     /// solar constant C (W/m²), before the structure's area factor.
     pub fn face_fluxes(&self, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
-        self.face_fluxes_of(&self.geometry(t), t, s, solar_constant)
+        self.face_fluxes_of(&self.geometry(t), s, solar_constant)
     }
 
-    /// [`Orbit::face_fluxes`] of the geometry `g` at time t ([`Orbit::geometry_in`]).
-    pub fn face_fluxes_of(&self, g: &Geometry, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
-        self.sources(g, t, s, solar_constant)
+    /// [`Orbit::face_fluxes`] of the geometry `g` of a time ([`Orbit::geometry_in`]).
+    pub fn face_fluxes_of(&self, g: &Geometry, s: f64, solar_constant: f64) -> FaceFluxes {
+        self.sources(g, s, solar_constant)
             .fluxes(g.normal, self.attitude == Attitude::SunPointing)
     }
 
-    /// What heats a flat face at time t, whatever its normal: the Sun's and the satellite's
+    /// What heats a flat face at the time of the geometry `g`, whatever its normal: the Sun's and the satellite's
     /// directions, the direct sunlight C · scale · s, the albedo's sunlit-Earth factor
     /// a · C · scale · max(cos Z, 0), the Earth's infrared and H = r/R_E.
-    pub fn sources(&self, g: &Geometry, t: f64, s: f64, solar_constant: f64) -> Sources {
-        let sunlight = solar_constant * self.flux_scale(t);
+    pub fn sources(&self, g: &Geometry, s: f64, solar_constant: f64) -> Sources {
+        let sunlight = solar_constant * g.flux_scale;
         Sources {
             sun: g.sun,
             position: g.position,
@@ -294,10 +301,10 @@ impl Orbit {
             .absorbed(optics)
     }
 
-    /// The loads at time t of the geometry `g` there ([`Orbit::geometry_in`]) for the
+    /// The loads at the time of the geometry `g` ([`Orbit::geometry_in`]) for the
     /// illuminated fraction `s`: [`Orbit::loads`] without computing the geometry again.
-    pub fn loads_of(&self, g: &Geometry, t: f64, s: f64, optics: &Optics) -> Loads {
-        self.face_fluxes_of(g, t, s, optics.solar_constant)
+    pub fn loads_of(&self, g: &Geometry, s: f64, optics: &Optics) -> Loads {
+        self.face_fluxes_of(g, s, optics.solar_constant)
             .absorbed(optics)
     }
 
@@ -498,6 +505,38 @@ mod tests {
                 earth_view_factor(edge - 1e-12, h),
             );
             assert!((a - b).abs() < 1e-9, "{a} {b}");
+        }
+    }
+
+    /// The two faces' view factors at once are each face's alone: the back's is the front's
+    /// formula at the opposite normal (the arcsine shared, the arccosine π less the front's),
+    /// on drawn heights and angles, the edges of full view and of no view included.
+    #[test]
+    fn both_faces_view_factors_are_each_faces_own() {
+        let mut draw = crate::numerics::testing::uniform_draws(77);
+        for _ in 0..20_000 {
+            let h = 1.0 + 1e-3 + 8.0 * draw() * draw();
+            let c = match (draw() * 4.0) as u32 {
+                0 => 1.0 / h * (1.0 + 1e-9 * (draw() - 0.5)),
+                1 => -1.0 / h * (1.0 + 1e-9 * (draw() - 0.5)),
+                _ => 2.0 * draw() - 1.0,
+            };
+            let (front, back) = earth_view_factors(c, h);
+            assert_eq!(front, earth_view_factor(c, h));
+            let alone = earth_view_factor(-c, h);
+            assert!(
+                (back - alone).abs() <= 1e-15,
+                "H {h} cos {c}: {back} vs {alone}"
+            );
+        }
+        for deg in [0.0_f64, 60.0, 95.0, 120.0, 180.0] {
+            let lambda = deg.to_radians();
+            let back = earth_view_factors(lambda.cos(), 1.2).1;
+            let numeric = view_factor_by_quadrature(PI - lambda, 1.2);
+            assert!(
+                (back - numeric).abs() < 2e-5,
+                "λ {deg}°: {back} vs {numeric}"
+            );
         }
     }
 

@@ -186,6 +186,79 @@ pub struct Frame {
     node_rate: f64,
     /// Sine and cosine of the inclination.
     inclination: (f64, f64),
+    /// The slowly turning angles near a reference time ([`Orbit::frame_near`]), when a run
+    /// reads its loads many times there.
+    sky: Option<Sky>,
+}
+
+/// The angles that turn slowly against an orbit — the Sun's ecliptic longitude, the node's
+/// precession, the Earth's mean anomaly — as sines and cosines at a reference time and their
+/// rates: near it each is that sine and cosine turned by a small angle (a series exact to
+/// rounding), where a run would otherwise take a sine and cosine of each at every load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Sky {
+    t_ref: f64,
+    /// How far from `t_ref` (s) every angle stays within [`SMALL_TURN`].
+    reach: f64,
+    longitude: Turning,
+    node: Turning,
+    anomaly: Turning,
+    /// Sine and cosine of the obliquity.
+    obliquity: (f64, f64),
+}
+
+/// The largest turn (rad) of a [`Sky`]'s angles from their reference: the series of
+/// [`small_sin_cos`] to x¹¹ is exact to rounding there (its first term left out, x¹³/13!, is
+/// 2e-23).
+const SMALL_TURN: f64 = 0.1;
+
+/// Sine and cosine of an angle at a reference time, and its rate, rad/s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Turning {
+    sin: f64,
+    cos: f64,
+    rate: f64,
+}
+
+impl Turning {
+    fn new(angle: f64, rate: f64) -> Self {
+        let (sin, cos) = angle.sin_cos();
+        Turning { sin, cos, rate }
+    }
+
+    /// Sine and cosine `dt` after the reference time (|rate dt| ≤ [`SMALL_TURN`]).
+    #[inline]
+    fn after(&self, dt: f64) -> (f64, f64) {
+        let (s, c) = small_sin_cos(self.rate * dt);
+        (self.sin * c + self.cos * s, self.cos * c - self.sin * s)
+    }
+}
+
+/// sin x and cos x for |x| ≤ [`SMALL_TURN`], by their Taylor series to x¹¹ and x¹².
+#[inline]
+fn small_sin_cos(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    let sin = x
+        * (1.0
+            - x2 / 6.0
+                * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0 * (1.0 - x2 / 110.0)))));
+    let cos = 1.0
+        - x2 / 2.0
+            * (1.0
+                - x2 / 12.0
+                    * (1.0
+                        - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0 * (1.0 - x2 / 132.0)))));
+    (sin, cos)
+}
+
+impl Frame {
+    /// The sky near t, when the frame has a reference that reaches it.
+    #[inline]
+    fn sky_near(&self, t: f64) -> Option<(&Sky, f64)> {
+        let sky = self.sky.as_ref()?;
+        let dt = t - sky.t_ref;
+        (dt.abs() <= sky.reach).then_some((sky, dt))
+    }
 }
 
 /// Angle between the satellite's direction `sat` and the anti-Sun direction (`sun` the Sun's),
@@ -433,6 +506,40 @@ impl Orbit {
         [cl, ce * sl, se * sl]
     }
 
+    /// [`Orbit::sun_direction`] near `frame`'s reference time ([`Orbit::frame_near`]).
+    #[inline]
+    pub fn sun_direction_in(&self, frame: &Frame, t: f64) -> [f64; 3] {
+        match frame.sky_near(t) {
+            Some((sky, dt)) if self.season => {
+                let (sl, cl) = sky.longitude.after(dt);
+                let (se, ce) = sky.obliquity;
+                [cl, ce * sl, se * sl]
+            }
+            _ => self.sun_direction(t),
+        }
+    }
+
+    /// [`Orbit::sun_distance_au`] near `frame`'s reference time ([`Orbit::frame_near`]).
+    #[inline]
+    pub fn sun_distance_au_in(&self, frame: &Frame, t: f64) -> f64 {
+        match frame.sky_near(t) {
+            Some((sky, dt)) if self.eccentric_sun => {
+                1.0 - EARTH_ECCENTRICITY * sky.anomaly.after(dt).1
+            }
+            _ => self.sun_distance_au(t),
+        }
+    }
+
+    /// [`Orbit::flux_scale`] near `frame`'s reference time ([`Orbit::frame_near`]).
+    #[inline]
+    pub fn flux_scale_in(&self, frame: &Frame, t: f64) -> f64 {
+        if !self.eccentric_sun {
+            return 1.0;
+        }
+        let r = self.sun_distance_au_in(frame, t);
+        1.0 / (r * r)
+    }
+
     /// What the geometry of an inclined orbit takes at every time but that does not change with
     /// it, computed once for the many times a run reads its loads (the same bits as computing
     /// them at each time).
@@ -443,12 +550,50 @@ impl Orbit {
                 u0: 0.0,
                 node_rate: 0.0,
                 inclination: (0.0, 1.0),
+                sky: None,
             };
         }
         Frame {
             u0: self.noon(0.0) + self.phase0,
             node_rate: self.nodal_rate(),
             inclination: self.inclination.sin_cos(),
+            sky: None,
+        }
+    }
+
+    /// [`Orbit::frame`] with the slowly turning angles referred to `t_ref`: for the many loads a
+    /// run reads near it (a segment's), each of those angles' sine and cosine by a small turn
+    /// from there instead of their own (the same values to rounding). Times beyond the
+    /// reference's reach take their own. The equatorial orbit keeps its own arithmetic (the
+    /// presets' runs, recorded to the bit).
+    pub fn frame_near(&self, t_ref: f64) -> Frame {
+        if self.equatorial() {
+            return self.frame();
+        }
+        let year = 2.0 * PI / (YEAR_DAYS * DAY);
+        let node_rate = self.nodal_rate();
+        let rates = [
+            if self.season { year } else { 0.0 },
+            node_rate,
+            if self.eccentric_sun { year } else { 0.0 },
+        ];
+        let fastest = rates.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        let reach = if fastest > 0.0 {
+            SMALL_TURN / fastest
+        } else {
+            f64::INFINITY
+        };
+        let day = self.day_of_year(t_ref);
+        Frame {
+            sky: Some(Sky {
+                t_ref,
+                reach,
+                longitude: Turning::new(2.0 * PI * (day - EQUINOX_DAY) / YEAR_DAYS, year),
+                node: Turning::new(self.raan + node_rate * t_ref, node_rate),
+                anomaly: Turning::new(2.0 * PI * (day - PERIHELION_DAY) / YEAR_DAYS, year),
+                obliquity: OBLIQUITY.sin_cos(),
+            }),
+            ..self.frame()
         }
     }
 
@@ -459,14 +604,17 @@ impl Orbit {
             u0: 0.0, // unread
             node_rate: self.nodal_rate(),
             inclination: self.inclination.sin_cos(),
+            sky: None,
         };
         self.plane_in(&frame, t)
     }
 
     /// [`Orbit::plane`] with the orbit's constants from `frame`.
     fn plane_in(&self, frame: &Frame, t: f64) -> [[f64; 3]; 3] {
-        let node = self.raan + frame.node_rate * t;
-        let (so, co) = node.sin_cos();
+        let (so, co) = match frame.sky_near(t) {
+            Some((sky, dt)) => sky.node.after(dt),
+            None => (self.raan + frame.node_rate * t).sin_cos(),
+        };
         let (si, ci) = frame.inclination;
         [
             [co, so, 0.0],
@@ -541,7 +689,10 @@ impl Orbit {
     /// the Earth's centre, rad in [0, π]; `frame` the orbit's constants ([`Orbit::frame`]).
     fn anti_sun_angle_in(&self, frame: &Frame, t: f64) -> f64 {
         if !self.equatorial() {
-            return anti_sun_angle_between(self.position_in(frame, t), self.sun_direction(t));
+            return anti_sun_angle_between(
+                self.position_in(frame, t),
+                self.sun_direction_in(frame, t),
+            );
         }
         if !self.season {
             let beta = 2.0 * PI * t / self.period + self.phase0;
@@ -557,11 +708,11 @@ impl Orbit {
     /// Seen from the satellite at time t, `psi` from the anti-Sun direction
     /// ([`Orbit::anti_sun_angle_in`]): the angle between the Earth's and the Sun's centres and
     /// the Sun's angular radius, rad. For the cylinder the Sun is a point at infinity.
-    fn sky_at(&self, psi: f64, t: f64) -> (f64, f64) {
+    fn sky_at(&self, frame: &Frame, psi: f64, t: f64) -> (f64, f64) {
         if self.shadow != Shadow::Penumbra {
             return (psi, 0.0);
         }
-        let d = AU * self.sun_distance_au(t);
+        let d = AU * self.sun_distance_au_in(frame, t);
         let (sp, cp) = psi.sin_cos();
         let r = self.radius;
         let separation = (d * sp).atan2(r + d * cp);
@@ -579,13 +730,13 @@ impl Orbit {
     pub fn illumination_in(&self, frame: &Frame, t: f64) -> f64 {
         match self.shadow {
             Shadow::None => 1.0,
-            _ => self.illumination_seen(self.anti_sun_angle_in(frame, t), t),
+            _ => self.illumination_seen(frame, self.anti_sun_angle_in(frame, t), t),
         }
     }
 
     /// The illuminated fraction at time t where the satellite is `psi` from the anti-Sun
     /// direction.
-    fn illumination_seen(&self, psi: f64, t: f64) -> f64 {
+    fn illumination_seen(&self, frame: &Frame, psi: f64, t: f64) -> f64 {
         match self.shadow {
             Shadow::None => 1.0,
             Shadow::Cylindrical => {
@@ -596,7 +747,7 @@ impl Orbit {
                 }
             }
             Shadow::Penumbra => {
-                let (sep, rho_s) = self.sky_at(psi, t);
+                let (sep, rho_s) = self.sky_at(frame, psi, t);
                 visible_fraction(rho_s, self.earth_angular_radius(), sep)
             }
         }
@@ -609,7 +760,7 @@ impl Orbit {
         if self.equatorial() || self.shadow == Shadow::None {
             return self.illumination_in(frame, t);
         }
-        self.illumination_seen(anti_sun_angle_between(sat, sun), t)
+        self.illumination_seen(frame, anti_sun_angle_between(sat, sun), t)
     }
 
     /// Illumination to use inside the segment [a, b] between two breakpoints. With the cylinder
@@ -762,7 +913,7 @@ impl Orbit {
         let quarter = 0.25 * self.synodic_period();
         let rho_e = self.earth_angular_radius();
         let frame = self.frame();
-        let sky = |t: f64| self.sky_at(self.anti_sun_angle_in(&frame, t), t);
+        let sky = |t: f64| self.sky_at(&frame, self.anti_sun_angle_in(&frame, t), t);
         let outer = |t: f64| {
             let (sep, rho_s) = sky(t);
             sep - rho_e - rho_s
@@ -937,19 +1088,72 @@ pub fn visible_fraction(rho_s: f64, rho_e: f64, sep: f64) -> f64 {
 
 /// The time where the increasing-away-from-`neg` function f changes sign, between `neg`
 /// (f < 0) and `pos` (f ≥ 0), by bisection to 1e-7 s.
+///
+/// The bisection's answer, found with few evaluations of f: the sign change is first bracketed
+/// tightly by regula falsi ([`sign_change_bracket`]); a bisection point outside that bracket
+/// takes the sign f has there (f is monotonic on each side), one inside it evaluates f. So the
+/// result is the plain bisection's to the bit, at about a third of its evaluations.
 fn bisect(f: impl Fn(f64) -> f64, mut neg: f64, mut pos: f64) -> f64 {
+    let (low, high) = sign_change_bracket(&f, neg, pos);
+    let (lo, hi) = (low.min(high), low.max(high));
     for _ in 0..200 {
         let mid = 0.5 * (neg + pos);
         if (pos - neg).abs() < 1e-7 || mid == neg || mid == pos {
             break;
         }
-        if f(mid) < 0.0 {
+        let negative = if mid < lo || mid > hi {
+            // Outside the bracket: on neg's side of it f < 0, on pos's f ≥ 0.
+            (mid - low).abs() < (mid - high).abs()
+        } else {
+            f(mid) < 0.0
+        };
+        if negative {
             neg = mid;
         } else {
             pos = mid;
         }
     }
     0.5 * (neg + pos)
+}
+
+/// Points `(low, high)` within 1e-9 s of each other (or a few roundings of t) with
+/// f(low) < 0 ≤ f(high), between `neg` (f < 0) and `pos` (f ≥ 0): the Illinois variant of
+/// regula falsi (the end kept twice has its value halved: ~10 evaluations on the eclipse's
+/// functions), every step at least half the tolerance inside the bracket (a step onto the sign
+/// change then closes it from the other side). After 40 steps the bracket as it stands.
+fn sign_change_bracket(f: &impl Fn(f64) -> f64, neg: f64, pos: f64) -> (f64, f64) {
+    let (mut a, mut fa) = (neg, f(neg));
+    let (mut b, mut fb) = (pos, f(pos));
+    if !(fa < 0.0 && fb >= 0.0) {
+        // Not the bracket the caller promised: the whole interval, every point evaluated.
+        return (neg, pos);
+    }
+    let tolerance = (1e-9_f64).max(4.0 * f64::EPSILON * a.abs().max(b.abs()));
+    // Which end the last step moved: -1 the negative one, 1 the positive one.
+    let mut moved = 0_i8;
+    for _ in 0..40 {
+        if (b - a).abs() <= tolerance {
+            break;
+        }
+        let x = b - fb * (b - a) / (fb - fa);
+        let (lo, hi) = (a.min(b), a.max(b));
+        let x = x.clamp(lo + 0.5 * tolerance, hi - 0.5 * tolerance);
+        let fx = f(x);
+        if fx < 0.0 {
+            (a, fa) = (x, fx);
+            if moved == -1 {
+                fb *= 0.5;
+            }
+            moved = -1;
+        } else {
+            (b, fb) = (x, fx);
+            if moved == 1 {
+                fa *= 0.5;
+            }
+            moved = 1;
+        }
+    }
+    (a, b)
 }
 
 /// The minimum of a unimodal f on [a, b] by golden-section search, to 1e-3 s.
@@ -961,6 +1165,161 @@ fn golden_min(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::cell::Cell;
+
+    /// Bisection to 1e-7 s as it was written before its bracket: the reference of [`bisect`].
+    fn plain_bisection(f: impl Fn(f64) -> f64, mut neg: f64, mut pos: f64) -> f64 {
+        for _ in 0..200 {
+            let mid = 0.5 * (neg + pos);
+            if (pos - neg).abs() < 1e-7 || mid == neg || mid == pos {
+                break;
+            }
+            if f(mid) < 0.0 {
+                neg = mid;
+            } else {
+                pos = mid;
+            }
+        }
+        0.5 * (neg + pos)
+    }
+
+    /// The bracketed bisection gives the plain one's bits on drawn monotonic functions (flat at
+    /// `neg` like the eclipse functions at the deepest point, steep, kinked, at times up to ten
+    /// years) and on the eclipses of drawn inclined orbits, where it takes under a third of the
+    /// evaluations (measured 1716 against 5489).
+    #[test]
+    fn the_bracketed_bisection_is_the_plain_ones_to_the_bit() {
+        let mut draw = crate::numerics::testing::uniform_draws(99);
+        for _ in 0..3000 {
+            let t0 = 3e8 * draw() * draw();
+            let span = 10.0 + 3000.0 * draw();
+            let root = t0 + span * (0.01 + 0.98 * draw());
+            let power = 1.0 + 2.0 * draw();
+            let kink = draw() < 0.3;
+            let scale = 10f64.powf(-6.0 + 6.0 * draw());
+            let f = |t: f64| {
+                let d = (t - t0) / span;
+                let r = (root - t0) / span;
+                let g = d.powf(power) - r.powf(power);
+                scale * if kink && g > 0.0 { 5.0 * g } else { g }
+            };
+            for (neg, pos) in [(t0, t0 + span), (t0 + span, t0)] {
+                let f = |t: f64| {
+                    if neg < pos {
+                        f(t)
+                    } else {
+                        -f(2.0 * t0 + span - t)
+                    }
+                };
+                assert_eq!(bisect(f, neg, pos), plain_bisection(f, neg, pos));
+            }
+        }
+        // The eclipse's functions: counted.
+        let (calls, plain_calls) = (Cell::new(0_u64), Cell::new(0_u64));
+        for _ in 0..30 {
+            let o = Orbit {
+                inclination: 1.5 * draw() + 0.01,
+                raan: 6.0 * draw(),
+                epoch_day: 365.0 * draw(),
+                season: true,
+                eccentric_sun: true,
+                j2: true,
+                shadow: Shadow::Penumbra,
+                ..Orbit::leo(300e3 + 3e6 * draw())
+            };
+            let frame = o.frame();
+            let rho_e = o.earth_angular_radius();
+            let outer = |t: f64| {
+                let (sep, rho_s) = o.sky_at(&frame, o.anti_sun_angle_in(&frame, t), t);
+                sep - rho_e - rho_s
+            };
+            let t = 3e8 * draw();
+            for e in o.eclipses(t, t + 3.0 * o.period) {
+                let quarter = 0.25 * o.synodic_period();
+                for end in [e.centre - quarter, e.centre + quarter] {
+                    let counted = |t: f64| {
+                        calls.set(calls.get() + 1);
+                        outer(t)
+                    };
+                    let reference = |t: f64| {
+                        plain_calls.set(plain_calls.get() + 1);
+                        outer(t)
+                    };
+                    assert_eq!(
+                        bisect(counted, e.centre, end),
+                        plain_bisection(reference, e.centre, end)
+                    );
+                }
+            }
+        }
+        assert!(
+            3 * calls.get() < plain_calls.get(),
+            "{calls:?} vs {plain_calls:?}"
+        );
+    }
+
+    /// The small turn's series is the sine and cosine to rounding over its whole range.
+    #[test]
+    fn a_small_turn_is_its_sine_and_cosine() {
+        for k in -2000..=2000 {
+            let x = SMALL_TURN * k as f64 / 2000.0;
+            let (s, c) = small_sin_cos(x);
+            let (ws, wc) = x.sin_cos();
+            assert!(
+                (s - ws).abs() <= 2.0 * f64::EPSILON * ws.abs(),
+                "x {x}: {s} vs {ws}"
+            );
+            assert!((c - wc).abs() <= 2.0 * f64::EPSILON, "x {x}: {c} vs {wc}");
+        }
+    }
+
+    /// A frame referred to a time gives every slowly turning quantity as the orbit does at each
+    /// time, to rounding: the Sun's direction and distance, the satellite's position and the
+    /// illumination, on drawn inclined orbits, near the reference and beyond its reach (where
+    /// the frame takes them directly).
+    #[test]
+    fn a_frame_near_a_time_reads_the_orbits_sky() {
+        let mut draw = crate::numerics::testing::uniform_draws(4242);
+        for _ in 0..60 {
+            let o = Orbit {
+                inclination: 1.5 * draw() + 0.01,
+                raan: 6.0 * draw(),
+                epoch_day: 365.0 * draw(),
+                phase0: draw() - 0.5,
+                season: draw() < 0.8,
+                eccentric_sun: draw() < 0.8,
+                j2: draw() < 0.8,
+                shadow: Shadow::Penumbra,
+                ..Orbit::leo(300e3 + 3e7 * draw() * draw())
+            };
+            let t_ref = 3e8 * draw();
+            let frame = o.frame_near(t_ref);
+            let plain = o.frame();
+            let reach = frame.sky.map_or(f64::INFINITY, |s| s.reach);
+            assert!(
+                reach >= 0.1 / (2.0 * PI / (YEAR_DAYS * DAY)) * 0.01,
+                "{reach}"
+            );
+            for _ in 0..40 {
+                let dt = (2.0 * draw() - 1.0) * o.period.max(1e5) * 3.0;
+                let t = t_ref + dt;
+                // Years into a run an angle itself carries ~1e-14 rad of rounding (either way).
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-13;
+                let (sun, want) = (o.sun_direction_in(&frame, t), o.sun_direction(t));
+                assert!(
+                    (0..3).all(|k| close(sun[k], want[k])),
+                    "{sun:?} vs {want:?}"
+                );
+                let (d, want) = (o.sun_distance_au_in(&frame, t), o.sun_distance_au(t));
+                assert!(close(d, want), "{d} vs {want}");
+                let (p, want) = (o.position_in(&frame, t), o.position_in(&plain, t));
+                assert!((0..3).all(|k| close(p[k], want[k])), "{p:?} vs {want:?}");
+                // s moves ~1/ρ_Sun (~200) per radian of the Sun's place in the penumbra.
+                let (s, want) = (o.illumination_in(&frame, t), o.illumination(t));
+                assert!((s - want).abs() <= 1e-11, "{s} vs {want}");
+            }
+        }
+    }
 
     #[test]
     fn geo_eclipse_is_about_seventy_minutes() {
