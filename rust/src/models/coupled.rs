@@ -686,6 +686,44 @@ mod tests {
         }
     }
 
+    /// A system integrated over cuts its caller lists (an orbit's from its eclipse table) is the
+    /// system integrated over its own: the same bits, on a heated inclined orbit with its
+    /// penumbrae over two orbits, and over one penumbra alone with no cut inside it.
+    #[test]
+    fn an_integration_over_known_cuts_is_the_systems_own() {
+        use crate::numerics::integrate::{solve, Method, StepCounter, Tolerances, WithCuts};
+        let p = Panel::paper();
+        let o = Orbit {
+            shadow: Shadow::Penumbra,
+            albedo: 0.3,
+            earth_ir: 237.0,
+            inclination: 0.5,
+            season: true,
+            eccentric_sun: true,
+            j2: true,
+            ..Orbit::leo(540e3)
+        };
+        let mut sys = Coupled::new(p, o, HingeModel::Linear, Coupling::ProjectedArea);
+        let method = Method::Dopri5(Tolerances::default());
+        let y0 = sys.sunlit_steady_state(0.0).unwrap();
+        let (t0, t1) = (0.0, 2.0 * o.period);
+        let cuts = o.breakpoints(t0, t1);
+        assert!(cuts.len() >= 8, "{cuts:?}");
+        let penumbra = (cuts[0], cuts[1]);
+        for ((a, b), listed) in [((t0, t1), cuts.clone()), (penumbra, Vec::new())] {
+            let (own, y_own) =
+                solve(&mut sys, &method, a, y0, b, &mut StepCounter::default()).unwrap();
+            let mut known = WithCuts {
+                system: &mut sys,
+                cuts: &listed,
+            };
+            let (with, y_with) =
+                solve(&mut known, &method, a, y0, b, &mut StepCounter::default()).unwrap();
+            assert_eq!(own, with);
+            assert_eq!(y_own.as_slice(), y_with.as_slice());
+        }
+    }
+
     /// The folded coefficients give the rates of the textbook form of the equations.
     #[test]
     fn coupled_rhs_matches_the_equations_term_by_term() {

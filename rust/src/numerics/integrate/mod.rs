@@ -56,6 +56,44 @@ where
     fn enter_segment(&mut self, _a: f64, _b: f64) {}
 }
 
+/// `system` over a span whose breakpoints its caller knows already (an orbit's, from a table of
+/// its eclipses): `cuts`, sorted, instead of the system's own search for them.
+pub struct WithCuts<'a, S> {
+    pub system: &'a mut S,
+    pub cuts: &'a [f64],
+}
+
+impl<D: Dim, S: OdeSystem<D>> OdeSystem<D> for WithCuts<'_, S>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &State<D>) -> State<D> {
+        self.system.rhs(t, y)
+    }
+
+    #[inline(always)]
+    fn rhs_fused(&self, t: f64, y: &State<D>) -> State<D> {
+        self.system.rhs_fused(t, y)
+    }
+
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        self.cuts
+            .iter()
+            .copied()
+            .filter(|&c| c > t0 && c < t1)
+            .collect()
+    }
+
+    fn check_span(&self, t0: f64, t1: f64) -> Result<()> {
+        self.system.check_span(t0, t1)
+    }
+
+    fn enter_segment(&mut self, a: f64, b: f64) {
+        self.system.enter_segment(a, b);
+    }
+}
+
 /// One accepted step [t0, t1] and its continuous extension.
 ///
 /// The interpolant is y(t0 + θh) = r1 + θ(r2 + (1−θ)(r3 + θ(r4 + (1−θ) r5))): Dormand–Prince's

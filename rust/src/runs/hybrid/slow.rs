@@ -39,7 +39,7 @@ use crate::inputs::orbit::{breakpoints_of, EclipseTable, Shadow};
 use crate::models::coupled::Coupled;
 use crate::models::hinge::{quasi_static, HingeModel};
 use crate::numerics::integrate::dop853::{self, Dop853Step};
-use crate::numerics::integrate::{solve, OdeSystem, State, Tolerances};
+use crate::numerics::integrate::{solve, OdeSystem, State, Tolerances, WithCuts};
 use crate::numerics::quadrature::GAUSS_5;
 use crate::runs::hybrid::jacobian::Linearisation;
 use crate::runs::hybrid::{counted_as_fallback, HybridRun, Propagated};
@@ -1085,7 +1085,12 @@ pub(crate) fn run_slow(
                     stats.n_steps + stats.n_rejected + slow_steps + full_steps,
                     a,
                 )?;
-                let (st, y1) = solve(&mut full, &full_method, a, y, b, &mut obs)?;
+                // [a, b] lies between two of the orbit's breakpoints: none inside.
+                let mut within = WithCuts {
+                    system: &mut full,
+                    cuts: &[],
+                };
+                let (st, y1) = solve(&mut within, &full_method, a, y, b, &mut obs)?;
                 if let Some(e) = obs.error.take() {
                     return Err(e);
                 }
@@ -1169,8 +1174,13 @@ pub(crate) fn run_slow(
             // This orbit in full, from its start; the next one tries slow time again.
             obs.collector.rewind(mark);
             check_budget(stats.n_steps + stats.n_rejected, orbit_start)?;
+            // The orbit's breakpoints, as slow time cut it.
+            let mut orbit = WithCuts {
+                system: &mut full,
+                cuts: &cuts,
+            };
             let (st, y1) = solve(
-                &mut full,
+                &mut orbit,
                 &full_method,
                 orbit_start,
                 y_start,
