@@ -186,6 +186,8 @@ pub struct Frame {
     node_rate: f64,
     /// Sine and cosine of the inclination.
     inclination: (f64, f64),
+    /// [`Orbit::earth_angular_radius`], rad.
+    earth_angular_radius: f64,
     /// The slowly turning angles near a reference time ([`Orbit::frame_near`]), when a run
     /// reads its loads many times there.
     sky: Option<Sky>,
@@ -261,11 +263,37 @@ impl Frame {
     }
 }
 
-/// Angle between the satellite's direction `sat` and the anti-Sun direction (`sun` the Sun's),
-/// both unit and from the Earth's centre, rad in [0, π]: the atan2 of |sat × S| and −sat·S,
-/// accurate at both ends, unlike acos.
-fn anti_sun_angle_between(sat: [f64; 3], sun: [f64; 3]) -> f64 {
-    norm(cross(sat, sun)).atan2(-dot(sat, sun))
+/// The satellite's angle ψ from the anti-Sun direction, both from the Earth's centre, as the
+/// geometry gives it: the angle itself, or its sine and cosine (a common positive factor within
+/// rounding of 1 allowed). The penumbra reads the sine and cosine, the cylinder the angle.
+#[derive(Debug, Clone, Copy)]
+enum AntiSun {
+    Angle(f64),
+    SinCos(f64, f64),
+}
+
+impl AntiSun {
+    /// ψ of the satellite's direction `sat` and the Sun's `sun` (unit, from the Earth's centre):
+    /// sin ψ = |sat × S| and cos ψ = −sat·S, whose atan2 is accurate at both ends, unlike acos.
+    fn between(sat: [f64; 3], sun: [f64; 3]) -> Self {
+        AntiSun::SinCos(norm(cross(sat, sun)), -dot(sat, sun))
+    }
+
+    /// ψ, rad in [0, π].
+    fn angle(self) -> f64 {
+        match self {
+            AntiSun::Angle(psi) => psi,
+            AntiSun::SinCos(s, c) => s.atan2(c),
+        }
+    }
+
+    /// (sin ψ, cos ψ).
+    fn sin_cos(self) -> (f64, f64) {
+        match self {
+            AntiSun::Angle(psi) => psi.sin_cos(),
+            AntiSun::SinCos(s, c) => (s, c),
+        }
+    }
 }
 
 impl Orbit {
@@ -550,6 +578,7 @@ impl Orbit {
                 u0: 0.0,
                 node_rate: 0.0,
                 inclination: (0.0, 1.0),
+                earth_angular_radius: self.earth_angular_radius(),
                 sky: None,
             };
         }
@@ -557,6 +586,7 @@ impl Orbit {
             u0: self.noon(0.0) + self.phase0,
             node_rate: self.nodal_rate(),
             inclination: self.inclination.sin_cos(),
+            earth_angular_radius: self.earth_angular_radius(),
             sky: None,
         }
     }
@@ -604,6 +634,7 @@ impl Orbit {
             u0: 0.0, // unread
             node_rate: self.nodal_rate(),
             inclination: self.inclination.sin_cos(),
+            earth_angular_radius: 0.0, // unread
             sky: None,
         };
         self.plane_in(&frame, t)
@@ -685,35 +716,33 @@ impl Orbit {
         dot(self.sun_direction(t), h).clamp(-1.0, 1.0).asin()
     }
 
-    /// Angle between the satellite's direction and the anti-Sun direction at time t, both from
-    /// the Earth's centre, rad in [0, π]; `frame` the orbit's constants ([`Orbit::frame`]).
-    fn anti_sun_angle_in(&self, frame: &Frame, t: f64) -> f64 {
+    /// The satellite's angle from the anti-Sun direction at time t, both from the Earth's
+    /// centre, as the shadow reads it ([`AntiSun`]); `frame` the orbit's constants
+    /// ([`Orbit::frame`]).
+    fn anti_sun_in(&self, frame: &Frame, t: f64) -> AntiSun {
         if !self.equatorial() {
-            return anti_sun_angle_between(
-                self.position_in(frame, t),
-                self.sun_direction_in(frame, t),
-            );
+            return AntiSun::between(self.position_in(frame, t), self.sun_direction_in(frame, t));
         }
         if !self.season {
             let beta = 2.0 * PI * t / self.period + self.phase0;
             let from_anti_sun = (beta - PI).rem_euclid(2.0 * PI);
-            return from_anti_sun.min(2.0 * PI - from_anti_sun);
+            return AntiSun::Angle(from_anti_sun.min(2.0 * PI - from_anti_sun));
         }
         let beta = self.rate() * t + self.phase0;
         let (sd, cd) = self.declination(t).sin_cos();
         let (sb, cb) = beta.sin_cos();
-        (sd * sd + cd * cd * sb * sb).sqrt().atan2(-cd * cb)
+        AntiSun::SinCos((sd * sd + cd * cd * sb * sb).sqrt(), -cd * cb)
     }
 
-    /// Seen from the satellite at time t, `psi` from the anti-Sun direction
-    /// ([`Orbit::anti_sun_angle_in`]): the angle between the Earth's and the Sun's centres and
-    /// the Sun's angular radius, rad. For the cylinder the Sun is a point at infinity.
-    fn sky_at(&self, frame: &Frame, psi: f64, t: f64) -> (f64, f64) {
+    /// Seen from the satellite at time t, `anti` from the anti-Sun direction
+    /// ([`Orbit::anti_sun_in`]): the angle between the Earth's and the Sun's centres and the
+    /// Sun's angular radius, rad. For the cylinder the Sun is a point at infinity.
+    fn sky_at(&self, frame: &Frame, anti: AntiSun, t: f64) -> (f64, f64) {
         if self.shadow != Shadow::Penumbra {
-            return (psi, 0.0);
+            return (anti.angle(), 0.0);
         }
         let d = AU * self.sun_distance_au_in(frame, t);
-        let (sp, cp) = psi.sin_cos();
+        let (sp, cp) = anti.sin_cos();
         let r = self.radius;
         let separation = (d * sp).atan2(r + d * cp);
         let to_sun = (d * d + r * r + 2.0 * d * r * cp).sqrt();
@@ -730,25 +759,25 @@ impl Orbit {
     pub fn illumination_in(&self, frame: &Frame, t: f64) -> f64 {
         match self.shadow {
             Shadow::None => 1.0,
-            _ => self.illumination_seen(frame, self.anti_sun_angle_in(frame, t), t),
+            _ => self.illumination_seen(frame, self.anti_sun_in(frame, t), t),
         }
     }
 
-    /// The illuminated fraction at time t where the satellite is `psi` from the anti-Sun
+    /// The illuminated fraction at time t where the satellite is `anti` from the anti-Sun
     /// direction.
-    fn illumination_seen(&self, frame: &Frame, psi: f64, t: f64) -> f64 {
+    fn illumination_seen(&self, frame: &Frame, anti: AntiSun, t: f64) -> f64 {
         match self.shadow {
             Shadow::None => 1.0,
             Shadow::Cylindrical => {
-                if psi < self.shadow_half_angle() {
+                if anti.angle() < self.shadow_half_angle() {
                     0.0
                 } else {
                     1.0
                 }
             }
             Shadow::Penumbra => {
-                let (sep, rho_s) = self.sky_at(frame, psi, t);
-                visible_fraction(rho_s, self.earth_angular_radius(), sep)
+                let (sep, rho_s) = self.sky_at(frame, anti, t);
+                visible_fraction(rho_s, frame.earth_angular_radius, sep)
             }
         }
     }
@@ -760,7 +789,7 @@ impl Orbit {
         if self.equatorial() || self.shadow == Shadow::None {
             return self.illumination_in(frame, t);
         }
-        self.illumination_seen(frame, anti_sun_angle_between(sat, sun), t)
+        self.illumination_seen(frame, AntiSun::between(sat, sun), t)
     }
 
     /// Illumination to use inside the segment [a, b] between two breakpoints. With the cylinder
@@ -913,7 +942,7 @@ impl Orbit {
         let quarter = 0.25 * self.synodic_period();
         let rho_e = self.earth_angular_radius();
         let frame = self.frame();
-        let sky = |t: f64| self.sky_at(&frame, self.anti_sun_angle_in(&frame, t), t);
+        let sky = |t: f64| self.sky_at(&frame, self.anti_sun_in(&frame, t), t);
         let outer = |t: f64| {
             let (sep, rho_s) = sky(t);
             sep - rho_e - rho_s
@@ -1078,10 +1107,9 @@ pub fn visible_fraction(rho_s: f64, rho_e: f64, sep: f64) -> f64 {
     let x_s = (sep * sep + rho_s * rho_s - rho_e * rho_e) / (2.0 * sep);
     let x_e = sep - x_s;
     let h = (rho_s * rho_s - x_s * x_s).max(0.0).sqrt();
-    let segment = |r: f64, x: f64| {
-        let a = h.atan2(x);
-        r * r * (a - a.sin() * a.cos())
-    };
+    // A circle of radius r cut at x from its centre by the chord of half-length h: the segment
+    // r² (a − sin a cos a), a = atan2(h, x), where r sin a = h and r cos a = x.
+    let segment = |r: f64, x: f64| r * r * h.atan2(x) - h * x;
     let overlap = segment(rho_s, x_s) + segment(rho_e, x_e);
     (1.0 - overlap / (PI * rho_s * rho_s)).clamp(0.0, 1.0)
 }
@@ -1230,7 +1258,7 @@ mod tests {
             let frame = o.frame();
             let rho_e = o.earth_angular_radius();
             let outer = |t: f64| {
-                let (sep, rho_s) = o.sky_at(&frame, o.anti_sun_angle_in(&frame, t), t);
+                let (sep, rho_s) = o.sky_at(&frame, o.anti_sun_in(&frame, t), t);
                 sep - rho_e - rho_s
             };
             let t = 3e8 * draw();
