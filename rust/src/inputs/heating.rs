@@ -29,7 +29,7 @@ use crate::inputs::attitude::Attitude;
 use crate::inputs::orbit::{Frame, Orbit};
 use crate::inputs::panel::Panel;
 use crate::numerics::vector::{cross, dot, norm};
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_1_PI, PI};
 
 /// View factor from a flat plate to a sphere: `cos_lambda` the cosine of the angle between the
 /// plate's normal and the direction to the sphere's centre, `h` = distance / sphere radius > 1.
@@ -38,29 +38,66 @@ use std::f64::consts::PI;
 /// (the plate's plane cuts the sphere), with x = sqrt(H² − 1):
 /// F = 1/2 − asin(x / (H sin λ))/π + [cos λ acos(−x cot λ) − x sqrt(1 − H² cos²λ)] / (π H²).
 pub fn earth_view_factor(cos_lambda: f64, h: f64) -> f64 {
-    earth_view_factors(cos_lambda, h).0
+    EarthView::new(h).factors(cos_lambda).0
 }
 
 /// [`earth_view_factor`] of a plate's two faces, the front's normal at `cos_lambda` to the
-/// direction of the sphere and the back's opposite: (front, back). Where the plate's plane cuts
-/// the sphere both faces share the arcsine, and the back's arccosine is π less the front's.
+/// direction of the sphere and the back's opposite: (front, back).
 pub fn earth_view_factors(cos_lambda: f64, h: f64) -> (f64, f64) {
-    let c = cos_lambda.clamp(-1.0, 1.0);
-    let h2 = h * h;
-    if c * h >= 1.0 {
-        return (c / h2, 0.0);
+    EarthView::new(h).factors(cos_lambda)
+}
+
+/// The sphere seen from H = distance / radius: the constants of [`earth_view_factor`] that do
+/// not depend on the plate's angle, computed once for an orbit's many loads.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EarthView {
+    h: f64,
+    h2: f64,
+    /// x = sqrt(H² − 1), x / H and 1/(π H²).
+    x: f64,
+    x_over_h: f64,
+    per_pi_h2: f64,
+}
+
+impl EarthView {
+    pub fn new(h: f64) -> Self {
+        let h2 = h * h;
+        let x = (h2 - 1.0).sqrt();
+        EarthView {
+            h,
+            h2,
+            x,
+            x_over_h: x / h,
+            per_pi_h2: 1.0 / (PI * h2),
+        }
     }
-    if c * h <= -1.0 {
-        return (0.0, -c / h2);
+
+    /// H = distance / radius.
+    pub fn height_ratio(&self) -> f64 {
+        self.h
     }
-    let x = (h2 - 1.0).sqrt();
-    let s = (1.0 - c * c).sqrt();
-    let first = 0.5 - (x / (h * s)).min(1.0).asin() / PI;
-    let arc = (-x * (c / s)).clamp(-1.0, 1.0).acos();
-    let chord = x * (1.0 - h2 * c * c).max(0.0).sqrt();
-    let front = first + (c * arc - chord) / (PI * h2);
-    let back = first + (-c * (PI - arc) - chord) / (PI * h2);
-    (front.max(0.0), back.max(0.0))
+
+    /// The view factors of a plate's two faces, the front's normal at `cos_lambda` to the
+    /// direction of the sphere: (front, back). Where the plate's plane cuts the sphere both
+    /// faces share the arcsine, and the back's arccosine is π less the front's.
+    pub fn factors(&self, cos_lambda: f64) -> (f64, f64) {
+        let c = cos_lambda.clamp(-1.0, 1.0);
+        let (h, h2, x) = (self.h, self.h2, self.x);
+        if c * h >= 1.0 {
+            return (c / h2, 0.0);
+        }
+        if c * h <= -1.0 {
+            return (0.0, -c / h2);
+        }
+        // sin λ > 0 here: |cos λ| < 1/H < 1.
+        let per_sin = 1.0 / (1.0 - c * c).sqrt();
+        let first = 0.5 - (self.x_over_h * per_sin).min(1.0).asin() * FRAC_1_PI;
+        let arc = (-x * c * per_sin).clamp(-1.0, 1.0).acos();
+        let chord = x * (1.0 - h2 * c * c).max(0.0).sqrt();
+        let front = first + (c * arc - chord) * self.per_pi_h2;
+        let back = first + (-c * (PI - arc) - chord) * self.per_pi_h2;
+        (front.max(0.0), back.max(0.0))
+    }
 }
 
 /// The panel's optical properties that turn incident fluxes into absorbed ones.
@@ -182,8 +219,8 @@ pub struct Sources {
     pub albedo: f64,
     /// E_IR, W/m².
     pub earth_ir: f64,
-    /// H = r/R_E.
-    pub height_ratio: f64,
+    /// The Earth seen from the orbit (H = r/R_E).
+    pub earth: EarthView,
 }
 
 impl Sources {
@@ -195,10 +232,9 @@ impl Sources {
         } else {
             dot(normal, self.sun).clamp(-1.0, 1.0)
         };
-        let h = self.height_ratio;
         // The direction to the Earth's centre is −position.
         let cos_front = -dot(normal, self.position);
-        let (view_front, view_back) = earth_view_factors(cos_front, h);
+        let (view_front, view_back) = self.earth.factors(cos_front);
         FaceFluxes {
             sun_front: self.direct * cos_sun.max(0.0),
             sun_back: self.direct * (-cos_sun).max(0.0),
@@ -228,6 +264,12 @@ impl Orbit {
     #[inline]
     pub fn has_face_loads(&self) -> bool {
         self.albedo != 0.0 || self.earth_ir != 0.0 || self.attitude != Attitude::SunPointing
+    }
+
+    /// The Earth seen from the orbit: the view factors' constants at H = r/R_E, computed once
+    /// for a run's many loads.
+    pub fn earth_view(&self) -> EarthView {
+        EarthView::new(self.radius / self.earth_radius)
     }
 
     /// The front normal at time t, with the Sun's and the satellite's directions.
@@ -270,19 +312,25 @@ impl Orbit {
     /// Incident fluxes on each face at time t for the illuminated fraction `s` of the Sun and a
     /// solar constant C (W/m²), before the structure's area factor.
     pub fn face_fluxes(&self, t: f64, s: f64, solar_constant: f64) -> FaceFluxes {
-        self.face_fluxes_of(&self.geometry(t), s, solar_constant)
+        self.face_fluxes_of(&self.geometry(t), s, solar_constant, &self.earth_view())
     }
 
     /// [`Orbit::face_fluxes`] of the geometry `g` of a time ([`Orbit::geometry_in`]).
-    pub fn face_fluxes_of(&self, g: &Geometry, s: f64, solar_constant: f64) -> FaceFluxes {
-        self.sources(g, s, solar_constant)
+    pub fn face_fluxes_of(
+        &self,
+        g: &Geometry,
+        s: f64,
+        solar_constant: f64,
+        earth: &EarthView,
+    ) -> FaceFluxes {
+        self.sources(g, s, solar_constant, earth)
             .fluxes(g.normal, self.attitude == Attitude::SunPointing)
     }
 
     /// What heats a flat face at the time of the geometry `g`, whatever its normal: the Sun's and the satellite's
     /// directions, the direct sunlight C · scale · s, the albedo's sunlit-Earth factor
     /// a · C · scale · max(cos Z, 0), the Earth's infrared and H = r/R_E.
-    pub fn sources(&self, g: &Geometry, s: f64, solar_constant: f64) -> Sources {
+    pub fn sources(&self, g: &Geometry, s: f64, solar_constant: f64, earth: &EarthView) -> Sources {
         let sunlight = solar_constant * g.flux_scale;
         Sources {
             sun: g.sun,
@@ -290,7 +338,7 @@ impl Orbit {
             direct: sunlight * s,
             albedo: self.albedo * sunlight * dot(g.position, g.sun).max(0.0),
             earth_ir: self.earth_ir,
-            height_ratio: self.radius / self.earth_radius,
+            earth: *earth,
         }
     }
 
@@ -303,8 +351,8 @@ impl Orbit {
 
     /// The loads at the time of the geometry `g` ([`Orbit::geometry_in`]) for the
     /// illuminated fraction `s`: [`Orbit::loads`] without computing the geometry again.
-    pub fn loads_of(&self, g: &Geometry, s: f64, optics: &Optics) -> Loads {
-        self.face_fluxes_of(g, s, optics.solar_constant)
+    pub fn loads_of(&self, g: &Geometry, s: f64, optics: &Optics, earth: &EarthView) -> Loads {
+        self.face_fluxes_of(g, s, optics.solar_constant, earth)
             .absorbed(optics)
     }
 

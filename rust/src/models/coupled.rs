@@ -2,7 +2,7 @@
 //! driven by a prescribed moment. Each implements [`OdeSystem`].
 
 use crate::error::{Error, Result};
-use crate::inputs::heating::{Loads, Optics};
+use crate::inputs::heating::{EarthView, Loads, Optics};
 use crate::inputs::orbit::{Frame, Orbit, Shadow};
 use crate::inputs::panel::Panel;
 use crate::models::hinge::{
@@ -39,6 +39,8 @@ pub(crate) struct Sunlight {
     optics: Option<Optics>,
     /// The orbit's constants its geometry reads at every time.
     frame: Frame,
+    /// The Earth seen from the orbit, for the view factors.
+    earth: EarthView,
     /// The orbit heats more than the front's sunlight and the optics are known: the right-hand
     /// side takes [`Sunlight::loads`] instead of [`Sunlight::flux`].
     pub(crate) face_loads: bool,
@@ -54,6 +56,7 @@ impl Sunlight {
             constant_s: None,
             optics: None,
             frame: orbit.frame(),
+            earth: orbit.earth_view(),
             face_loads: false,
         }
     }
@@ -106,7 +109,7 @@ impl Sunlight {
                         .illumination_between(&self.frame, g.position, g.sun, t),
                     _ => self.illumination(t),
                 };
-                self.orbit.loads_of(&g, s, optics)
+                self.orbit.loads_of(&g, s, optics, &self.earth)
             }
             _ => Loads::sun(self.flux(t)),
         }

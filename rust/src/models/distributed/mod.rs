@@ -137,7 +137,7 @@ impl ElementHeat {
     pub fn at(orbit: &Orbit, t: f64, s: f64, optics: Optics) -> Self {
         let g = orbit.geometry(t);
         ElementHeat {
-            sources: orbit.sources(&g, s, optics.solar_constant),
+            sources: orbit.sources(&g, s, optics.solar_constant, &orbit.earth_view()),
             normal: g.normal,
             length: orbit.length_direction(t, g.normal),
             optics,
