@@ -186,7 +186,8 @@ pub struct Frame {
     node_rate: f64,
     /// Sine and cosine of the inclination.
     inclination: (f64, f64),
-    /// [`Orbit::earth_angular_radius`], rad.
+    /// [`Orbit::earth_angular_radius`], rad: the penumbra's (0 and unread with another
+    /// shadow, whose frames are built at every position some paths ask for).
     earth_angular_radius: f64,
     /// The slowly turning angles near a reference time ([`Orbit::frame_near`]), when a run
     /// reads its loads many times there.
@@ -460,6 +461,14 @@ impl Orbit {
         (self.earth_radius / self.radius).asin()
     }
 
+    /// [`Orbit::earth_angular_radius`] for a frame: the penumbra's, else 0 (unread).
+    fn penumbra_earth_radius(&self) -> f64 {
+        match self.shadow {
+            Shadow::Penumbra => self.earth_angular_radius(),
+            _ => 0.0,
+        }
+    }
+
     /// Angular radius of the Earth seen from the orbit, rad (equal to `shadow_half_angle`).
     pub fn earth_angular_radius(&self) -> f64 {
         self.shadow_half_angle()
@@ -578,7 +587,7 @@ impl Orbit {
                 u0: 0.0,
                 node_rate: 0.0,
                 inclination: (0.0, 1.0),
-                earth_angular_radius: self.earth_angular_radius(),
+                earth_angular_radius: self.penumbra_earth_radius(),
                 sky: None,
             };
         }
@@ -586,7 +595,7 @@ impl Orbit {
             u0: self.noon(0.0) + self.phase0,
             node_rate: self.nodal_rate(),
             inclination: self.inclination.sin_cos(),
-            earth_angular_radius: self.earth_angular_radius(),
+            earth_angular_radius: self.penumbra_earth_radius(),
             sky: None,
         }
     }
