@@ -5,7 +5,7 @@ use super::cancel::{cancellable, CancelToken};
 use super::convert::{coupling, float_item, orbit_from, solver_from, RunOptions};
 use super::error::shield;
 use super::flutter::set_spectrum;
-use super::orbits::summary_dict;
+use super::orbits::{hybrid_counters, summary_dict};
 use super::transient_dict;
 use crate::analysis::flutter::check_flux;
 use crate::inputs::boom::{Boom, BOOM_TABLE};
@@ -177,27 +177,13 @@ fn run_boom_orbits<'py>(
         })?;
         let d = summary_dict(py, &out, &method)?;
         if hybrid.is_some() {
-            let simulated = out.stats.t_end - t_start;
-            for (name, value) in [("t_linear", 0.0), ("t_exponential", 0.0), ("t_slow", 0.0)] {
-                d.set_item(name, value)?;
-            }
-            d.set_item("t_fallback", simulated)?;
-            for name in [
-                "n_arcs",
-                "n_exp_steps",
-                "n_reread_steps",
-                "n_slow_steps",
-                "n_refused_orbits",
-                "n_refused_separation",
-                "n_refused_ringing",
-                "n_refused_split",
-                "n_refused_limit",
-                "n_refused_gate",
-                "n_refused_growth",
-            ] {
-                d.set_item(name, 0u64)?;
-            }
-            d.set_item("n_fallback_steps", out.stats.n_steps)?;
+            // All of it the fallback's: the tube has no hybrid regime.
+            let all_full = crate::runs::hybrid::HybridRun {
+                t_fallback: out.stats.t_end - t_start,
+                n_fallback_steps: out.stats.n_steps,
+                ..Default::default()
+            };
+            hybrid_counters(d.clone(), &all_full)?;
             d.set_item(
                 "fallback",
                 "the hybrid propagator's linear arcs are the plate's modal form; the tube ran \

@@ -308,31 +308,17 @@ fn run_distributed_orbits<'py>(
             // Named as the hybrid runs' counters: its full integration is their fallback, the
             // umbra (the temperatures integrated alone, the modes exactly) their exponential
             // steps.
-            for (name, value) in [
-                ("t_linear", split.t_linear),
-                ("t_exponential", split.t_umbra),
-                ("t_slow", 0.0),
-                ("t_fallback", split.t_full),
-            ] {
-                d.set_item(name, value)?;
-            }
-            for (name, value) in [
-                ("n_arcs", split.n_arcs),
-                ("n_exp_steps", split.n_umbra_steps),
-                ("n_fallback_steps", split.n_full_steps),
-                ("n_reread_steps", 0),
-                ("n_slow_steps", 0),
-                ("n_refused_orbits", 0),
-                ("n_refused_separation", 0),
-                ("n_refused_ringing", 0),
-                ("n_refused_split", 0),
-                ("n_refused_limit", 0),
-                ("n_refused_gate", 0),
-                ("n_refused_growth", 0),
-                ("n_refused_arcs", split.n_refused),
-            ] {
-                d.set_item(name, value)?;
-            }
+            let counters = crate::runs::hybrid::HybridRun {
+                t_linear: split.t_linear,
+                t_exponential: split.t_umbra,
+                t_fallback: split.t_full,
+                n_arcs: split.n_arcs,
+                n_exp_steps: split.n_umbra_steps,
+                n_fallback_steps: split.n_full_steps,
+                ..Default::default()
+            };
+            super::orbits::hybrid_counters(d.clone(), &counters)?;
+            d.set_item("n_refused_arcs", split.n_refused)?;
         }
         modal_info(py, &m, &d)?;
         Ok(d)

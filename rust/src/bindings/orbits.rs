@@ -78,7 +78,7 @@ fn run_orbits<'py>(
 }
 
 /// A hybrid run's summary columns with how it split the simulated time.
-fn hybrid_counters<'py>(
+pub(super) fn hybrid_counters<'py>(
     d: Bound<'py, PyDict>,
     out: &crate::runs::hybrid::HybridRun,
 ) -> PyResult<Bound<'py, PyDict>> {

@@ -124,6 +124,37 @@ pub struct HybridRun {
     pub n_refused_growth: u64,
 }
 
+impl Default for HybridRun {
+    /// No orbit run, every time and count zero: what a run fills in, and what a path that has no
+    /// hybrid reports.
+    fn default() -> Self {
+        HybridRun {
+            run: OrbitRun {
+                summaries: Vec::new(),
+                stats: Stats::default(),
+                y_end: Vector4::zeros(),
+                crossing: None,
+            },
+            t_linear: 0.0,
+            t_exponential: 0.0,
+            t_fallback: 0.0,
+            n_arcs: 0,
+            n_exp_steps: 0,
+            n_fallback_steps: 0,
+            n_reread_steps: 0,
+            t_slow: 0.0,
+            n_slow_steps: 0,
+            n_refused_orbits: 0,
+            n_refused_separation: 0,
+            n_refused_ringing: 0,
+            n_refused_split: 0,
+            n_refused_limit: 0,
+            n_refused_gate: 0,
+            n_refused_growth: 0,
+        }
+    }
+}
+
 /// What the state at a sunlit time allows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Regime {
@@ -202,28 +233,9 @@ pub(crate) fn counted_as_fallback(
     n_steps: u64,
 ) -> HybridRun {
     HybridRun {
-        run: OrbitRun {
-            summaries: Vec::new(),
-            stats: Stats::default(),
-            y_end: Vector4::zeros(),
-            crossing: None,
-        },
-        t_linear: 0.0,
-        t_exponential: 0.0,
         t_fallback: summaries.iter().map(|s| s.t_end - s.t_start).sum(),
-        n_arcs: 0,
-        n_exp_steps: 0,
         n_fallback_steps: n_steps,
-        n_reread_steps: 0,
-        t_slow: 0.0,
-        n_slow_steps: 0,
-        n_refused_orbits: 0,
-        n_refused_separation: 0,
-        n_refused_ringing: 0,
-        n_refused_split: 0,
-        n_refused_limit: 0,
-        n_refused_gate: 0,
-        n_refused_growth: 0,
+        ..HybridRun::default()
     }
 }
 
@@ -299,30 +311,7 @@ pub(crate) fn propagate<const N: usize, M: HybridModel<N>>(
             t_end: t_start,
             ..Stats::default()
         },
-        out: HybridRun {
-            run: OrbitRun {
-                summaries: Vec::new(),
-                stats: Stats::default(),
-                y_end: Vector4::zeros(),
-                crossing: None,
-            },
-            t_linear: 0.0,
-            t_exponential: 0.0,
-            t_fallback: 0.0,
-            n_arcs: 0,
-            n_exp_steps: 0,
-            n_fallback_steps: 0,
-            n_reread_steps: 0,
-            t_slow: 0.0,
-            n_slow_steps: 0,
-            n_refused_orbits: 0,
-            n_refused_separation: 0,
-            n_refused_ringing: 0,
-            n_refused_split: 0,
-            n_refused_limit: 0,
-            n_refused_gate: 0,
-            n_refused_growth: 0,
-        },
+        out: HybridRun::default(),
         judge: Judge {
             panel,
             orbit: *orbit,
