@@ -41,12 +41,6 @@ pub fn earth_view_factor(cos_lambda: f64, h: f64) -> f64 {
     EarthView::new(h).factors(cos_lambda).0
 }
 
-/// [`earth_view_factor`] of a plate's two faces, the front's normal at `cos_lambda` to the
-/// direction of the sphere and the back's opposite: (front, back).
-pub fn earth_view_factors(cos_lambda: f64, h: f64) -> (f64, f64) {
-    EarthView::new(h).factors(cos_lambda)
-}
-
 /// The sphere seen from H = distance / radius: the constants of [`earth_view_factor`] that do
 /// not depend on the plate's angle, computed once for an orbit's many loads.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,11 +64,6 @@ impl EarthView {
             x_over_h: x / h,
             per_pi_h2: 1.0 / (PI * h2),
         }
-    }
-
-    /// H = distance / radius.
-    pub fn height_ratio(&self) -> f64 {
-        self.h
     }
 
     /// The view factors of a plate's two faces, the front's normal at `cos_lambda` to the
@@ -327,9 +316,10 @@ impl Orbit {
             .fluxes(g.normal, self.attitude == Attitude::SunPointing)
     }
 
-    /// What heats a flat face at the time of the geometry `g`, whatever its normal: the Sun's and the satellite's
-    /// directions, the direct sunlight C · scale · s, the albedo's sunlit-Earth factor
-    /// a · C · scale · max(cos Z, 0), the Earth's infrared and H = r/R_E.
+    /// What heats a flat face at the time of the geometry `g`, whatever its normal: the Sun's
+    /// and the satellite's directions, the direct sunlight C · scale · s, the albedo's
+    /// sunlit-Earth factor a · C · scale · max(cos Z, 0), the Earth's infrared and the Earth
+    /// seen from the orbit (`earth`, [`Orbit::earth_view`]).
     pub fn sources(&self, g: &Geometry, s: f64, solar_constant: f64, earth: &EarthView) -> Sources {
         let sunlight = solar_constant * g.flux_scale;
         Sources {
@@ -569,7 +559,7 @@ mod tests {
                 1 => -1.0 / h * (1.0 + 1e-9 * (draw() - 0.5)),
                 _ => 2.0 * draw() - 1.0,
             };
-            let (front, back) = earth_view_factors(c, h);
+            let (front, back) = EarthView::new(h).factors(c);
             assert_eq!(front, earth_view_factor(c, h));
             let alone = earth_view_factor(-c, h);
             assert!(
@@ -579,7 +569,7 @@ mod tests {
         }
         for deg in [0.0_f64, 60.0, 95.0, 120.0, 180.0] {
             let lambda = deg.to_radians();
-            let back = earth_view_factors(lambda.cos(), 1.2).1;
+            let back = EarthView::new(1.2).factors(lambda.cos()).1;
             let numeric = view_factor_by_quadrature(PI - lambda, 1.2);
             assert!(
                 (back - numeric).abs() < 2e-5,

@@ -68,6 +68,8 @@ pub const DAY: f64 = 86_400.0;
 pub const YEAR_DAYS: f64 = 365.242_2;
 /// Obliquity of the ecliptic, rad (23.44°).
 pub const OBLIQUITY: f64 = 23.44 * PI / 180.0;
+/// The Sun's mean motion along the ecliptic, rad/s (2π a tropical year).
+const SUN_RATE: f64 = 2.0 * PI / (YEAR_DAYS * DAY);
 /// Eccentricity of the Earth's orbit.
 pub const EARTH_ECCENTRICITY: f64 = 0.0167;
 /// Mean day of the March equinox, days since 1 January 00:00 UTC (about 20 March, 12:00).
@@ -262,6 +264,17 @@ impl Frame {
         let dt = t - sky.t_ref;
         (dt.abs() <= sky.reach).then_some((sky, dt))
     }
+}
+
+/// The orbit plane of a node at (sin, cos) `node` and an inclination at (sin, cos)
+/// `inclination`: the node direction P, the direction Q a quarter orbit on, and the normal h.
+fn plane_of(node: (f64, f64), inclination: (f64, f64)) -> [[f64; 3]; 3] {
+    let ((so, co), (si, ci)) = (node, inclination);
+    [
+        [co, so, 0.0],
+        [-ci * so, ci * co, si],
+        [si * so, -si * co, ci],
+    ]
 }
 
 /// The satellite's angle ψ from the anti-Sun direction, both from the Earth's centre, as the
@@ -489,8 +502,17 @@ impl Orbit {
         if !self.season {
             return 0.0;
         }
-        let lon = 2.0 * PI * (self.day_of_year(t) - EQUINOX_DAY) / YEAR_DAYS;
-        (OBLIQUITY.sin() * lon.sin()).asin()
+        (OBLIQUITY.sin() * self.ecliptic_longitude(t).sin()).asin()
+    }
+
+    /// The Sun's ecliptic longitude at time t, rad (0 at the March equinox).
+    fn ecliptic_longitude(&self, t: f64) -> f64 {
+        2.0 * PI * (self.day_of_year(t) - EQUINOX_DAY) / YEAR_DAYS
+    }
+
+    /// The Earth's mean anomaly at time t, rad (0 at perihelion).
+    fn mean_anomaly(&self, t: f64) -> f64 {
+        2.0 * PI * (self.day_of_year(t) - PERIHELION_DAY) / YEAR_DAYS
     }
 
     /// Sun–Earth distance at time t, au (1 without `eccentric_sun`).
@@ -498,17 +520,12 @@ impl Orbit {
         if !self.eccentric_sun {
             return 1.0;
         }
-        1.0 - EARTH_ECCENTRICITY
-            * (2.0 * PI * (self.day_of_year(t) - PERIHELION_DAY) / YEAR_DAYS).cos()
+        1.0 - EARTH_ECCENTRICITY * self.mean_anomaly(t).cos()
     }
 
     /// Rate of the orbit phase relative to the Sun, rad/s.
     pub fn rate(&self) -> f64 {
-        let sun = if self.season {
-            2.0 * PI / (YEAR_DAYS * DAY)
-        } else {
-            0.0
-        };
+        let sun = if self.season { SUN_RATE } else { 0.0 };
         2.0 * PI / self.period - sun
     }
 
@@ -537,8 +554,7 @@ impl Orbit {
         if !self.season {
             return [1.0, 0.0, 0.0];
         }
-        let lon = 2.0 * PI * (self.day_of_year(t) - EQUINOX_DAY) / YEAR_DAYS;
-        let (sl, cl) = lon.sin_cos();
+        let (sl, cl) = self.ecliptic_longitude(t).sin_cos();
         let (se, ce) = OBLIQUITY.sin_cos();
         [cl, ce * sl, se * sl]
     }
@@ -609,12 +625,11 @@ impl Orbit {
         if self.equatorial() {
             return self.frame();
         }
-        let year = 2.0 * PI / (YEAR_DAYS * DAY);
         let node_rate = self.nodal_rate();
         let rates = [
-            if self.season { year } else { 0.0 },
+            if self.season { SUN_RATE } else { 0.0 },
             node_rate,
-            if self.eccentric_sun { year } else { 0.0 },
+            if self.eccentric_sun { SUN_RATE } else { 0.0 },
         ];
         let fastest = rates.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
         let reach = if fastest > 0.0 {
@@ -622,14 +637,13 @@ impl Orbit {
         } else {
             f64::INFINITY
         };
-        let day = self.day_of_year(t_ref);
         Frame {
             sky: Some(Sky {
                 t_ref,
                 reach,
-                longitude: Turning::new(2.0 * PI * (day - EQUINOX_DAY) / YEAR_DAYS, year),
-                node: Turning::new(self.raan + node_rate * t_ref, node_rate),
-                anomaly: Turning::new(2.0 * PI * (day - PERIHELION_DAY) / YEAR_DAYS, year),
+                longitude: Turning::new(self.ecliptic_longitude(t_ref), SUN_RATE),
+                node: Turning::new(self.node_angle(t_ref), node_rate),
+                anomaly: Turning::new(self.mean_anomaly(t_ref), SUN_RATE),
                 obliquity: OBLIQUITY.sin_cos(),
             }),
             ..self.frame()
@@ -639,28 +653,21 @@ impl Orbit {
     /// The orbit plane at time t: the node direction P, the direction Q a quarter orbit on, and
     /// the normal h (u = 0 at P, u = π/2 at Q).
     fn plane(&self, t: f64) -> [[f64; 3]; 3] {
-        let frame = Frame {
-            u0: 0.0, // unread
-            node_rate: self.nodal_rate(),
-            inclination: self.inclination.sin_cos(),
-            earth_angular_radius: 0.0, // unread
-            sky: None,
-        };
-        self.plane_in(&frame, t)
+        plane_of(self.node_angle(t).sin_cos(), self.inclination.sin_cos())
     }
 
     /// [`Orbit::plane`] with the orbit's constants from `frame`.
     fn plane_in(&self, frame: &Frame, t: f64) -> [[f64; 3]; 3] {
-        let (so, co) = match frame.sky_near(t) {
+        let node = match frame.sky_near(t) {
             Some((sky, dt)) => sky.node.after(dt),
             None => (self.raan + frame.node_rate * t).sin_cos(),
         };
-        let (si, ci) = frame.inclination;
-        [
-            [co, so, 0.0],
-            [-ci * so, ci * co, si],
-            [si * so, -si * co, ci],
-        ]
+        plane_of(node, frame.inclination)
+    }
+
+    /// The ascending node's right ascension at time t, rad (precessing with J2).
+    fn node_angle(&self, t: f64) -> f64 {
+        self.raan + self.nodal_rate() * t
     }
 
     /// Direction of the ascending node at time t (x for an equatorial orbit).
@@ -690,7 +697,7 @@ impl Orbit {
     pub fn position_in(&self, frame: &Frame, t: f64) -> [f64; 3] {
         if !self.equatorial() {
             let [p, q, _] = self.plane_in(frame, t);
-            let (su, cu) = (frame.u0 + 2.0 * PI / self.period * t).sin_cos();
+            let (su, cu) = self.latitude_argument(frame.u0, t).sin_cos();
             return [0, 1, 2].map(|k| cu * p[k] + su * q[k]);
         }
         let phase = if self.season {
@@ -710,9 +717,9 @@ impl Orbit {
         dot(s, q).atan2(dot(s, p))
     }
 
-    /// Argument of latitude of the satellite, u(t) = u₀ + n t, rad.
-    fn latitude_argument(&self, t: f64) -> f64 {
-        self.frame().u0 + 2.0 * PI / self.period * t
+    /// Argument of latitude of the satellite, u(t) = u₀ + n t, rad (`u0` the frame's).
+    fn latitude_argument(&self, u0: f64, t: f64) -> f64 {
+        u0 + 2.0 * PI / self.period * t
     }
 
     /// The Sun's angle to the orbit plane at time t, rad in [−π/2, π/2], positive on the side of
@@ -843,9 +850,10 @@ impl Orbit {
     /// nearest `guess`, s. The noon moves slowly against the satellite, so each correction by
     /// the phase left to go gains about two digits.
     fn midnight_near(&self, guess: f64) -> f64 {
+        let u0 = self.frame().u0;
         let mut t = guess;
         for _ in 0..4 {
-            let phase = self.latitude_argument(t) - self.noon(t) - PI;
+            let phase = self.latitude_argument(u0, t) - self.noon(t) - PI;
             let off = phase - 2.0 * PI * (phase / (2.0 * PI)).round();
             t -= off / self.rate();
         }
@@ -893,11 +901,7 @@ impl Orbit {
         } else {
             // β changes no faster than the Sun moves (2π/Y) plus the normal turns (|Ω̇| sin i):
             // the bound over the whole window, with room for rounding.
-            let sun = if self.season {
-                2.0 * PI / (YEAR_DAYS * DAY)
-            } else {
-                0.0
-            };
+            let sun = if self.season { SUN_RATE } else { 0.0 };
             let turn = self.nodal_rate().abs() * self.inclination.sin();
             self.beta(c).abs() - (sun + turn) * quarter - 1e-6
         };
@@ -1333,10 +1337,7 @@ mod tests {
             let frame = o.frame_near(t_ref);
             let plain = o.frame();
             let reach = frame.sky.map_or(f64::INFINITY, |s| s.reach);
-            assert!(
-                reach >= 0.1 / (2.0 * PI / (YEAR_DAYS * DAY)) * 0.01,
-                "{reach}"
-            );
+            assert!(reach >= 0.1 / SUN_RATE * 0.01, "{reach}");
             for _ in 0..40 {
                 let dt = (2.0 * draw() - 1.0) * o.period.max(1e5) * 3.0;
                 let t = t_ref + dt;
