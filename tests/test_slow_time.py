@@ -17,8 +17,10 @@ import warnings
 from dataclasses import dataclass
 
 import hypothesis.strategies as st
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, Phase, given, note, settings
+from test_hybrid import METRICS
 from test_hybrid_properties import (
     compared_orbits,
     gate_failures,
@@ -29,6 +31,7 @@ from test_hybrid_properties import (
 
 import thermojitter as tj
 from conftest import panels
+from thermojitter import _core
 from thermojitter import materials as mat
 from thermojitter.longrun import SLOW_GUARDS
 
@@ -252,3 +255,28 @@ def test_a_ringing_carried_over_many_orbits_keeps_its_phase() -> None:
     for name in ("jitter_rms", "jitter_peak"):
         a, b = full.columns[name], hybrid.columns[name]
         assert (abs(b - a) <= 0.5 * 0.02 * abs(a)).all(), (name, abs(b - a) / abs(a))
+
+
+@pytest.mark.parametrize("heated", [False, True])
+def test_a_long_call_cut_into_pieces_is_the_call_whole(heated: bool) -> None:
+    # A call of 2 x PIECE_ORBITS orbits on slow time runs in two pieces at once, the second
+    # warmed up from the run's own start; the same orbits in two calls of one piece each (the
+    # second from the first's end) read the same summaries far inside the accuracy gate.
+    n = 2 * _core.SLOW_PIECE_ORBITS
+    orbit = tj.Orbit.circular(540e3, math.radians(28.5)) if heated else tj.Orbit.leo(540e3)
+    kw = {"progress": False, "method": "hybrid", "on_limit": "flag"}
+    cut = tj.simulate_orbits(tj.Panel.paper(), orbit, n, orbits_per_call=n, **kw)  # type: ignore[arg-type]
+    whole = tj.simulate_orbits(tj.Panel.paper(), orbit, n, orbits_per_call=n // 2, **kw)  # type: ignore[arg-type]
+    assert cut.propagation["n_pieces"] == 2
+    assert cut.propagation["n_pieces_rerun"] == 0
+    assert cut.propagation["n_warmup_orbits"] > 0
+    assert whole.propagation["n_pieces"] == 2  # one piece in each of two calls
+    assert whole.propagation["n_warmup_orbits"] == 0
+    worst = 0.0
+    for name in METRICS:
+        a, b = whole.columns[name], cut.columns[name]
+        assert (np.isnan(a) == np.isnan(b)).all(), name
+        defined = ~np.isnan(a)
+        gate = np.where(np.abs(a) < 5e-5, 1e-6, 0.02 * np.abs(a))
+        worst = max(worst, float(np.max(np.abs(b - a)[defined] / gate[defined], initial=0.0)))
+    assert worst < 0.1, worst

@@ -12,6 +12,7 @@ __all__ = [
     "least_steps",
     "SLOW_ORBIT",
     "SLOW_RING_LIMIT",
+    "SLOW_PIECE_ORBITS",
     "leo_orbit",
     "eclipse_duration",
     "SIDEREAL_DAY",
@@ -133,6 +134,7 @@ ENSEMBLE_LANES: int  # SIMD lanes of one lockstep group
 ENSEMBLE_RUNS_PER_CORE: int  # samples one core runs at once (its groups' lanes)
 SLOW_RING_LIMIT: float  # largest ringing (rad) the hybrid carries on slow time
 SLOW_ORBIT: float  # orbits shorter than this (s) run on slow time under the hybrid
+SLOW_PIECE_ORBITS: int  # a call of twice this many slow-time orbits runs in pieces at once
 KERNEL_VARIABLE: str  # environment variable: "portable" forces the kernels without FMA
 KERNEL_CHOICES: list[str]  # its values ("auto", "portable")
 SOLVER_DEFAULTS: dict[str, Any]

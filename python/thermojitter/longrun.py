@@ -112,13 +112,16 @@ HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
     "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits", "n_refused_separation",
     "n_refused_ringing", "n_refused_split", "n_refused_limit", "n_refused_gate",
-    "n_refused_growth",
+    "n_refused_growth", "n_pieces", "n_warmup_orbits", "n_pieces_rerun",
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model, slow time (short orbits and varying loads) and the
 hinge-resolved fallback; ``n_refused_orbits`` of slow time's orbits given back to the full
 integration, and by which guard (``n_refused_separation``, ``_ringing``, ``_split``, ``_limit``,
-``_gate``, ``_growth``)."""
+``_gate``, ``_growth``); ``n_pieces`` into which a call's long slow-time run was cut to run on
+several cores (summed over calls), the orbits their warm-ups ran (``n_warmup_orbits``, not
+summarised) and the pieces run again in order because their warmed-up start missed
+(``n_pieces_rerun``)."""
 
 
 @dataclass

@@ -457,6 +457,10 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VALIDITY_LIMIT", crate::models::hinge::VALIDITY_LIMIT)?;
     m.add("SLOW_RING_LIMIT", crate::runs::hybrid::slow::RING_LIMIT)?;
     m.add("SLOW_ORBIT", crate::runs::hybrid::slow::SHORT_ORBIT)?;
+    m.add(
+        "SLOW_PIECE_ORBITS",
+        crate::runs::hybrid::pieces::PIECE_ORBITS,
+    )?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(validate_panel, m)?)?;
     m.add_function(wrap_pyfunction!(validate_orbit, m)?)?;

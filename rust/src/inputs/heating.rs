@@ -448,6 +448,64 @@ impl Orbit {
         out
     }
 
+    /// The times in (x0, x1) where a load is not smooth: where the Sun crosses a face's plane,
+    /// the sub-satellite point crosses the terminator (as [`Orbit::kinks`]), and where a face's
+    /// view of the Earth becomes full (cos λ H = ±1, λ the front normal's angle to the nadir:
+    /// the view factor's partial branch starts there like a power 3/2). Each is searched on
+    /// pieces of at most `span` s, found where its function changes sign between a piece's
+    /// ends (two crossings inside one piece are not found: a table fitted across them refuses
+    /// that part), to the rounding of t; sorted.
+    pub(crate) fn load_kinks(&self, x0: f64, x1: f64, span: f64) -> Vec<f64> {
+        let h = self.radius / self.earth_radius;
+        // Each function of the geometry whose sign change is a kink.
+        let mut kinds: Vec<fn(&Geometry, f64) -> f64> =
+            vec![|g, h| -dot(g.normal, g.position) * h - 1.0, |g, h| {
+                -dot(g.normal, g.position) * h + 1.0
+            }];
+        if self.attitude != Attitude::SunPointing {
+            kinds.push(|g, _| dot(g.normal, g.sun));
+        }
+        if self.albedo != 0.0 {
+            kinds.push(|g, _| dot(g.position, g.sun));
+        }
+        let pieces = ((x1 - x0) / span).ceil().max(1.0) as usize;
+        let ends: Vec<f64> = (0..=pieces)
+            .map(|k| {
+                if k == pieces {
+                    x1
+                } else {
+                    x0 + (x1 - x0) * k as f64 / pieces as f64
+                }
+            })
+            .collect();
+        let at_ends: Vec<Geometry> = ends.iter().map(|&t| self.geometry(t)).collect();
+        let mut out = Vec::new();
+        for kind in kinds {
+            for k in 0..pieces {
+                let (mut lo, mut hi) = (ends[k], ends[k + 1]);
+                let low = kind(&at_ends[k], h) > 0.0;
+                if low == (kind(&at_ends[k + 1], h) > 0.0) {
+                    continue;
+                }
+                loop {
+                    let mid = 0.5 * (lo + hi);
+                    if mid <= lo || mid >= hi {
+                        break;
+                    }
+                    if (kind(&self.geometry(mid), h) > 0.0) == low {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                out.push(hi);
+            }
+        }
+        out.retain(|&t| t > x0 && t < x1);
+        out.sort_by(f64::total_cmp);
+        out
+    }
+
     /// The loads averaged over the sunlit arc of the orbit that begins at `t0` (one period):
     /// (1/τ) ∫ loads(t, s(t)) dt over the times with s(t) > 0 (the penumbra's partial Sun
     /// included), τ their total length. On an orbit without Earth heating or attitude, the

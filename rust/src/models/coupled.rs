@@ -324,6 +324,11 @@ where
         self.sun.sunlit_loads(t)
     }
 
+    /// Whether the Sun's illuminated fraction changes along the current segment (a penumbra).
+    pub(crate) fn illumination_varies(&self) -> bool {
+        self.sun.constant_s.is_none()
+    }
+
     /// The absorbed loads at time t inside the current segment.
     pub fn loads_at(&self, t: f64) -> Loads {
         self.sun.loads(t)
@@ -406,6 +411,12 @@ where
     #[inline(always)]
     pub fn rhs_at_loads(&self, loads: Loads, y: &State<D>) -> State<D> {
         self.rhs_at_loads_as::<false>(loads, y)
+    }
+
+    /// [`Coupled::rhs_at_loads`] with the models' fused rates (the loop compiled for FMA).
+    #[inline(always)]
+    pub(crate) fn rhs_at_loads_fused(&self, loads: Loads, y: &State<D>) -> State<D> {
+        self.rhs_at_loads_as::<true>(loads, y)
     }
 
     /// [`Coupled::rhs_at_loads`], with the models' fused rates when `FUSED`.

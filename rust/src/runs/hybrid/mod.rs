@@ -27,7 +27,9 @@ mod laminate_tests;
 pub mod layered;
 pub mod linear;
 pub(crate) mod model;
+pub mod pieces;
 pub mod slow;
+pub(crate) mod tabulated;
 
 use crate::cancel::Cancel;
 use crate::error::{require_positive, Error, Result};
@@ -122,6 +124,37 @@ pub struct HybridRun {
     pub n_refused_limit: u64,
     pub n_refused_gate: u64,
     pub n_refused_growth: u64,
+    /// Pieces a long slow-time run was cut into to run on several cores ([`pieces`]; 1 for a
+    /// run in one piece, 0 off slow time), the orbits their warm-ups ran (not summarised), and
+    /// the pieces run again in order because their warmed-up start missed.
+    pub n_pieces: u64,
+    pub n_warmup_orbits: u64,
+    pub n_pieces_rerun: u64,
+}
+
+impl HybridRun {
+    /// Adds the counters of `other`, a run that follows this one (the `run`s are left).
+    pub(crate) fn add(&mut self, other: &HybridRun) {
+        self.t_linear += other.t_linear;
+        self.t_exponential += other.t_exponential;
+        self.t_fallback += other.t_fallback;
+        self.n_arcs += other.n_arcs;
+        self.n_exp_steps += other.n_exp_steps;
+        self.n_fallback_steps += other.n_fallback_steps;
+        self.n_reread_steps += other.n_reread_steps;
+        self.t_slow += other.t_slow;
+        self.n_slow_steps += other.n_slow_steps;
+        self.n_refused_orbits += other.n_refused_orbits;
+        self.n_refused_separation += other.n_refused_separation;
+        self.n_refused_ringing += other.n_refused_ringing;
+        self.n_refused_split += other.n_refused_split;
+        self.n_refused_limit += other.n_refused_limit;
+        self.n_refused_gate += other.n_refused_gate;
+        self.n_refused_growth += other.n_refused_growth;
+        self.n_pieces += other.n_pieces;
+        self.n_warmup_orbits += other.n_warmup_orbits;
+        self.n_pieces_rerun += other.n_pieces_rerun;
+    }
 }
 
 impl Default for HybridRun {
@@ -151,6 +184,9 @@ impl Default for HybridRun {
             n_refused_limit: 0,
             n_refused_gate: 0,
             n_refused_growth: 0,
+            n_pieces: 0,
+            n_warmup_orbits: 0,
+            n_pieces_rerun: 0,
         }
     }
 }
@@ -198,7 +234,7 @@ pub fn run_orbits_hybrid(
     spec.panel.validate()?;
     check_request(spec, y0.as_slice(), settings, cancel)?;
     if slow::applies(spec) {
-        let done = slow::run_slow(spec, y0, cancel)?;
+        let done = pieces::run_in_pieces(spec, y0, cancel)?;
         return Ok(HybridRun {
             run: done.run,
             ..done.split

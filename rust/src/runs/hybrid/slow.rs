@@ -36,12 +36,14 @@ use crate::cancel::Cancel;
 use crate::error::Result;
 use crate::inputs::heating::Loads;
 use crate::inputs::orbit::{breakpoints_of, EclipseTable, Shadow};
+use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupled;
 use crate::models::hinge::{quasi_static, HingeModel};
 use crate::numerics::integrate::dop853::{self, Dop853Step};
 use crate::numerics::integrate::{solve, OdeSystem, State, Tolerances, WithCuts};
 use crate::numerics::quadrature::GAUSS_5;
 use crate::runs::hybrid::jacobian::Linearisation;
+use crate::runs::hybrid::tabulated::{self, LoadTable, Tabulated};
 use crate::runs::hybrid::{counted_as_fallback, HybridRun, Propagated};
 use crate::runs::orbits::STEPS_PER_HINGE_PERIOD;
 use crate::runs::orbits::{resolve_hinge, Collector, OrbitRunSpec, SummaryObserver, TwoLayerView};
@@ -95,6 +97,8 @@ struct SlowModel {
     /// The segment being integrated: the loads' side of each shadow edge, and the flow's
     /// derivative kept inside it.
     segment: (f64, f64),
+    /// The segment's loads, tabulated on entering it (under the Earth's heat or an attitude).
+    table: Option<LoadTable>,
 }
 
 /// A point of the slow manifold.
@@ -145,17 +149,19 @@ impl SlowModel {
             scales: scales(p.moment_per_kelvin() / p.hinge_stiffness),
             gauss_cosines: GAUSS_5.map(|(x, wt)| ((0.5 * PI * (x + 1.0)).cos(), wt)),
             segment: (f64::NEG_INFINITY, f64::INFINITY),
+            table: None,
         }
     }
 
     fn enter(&mut self, a: f64, b: f64) {
         self.segment = (a, b);
         self.system.enter_segment(a, b);
+        self.table = LoadTable::fit(&self.system, a, b);
     }
 
     fn loads(&self, t: f64) -> Loads {
         if self.system.has_face_loads() {
-            self.system.loads_at(t)
+            tabulated::loads_at(&self.system, self.table.as_ref(), t)
         } else {
             Loads::sun(self.system.flux_at(t))
         }
@@ -395,6 +401,28 @@ fn scales(per_kelvin: f64) -> (f64, f64) {
     };
     let unit = SLOW_TOLERANCES.atol;
     (MEAN_TOLERANCE / unit, difference / unit)
+}
+
+/// Whether slow time cannot tell the states `a` and `b` of `panel` apart: their temperatures
+/// within one step's error tolerance of its integration (on the mean and on T_f − T_b, each
+/// in its scaled unit: atol plus rtol of the value), and their dynamic parts θ − θ₀ and rates
+/// within [`ANGLE_TOLERANCE`] (the rate over the hinge's angular frequency). A run of slow time
+/// from either is as good as from the other: each step moves its state by as much.
+pub(crate) fn indistinct(panel: &Panel, a: &Vector4<f64>, b: &Vector4<f64>) -> bool {
+    let per_kelvin = panel.moment_per_kelvin() / panel.hinge_stiffness;
+    let (mean, difference) = scales(per_kelvin);
+    let Tolerances { rtol, atol, .. } = SLOW_TOLERANCES;
+    let close = |x: f64, y: f64, scale: f64| {
+        let (x, y) = (x / scale, y / scale);
+        (x - y).abs() <= atol + rtol * x.abs().max(y.abs())
+    };
+    let dynamic = |y: &Vector4<f64>| {
+        y[2] - quasi_static(panel.moment_per_kelvin(), panel.hinge_stiffness, y[0], y[1])
+    };
+    close(0.5 * (a[0] + a[1]), 0.5 * (b[0] + b[1]), mean)
+        && close(a[0] - a[1], b[0] - b[1], difference)
+        && (dynamic(a) - dynamic(b)).abs() <= ANGLE_TOLERANCE
+        && (a[3] - b[3]).abs() <= ANGLE_TOLERANCE * panel.natural_angular_frequency()
 }
 
 /// The root of det(λ − J) nearest `guess` by Newton's method on the characteristic polynomial
@@ -1086,8 +1114,9 @@ pub(crate) fn run_slow(
                     a,
                 )?;
                 // [a, b] lies between two of the orbit's breakpoints: none inside.
+                let mut tabulated = Tabulated::new(&mut full);
                 let mut within = WithCuts {
-                    system: &mut full,
+                    system: &mut tabulated,
                     cuts: &[],
                 };
                 let (st, y1) = solve(&mut within, &full_method, a, y, b, &mut obs)?;
@@ -1175,8 +1204,9 @@ pub(crate) fn run_slow(
             obs.collector.rewind(mark);
             check_budget(stats.n_steps + stats.n_rejected, orbit_start)?;
             // The orbit's breakpoints, as slow time cut it.
+            let mut tabulated = Tabulated::new(&mut full);
             let mut orbit = WithCuts {
-                system: &mut full,
+                system: &mut tabulated,
                 cuts: &cuts,
             };
             let (st, y1) = solve(

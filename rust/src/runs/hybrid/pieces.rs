@@ -1,0 +1,312 @@
+//! A long slow-time run cut into pieces of orbits that run at once on the machine's cores.
+//!
+//! The panel forgets its past: the temperatures within minutes of an orbit, the hinge's ringing
+//! at its damping rate (Table 1 on a 540 km orbit: to about half of itself each orbit). So a piece
+//! that starts from any plausible state some [`warmup_orbits`] before its first orbit reaches
+//! that orbit in the state the run before it ends in, to rounding. Each piece after the first
+//! does so, all pieces run in parallel, and then, in order, each piece's warmed-up start is
+//! checked against the end of the piece before it ([`agrees`]). A piece that does not agree
+//! (flutter, a panel damped too little, a warm-up given back to the full integration where the
+//! run was not) is run again from that end: the run is then the serial one, only slower.
+//!
+//! The cut depends on the run alone (its orbits and panel), not on the number of threads: the
+//! same run gives the same numbers on any machine.
+
+use crate::cancel::Cancel;
+use crate::error::Result;
+use crate::runs::hybrid::{slow, Propagated};
+use crate::runs::orbits::OrbitRunSpec;
+use nalgebra::Vector4;
+use rayon::prelude::*;
+
+/// Orbits a piece holds at least: a run of fewer than twice this runs whole.
+pub const PIECE_ORBITS: u64 = 2000;
+/// The factor by which the warm-up shrinks a piece's start error, at [`WARMUP_RATE`].
+const WARMUP_DECAY: f64 = 1e-14;
+/// The rate at which a start error is taken to shrink, as a share of the ringing's structural
+/// decay rate c_d/(2 I_B). The thermal coupling takes some damping: Table 1 on `Orbit::leo`
+/// (540 km) lost an error from a start 28 orbits early only to 5e-10 rad (0.57 of the
+/// structural rate, in log), and to 6e-13 from 55 orbits early, the rounding of two histories.
+/// Whatever the rate, the check of each piece's start decides ([`agrees`]).
+const WARMUP_RATE: f64 = 0.5;
+/// A warm-up of more orbits than this share of a piece is not worth it: such a run runs whole.
+const WARMUP_SHARE: f64 = 0.05;
+/// The warm-up of a piece, in orbits: enough for the hinge's structural damping to shrink an
+/// error of its start by [`WARMUP_DECAY`], and at least two (the temperatures' own memory is
+/// under an orbit). None when the hinge is undamped.
+pub fn warmup_orbits(spec: &OrbitRunSpec) -> Option<u64> {
+    // The ringing's amplitude decays as exp(−c_d t / (2 I_B)).
+    let rate = WARMUP_RATE * 0.5 * spec.panel.damping_rate();
+    if rate.is_nan() || rate <= 0.0 {
+        return None;
+    }
+    let orbits = (-WARMUP_DECAY.ln() / (rate * spec.orbit.period)).ceil();
+    Some(orbits.max(2.0) as u64)
+}
+
+/// The pieces of a run of `spec`: (first orbit, orbits) from its start, and the warm-up; one
+/// piece when the run is short or its warm-up too long.
+pub fn layout(spec: &OrbitRunSpec) -> (Vec<(u64, u64)>, u64) {
+    let n = spec.n_orbits;
+    let whole = (vec![(0, n)], 0);
+    let count = n / PIECE_ORBITS;
+    let Some(warmup) = warmup_orbits(spec) else {
+        return whole;
+    };
+    if count < 2 || warmup as f64 > WARMUP_SHARE * (n / count) as f64 {
+        return whole;
+    }
+    let (base, extra) = (n / count, n % count);
+    let mut pieces = Vec::with_capacity(count as usize);
+    let mut first = 0;
+    for k in 0..count {
+        let len = base + u64::from(k < extra);
+        pieces.push((first, len));
+        first += len;
+    }
+    (pieces, warmup)
+}
+
+/// Whether the warmed-up start `warm` of a piece is the state `end` the piece before it ended
+/// in, as far as slow time can tell ([`slow::indistinct`]: within one step's tolerance of its
+/// integration). Not to rounding: under the Earth's heat a step across the albedo's kink at
+/// the terminator is accepted or not on a hair, so two histories of the same orbits end their
+/// orbits apart by up to that tolerance (5e-5 K measured on 540 km equatorial orbits, 1e-11 K
+/// under the Sun alone), which the next orbit forgets as it forgets any step's error.
+pub fn agrees(spec: &OrbitRunSpec, warm: &Vector4<f64>, end: &Vector4<f64>) -> bool {
+    slow::indistinct(&spec.panel, warm, end)
+}
+
+/// The part of `spec` from its orbit `first`, `n` orbits long.
+fn part(spec: &OrbitRunSpec, first: u64, n: u64) -> OrbitRunSpec {
+    OrbitRunSpec {
+        t_start: spec.t_start + first as f64 * spec.orbit.period,
+        first_index: spec.first_index + first,
+        n_orbits: n,
+        ..*spec
+    }
+}
+
+/// A piece as run in parallel: the first piece's run from the run's own state, or a later
+/// piece's warmed-up start and its run from there (None when its warm-up stopped or failed,
+/// which tells nothing: the piece then runs in order).
+enum Piece {
+    First(Result<Propagated<4>>),
+    Warmed(Option<(Vector4<f64>, Result<Propagated<4>>)>),
+}
+
+/// Runs `spec` from `y0` on slow time, in pieces where it is long ([`layout`]); the same
+/// summaries as one piece, the counters with the pieces' warm-ups and reruns added.
+pub(crate) fn run_in_pieces(
+    spec: &OrbitRunSpec,
+    y0: Vector4<f64>,
+    cancel: &Cancel,
+) -> Result<Propagated<4>> {
+    let (pieces, warmup) = layout(spec);
+    if pieces.len() < 2 {
+        let mut whole = slow::run_slow(spec, y0, cancel)?;
+        whole.split.n_pieces = 1;
+        return Ok(whole);
+    }
+    run_cut(spec, y0, cancel, &pieces, warmup)
+}
+
+/// [`run_in_pieces`] with its cut given: `pieces` (first orbit, orbits), each after the first
+/// warmed up over `warmup` orbits.
+fn run_cut(
+    spec: &OrbitRunSpec,
+    y0: Vector4<f64>,
+    cancel: &Cancel,
+    pieces: &[(u64, u64)],
+    warmup: u64,
+) -> Result<Propagated<4>> {
+    let ran: Vec<Piece> = pieces
+        .par_iter()
+        .enumerate()
+        .map(|(k, &(first, n))| {
+            if k == 0 {
+                return Piece::First(slow::run_slow(&part(spec, first, n), y0, cancel));
+            }
+            // From the run's own start state, `warmup` orbits early.
+            let warm = slow::run_slow(&part(spec, first - warmup, warmup), y0, cancel);
+            Piece::Warmed(match warm {
+                Ok(w) if !w.run.stats.stopped => {
+                    let start = w.run.y_end;
+                    Some((start, slow::run_slow(&part(spec, first, n), start, cancel)))
+                }
+                _ => None,
+            })
+        })
+        .collect();
+    let mut ran = ran.into_iter().zip(pieces);
+    let Some((Piece::First(first_run), _)) = ran.next() else {
+        unreachable!("the first piece starts from the run's own state");
+    };
+    let mut out = first_run?;
+    for (piece, &(first, n)) in ran {
+        cancel.check()?;
+        if out.run.stats.stopped {
+            break;
+        }
+        let end = out.run.y_end;
+        let done = match piece {
+            Piece::Warmed(Some((start, Ok(p)))) if agrees(spec, &start, &end) => p,
+            // A start that does not agree, or a piece that failed from it: in order, from the
+            // end of the piece before.
+            _ => {
+                let mut p = slow::run_slow(&part(spec, first, n), end, cancel)?;
+                p.split.n_pieces_rerun += 1;
+                p
+            }
+        };
+        out = joined(out, done);
+        out.split.n_warmup_orbits += warmup;
+    }
+    out.split.n_pieces = pieces.len() as u64;
+    Ok(out)
+}
+
+/// Two consecutive runs as one: the summaries in order, the counters added, the later end.
+fn joined(mut a: Propagated<4>, b: Propagated<4>) -> Propagated<4> {
+    let (ra, rb) = (&mut a.run, b.run);
+    ra.summaries.extend(rb.summaries);
+    ra.stats.n_steps += rb.stats.n_steps;
+    ra.stats.n_rejected += rb.stats.n_rejected;
+    ra.stats.n_rhs += rb.stats.n_rhs;
+    ra.stats.t_end = rb.stats.t_end;
+    ra.stats.stopped = rb.stats.stopped;
+    ra.y_end = rb.y_end;
+    ra.crossing = ra.crossing.or(rb.crossing);
+    a.split.add(&b.split);
+    a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inputs::orbit::Orbit;
+    use crate::inputs::panel::Panel;
+    use crate::models::coupled::Coupling;
+    use crate::models::hinge::HingeModel;
+    use crate::numerics::integrate::{Method, Tolerances};
+    use crate::runs::orbits::{start_state, SummaryOptions};
+
+    fn spec(panel: Panel, orbit: Orbit, n: u64) -> OrbitRunSpec {
+        OrbitRunSpec {
+            panel,
+            orbit,
+            model: HingeModel::Linear,
+            coupling: Coupling::ProjectedArea,
+            method: Method::Dopri5(Tolerances::default()),
+            t_start: 0.0,
+            first_index: 0,
+            n_orbits: n,
+            options: SummaryOptions {
+                window: 600.0,
+                theta_limit: 0.5,
+                stop_at_limit: true,
+                steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
+            },
+        }
+    }
+
+    #[test]
+    fn the_pieces_cover_the_run_in_order() {
+        let s = spec(Panel::paper(), Orbit::leo(540e3), 10_001);
+        let (pieces, warmup) = layout(&s);
+        assert_eq!(pieces.len(), 5);
+        assert!((2..PIECE_ORBITS / 10).contains(&warmup), "{warmup}");
+        let mut next = 0;
+        for &(first, n) in &pieces {
+            assert_eq!(first, next);
+            assert!(n >= PIECE_ORBITS);
+            next += n;
+        }
+        assert_eq!(next, 10_001);
+        // Short runs and undamped hinges run whole.
+        assert_eq!(
+            layout(&spec(Panel::paper(), Orbit::leo(540e3), 3999))
+                .0
+                .len(),
+            1
+        );
+        let undamped = Panel {
+            damping: 0.0,
+            ..Panel::paper()
+        };
+        assert_eq!(
+            layout(&spec(undamped, Orbit::leo(540e3), 10_000)).0.len(),
+            1
+        );
+    }
+
+    #[test]
+    fn the_warmup_shrinks_the_ringing_by_its_factor() {
+        let s = spec(Panel::paper(), Orbit::leo(540e3), 10_000);
+        let w = warmup_orbits(&s).unwrap() as f64;
+        let decay = |orbits: f64| {
+            (-WARMUP_RATE * 0.5 * s.panel.damping_rate() * orbits * s.orbit.period).exp()
+        };
+        assert!(decay(w) <= WARMUP_DECAY && decay(w - 1.0) > WARMUP_DECAY);
+    }
+
+    /// A run in pieces is the run in one piece: every summary within 1e-3 of the accuracy gate
+    /// (2 %, or 1e-6 rad below 5e-5 rad) of it. (Not to the bit: the pieces' orbits start at
+    /// times rounded apart by ~2e-9 s, and slow time's read of a cylindrical shadow's ringing
+    /// moves by ~1e-7 rad from one orbit to the next of the same run.)
+    #[test]
+    fn a_run_in_pieces_is_the_run_whole() {
+        let s = spec(Panel::paper(), Orbit::leo(540e3), 2 * PIECE_ORBITS + 7);
+        let y0 = start_state(&s.panel, &s.orbit, s.coupling, s.t_start).unwrap();
+        let whole = slow::run_slow(&s, y0, &Cancel::new()).unwrap();
+        let cut = run_in_pieces(&s, y0, &Cancel::new()).unwrap();
+        assert_eq!(cut.split.n_pieces, 2);
+        assert_eq!(cut.split.n_pieces_rerun, 0);
+        assert_eq!(cut.split.n_warmup_orbits, layout(&s).1);
+        assert_eq!(cut.split.n_slow_steps, whole.split.n_slow_steps);
+        assert_eq!(cut.run.summaries.len(), whole.run.summaries.len());
+        let mut worst: f64 = 0.0;
+        for (a, b) in whole.run.summaries.iter().zip(&cut.run.summaries) {
+            assert_eq!(a.index, b.index);
+            for (x, y) in [
+                (a.theta_max, b.theta_max),
+                (a.theta_min, b.theta_min),
+                (a.amplitude, b.amplitude),
+                (a.jitter_rms, b.jitter_rms),
+                (a.jitter_peak, b.jitter_peak),
+                (a.entry_theta_min, b.entry_theta_min),
+                (a.exit_theta_max, b.exit_theta_max),
+            ] {
+                let gate = if x.abs() < 5e-5 { 1e-6 } else { 0.02 * x.abs() };
+                worst = worst.max((x - y).abs() / gate);
+            }
+        }
+        assert!(worst < 1e-3, "{worst:e}");
+        assert!((whole.run.y_end - cut.run.y_end).abs().max() < 1e-9);
+    }
+
+    /// A piece whose warmed-up start misses the end of the piece before runs again from that
+    /// end: here a warm-up of two orbits, which leaves the hinge's ringing unforgotten.
+    #[test]
+    fn a_piece_that_misses_its_start_runs_again_in_order() {
+        let s = spec(Panel::paper(), Orbit::leo(540e3), 300);
+        let y0 = start_state(&s.panel, &s.orbit, s.coupling, s.t_start).unwrap();
+        let pieces = [(0, 100), (100, 100), (200, 100)];
+        let cut = run_cut(&s, y0, &Cancel::new(), &pieces, 2).unwrap();
+        assert_eq!(cut.split.n_pieces_rerun, 2);
+        assert_eq!(cut.split.n_warmup_orbits, 4);
+        let whole = slow::run_slow(&s, y0, &Cancel::new()).unwrap();
+        assert_eq!(cut.split.n_slow_steps, whole.split.n_slow_steps);
+        for (a, b) in whole.run.summaries.iter().zip(&cut.run.summaries) {
+            let gate = 0.02 * a.theta_min.abs();
+            assert!(
+                (a.theta_min - b.theta_min).abs() < 1e-3 * gate,
+                "{a:?} {b:?}"
+            );
+        }
+        // With the warm-up of the run's own cut the starts agree.
+        let (_, warmup) = layout(&spec(Panel::paper(), Orbit::leo(540e3), 2 * PIECE_ORBITS));
+        let cut = run_cut(&s, y0, &Cancel::new(), &pieces[..2], warmup).unwrap();
+        assert_eq!(cut.split.n_pieces_rerun, 0);
+    }
+}
