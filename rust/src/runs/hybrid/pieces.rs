@@ -68,13 +68,14 @@ pub fn layout(spec: &OrbitRunSpec) -> (Vec<(u64, u64)>, u64) {
 }
 
 /// Whether the warmed-up start `warm` of a piece is the state `end` the piece before it ended
-/// in, as far as slow time can tell ([`slow::indistinct`]: within one step's tolerance of its
-/// integration). Not to rounding: under the Earth's heat a step across the albedo's kink at
-/// the terminator is accepted or not on a hair, so two histories of the same orbits end their
-/// orbits apart by up to that tolerance (5e-5 K measured on 540 km equatorial orbits, 1e-11 K
-/// under the Sun alone), which the next orbit forgets as it forgets any step's error.
-pub fn agrees(spec: &OrbitRunSpec, warm: &Vector4<f64>, end: &Vector4<f64>) -> bool {
-    slow::indistinct(&spec.panel, warm, end)
+/// in, `ring` the largest dynamic part of that piece's last orbit, as far as slow time can tell
+/// ([`slow::indistinct`]). Not to rounding: under the Earth's heat a step across the albedo's
+/// kink at the terminator is accepted or not on a hair, so two histories of the same orbits
+/// end their orbits apart by up to slow time's tolerances (5e-5 K measured on 540 km equatorial
+/// orbits, 1e-11 K under the Sun alone), which the next orbits forget as they forget any step's
+/// error.
+pub fn agrees(spec: &OrbitRunSpec, warm: &Vector4<f64>, end: &Vector4<f64>, ring: f64) -> bool {
+    slow::indistinct(&spec.panel, warm, end, ring)
 }
 
 /// The part of `spec` from its orbit `first`, `n` orbits long.
@@ -149,8 +150,10 @@ fn run_cut(
             break;
         }
         let end = out.run.y_end;
+        // The largest dynamic part of the orbit that ends there: the ringing's scale.
+        let ring = out.run.summaries.last().map_or(0.0, |s| s.jitter_peak);
         let done = match piece {
-            Piece::Warmed(Some((start, Ok(p)))) if agrees(spec, &start, &end) => p,
+            Piece::Warmed(Some((start, Ok(p)))) if agrees(spec, &start, &end, ring) => p,
             // A start that does not agree, or a piece that failed from it: in order, from the
             // end of the piece before.
             _ => {

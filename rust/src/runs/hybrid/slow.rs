@@ -403,38 +403,38 @@ fn scales(per_kelvin: f64) -> (f64, f64) {
     (MEAN_TOLERANCE / unit, difference / unit)
 }
 
-/// A ringing's share by which two states slow time holds for the same may differ: a thirtieth
-/// of the error its gate check budgets for the ringing ([`RING_ACCURACY`]).
-const RING_MATCH: f64 = 1e-4;
+/// The share of the θ error an orbit's gate check allows for ([`THETA_ACCURACY`] of the
+/// ringing) by which two states slow time holds for the same may differ.
+const STATE_MATCH: f64 = 0.2;
 
-/// Whether slow time cannot tell the states `a` and `b` of `panel` apart: their temperatures
-/// within one step's error tolerance of its integration (on the mean and on T_f − T_b, each
-/// in its scaled unit: atol plus rtol of the value), and their dynamic parts θ − θ₀ and rates
-/// (over the hinge's angular frequency) within [`ANGLE_TOLERANCE`] or [`RING_MATCH`] of the
-/// ringing's amplitude, whichever is larger. A run of slow time from either is as good as from
-/// the other. (The non-linear hinge's ringing, its frequency set by its amplitude, keeps two
-/// histories ~1e-7 rad apart at Table 1's 1.3e-3 rad on a heated 540 km orbit.)
-pub(crate) fn indistinct(panel: &Panel, a: &Vector4<f64>, b: &Vector4<f64>) -> bool {
-    let per_kelvin = panel.moment_per_kelvin() / panel.hinge_stiffness;
+/// Whether slow time cannot tell the states `a` and `b` of `panel` apart, `ring` the largest
+/// dynamic part of the orbit they end (its `jitter_peak`): their mean temperatures within one
+/// step's error tolerance of its integration (atol plus rtol of the value, in its scaled unit),
+/// and their quasi-static angles θ₀ = M_T/K_el, dynamic parts θ − θ₀ and rates (over the
+/// hinge's angular frequency) within [`ANGLE_TOLERANCE`] or [`STATE_MATCH`] of the θ error the
+/// gate check allows the orbit for its ringing, whichever is larger. A run of slow time from
+/// either is then as good as from the other: two histories of the same heated orbits end them
+/// this far apart (a step across the albedo's kink accepted or not on a hair; the non-linear
+/// hinge's ringing, its frequency set by its amplitude), ~1e-7 rad at Table 1's 1.3e-3 rad.
+pub(crate) fn indistinct(panel: &Panel, a: &Vector4<f64>, b: &Vector4<f64>, ring: f64) -> bool {
+    let (moment, stiffness) = (panel.moment_per_kelvin(), panel.hinge_stiffness);
     let omega = panel.natural_angular_frequency();
-    let (mean, difference) = scales(per_kelvin);
+    let (mean, _) = scales(moment / stiffness);
     let Tolerances { rtol, atol, .. } = SLOW_TOLERANCES;
-    let close = |x: f64, y: f64, scale: f64| {
-        let (x, y) = (x / scale, y / scale);
-        (x - y).abs() <= atol + rtol * x.abs().max(y.abs())
+    let (ma, mb) = (0.5 * (a[0] + a[1]) / mean, 0.5 * (b[0] + b[1]) / mean);
+    // θ₀, the dynamic part and the rate over ω.
+    let angles = |y: &Vector4<f64>| {
+        let th0 = quasi_static(moment, stiffness, y[0], y[1]);
+        [th0, y[2] - th0, y[3] / omega]
     };
-    // The dynamic part and the rate over ω: the ringing's two phases.
-    let dynamic = |y: &Vector4<f64>| {
-        let th0 = quasi_static(panel.moment_per_kelvin(), panel.hinge_stiffness, y[0], y[1]);
-        (y[2] - th0, y[3] / omega)
-    };
-    let ((da, ra), (db, rb)) = (dynamic(a), dynamic(b));
-    let ring = da.hypot(ra).max(db.hypot(rb));
-    let allowed = ANGLE_TOLERANCE.max(RING_MATCH * ring);
-    close(0.5 * (a[0] + a[1]), 0.5 * (b[0] + b[1]), mean)
-        && close(a[0] - a[1], b[0] - b[1], difference)
-        && (da - db).abs() <= allowed
-        && (ra - rb).abs() <= allowed
+    let (pa, pb) = (angles(a), angles(b));
+    let ring = [pa, pb]
+        .iter()
+        .map(|p| p[1].hypot(p[2]))
+        .fold(ring.abs(), f64::max);
+    let allowed = ANGLE_TOLERANCE.max(STATE_MATCH * THETA_ACCURACY * ring);
+    (ma - mb).abs() <= atol + rtol * ma.abs().max(mb.abs())
+        && (0..3).all(|k| (pa[k] - pb[k]).abs() <= allowed)
 }
 
 /// The root of det(λ − J) nearest `guess` by Newton's method on the characteristic polynomial
