@@ -189,28 +189,12 @@ mod tests {
     use super::*;
     use crate::inputs::orbit::Orbit;
     use crate::inputs::panel::Panel;
-    use crate::models::coupled::Coupling;
     use crate::models::hinge::HingeModel;
-    use crate::numerics::integrate::{Method, Tolerances};
-    use crate::runs::orbits::{start_state, SummaryOptions};
+    use crate::runs::orbits::start_state;
 
+    /// A run of the linear hinge, as slow time's own tests ask for one.
     fn spec(panel: Panel, orbit: Orbit, n: u64) -> OrbitRunSpec {
-        OrbitRunSpec {
-            panel,
-            orbit,
-            model: HingeModel::Linear,
-            coupling: Coupling::ProjectedArea,
-            method: Method::Dopri5(Tolerances::default()),
-            t_start: 0.0,
-            first_index: 0,
-            n_orbits: n,
-            options: SummaryOptions {
-                window: 600.0,
-                theta_limit: 0.5,
-                stop_at_limit: true,
-                steps_per_period: crate::runs::orbits::STEPS_PER_HINGE_PERIOD,
-            },
-        }
+        crate::runs::hybrid::slow::tests::spec(panel, orbit, HingeModel::Linear, n)
     }
 
     #[test]

@@ -1262,7 +1262,7 @@ pub(crate) fn run_slow(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::inputs::orbit::Orbit;
     use crate::inputs::panel::Panel;
@@ -1272,7 +1272,7 @@ mod tests {
         run_orbits, start_state, OrbitRunRequest, OrbitSummary, SummaryOptions,
     };
 
-    fn spec(panel: Panel, orbit: Orbit, model: HingeModel, n: u64) -> OrbitRunSpec {
+    pub(crate) fn spec(panel: Panel, orbit: Orbit, model: HingeModel, n: u64) -> OrbitRunSpec {
         OrbitRunSpec {
             panel,
             orbit,
