@@ -398,25 +398,21 @@ impl Orbit {
     }
 }
 
-/// Where `f` changes sign in (a, b), when its ends differ in sign: bisection to the rounding of t.
-fn sign_change(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Option<f64> {
-    let (mut lo, mut hi) = (a, b);
-    let low_sign = f(lo) > 0.0;
-    if low_sign == (f(hi) > 0.0) {
-        return None;
-    }
-    while hi - lo > 1e-12 * hi.abs().max(1.0) {
+/// Where `f` changes sign in (lo, hi), `low` whether f(lo) > 0 (f(hi) on the other side): bisection
+/// until the bracket is at most `rel` max(|hi|, 1) wide (0: two adjacent floats), its middle.
+fn sign_change(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, low: bool, rel: f64) -> f64 {
+    while hi - lo > rel * hi.abs().max(1.0) {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             break;
         }
-        if (f(mid) > 0.0) == low_sign {
+        if (f(mid) > 0.0) == low {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    Some(0.5 * (lo + hi))
+    0.5 * (lo + hi)
 }
 
 /// Subintervals of the sunlit-arc average per orbit period. The loads are smooth on each piece
@@ -430,45 +426,55 @@ impl Orbit {
     /// The times in (x0, x1) where a load has a kink — the Sun crossing the faces' plane, the
     /// sub-satellite point crossing the terminator — each where its cosine changes sign between
     /// the ends (the interval is short against the orbit: at most one crossing of each), found
-    /// by bisection; sorted.
+    /// by bisection to 1e-12 of t; sorted.
     fn kinks(&self, x0: f64, x1: f64) -> Vec<f64> {
-        let incidence = |t: f64| {
-            let g = self.geometry(t);
-            dot(g.normal, g.sun)
-        };
-        let zenith = |t: f64| dot(self.position(t), self.sun_direction(t));
-        let mut out = Vec::new();
-        if self.attitude != Attitude::SunPointing {
-            out.extend(sign_change(incidence, x0, x1));
-        }
-        if self.albedo != 0.0 {
-            out.extend(sign_change(zenith, x0, x1));
-        }
-        out.sort_by(f64::total_cmp);
-        out
+        self.crossings(&self.kink_functions(false), x0, x1, 1, 1e-12)
     }
 
-    /// The times in (x0, x1) where a load is not smooth: where the Sun crosses a face's plane,
-    /// the sub-satellite point crosses the terminator (as [`Orbit::kinks`]), and where a face's
-    /// view of the Earth becomes full (cos λ H = ±1, λ the front normal's angle to the nadir:
-    /// the view factor's partial branch starts there like a power 3/2). Each is searched on
-    /// pieces of at most `span` s, found where its function changes sign between a piece's
+    /// The times in (x0, x1) where a load is not smooth: its kinks ([`Orbit::kinks`]) and where a
+    /// face's view of the Earth becomes full (cos λ H = ±1, λ the front normal's angle to the
+    /// nadir: the view factor's partial branch starts there like a power 3/2). Each is searched
+    /// on pieces of at most `span` s, found where its function changes sign between a piece's
     /// ends (two crossings inside one piece are not found: a table fitted across them refuses
     /// that part), to the rounding of t; sorted.
     pub(crate) fn load_kinks(&self, x0: f64, x1: f64, span: f64) -> Vec<f64> {
-        let h = self.radius / self.earth_radius;
-        // Each function of the geometry whose sign change is a kink.
-        let mut kinds: Vec<fn(&Geometry, f64) -> f64> =
-            vec![|g, h| -dot(g.normal, g.position) * h - 1.0, |g, h| {
-                -dot(g.normal, g.position) * h + 1.0
-            }];
+        let pieces = ((x1 - x0) / span).ceil().max(1.0) as usize;
+        self.crossings(&self.kink_functions(true), x0, x1, pieces, 0.0)
+    }
+
+    /// The functions of the geometry (and H = r/R_E) whose sign changes are the loads' kinks:
+    /// the Sun crossing a face's plane (an attitude other than Sun-pointing), the sub-satellite
+    /// point crossing the terminator (albedo) and, with `edges`, a face's view of the Earth
+    /// becoming full.
+    fn kink_functions(&self, edges: bool) -> Vec<fn(&Geometry, f64) -> f64> {
+        let mut out: Vec<fn(&Geometry, f64) -> f64> = Vec::new();
+        if edges {
+            out.push(|g, h| -dot(g.normal, g.position) * h - 1.0);
+            out.push(|g, h| -dot(g.normal, g.position) * h + 1.0);
+        }
         if self.attitude != Attitude::SunPointing {
-            kinds.push(|g, _| dot(g.normal, g.sun));
+            out.push(|g, _| dot(g.normal, g.sun));
         }
         if self.albedo != 0.0 {
-            kinds.push(|g, _| dot(g.position, g.sun));
+            out.push(|g, _| dot(g.position, g.sun));
         }
-        let pieces = ((x1 - x0) / span).ceil().max(1.0) as usize;
+        out
+    }
+
+    /// Where each of `functions` changes sign between the ends of one of `pieces` equal pieces
+    /// of (x0, x1), bisected to `rel` of t ([`sign_change`]); sorted.
+    fn crossings(
+        &self,
+        functions: &[fn(&Geometry, f64) -> f64],
+        x0: f64,
+        x1: f64,
+        pieces: usize,
+        rel: f64,
+    ) -> Vec<f64> {
+        if functions.is_empty() {
+            return Vec::new();
+        }
+        let h = self.radius / self.earth_radius;
         let ends: Vec<f64> = (0..=pieces)
             .map(|k| {
                 if k == pieces {
@@ -480,25 +486,13 @@ impl Orbit {
             .collect();
         let at_ends: Vec<Geometry> = ends.iter().map(|&t| self.geometry(t)).collect();
         let mut out = Vec::new();
-        for kind in kinds {
+        for f in functions {
             for k in 0..pieces {
-                let (mut lo, mut hi) = (ends[k], ends[k + 1]);
-                let low = kind(&at_ends[k], h) > 0.0;
-                if low == (kind(&at_ends[k + 1], h) > 0.0) {
-                    continue;
+                let low = f(&at_ends[k], h) > 0.0;
+                if low != (f(&at_ends[k + 1], h) > 0.0) {
+                    let at = |t: f64| f(&self.geometry(t), h);
+                    out.push(sign_change(at, ends[k], ends[k + 1], low, rel));
                 }
-                loop {
-                    let mid = 0.5 * (lo + hi);
-                    if mid <= lo || mid >= hi {
-                        break;
-                    }
-                    if (kind(&self.geometry(mid), h) > 0.0) == low {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                out.push(hi);
             }
         }
         out.retain(|&t| t > x0 && t < x1);
