@@ -88,13 +88,9 @@ fn part(spec: &OrbitRunSpec, first: u64, n: u64) -> OrbitRunSpec {
     }
 }
 
-/// A piece as run in parallel: the first piece's run from the run's own state, or a later
-/// piece's warmed-up start and its run from there (None when its warm-up stopped or failed,
-/// which tells nothing: the piece then runs in order).
-enum Piece {
-    First(Result<Propagated<4>>),
-    Warmed(Option<(Vector4<f64>, Result<Propagated<4>>)>),
-}
+/// A later piece as run in parallel: its warmed-up start and its run from there (None when its
+/// warm-up stopped or failed, which tells nothing: the piece then runs in order).
+type Warmed = Option<(Vector4<f64>, Result<Propagated<4>>)>;
 
 /// Runs `spec` from `y0` on slow time, in pieces where it is long ([`layout`]); the same
 /// summaries as one piece, the counters with the pieces' warm-ups and reruns added.
@@ -121,30 +117,28 @@ fn run_cut(
     pieces: &[(u64, u64)],
     warmup: u64,
 ) -> Result<Propagated<4>> {
-    let ran: Vec<Piece> = pieces
-        .par_iter()
-        .enumerate()
-        .map(|(k, &(first, n))| {
-            if k == 0 {
-                return Piece::First(slow::run_slow(&part(spec, first, n), y0, cancel));
-            }
-            // From the run's own start state, `warmup` orbits early.
-            let warm = slow::run_slow(&part(spec, first - warmup, warmup), y0, cancel);
-            Piece::Warmed(match warm {
-                Ok(w) if !w.run.stats.stopped => {
-                    let start = w.run.y_end;
-                    Some((start, slow::run_slow(&part(spec, first, n), start, cancel)))
-                }
-                _ => None,
-            })
-        })
-        .collect();
-    let mut ran = ran.into_iter().zip(pieces);
-    let Some((Piece::First(first_run), _)) = ran.next() else {
-        unreachable!("the first piece starts from the run's own state");
-    };
+    let (first, later) = pieces.split_first().expect("a cut has at least one piece");
+    let (first_run, warmed): (_, Vec<Warmed>) = rayon::join(
+        || slow::run_slow(&part(spec, first.0, first.1), y0, cancel),
+        || {
+            later
+                .par_iter()
+                .map(|&(first, n)| {
+                    // From the run's own start state, `warmup` orbits early.
+                    let warm = slow::run_slow(&part(spec, first - warmup, warmup), y0, cancel);
+                    match warm {
+                        Ok(w) if !w.run.stats.stopped => {
+                            let start = w.run.y_end;
+                            Some((start, slow::run_slow(&part(spec, first, n), start, cancel)))
+                        }
+                        _ => None,
+                    }
+                })
+                .collect()
+        },
+    );
     let mut out = first_run?;
-    for (piece, &(first, n)) in ran {
+    for (piece, &(first, n)) in warmed.into_iter().zip(later) {
         cancel.check()?;
         if out.run.stats.stopped {
             break;
@@ -153,7 +147,7 @@ fn run_cut(
         // The largest dynamic part of the orbit that ends there: the ringing's scale.
         let ring = out.run.summaries.last().map_or(0.0, |s| s.jitter_peak);
         let done = match piece {
-            Piece::Warmed(Some((start, Ok(p)))) if agrees(spec, &start, &end, ring) => p,
+            Some((start, Ok(p))) if agrees(spec, &start, &end, ring) => p,
             // A start that does not agree, or a piece that failed from it: in order, from the
             // end of the piece before.
             _ => {

@@ -106,7 +106,7 @@ pub(crate) fn loads_at(system: &Coupled, table: Option<&LoadTable>, t: f64) -> L
 /// The panel on its hinge with each segment's loads tabulated on entering it: the full
 /// integration inside a slow-time run (penumbrae, orbits given back).
 pub(crate) struct Tabulated<'a> {
-    pub system: &'a mut Coupled,
+    system: &'a mut Coupled,
     table: Option<LoadTable>,
 }
 
