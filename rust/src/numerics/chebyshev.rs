@@ -34,18 +34,21 @@ pub struct Table<const N: usize> {
     refused: Vec<bool>,
 }
 
-/// The Chebyshev series Σ c_m T_m(x) of each component by Clenshaw's recurrence.
+/// The Chebyshev series Σ c_m T_m(x) of each component by Clenshaw's recurrence, the
+/// components' recurrences side by side (each a chain of dependent operations: interleaved,
+/// they overlap).
 #[inline(always)]
 fn clenshaw<const N: usize>(c: &[[f64; N]; DEGREE + 1], x: f64) -> [f64; N] {
-    std::array::from_fn(|i| {
-        let (mut b1, mut b2) = (0.0, 0.0);
-        for cm in c[1..].iter().rev() {
-            let b0 = 2.0 * x * b1 - b2 + cm[i];
-            b2 = b1;
-            b1 = b0;
+    let two_x = 2.0 * x;
+    let (mut b1, mut b2) = ([0.0; N], [0.0; N]);
+    for cm in c[1..].iter().rev() {
+        for i in 0..N {
+            let b0 = two_x * b1[i] - b2[i] + cm[i];
+            b2[i] = b1[i];
+            b1[i] = b0;
         }
-        x * b1 - b2 + c[0][i]
-    })
+    }
+    std::array::from_fn(|i| x * b1[i] - b2[i] + c[0][i])
 }
 
 impl<const N: usize> Table<N> {

@@ -9,6 +9,8 @@
 //! no growth right after a rejection. A step is accepted only when its continuous extension also
 //! holds the tolerance inside it ([`extension_error`]): between the ends of a long step on a
 //! settling solution the extension's error can be many times the end's, and callers read there.
+//! The first step is Hairer's estimate grown by trial steps not taken ([`first_step`]), so that a
+//! segment does not spend its first accepted steps growing it ten-fold at a time.
 
 // The tableau's coefficients as published, to 30 digits: rounding is the compiler's.
 #![allow(clippy::excessive_precision)]
@@ -299,6 +301,12 @@ const DENSE: [[f64; EXTENDED]; 4] = [
 const SAFETY: f64 = 0.9;
 const MAX_FACTOR: f64 = 10.0;
 const ERROR_EXPONENT: f64 = -1.0 / 8.0;
+/// A trial first step whose error is below this is grown before any step is taken
+/// ([`first_step`]).
+const PROBE_ERROR: f64 = 1e-4;
+/// The most a first step is grown at one probe, and the number of probes.
+const PROBE_FACTOR: f64 = 1e4;
+const PROBES: usize = 4;
 
 /// One accepted step [t0, t1] and its continuous extension, of order seven:
 /// y(t0 + xh) = y0 + x(r0 + (1−x)(r1 + x(r2 + (1−x)(r3 + x(r4 + (1−x)(r5 + x r6)))))).
@@ -493,6 +501,47 @@ where
         .fold(0.0, f64::max)
 }
 
+/// The first step from (t0, y0), f0 = f(t0, y0), towards t1, at most `limit`. Hairer's estimate for the eighth
+/// order (the fifth-order estimator's error goes as h⁶ but the steps' as h⁸) is cautious: on a
+/// solution smooth over many times that step it is a fraction of a second where tens of seconds
+/// hold the tolerance, and the controller then grows it at most [`MAX_FACTOR`] a step, each
+/// step carrying its caller's work. So trial steps are tried first, not taken: while one's
+/// error is below [`PROBE_ERROR`] the step grows by the controller's own rule, the error going
+/// as h⁸ (at most [`PROBE_FACTOR`] a trial, [`PROBES`] trials).
+fn first_step<D: Dim, S: OdeSystem<D>>(
+    system: &S,
+    (t0, t1): (f64, f64),
+    y0: &State<D>,
+    f0: &State<D>,
+    tol: &Tolerances,
+    limit: f64,
+    stats: &mut Stats,
+) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let longest = (t1 - t0).min(tol.max_step).min(limit);
+    let mut h = initial_step(7, system, t0, y0, f0, t1 - t0, tol, stats).min(longest);
+    for _ in 0..PROBES {
+        if h >= longest {
+            break;
+        }
+        let (_, _, err) = trial(system, t0, h, y0, f0, tol);
+        stats.n_rhs += (STAGES - 1) as u64;
+        // NaN and a large error alike end the probes: the controller takes it from there.
+        if err.is_nan() || err >= PROBE_ERROR {
+            break;
+        }
+        let factor = if err == 0.0 {
+            PROBE_FACTOR
+        } else {
+            PROBE_FACTOR.min(SAFETY * err.powf(ERROR_EXPONENT))
+        };
+        h = (h * factor).min(longest);
+    }
+    h
+}
+
 /// Integrates `system` over [t0, t1] (one segment: its right-hand side smooth there), telling
 /// `on_step` each accepted step; it stops early on `ControlFlow::Break`. Returns the counters and
 /// the state at `stats.t_end`.
@@ -502,6 +551,23 @@ pub fn solve<D: Dim, S: OdeSystem<D>>(
     t0: f64,
     y0: State<D>,
     t1: f64,
+    on_step: &mut dyn FnMut(&Dop853Step<D>) -> ControlFlow<()>,
+) -> Result<(Stats, State<D>)>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    solve_from_within(system, tol, t0, y0, t1, f64::INFINITY, on_step)
+}
+
+/// [`solve`] with its first step at most `first_limit` long: where the caller's own work over a
+/// step needs it shorter than the solution's accuracy does at the start.
+pub fn solve_from_within<D: Dim, S: OdeSystem<D>>(
+    system: &S,
+    tol: &Tolerances,
+    t0: f64,
+    y0: State<D>,
+    t1: f64,
+    first_limit: f64,
     on_step: &mut dyn FnMut(&Dop853Step<D>) -> ControlFlow<()>,
 ) -> Result<(Stats, State<D>)>
 where
@@ -524,9 +590,7 @@ where
     let mut t = t0;
     let mut f0 = system.rhs(t, &y);
     stats.n_rhs += 1;
-    // The fifth-order estimator's error goes as h⁶ but the steps' as h⁸: the eighth order's
-    // first step, as Hairer's DOP853 takes it.
-    let mut h_abs = initial_step(7, system, t, &y, &f0, t1 - t0, tol, &mut stats).min(tol.max_step);
+    let mut h_abs = first_step(system, (t0, t1), &y, &f0, tol, first_limit, &mut stats);
     while t < t1 {
         let min_step = 10.0 * (next_up(t) - t);
         h_abs = h_abs.max(min_step);
@@ -839,5 +903,58 @@ mod tests {
             })
             .is_err()
         );
+    }
+
+    /// y' = −(y − cos(t/300)): a solution smooth on hundreds of seconds, from a start that
+    /// already follows it.
+    struct Slow;
+    impl OdeSystem<U1> for Slow {
+        fn rhs(&self, t: f64, y: &Vector1<f64>) -> Vector1<f64> {
+            Vector1::new(-(y[0] - (t / 300.0).cos()) / 50.0)
+        }
+    }
+
+    #[test]
+    fn a_smooth_start_is_probed_to_the_step_the_solution_allows() {
+        let tol = Tolerances {
+            rtol: 1e-8,
+            atol: 1e-8,
+            max_step: 1e4,
+            max_steps: 100_000,
+        };
+        let y0 = Vector1::new(1.0);
+        let f0 = Slow.rhs(0.0, &y0);
+        let mut stats = Stats::default();
+        let estimate = initial_step(7, &Slow, 0.0, &y0, &f0, 3000.0, &tol, &mut stats);
+        let run = |limit: f64| {
+            let mut steps = Vec::new();
+            let (st, y1) = solve_from_within(&Slow, &tol, 0.0, y0, 3000.0, limit, &mut |s| {
+                steps.push(s.t1 - s.t0);
+                ControlFlow::Continue(())
+            })
+            .unwrap();
+            (st, y1, steps)
+        };
+        let (stats, y1, steps) = run(f64::INFINITY);
+        // Far past the estimate, and the whole run as accurate as a tight one's.
+        assert!(steps[0] > 100.0 * estimate, "{} vs {estimate}", steps[0]);
+        let tight = Tolerances {
+            rtol: 1e-12,
+            atol: 1e-12,
+            ..tol
+        };
+        let (_, reference) = solve(&Slow, &tight, 0.0, y0, 3000.0, &mut |_| {
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert!(
+            (y1[0] - reference[0]).abs() < 1e-7,
+            "{}",
+            y1[0] - reference[0]
+        );
+        // A first step asked shorter is kept so; the controller grows it from there.
+        let (limited, _, short) = run(2.0);
+        assert!(short[0] <= 2.0, "{}", short[0]);
+        assert!(limited.n_steps > stats.n_steps);
     }
 }
