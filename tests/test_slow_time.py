@@ -171,6 +171,30 @@ def test_a_panel_past_a_guard_is_given_back_to_the_full_integration(
         assert (hybrid.columns[name] == column).all() or name in ("index",), name
 
 
+def test_a_window_slow_time_cannot_vouch_for_alone_runs_in_full_alone() -> None:
+    """Table 1 on the heated 540 km orbit where its orbits start in the shadow and θ's least in
+    the window after entry passes 0 with the season (orbits 338 on of a year from 1 January): slow
+    time cannot vouch for that column so near 0, so each such orbit runs its window in full from
+    its start, and slow time the rest. Every column holds the gate of rk45, no orbit is given
+    back whole, and the time in full is those windows and the penumbrae."""
+    orbit = tj.Orbit.circular(540e3, inclination=math.radians(28.5))
+    n = 16
+    kw = {"t_start": 338 * orbit.period, "orbits_per_call": n, "progress": False}
+    full = tj.simulate_orbits(tj.Panel.paper(), orbit, n, method="rk45", **kw)  # type: ignore[arg-type]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tj.HybridFallbackWarning)
+        hybrid = tj.simulate_orbits(tj.Panel.paper(), orbit, n, method="hybrid", **kw)  # type: ignore[arg-type]
+    p = hybrid.propagation
+    assert p["n_refused_orbits"] == 0
+    windows = p["n_refused_windows"]
+    assert windows >= 4, windows
+    assert p["t_slow"] + p["t_fallback"] == pytest.approx(n * orbit.period, rel=1e-9)
+    # A window (600 s) and at most a penumbra or two of each orbit in full, not whole orbits.
+    assert p["t_fallback"] < windows * 700.0 + n * 60.0, p["t_fallback"]
+    failures = gate_failures(full, hybrid, n)
+    assert not failures, "; ".join(failures[:5])
+
+
 def test_a_fluttering_panel_on_a_low_orbit_holds_the_gate() -> None:
     """Drawn by the slow tier: a light panel fluttering at 400 km (its ringing ~1.6 x an
     orbit). Slow time held each orbit it kept to the gate, but handed its error, a fraction of

@@ -112,13 +112,15 @@ HYBRID_COUNTERS = (
     "t_linear", "t_exponential", "t_fallback", "n_arcs", "n_exp_steps", "n_fallback_steps",
     "n_reread_steps", "t_slow", "n_slow_steps", "n_refused_orbits", "n_refused_separation",
     "n_refused_ringing", "n_refused_split", "n_refused_limit", "n_refused_gate",
-    "n_refused_growth", "n_pieces", "n_warmup_orbits", "n_pieces_rerun",
+    "n_refused_growth", "n_refused_windows", "n_pieces", "n_warmup_orbits", "n_pieces_rerun",
 )  # fmt: skip
 """How a hybrid run split its simulated time (s) and work between linear arcs, the exponential
 integrator of the non-linear model, slow time (short orbits and varying loads) and the
 hinge-resolved fallback; ``n_refused_orbits`` of slow time's orbits given back to the full
 integration, and by which guard (``n_refused_separation``, ``_ringing``, ``_split``, ``_limit``,
-``_gate``, ``_growth``); ``n_pieces`` into which a call's long slow-time run was cut to run on
+``_gate``, ``_growth``) and the orbits that ran only a window in full, from their start, because
+slow time could not vouch for that window's summaries alone (``n_refused_windows``, slow time
+after it); ``n_pieces`` into which a call's long slow-time run was cut to run on
 several cores (summed over calls), the orbits their warm-ups ran (``n_warmup_orbits``, not
 summarised) and the pieces run again in order because their warmed-up start missed
 (``n_pieces_rerun``)."""
@@ -493,8 +495,10 @@ def simulate_orbits(
       the thermal rates are not slow against the hinge, or a summary lies too near 0 for the
       closed form's accuracy (0.3 % of the ringing's amplitude) is integrated again in full
       with rk45 from its start (``propagation["n_refused_orbits"]``, and a
-      :class:`thermojitter.errors.HybridFallbackWarning`); ``propagation["t_slow"]`` is the
-      time carried on slow time.
+      :class:`thermojitter.errors.HybridFallbackWarning`); where only the summaries of the window
+      after entry or exit lie too near 0, the orbit runs in full from its start to that
+      window's end and on slow time after it (``propagation["n_refused_windows"]``, no warning:
+      those summaries are rk45's); ``propagation["t_slow"]`` is the time carried on slow time.
 
     A :class:`thermojitter.Boom` in place of the panel runs the tube: ``y0`` and ``y_end`` are
     (T_mean, T_circ, θ, θ̇), the summaries read θ (the tip deflection over the length) and its

@@ -85,7 +85,7 @@ pub(super) fn hybrid_counters<'py>(
     set_named!(d, out; fields t_linear, t_exponential, t_fallback, n_arcs, n_exp_steps,
         n_fallback_steps, n_reread_steps, t_slow, n_slow_steps, n_refused_orbits,
         n_refused_separation, n_refused_ringing, n_refused_split, n_refused_limit, n_refused_gate,
-        n_refused_growth, n_pieces, n_warmup_orbits, n_pieces_rerun);
+        n_refused_growth, n_refused_windows, n_pieces, n_warmup_orbits, n_pieces_rerun);
     Ok(d)
 }
 

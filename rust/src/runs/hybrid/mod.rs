@@ -124,6 +124,10 @@ pub struct HybridRun {
     pub n_refused_limit: u64,
     pub n_refused_gate: u64,
     pub n_refused_growth: u64,
+    /// Orbits of which slow time could not vouch for a window's summaries alone (too near 0):
+    /// each ran in full from its start to that window's end, then on slow time (not given back,
+    /// not in `n_refused_orbits`).
+    pub n_refused_windows: u64,
     /// Pieces a long slow-time run was cut into to run on several cores ([`pieces`]; 1 for a
     /// run in one piece, 0 off slow time), the orbits their warm-ups ran (not summarised), and
     /// the pieces run again in order because their warmed-up start missed.
@@ -151,6 +155,7 @@ impl HybridRun {
         self.n_refused_limit += other.n_refused_limit;
         self.n_refused_gate += other.n_refused_gate;
         self.n_refused_growth += other.n_refused_growth;
+        self.n_refused_windows += other.n_refused_windows;
         self.n_pieces += other.n_pieces;
         self.n_warmup_orbits += other.n_warmup_orbits;
         self.n_pieces_rerun += other.n_pieces_rerun;
@@ -184,6 +189,7 @@ impl Default for HybridRun {
             n_refused_limit: 0,
             n_refused_gate: 0,
             n_refused_growth: 0,
+            n_refused_windows: 0,
             n_pieces: 0,
             n_warmup_orbits: 0,
             n_pieces_rerun: 0,

@@ -30,7 +30,9 @@
 //! split must converge, |θ| stay within the run's limit, and every summary of the orbit hold
 //! the accuracy gate by twice the error the ringing may carry ([`RING_ACCURACY`] of its
 //! amplitude). An orbit where one fails is integrated again in full from its start; the next
-//! orbit tries slow time again.
+//! orbit tries slow time again. Where only a window's summaries fail the last (a column near 0
+//! read after entry or exit), the orbit runs in full from its start to that window's end and on
+//! slow time after it: those summaries are the full integration's, as in an orbit given back.
 
 use crate::cancel::Cancel;
 use crate::error::Result;
@@ -1017,15 +1019,47 @@ fn ring_accuracy(model: HingeModel, ring: f64) -> f64 {
 /// edge and of an orbit's start.
 const THETA_ACCURACY: f64 = 2e-3;
 
-/// Whether every summary of the orbit just run (the collector's current one) holds the accuracy
-/// gate (2 %, or 1e-6 rad below 5e-5 rad) by twice the error the ringing of amplitude up to
-/// `ring` may carry: a column near 0 (θ_min of a panel that barely bends back) cannot. The RMS
-/// of the dynamic part scales with the ringing, so its error is that fraction of itself.
-fn within_gate<V: crate::runs::orbits::SummaryView>(
+/// Which summaries of the orbit just run (the collector's current one) slow time cannot vouch
+/// for: those that do not hold the accuracy gate (2 %, or 1e-6 rad below 5e-5 rad) by twice the
+/// error the ringing of amplitude up to `ring` may carry (a column near 0, θ_min of a panel that
+/// barely bends back, cannot); the RMS of the dynamic part scales with the ringing, so its error
+/// is that fraction of itself. A window that ends by `full_until` was read in full: its
+/// summaries are not slow time's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Unvouched {
+    /// The orbit's own: the RMS and peak of the dynamic part, θ's extremes and amplitude.
+    orbit: bool,
+    /// The window after entry's (its θ_min and peak), and after exit's.
+    entry: bool,
+    exit: bool,
+}
+
+impl Unvouched {
+    fn none(&self) -> bool {
+        !(self.orbit || self.entry || self.exit)
+    }
+
+    /// The end of the last window not vouched for, within the orbit.
+    fn windows_end<V: crate::runs::orbits::SummaryView>(&self, c: &Collector<V>) -> f64 {
+        let s = &c.current;
+        let w = c.options.window;
+        let end = |on: bool, start: f64| {
+            if on {
+                (start + w).min(s.t_end)
+            } else {
+                f64::NEG_INFINITY
+            }
+        };
+        end(self.entry, s.t_entry).max(end(self.exit, s.t_exit))
+    }
+}
+
+fn unvouched<V: crate::runs::orbits::SummaryView>(
     c: &Collector<V>,
     ring: f64,
     model: HingeModel,
-) -> bool {
+    full_until: f64,
+) -> Unvouched {
     let s = &c.current;
     let holds = |v: f64, bound: f64| {
         let gate = if v.abs() < 5e-5 { 1e-6 } else { 0.02 * v.abs() };
@@ -1033,19 +1067,19 @@ fn within_gate<V: crate::runs::orbits::SummaryView>(
     };
     let rms = c.rms_so_far();
     let fraction = ring_accuracy(model, ring);
-    holds(rms, fraction * rms)
-        && holds(s.jitter_peak, fraction * ring)
-        && [
-            s.theta_max,
-            s.theta_min,
-            s.amplitude,
-            s.entry_theta_min,
-            s.exit_theta_max,
-            s.entry_peak,
-            s.exit_peak,
-        ]
-        .into_iter()
-        .all(|v| holds(v, THETA_ACCURACY * ring))
+    let theta = |v: f64| holds(v, THETA_ACCURACY * ring);
+    let w = c.options.window;
+    // A window read in full (or absent: its start NaN) needs no vouching.
+    let read_in_full = |start: f64| start.is_nan() || (start + w).min(s.t_end) <= full_until;
+    Unvouched {
+        orbit: !(holds(rms, fraction * rms)
+            && holds(s.jitter_peak, fraction * ring)
+            && [s.theta_max, s.theta_min, s.amplitude]
+                .into_iter()
+                .all(theta)),
+        entry: !(read_in_full(s.t_entry) || theta(s.entry_theta_min) && theta(s.entry_peak)),
+        exit: !(read_in_full(s.t_exit) || theta(s.exit_theta_max) && theta(s.exit_peak)),
+    }
 }
 
 /// Runs the orbits of `spec` from `y0` on slow time, each orbit in full where a guard refuses it
@@ -1117,117 +1151,148 @@ pub(crate) fn run_slow(
             orbit_end,
         ));
         cuts.push(orbit_end);
-        let mut refused = None;
-        let mut ring_max: f64 = 0.0;
-        // log |z| the ringing gains over the orbit's slow time.
-        let mut growth = 0.0;
-        let (mut slow_steps, mut full_steps, mut slow_time) = (0, 0, 0.0);
-        for pair in cuts.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
-            if b <= a {
-                continue;
+        // The orbit on slow time from `full_until` (before it in full): at first all of it;
+        // then, where only a window's summaries were too near 0 for slow time, from that
+        // window's end.
+        let mut full_until = orbit_start;
+        let (mut slow_steps, mut full_steps, mut slow_time);
+        let refused = loop {
+            let mut attempt_cuts = cuts.clone();
+            if full_until > orbit_start && !attempt_cuts.contains(&full_until) {
+                let at = attempt_cuts.partition_point(|&c| c < full_until);
+                attempt_cuts.insert(at, full_until);
             }
-            let mid = spec.orbit.illumination_on(0.5 * (a + b), a, b);
-            if matches!(spec.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0 {
-                check_budget(
-                    stats.n_steps + stats.n_rejected + slow_steps + full_steps,
-                    a,
-                )?;
-                // [a, b] lies between two of the orbit's breakpoints: none inside.
-                let mut tabulated = Tabulated::new(&mut full);
-                let mut within = WithCuts {
-                    system: &mut tabulated,
-                    cuts: &[],
+            let mut refused = None;
+            let mut ring_max: f64 = 0.0;
+            // log |z| the ringing gains over the orbit's slow time.
+            let mut growth = 0.0;
+            (slow_steps, full_steps, slow_time) = (0, 0, 0.0);
+            for pair in attempt_cuts.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                if b <= a {
+                    continue;
+                }
+                let mid = spec.orbit.illumination_on(0.5 * (a + b), a, b);
+                let penumbra =
+                    matches!(spec.orbit.shadow, Shadow::Penumbra) && mid > 0.0 && mid < 1.0;
+                if b <= full_until || penumbra {
+                    check_budget(
+                        stats.n_steps + stats.n_rejected + slow_steps + full_steps,
+                        a,
+                    )?;
+                    // [a, b] lies between two of the orbit's breakpoints: none inside.
+                    let mut tabulated = Tabulated::new(&mut full);
+                    let mut within = WithCuts {
+                        system: &mut tabulated,
+                        cuts: &[],
+                    };
+                    let (st, y1) = solve(&mut within, &full_method, a, y, b, &mut obs)?;
+                    if let Some(e) = obs.error.take() {
+                        return Err(e);
+                    }
+                    full_steps += st.n_steps;
+                    stats.n_rejected += st.n_rejected;
+                    stats.n_rhs += st.n_rhs;
+                    y = y1;
+                    if st.stopped {
+                        // The full integration stopped at the run's limit.
+                        split.n_slow_steps += slow_steps;
+                        split.n_fallback_steps += full_steps;
+                        split.t_slow += slow_time;
+                        split.t_fallback += (st.t_end - orbit_start) - slow_time;
+                        stats.n_steps += slow_steps + full_steps;
+                        stats.stopped = true;
+                        stats.t_end = st.t_end;
+                        return Ok(Propagated {
+                            run: obs.collector.finish(stats, y),
+                            split,
+                        });
+                    }
+                    continue;
+                }
+                model.enter(a, b);
+                let Some((manifold, mode, z)) = model.split(a, &y, lambda) else {
+                    refused = Some(Refusal::Split);
+                    break;
                 };
-                let (st, y1) = solve(&mut within, &full_method, a, y, b, &mut obs)?;
-                if let Some(e) = obs.error.take() {
+                if mode.separation > SEPARATION_LIMIT {
+                    refused = Some(Refusal::Separation);
+                    break;
+                }
+                if z.norm() > RING_LIMIT {
+                    refused = Some(Refusal::Ringing);
+                    break;
+                }
+                let mut ring = Ringing {
+                    model: &model,
+                    obs: &mut obs,
+                    z,
+                    mode,
+                    manifold,
+                    refusal: None,
+                    error: None,
+                    steps: 0,
+                    largest: 0.0,
+                    growth: 0.0,
+                };
+                let flow = SlowFlow { model: &model };
+                let temps = model.scaled(&Vector2::new(manifold.y[0], manifold.y[1]));
+                // The thermal block's rate bound (1/s): the segment's first step within its
+                // share.
+                let block = mode.separation * mode.lambda.im.abs();
+                let first = FIRST_STEP_SHARE / block;
+                let (st, _) = dop853::solve_from_within(
+                    &flow,
+                    &SLOW_TOLERANCES,
+                    a,
+                    temps,
+                    b,
+                    first,
+                    &mut |step| ring.on_step(step),
+                )?;
+                if let Some(e) = ring.error.take() {
                     return Err(e);
                 }
-                full_steps += st.n_steps;
-                stats.n_rejected += st.n_rejected;
-                stats.n_rhs += st.n_rhs;
-                y = y1;
-                if st.stopped {
-                    // The full integration stopped at the run's limit.
-                    split.n_fallback_steps += full_steps;
-                    stats.n_steps += slow_steps + full_steps;
-                    stats.stopped = true;
-                    stats.t_end = st.t_end;
-                    return Ok(Propagated {
-                        run: obs.collector.finish(stats, y),
-                        split,
-                    });
+                if ring.refusal.is_some() {
+                    refused = ring.refusal;
+                    break;
                 }
-                continue;
+                stats.n_rhs += st.n_rhs;
+                stats.n_rejected += st.n_rejected;
+                slow_steps += ring.steps;
+                check_budget(
+                    stats.n_steps + stats.n_rejected + slow_steps + full_steps,
+                    b,
+                )?;
+                ring_max = ring_max.max(ring.largest);
+                growth += ring.growth;
+                slow_time += b - a;
+                lambda = ring.mode.lambda;
+                let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
+                y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
             }
-            model.enter(a, b);
-            let Some((manifold, mode, z)) = model.split(a, &y, lambda) else {
-                refused = Some(Refusal::Split);
-                break;
-            };
-            if mode.separation > SEPARATION_LIMIT {
-                refused = Some(Refusal::Separation);
-                break;
+            // A ringing that grows over the orbit carries this orbit's error, a fraction of the
+            // ringing, into the next ones, grown with it: flutter goes to the full integration.
+            if refused.is_none() && growth > 0.0 {
+                refused = Some(Refusal::Growth);
             }
-            if z.norm() > RING_LIMIT {
-                refused = Some(Refusal::Ringing);
-                break;
+            if refused.is_some() {
+                break refused;
             }
-            let mut ring = Ringing {
-                model: &model,
-                obs: &mut obs,
-                z,
-                mode,
-                manifold,
-                refusal: None,
-                error: None,
-                steps: 0,
-                largest: 0.0,
-                growth: 0.0,
-            };
-            let flow = SlowFlow { model: &model };
-            let temps = model.scaled(&Vector2::new(manifold.y[0], manifold.y[1]));
-            // The thermal block's rate bound (1/s): the segment's first step within its share.
-            let block = mode.separation * mode.lambda.im.abs();
-            let first = FIRST_STEP_SHARE / block;
-            let (st, _) = dop853::solve_from_within(
-                &flow,
-                &SLOW_TOLERANCES,
-                a,
-                temps,
-                b,
-                first,
-                &mut |step| ring.on_step(step),
-            )?;
-            if let Some(e) = ring.error.take() {
-                return Err(e);
+            let unvouched = unvouched(&obs.collector, ring_max, spec.model, full_until);
+            if unvouched.none() {
+                break None;
             }
-            if ring.refusal.is_some() {
-                refused = ring.refusal;
-                break;
+            // Only a window's summaries, read on slow time: that window in full, from the
+            // orbit's start (its state is this orbit's start), and slow time after it.
+            let window_end = unvouched.windows_end(&obs.collector);
+            if unvouched.orbit || full_until > orbit_start || window_end >= orbit_end {
+                break Some(Refusal::Gate);
             }
-            stats.n_rhs += st.n_rhs;
-            stats.n_rejected += st.n_rejected;
-            slow_steps += ring.steps;
-            check_budget(
-                stats.n_steps + stats.n_rejected + slow_steps + full_steps,
-                b,
-            )?;
-            ring_max = ring_max.max(ring.largest);
-            growth += ring.growth;
-            slow_time += b - a;
-            lambda = ring.mode.lambda;
-            let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
-            y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
-        }
-        // A ringing that grows over the orbit carries this orbit's error, a fraction of the
-        // ringing, into the next ones, grown with it: flutter goes to the full integration.
-        if refused.is_none() && growth > 0.0 {
-            refused = Some(Refusal::Growth);
-        }
-        if refused.is_none() && !within_gate(&obs.collector, ring_max, spec.model) {
-            refused = Some(Refusal::Gate);
-        }
+            obs.collector.rewind(mark);
+            y = y_start;
+            full_until = window_end;
+        };
         if let Some(reason) = refused {
             // This orbit in full, from its start; the next one tries slow time again.
             obs.collector.rewind(mark);
@@ -1263,6 +1328,9 @@ pub(crate) fn run_slow(
                 break;
             }
             continue;
+        }
+        if full_until > orbit_start {
+            split.n_refused_windows += 1;
         }
         split.n_slow_steps += slow_steps;
         split.n_fallback_steps += full_steps;
