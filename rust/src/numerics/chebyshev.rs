@@ -22,6 +22,19 @@ pub const DEGREE: usize = 10;
 /// uncertain: its arguments (a phase rate × t + an offset, and what follows) each round once.
 pub const TIME_ROUNDINGS: f64 = 16.0;
 
+/// How a [`Table`] keeps and reads each part's polynomial.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// The Chebyshev series, read by Clenshaw's recurrence: a chain of [`DEGREE`] dependent
+    /// multiply-adds (the form the records of the GEO penumbra were made with).
+    Chebyshev,
+    /// The same polynomial in powers of x, read by Estrin's scheme: a tree of multiply-adds
+    /// about half as deep. Converting a series of degree 10 to powers loses a few digits at
+    /// most (its terms of high degree, whose power coefficients grow as 2^m, are ~1e-12 of the
+    /// function's size): each part is checked in this form.
+    Power,
+}
+
 /// N functions on [a, b] as Chebyshev series of degree [`DEGREE`] in v, one per part.
 #[derive(Debug, Clone)]
 pub struct Table<const N: usize> {
@@ -29,6 +42,8 @@ pub struct Table<const N: usize> {
     /// 2 / (b − a).
     scale: f64,
     parts: usize,
+    form: Form,
+    /// Each part's polynomial in `form`.
     coefficients: Vec<[[f64; N]; DEGREE + 1]>,
     /// Parts whose check failed: the caller evaluates the functions there.
     refused: Vec<bool>,
@@ -51,18 +66,75 @@ fn clenshaw<const N: usize>(c: &[[f64; N]; DEGREE + 1], x: f64) -> [f64; N] {
     std::array::from_fn(|i| x * b1[i] - b2[i] + c[0][i])
 }
 
+/// The polynomial Σ p_j x^j of each component by Estrin's scheme: pairs of terms joined by x,
+/// then pairs of pairs by x², and so on (written out for [`DEGREE`] = 10).
+#[inline(always)]
+fn estrin<const N: usize>(p: &[[f64; N]; DEGREE + 1], x: f64) -> [f64; N] {
+    const { assert!(DEGREE == 10) };
+    let (x2, x4) = (x * x, x * x * (x * x));
+    let x8 = x4 * x4;
+    std::array::from_fn(|i| {
+        let pair = |j: usize| p[j][i] + p[j + 1][i] * x;
+        let (a, b, c) = (
+            pair(0) + pair(2) * x2,
+            pair(4) + pair(6) * x2,
+            pair(8) + p[10][i] * x2,
+        );
+        (a + b * x4) + c * x8
+    })
+}
+
+/// The Chebyshev series `c` in powers of x: T_0 = 1, T_1 = x, T_{m+1} = 2x T_m − T_{m−1}.
+fn to_powers<const N: usize>(c: &[[f64; N]; DEGREE + 1]) -> [[f64; N]; DEGREE + 1] {
+    let mut out = [[0.0; N]; DEGREE + 1];
+    // The power coefficients of T_{m−1} and T_m.
+    let (mut before, mut now) = ([0.0; DEGREE + 1], [0.0; DEGREE + 1]);
+    now[0] = 1.0;
+    for (m, cm) in c.iter().enumerate() {
+        if m == 1 {
+            (before, now) = (now, [0.0; DEGREE + 1]);
+            now[1] = 1.0;
+        } else if m > 1 {
+            let next: [f64; DEGREE + 1] = std::array::from_fn(|j| {
+                let shifted = if j > 0 { 2.0 * now[j - 1] } else { 0.0 };
+                shifted - before[j]
+            });
+            (before, now) = (now, next);
+        }
+        for (j, tj) in now.iter().enumerate() {
+            for i in 0..N {
+                out[j][i] += cm[i] * tj;
+            }
+        }
+    }
+    out
+}
+
 impl<const N: usize> Table<N> {
     /// Fits `f` on [a, b] (a < b) in `parts` parts of v at the Chebyshev–Lobatto points of
     /// each, then checks each part at the [`DEGREE`] points between them: a part where a
     /// component's |interpolant − f| exceeds its `tol` + [`TIME_ROUNDINGS`] ε max(|a|, |b|) ×
     /// (its largest slope between nodes) anywhere, or where f is not finite, is refused.
     pub fn fit(f: impl Fn(f64) -> [f64; N], a: f64, b: f64, parts: usize, tol: [f64; N]) -> Self {
+        Self::fit_in(Form::Chebyshev, f, a, b, parts, tol)
+    }
+
+    /// [`Table::fit`], each part kept, checked and read in `form`.
+    pub fn fit_in(
+        form: Form,
+        f: impl Fn(f64) -> [f64; N],
+        a: f64,
+        b: f64,
+        parts: usize,
+        tol: [f64; N],
+    ) -> Self {
         let n = DEGREE;
         let parts = parts.max(1);
         let mut out = Table {
             a,
             scale: 2.0 / (b - a),
             parts,
+            form,
             coefficients: vec![[[0.0; N]; DEGREE + 1]; parts],
             refused: vec![false; parts],
         };
@@ -99,11 +171,13 @@ impl<const N: usize> Table<N> {
             for m in [0, n] {
                 c[m] = c[m].map(|x| x * 0.5);
             }
-            let c = &out.coefficients[k];
+            if form == Form::Power {
+                *c = to_powers(c);
+            }
             let refused = (0..n).any(|j| {
                 let x = ((j as f64 + 0.5) * PI / n as f64).cos();
                 let exact = f(time_of(k, x));
-                let fit = clenshaw(c, x);
+                let fit = out.series(k, x);
                 // Not finite when f or the fit is not finite there: refused too.
                 (0..N).any(|i| {
                     let error = (fit[i] - exact[i]).abs();
@@ -124,7 +198,17 @@ impl<const N: usize> Table<N> {
         if self.refused[k] {
             return None;
         }
-        Some(clenshaw(&self.coefficients[k], 2.0 * (v - k as f64) - 1.0))
+        Some(self.series(k, 2.0 * (v - k as f64) - 1.0))
+    }
+
+    /// Part k's polynomial at x ∈ [−1, 1].
+    #[inline(always)]
+    fn series(&self, k: usize, x: f64) -> [f64; N] {
+        let c = &self.coefficients[k];
+        match self.form {
+            Form::Chebyshev => clenshaw(c, x),
+            Form::Power => estrin(c, x),
+        }
     }
 
     /// How many parts were refused.
@@ -192,5 +276,47 @@ mod tests {
         assert_eq!(p.at(0.3), None);
         // The parts away from the kink are smooth there and kept.
         assert!((p.at(0.01).unwrap() - f(0.01)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_series_in_powers_is_the_series() {
+        // Each T_m alone: its powers read back cos(m acos x).
+        for m in 0..=DEGREE {
+            let mut c = [[0.0; 1]; DEGREE + 1];
+            c[m] = [1.0];
+            let p = to_powers(&c);
+            for i in 0..=200 {
+                let x = -1.0 + i as f64 / 100.0;
+                let want = (m as f64 * x.acos()).cos();
+                assert!((estrin(&p, x)[0] - want).abs() < 1e-12, "T_{m}({x})");
+                assert!((clenshaw(&c, x)[0] - want).abs() < 1e-12, "T_{m}({x})");
+            }
+        }
+        // Two functions, three tables: both forms hold them, and agree to rounding.
+        let (a, b) = (1.0e6, 1.0e6 + 3000.0);
+        let f = |t: f64| {
+            let u = (t - a) / 5700.0 * std::f64::consts::TAU;
+            [
+                1361.0 * (0.3 + 0.7 * u.cos()),
+                240.0 * (1.0 + 0.2 * (2.0 * u).sin()),
+            ]
+        };
+        let tol = [1e-10 * 1361.0; 2];
+        let power = Table::fit_in(Form::Power, f, a, b, 10, tol);
+        let chebyshev = Table::fit(f, a, b, 10, tol);
+        assert_eq!((power.refused(), chebyshev.refused()), (0, 0));
+        for i in 0..=5000 {
+            let t = a + (b - a) * i as f64 / 5000.0;
+            let (p, c, want) = (power.at(t).unwrap(), chebyshev.at(t).unwrap(), f(t));
+            for k in 0..2 {
+                assert!(
+                    (p[k] - want[k]).abs() < tol[k],
+                    "t = {t}: {} vs {}",
+                    p[k],
+                    want[k]
+                );
+                assert!((p[k] - c[k]).abs() < 1e-11, "t = {t}: {} vs {}", p[k], c[k]);
+            }
+        }
     }
 }

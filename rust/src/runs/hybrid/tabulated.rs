@@ -8,7 +8,7 @@
 
 use crate::inputs::heating::Loads;
 use crate::models::coupled::Coupled;
-use crate::numerics::chebyshev::Table;
+use crate::numerics::chebyshev::{Form, Table};
 use crate::numerics::integrate::{OdeSystem, State};
 use nalgebra::U4;
 
@@ -69,7 +69,7 @@ impl LoadTable {
             .windows(2)
             .map(|w| {
                 let parts = ((w[1] - w[0]) / PART_SPAN).ceil().max(fewest as f64) as usize;
-                Table::fit(loads, w[0], w[1], parts, tol)
+                Table::fit_in(Form::Power, loads, w[0], w[1], parts, tol)
             })
             .collect();
         Some(LoadTable { cuts, tables })
