@@ -343,6 +343,19 @@ where
         &self.y0 + acc * x
     }
 
+    /// Bounds on component i of the continuous extension over the step: its nested form
+    /// evaluated in intervals, x and 1 − x each anywhere in [0, 1] (a level r + f·[lo, hi] with
+    /// f ∈ [0, 1] lies in [r + min(0, lo), r + max(0, hi)]), to rounding. About the range of y0
+    /// and y1, widened by the higher terms.
+    pub fn bounds(&self, i: usize) -> (f64, f64) {
+        let [r0, r1, r2, r3, r4, r5, r6] = &self.r;
+        let (mut lo, mut hi) = (r6[i], r6[i]);
+        for r in [r5, r4, r3, r2, r1, r0] {
+            (lo, hi) = (r[i] + lo.min(0.0), r[i] + hi.max(0.0));
+        }
+        (self.y0[i] + lo.min(0.0), self.y0[i] + hi.max(0.0))
+    }
+
     /// The continuous extension's time derivative at t in [t0, t1].
     pub fn slope(&self, t: f64) -> State<D> {
         let h = self.t1 - self.t0;
@@ -903,6 +916,38 @@ mod tests {
             })
             .is_err()
         );
+    }
+
+    #[test]
+    fn a_steps_bounds_hold_its_extension() {
+        let tol = Tolerances {
+            rtol: 1e-8,
+            atol: 1e-8,
+            max_step: 10.0,
+            max_steps: 100_000,
+        };
+        let mut steps = 0;
+        solve(&Riccati, &tol, 0.0, Vector1::new(0.5), 30.0, &mut |s| {
+            let (lo, hi) = s.bounds(0);
+            let values: Vec<f64> = (0..=200)
+                .map(|i| s.eval(s.t0 + (s.t1 - s.t0) * i as f64 / 200.0)[0])
+                .collect();
+            let (min, max) = values
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            // To rounding: y1 is the step's own, not the nested form's sum.
+            let ulps = 4.0 * f64::EPSILON * lo.abs().max(hi.abs());
+            assert!(
+                lo - ulps <= min && max <= hi + ulps,
+                "[{lo}, {hi}] vs [{min}, {max}]"
+            );
+            steps += 1;
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert!(steps > 5);
     }
 
     /// y' = −(y − cos(t/300)): a solution smooth on hundreds of seconds, from a start that

@@ -729,8 +729,39 @@ impl Ringing<'_, '_> {
         if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
             return Err(Refusal::Ringing);
         }
-        let (lo, hi) = theta.range(t0, t1);
+        // θ's bounds over the step: θ̄'s (θ₀ per unit of the scaled T_f − T_b, over the
+        // extension's bounds, and the lag's parabola) widened by the ringing's largest amplitude
+        // and a rounding margin. A side whose bound cannot move the orbit's extremes, its
+        // amplitude or the limit, outside its windows, is not read: it leaves the summaries as
+        // they are.
+        let per_unit = m.theta0(&m.temps(&Vector2::new(0.0, 1.0)));
+        let (u_lo, u_hi) = step.bounds(1);
+        let (lag_lo, lag_hi) = parabola_range(&lags, t0, t1);
+        let swing = log_amp_max.exp();
+        let bar_lo = (per_unit * u_lo).min(per_unit * u_hi) + lag_lo;
+        let bar_hi = (per_unit * u_lo).max(per_unit * u_hi) + lag_hi;
+        let margin = |v: f64| 1e-12 * v.abs() + 1e-15;
+        let (lo_bound, hi_bound) = (bar_lo - swing, bar_hi + swing);
+        let (lo_bound, hi_bound) = (lo_bound - margin(lo_bound), hi_bound + margin(hi_bound));
         let limit = self.obs.collector.options.theta_limit;
+        let (need_lo, need_hi) = {
+            let c = &self.obs.collector.current;
+            let w = self.obs.collector.options.window;
+            let in_window = [c.t_entry, c.t_exit]
+                .into_iter()
+                .any(|start| t0 <= start + w && t1 >= start);
+            let settled = c.t_start <= t0 && t1 <= c.t_end && !in_window;
+            let moves = |bound: f64| (bound - c.theta_eq).abs() > c.amplitude;
+            (
+                !settled || lo_bound < c.theta_min || moves(lo_bound) || lo_bound < -limit,
+                !settled || hi_bound > c.theta_max || moves(hi_bound) || hi_bound > limit,
+            )
+        };
+        let (lo, hi) = theta.sides(t0, t1, need_lo, need_hi);
+        let (lo, hi) = (
+            if need_lo { lo } else { lo_bound },
+            if need_hi { hi } else { hi_bound },
+        );
         if hi > limit || lo < -limit {
             return Err(Refusal::Limit);
         }
@@ -774,22 +805,32 @@ struct Wave<'f> {
 impl Wave<'_> {
     /// The smallest and largest of s + A cos φ over [a, b]: the envelope's samples shared.
     fn range(&self, a: f64, b: f64) -> (f64, f64) {
+        self.sides(a, b, true, true)
+    }
+
+    /// The smallest (if `low`) and largest (if `high`) of s + A cos φ over [a, b]; NaN for a
+    /// side not asked for.
+    fn sides(&self, a: f64, b: f64, low: bool, high: bool) -> (f64, f64) {
+        if !(low || high) {
+            return (f64::NAN, f64::NAN);
+        }
         // The ends' values serve both signs.
         let ends = [self.value(a), self.value(b)];
-        if b - a <= self.period {
-            return (
-                -self.extreme(a, b, -1.0, ends, None),
-                self.extreme(a, b, 1.0, ends, None),
-            );
-        }
-        let samples: [(f64, f64, f64); ENVELOPE_READS + 1] = std::array::from_fn(|i| {
-            let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
-            (t, (self.slow)(t), (self.amplitude)(t))
-        });
-        (
-            -self.extreme(a, b, -1.0, ends, Some(&samples)),
-            self.extreme(a, b, 1.0, ends, Some(&samples)),
-        )
+        let samples: Option<[(f64, f64, f64); ENVELOPE_READS + 1]> =
+            (b - a > self.period).then(|| {
+                std::array::from_fn(|i| {
+                    let t = a + (b - a) * i as f64 / ENVELOPE_READS as f64;
+                    (t, (self.slow)(t), (self.amplitude)(t))
+                })
+            });
+        let side = |on: bool, sign: f64| {
+            if on {
+                sign * self.extreme(a, b, sign, ends, samples.as_ref())
+            } else {
+                f64::NAN
+            }
+        };
+        (side(low, -1.0), side(high, 1.0))
     }
 
     /// s + A cos φ at t.
