@@ -662,7 +662,7 @@ impl Ringing<'_, '_> {
             Complex::new(1.0, 0.0)
                 - (modes[k].v[0] - modes[k].v[1]) * (m.moment_per_kelvin / m.stiffness)
         });
-        let log_kappa = Newton::new(&ts, &kappa.map(|k| k.norm().ln()));
+        let log_kappa = Newton::new(&ts, &kappa.map(|k| 0.5 * k.norm_sqr().ln()));
         let arg_kappa = Newton::new(&ts, &kappa.map(|k| k.arg()));
         let (log_z0, arg0) = (z0.norm().ln(), z0.arg());
         let log_amp = |t: f64| log_z0 + exponent(t).re;
@@ -716,8 +716,9 @@ impl Ringing<'_, '_> {
         let mut sq = 0.0;
         for (x, wt) in GAUSS_5 {
             let t = t0 + 0.5 * h * (1.0 + x);
-            let (lag, w) = (lags.at(t), kappa_z_at(t));
-            sq += 0.5 * h * wt * (lag * lag + 0.5 * w.norm_sqr());
+            // |κz|² takes no phase: the exponential of twice its log.
+            let (lag, log_w) = (lags.at(t), log_kappa.at(t) + log_z0 + exponent(t).re);
+            sq += 0.5 * h * wt * (lag * lag + 0.5 * (2.0 * log_w).exp());
         }
         let swing = |t: f64| {
             let (lag, w, r) = (lags.at(t), kappa_z_at(t), rate_at(t));
