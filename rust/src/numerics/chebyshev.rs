@@ -145,9 +145,15 @@ impl<const N: usize> Table<N> {
             let v = (k as f64 + 0.5 * (x + 1.0)) / parts as f64;
             a + (b - a) * 0.5 * (1.0 - (PI * v).cos())
         };
+        // The last part's end (its first node, x = 1) and f there: the next part's start.
+        let mut shared: Option<(f64, [f64; N])> = None;
         for k in 0..parts {
             let times: [f64; DEGREE + 1] = std::array::from_fn(|j| time_of(k, turn[j]));
-            let values = times.map(&f);
+            let values: [[f64; N]; DEGREE + 1] = std::array::from_fn(|j| match shared {
+                Some((t, value)) if j == n && t == times[j] => value,
+                _ => f(times[j]),
+            });
+            shared = Some((times[0], values[0]));
             let tol: [f64; N] = std::array::from_fn(|i| {
                 let slope = (0..n)
                     .map(|j| ((values[j + 1][i] - values[j][i]) / (times[j + 1] - times[j])).abs())
@@ -276,6 +282,24 @@ mod tests {
         assert_eq!(p.at(0.3), None);
         // The parts away from the kink are smooth there and kept.
         assert!((p.at(0.01).unwrap() - f(0.01)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn neighbouring_parts_share_their_node() {
+        let calls = std::cell::Cell::new(0);
+        let f = |t: f64| {
+            calls.set(calls.get() + 1);
+            [(t * 1e-3).sin()]
+        };
+        for (a, b) in [(0.0, 3.0), (1.0e6, 1.0e6 + 3000.0), (-7.0, 11.0)] {
+            for parts in [1, 2, 5, 8] {
+                calls.set(0);
+                let table = Table::fit(f, a, b, parts, [1e-3]);
+                assert_eq!(table.refused(), 0);
+                // 11 nodes and 10 checks a part, less one node between each two parts.
+                assert_eq!(calls.get(), parts * (2 * DEGREE + 1) - (parts - 1));
+            }
+        }
     }
 
     #[test]
