@@ -1161,7 +1161,10 @@ pub(crate) fn run_slow(
     };
     let mut y = y0;
     let mut t = spec.t_start;
-    let mut lambda = Complex::new(0.0, spec.panel.natural_angular_frequency());
+    // Each segment's split starts the hinge eigenvalue's Newton iteration from the natural
+    // frequency: its root's last bits depend on the start, and a start carried over from the
+    // last segment made a run's numbers depend, by an ulp, on how it was cut into calls.
+    let natural = Complex::new(0.0, spec.panel.natural_angular_frequency());
     // The full integration's step budget holds for the whole run, every kind of step counted
     // (as the hybrid's): each full stretch alone stops at it, and a run of one stretch an orbit
     // would otherwise take that many steps an orbit.
@@ -1253,7 +1256,7 @@ pub(crate) fn run_slow(
                     continue;
                 }
                 model.enter(a, b);
-                let Some((manifold, mode, z)) = model.split(a, &y, lambda) else {
+                let Some((manifold, mode, z)) = model.split(a, &y, natural) else {
                     refused = Some(Refusal::Split);
                     break;
                 };
@@ -1309,7 +1312,6 @@ pub(crate) fn run_slow(
                 ring_max = ring_max.max(ring.largest);
                 growth += ring.growth;
                 slow_time += b - a;
-                lambda = ring.mode.lambda;
                 let (m, md, z1) = (ring.manifold, ring.mode, ring.z);
                 y = m.y + Vector4::from_fn(|i, _| (z1 * md.v[i]).re);
             }

@@ -29,11 +29,10 @@ const KINK_SEARCH: f64 = 60.0;
 /// within minutes.
 const KINK_PARTS: usize = 2;
 /// Parts of a penumbra's table, in the variable in which its contacts are smooth (as the
-/// penumbra's flux interpolant of long orbits). Two would hold most of a low orbit's penumbrae
-/// (10 of 3600 parts refused on four low orbits, 400 to 1400 km, 30° to 98°), but then a
-/// heated 700 km run in calls of one orbit read its amplitude an ulp off the same run in one
-/// call (not understood yet); four refused none and keep the two runs the same bits.
-const PENUMBRA_PARTS: usize = 4;
+/// penumbra's flux interpolant of long orbits). Two hold a low orbit's penumbra of 8 to 15 s:
+/// none of 800 parts refused at 540 km (28.5°, 200 orbits), 10 of 3600 on four other low orbits
+/// (400 to 1400 km, 30° to 98°), which are then read exactly.
+const PENUMBRA_PARTS: usize = 2;
 
 /// The loads of one segment of an orbit: a table between each two of its kinks.
 #[derive(Debug, Clone)]
