@@ -585,6 +585,12 @@ impl<V: SummaryView> Collector<V> {
         (edges, n)
     }
 
+    /// The end of the current orbit's window that starts at `start` (its entry or exit): a
+    /// window's length on, or the orbit's end. NaN for a window the orbit does not have.
+    pub(crate) fn window_end(&self, start: f64) -> f64 {
+        (start + self.options.window).min(self.current.t_end)
+    }
+
     /// Whether a window's edge lies strictly inside (t0, t1) or the current orbit ends by t1 (an
     /// edge past the orbit's end is then in the step too).
     #[cold]

@@ -1084,10 +1084,9 @@ impl Unvouched {
     /// The end of the last window not vouched for, within the orbit.
     fn windows_end<V: crate::runs::orbits::SummaryView>(&self, c: &Collector<V>) -> f64 {
         let s = &c.current;
-        let w = c.options.window;
         let end = |on: bool, start: f64| {
             if on {
-                (start + w).min(s.t_end)
+                c.window_end(start)
             } else {
                 f64::NEG_INFINITY
             }
@@ -1110,9 +1109,8 @@ fn unvouched<V: crate::runs::orbits::SummaryView>(
     let rms = c.rms_so_far();
     let fraction = ring_accuracy(model, ring);
     let theta = |v: f64| holds(v, THETA_ACCURACY * ring);
-    let w = c.options.window;
     // A window read in full (or absent: its start NaN) needs no vouching.
-    let read_in_full = |start: f64| start.is_nan() || (start + w).min(s.t_end) <= full_until;
+    let read_in_full = |start: f64| start.is_nan() || c.window_end(start) <= full_until;
     Unvouched {
         orbit: !(holds(rms, fraction * rms)
             && holds(s.jitter_peak, fraction * ring)
