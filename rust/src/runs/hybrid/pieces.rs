@@ -19,8 +19,12 @@ use crate::runs::orbits::OrbitRunSpec;
 use nalgebra::Vector4;
 use rayon::prelude::*;
 
-/// Orbits a piece holds at least: a run of fewer than twice this runs whole.
+/// Orbits a piece costs at least, its warm-up counted: a run of fewer than twice this runs
+/// whole.
 pub const PIECE_ORBITS: u64 = 2000;
+/// Four or more pieces come in a multiple of this, each of the same cost: a whole number of
+/// rounds on two or four cores, none idle at the end (27 pieces on two cores ran 14 on one).
+const ROUND: u64 = 4;
 /// The factor by which the warm-up shrinks a piece's start error, at [`WARMUP_RATE`].
 const WARMUP_DECAY: f64 = 1e-14;
 /// The rate at which a start error is taken to shrink, as a share of the ringing's structural
@@ -45,22 +49,31 @@ pub fn warmup_orbits(spec: &OrbitRunSpec) -> Option<u64> {
 }
 
 /// The pieces of a run of `spec`: (first orbit, orbits) from its start, and the warm-up; one
-/// piece when the run is short or its warm-up too long.
+/// piece when the run is short or its warm-up too long. Each piece costs the same, its warm-up
+/// counted (the first, which has none, holds that many orbits more), and four or more come in a
+/// multiple of [`ROUND`].
 pub fn layout(spec: &OrbitRunSpec) -> (Vec<(u64, u64)>, u64) {
     let n = spec.n_orbits;
     let whole = (vec![(0, n)], 0);
-    let count = n / PIECE_ORBITS;
     let Some(warmup) = warmup_orbits(spec) else {
         return whole;
     };
+    let mut count = n / PIECE_ORBITS;
+    if count >= ROUND {
+        count -= count % ROUND;
+    }
     if count < 2 || warmup as f64 > WARMUP_SHARE * (n / count) as f64 {
         return whole;
     }
-    let (base, extra) = (n / count, n % count);
+    // The orbits and warm-ups over the pieces: each later piece holds `base` (or one more),
+    // the first its share and the warm-up.
+    let later = n - (n + (count - 1) * warmup) / count;
+    let (base, extra) = (later / (count - 1), later % (count - 1));
     let mut pieces = Vec::with_capacity(count as usize);
-    let mut first = 0;
-    for k in 0..count {
-        let len = base + u64::from(k < extra);
+    pieces.push((0, n - later));
+    let mut first = n - later;
+    for k in 1..count {
+        let len = base + u64::from(k <= extra);
         pieces.push((first, len));
         first += len;
     }
@@ -195,15 +208,27 @@ mod tests {
     fn the_pieces_cover_the_run_in_order() {
         let s = spec(Panel::paper(), Orbit::leo(540e3), 10_001);
         let (pieces, warmup) = layout(&s);
-        assert_eq!(pieces.len(), 5);
+        // Five pieces' worth, in a whole number of rounds.
+        assert_eq!(pieces.len(), 4);
         assert!((2..PIECE_ORBITS / 10).contains(&warmup), "{warmup}");
         let mut next = 0;
-        for &(first, n) in &pieces {
+        for (k, &(first, n)) in pieces.iter().enumerate() {
             assert_eq!(first, next);
-            assert!(n >= PIECE_ORBITS);
+            // The same cost each, warm-ups counted, to an orbit.
+            let cost = n + if k == 0 { 0 } else { warmup };
+            let first_cost = pieces[0].1;
+            assert!(cost.abs_diff(first_cost) <= 1, "{cost} {first_cost}");
+            assert!(cost >= PIECE_ORBITS);
             next += n;
         }
         assert_eq!(next, 10_001);
+        // A decade of a low orbit: 27 pieces' worth, 24 pieces.
+        assert_eq!(
+            layout(&spec(Panel::paper(), Orbit::leo(540e3), 55_110))
+                .0
+                .len(),
+            24
+        );
         // Short runs and undamped hinges run whole.
         assert_eq!(
             layout(&spec(Panel::paper(), Orbit::leo(540e3), 3999))
