@@ -1135,7 +1135,7 @@ pub fn visible_fraction(rho_s: f64, rho_e: f64, sep: f64) -> f64 {
 /// takes the sign f has there (f is monotonic on each side), one inside it evaluates f. So the
 /// result is the plain bisection's to the bit, at about a third of its evaluations.
 fn bisect(f: impl Fn(f64) -> f64, mut neg: f64, mut pos: f64) -> f64 {
-    let (low, high) = sign_change_bracket(&f, neg, pos);
+    let (low, high) = sign_change_bracket(&f, neg, pos, 1e-9);
     let (lo, hi) = (low.min(high), low.max(high));
     for _ in 0..200 {
         let mid = 0.5 * (neg + pos);
@@ -1157,19 +1157,24 @@ fn bisect(f: impl Fn(f64) -> f64, mut neg: f64, mut pos: f64) -> f64 {
     0.5 * (neg + pos)
 }
 
-/// Points `(low, high)` within 1e-9 s of each other (or a few roundings of t) with
+/// Points `(low, high)` within `width` of each other (or a few roundings of t) with
 /// f(low) < 0 ≤ f(high), between `neg` (f < 0) and `pos` (f ≥ 0): the Illinois variant of
 /// regula falsi (the end kept twice has its value halved: ~10 evaluations on the eclipse's
 /// functions), every step at least half the tolerance inside the bracket (a step onto the sign
 /// change then closes it from the other side). After 40 steps the bracket as it stands.
-fn sign_change_bracket(f: &impl Fn(f64) -> f64, neg: f64, pos: f64) -> (f64, f64) {
+pub(crate) fn sign_change_bracket(
+    f: &impl Fn(f64) -> f64,
+    neg: f64,
+    pos: f64,
+    width: f64,
+) -> (f64, f64) {
     let (mut a, mut fa) = (neg, f(neg));
     let (mut b, mut fb) = (pos, f(pos));
     if !(fa < 0.0 && fb >= 0.0) {
         // Not the bracket the caller promised: the whole interval, every point evaluated.
         return (neg, pos);
     }
-    let tolerance = (1e-9_f64).max(4.0 * f64::EPSILON * a.abs().max(b.abs()));
+    let tolerance = width.max(4.0 * f64::EPSILON * a.abs().max(b.abs()));
     // Which end the last step moved: -1 the negative one, 1 the positive one.
     let mut moved = 0_i8;
     for _ in 0..40 {
