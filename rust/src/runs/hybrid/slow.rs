@@ -447,16 +447,29 @@ pub(crate) fn indistinct(panel: &Panel, a: &Vector4<f64>, b: &Vector4<f64>, ring
         && (0..3).all(|k| (pa[k] - pb[k]).abs() <= allowed)
 }
 
+/// det(λ − J) = λ⁴ + c₃λ³ + c₂λ² + c₁λ + c₀ of a Jacobian whose θ row is (0, 0, 0, 1) (θ' =
+/// θ̇): [c₃, c₂, c₁, c₀] = [−E₁, E₂, −E₃, E₄], E_k the sum of J's k×k principal minors, of
+/// which that row zeroes or shortens all but four.
+fn characteristic(j: &Matrix4<f64>) -> [f64; 4] {
+    let a = |r: usize, k: usize| j[(r, k)];
+    debug_assert!((0..4).all(|k| a(2, k) == if k == 3 { 1.0 } else { 0.0 }));
+    let minor = |r: usize, s: usize, k: usize, l: usize| a(r, k) * a(s, l) - a(r, l) * a(s, k);
+    // The 2×2 principal minors: (0,1), (0,3), (1,3) and (2,3) = −a₃₂; (0,2), (1,2) are 0.
+    let e2 = minor(0, 1, 0, 1) + minor(0, 3, 0, 3) + minor(1, 3, 1, 3) - a(3, 2);
+    // The 3×3: (0,1,3) in full, (0,2,3) and (1,2,3) down to a 2×2 each; (0,1,2) is 0.
+    let d013 =
+        a(0, 0) * minor(1, 3, 1, 3) - a(0, 1) * minor(1, 3, 0, 3) + a(0, 3) * minor(1, 3, 0, 1);
+    let e3 = d013 - minor(0, 3, 0, 2) - minor(1, 3, 1, 2);
+    // det J along the θ row: −det of rows (0, 1, 3) and columns (0, 1, 2).
+    let e4 =
+        -(a(0, 0) * minor(1, 3, 1, 2) - a(0, 1) * minor(1, 3, 0, 2) + a(0, 2) * minor(1, 3, 0, 1));
+    [-(a(0, 0) + a(1, 1) + a(3, 3)), e2, -e3, e4]
+}
+
 /// The root of det(λ − J) nearest `guess` by Newton's method on the characteristic polynomial
-/// (its coefficients by Faddeev–LeVerrier); None unless it converges to an oscillation.
+/// ([`characteristic`]); None unless it converges to an oscillation.
 fn hinge_eigenvalue(j: &Matrix4<f64>, guess: Complex<f64>) -> Option<Complex<f64>> {
-    let c3 = -j.trace();
-    let m2 = j + Matrix4::identity() * c3;
-    let c2 = -(j * m2).trace() / 2.0;
-    let m3 = j * m2 + Matrix4::identity() * c2;
-    let c1 = -(j * m3).trace() / 3.0;
-    let m4 = j * m3 + Matrix4::identity() * c1;
-    let c0 = -(j * m4).trace() / 4.0;
+    let [c3, c2, c1, c0] = characteristic(j);
     let mut x = guess;
     for _ in 0..50 {
         let p = (((x + c3) * x + c2) * x + c1) * x + c0;
@@ -1502,6 +1515,40 @@ pub(crate) mod tests {
         assert!(worst < 0.01, "{worst} of the gate");
         assert_eq!(split.n_refused_orbits, 8, "{split:?}");
         assert!(split.n_refused_growth > 0, "{split:?}");
+    }
+
+    /// The characteristic polynomial by principal minors is Faddeev–LeVerrier's on drawn
+    /// Jacobians of the coupled panel's shape (θ row (0, 0, 0, 1)), and its roots are the
+    /// eigenvalues.
+    #[test]
+    fn the_characteristic_polynomial_is_faddeev_leverriers() {
+        let mut draw = crate::numerics::testing::uniform_draws(5);
+        for _ in 0..2000 {
+            let mut j = Matrix4::from_fn(|_, _| 10f64.powf(4.0 * draw() - 3.0) * (draw() - 0.5));
+            for k in 0..4 {
+                j[(2, k)] = if k == 3 { 1.0 } else { 0.0 };
+            }
+            let c3 = -j.trace();
+            let m2 = j + Matrix4::identity() * c3;
+            let c2 = -(j * m2).trace() / 2.0;
+            let m3 = j * m2 + Matrix4::identity() * c2;
+            let c1 = -(j * m3).trace() / 3.0;
+            let m4 = j * m3 + Matrix4::identity() * c1;
+            let c0 = -(j * m4).trace() / 4.0;
+            let scale = j.abs().max().max(1.0);
+            for (k, (got, want)) in characteristic(&j).iter().zip([c3, c2, c1, c0]).enumerate() {
+                assert!(
+                    (got - want).abs() <= 1e-12 * scale.powi(k as i32 + 1),
+                    "c{}: {got} vs {want}",
+                    3 - k
+                );
+            }
+            let [c3, c2, c1, c0] = characteristic(&j);
+            for e in j.complex_eigenvalues().iter() {
+                let p = (((e + c3) * e + c2) * e + c1) * e + c0;
+                assert!(p.norm() <= 1e-10 * scale.max(e.norm()).powi(4), "{p}");
+            }
+        }
     }
 
     #[test]
