@@ -11,7 +11,9 @@
 //! what the function itself is known to at times this large (its slope times a few roundings
 //! of t: [`TIME_ROUNDINGS`]): [`Table::at`] then answers None.
 
+use std::borrow::Cow;
 use std::f64::consts::{FRAC_1_PI, PI};
+use std::sync::OnceLock;
 
 /// Equal parts of v ∈ [0, 1] of an [`EndpointInterpolant`], each with its own polynomial.
 pub const PIECES: usize = 8;
@@ -110,6 +112,45 @@ fn to_powers<const N: usize>(c: &[[f64; N]; DEGREE + 1]) -> [[f64; N]; DEGREE + 
     out
 }
 
+/// A part's points in x: its Chebyshev–Lobatto nodes cos(iπ/n) (i ≤ n = [`DEGREE`]), then the
+/// n points halfway between them in angle, where its fit is checked.
+const POINTS: usize = 2 * DEGREE + 1;
+
+/// x at each of a part's [`POINTS`].
+fn point(i: usize) -> f64 {
+    let angle = if i <= DEGREE {
+        i as f64
+    } else {
+        (i - DEGREE - 1) as f64 + 0.5
+    };
+    (angle * PI / DEGREE as f64).cos()
+}
+
+/// Tables of up to this many parts share their points' places ([`places`]).
+const SHARED_PARTS: usize = 16;
+
+/// Where each part's [`POINTS`] lie in a table of `parts` parts: 1 − cos πv at them, v = (k +
+/// (1 + x)/2) / parts in part k, which is (t − a)/(b − a) times 2 on any [a, b]. The same for
+/// every table of as many parts: computed once for up to [`SHARED_PARTS`].
+fn places(parts: usize) -> Cow<'static, [[f64; POINTS]]> {
+    let compute = || -> Vec<[f64; POINTS]> {
+        (0..parts)
+            .map(|k| {
+                std::array::from_fn(|i| {
+                    let v = (k as f64 + 0.5 * (point(i) + 1.0)) / parts as f64;
+                    1.0 - (PI * v).cos()
+                })
+            })
+            .collect()
+    };
+    static SHARED: [OnceLock<Vec<[f64; POINTS]>>; SHARED_PARTS] =
+        [const { OnceLock::new() }; SHARED_PARTS];
+    match SHARED.get(parts.wrapping_sub(1)) {
+        Some(cell) => Cow::Borrowed(cell.get_or_init(compute)),
+        None => Cow::Owned(compute()),
+    }
+}
+
 impl<const N: usize> Table<N> {
     /// Fits `f` on [a, b] (a < b) in `parts` parts of v at the Chebyshev–Lobatto points of
     /// each, then checks each part at the [`DEGREE`] points between them: a part where a
@@ -141,14 +182,12 @@ impl<const N: usize> Table<N> {
         let rounding = TIME_ROUNDINGS * f64::EPSILON * a.abs().max(b.abs());
         // cos(iπ/n) for i < 2n: the nodes (i ≤ n) and the transform's cos(jmπ/n), jm mod 2n.
         let turn: [f64; 2 * DEGREE] = std::array::from_fn(|i| (i as f64 * PI / n as f64).cos());
-        let time_of = |k: usize, x: f64| {
-            let v = (k as f64 + 0.5 * (x + 1.0)) / parts as f64;
-            a + (b - a) * 0.5 * (1.0 - (PI * v).cos())
-        };
+        let places = places(parts);
+        let time_of = |k: usize, i: usize| a + (b - a) * 0.5 * places[k][i];
         // The last part's end (its first node, x = 1) and f there: the next part's start.
         let mut shared: Option<(f64, [f64; N])> = None;
         for k in 0..parts {
-            let times: [f64; DEGREE + 1] = std::array::from_fn(|j| time_of(k, turn[j]));
+            let times: [f64; DEGREE + 1] = std::array::from_fn(|j| time_of(k, j));
             let values: [[f64; N]; DEGREE + 1] = std::array::from_fn(|j| match shared {
                 Some((t, value)) if j == n && t == times[j] => value,
                 _ => f(times[j]),
@@ -180,9 +219,9 @@ impl<const N: usize> Table<N> {
             if form == Form::Power {
                 *c = to_powers(c);
             }
-            let refused = (0..n).any(|j| {
-                let x = ((j as f64 + 0.5) * PI / n as f64).cos();
-                let exact = f(time_of(k, x));
+            let refused = (n + 1..POINTS).any(|i| {
+                let x = point(i);
+                let exact = f(time_of(k, i));
                 let fit = out.series(k, x);
                 // Not finite when f or the fit is not finite there: refused too.
                 (0..N).any(|i| {
