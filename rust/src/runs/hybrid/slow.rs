@@ -304,7 +304,7 @@ impl SlowModel {
         let r0 = -(c(0, 2) + c(0, 3) * lambda);
         let r1 = -(c(1, 2) + c(1, 3) * lambda);
         let det = a * d - b * cc;
-        if det.norm() == 0.0 {
+        if det == Complex::new(0.0, 0.0) {
             return None;
         }
         let v0 = (r0 * d - b * r1) / det;
@@ -318,7 +318,7 @@ impl SlowModel {
         let w2 = -(w0 * c(0, 3) + w1 * c(1, 3) + c(3, 3) - lambda);
         let mut w = [w0, w1, w2, Complex::new(1.0, 0.0)];
         let norm: Complex<f64> = (0..4).map(|k| w[k] * v[k]).sum();
-        if norm.norm() == 0.0 {
+        if norm == Complex::new(0.0, 0.0) {
             return None;
         }
         for x in &mut w {
@@ -445,6 +445,41 @@ pub(crate) fn indistinct(panel: &Panel, a: &Vector4<f64>, b: &Vector4<f64>, ring
     let allowed = ANGLE_TOLERANCE.max(STATE_MATCH * THETA_ACCURACY * ring);
     (ma - mb).abs() <= atol + rtol * ma.abs().max(mb.abs())
         && (0..3).all(|k| (pa[k] - pb[k]).abs() <= allowed)
+}
+
+/// ln(1 − δ), its imaginary part in (−π, π]: for the small δ of a ringing's thermal share by
+/// the series −Σ δⁿ/n, cut where its next term is below 1e-19, without the logarithm and
+/// arctangent of 1 − δ; else those.
+fn ln_one_minus(delta: Complex<f64>) -> Complex<f64> {
+    // −δ (1 + δ (1/2 + δ (1/3 + … δ/n))).
+    fn series<const N: usize>(d: Complex<f64>) -> Complex<f64> {
+        let mut sum = Complex::new(1.0 / N as f64, 0.0);
+        for n in (1..N).rev() {
+            sum = sum * d + Complex::new(1.0 / n as f64, 0.0);
+        }
+        -(d * sum)
+    }
+    let size = delta.norm_sqr();
+    if size <= 1e-6 {
+        // |δ|⁷/7 ≤ 1.5e-22.
+        series::<6>(delta)
+    } else if size <= 1.0 / 256.0 {
+        // |δ|¹⁶/16 ≤ 4e-21.
+        series::<15>(delta)
+    } else {
+        let kappa = Complex::new(1.0, 0.0) - delta;
+        Complex::new(0.5 * kappa.norm_sqr().ln(), kappa.arg())
+    }
+}
+
+/// ln |z| from |z|² (no hypotenuse), where |z|² does not underflow.
+fn log_norm(z: Complex<f64>) -> f64 {
+    let square = z.norm_sqr();
+    if square >= f64::MIN_POSITIVE {
+        0.5 * square.ln()
+    } else {
+        z.norm().ln()
+    }
 }
 
 /// det(λ − J) = λ⁴ + c₃λ³ + c₂λ² + c₁λ + c₀ of a Jacobian whose θ row is (0, 0, 0, 1) (θ' =
@@ -613,7 +648,11 @@ impl Ringing<'_, '_> {
         }
         // In x = 2 (t − t0)/h − 1 the three points are x = −1, 0, 1. The exponent's rate there:
         // λ − wᵀv' + i Δω, v' from the parabola through the three modes (d/dt = (2/h) d/dx).
-        let amp = self.z.norm();
+        // |z| where the non-linear hinge's shift needs it (a hypotenuse a step saved otherwise).
+        let amp = match m.model {
+            HingeModel::Nonlinear => self.z.norm(),
+            HingeModel::Linear => 0.0,
+        };
         let slope = |c: usize, k: usize| -> Complex<f64> {
             let (a, b, d) = (modes[0].v[c], modes[1].v[c], modes[2].v[c]);
             let dx = match k {
@@ -671,13 +710,12 @@ impl Ringing<'_, '_> {
         // κ = 1 − (M_T per kelvin / K_el)(v_f − v_b): the dynamic part's share of the ringing
         // (the ringing's own thermal swing moves the quasi-static angle); its modulus and angle
         // interpolated apart, so that reads take no complex transcendental.
-        let kappa: [Complex<f64>; 3] = std::array::from_fn(|k| {
-            Complex::new(1.0, 0.0)
-                - (modes[k].v[0] - modes[k].v[1]) * (m.moment_per_kelvin / m.stiffness)
+        let log_kappa: [Complex<f64>; 3] = std::array::from_fn(|k| {
+            ln_one_minus((modes[k].v[0] - modes[k].v[1]) * (m.moment_per_kelvin / m.stiffness))
         });
-        let log_kappa = Newton::new(&ts, &kappa.map(|k| 0.5 * k.norm_sqr().ln()));
-        let arg_kappa = Newton::new(&ts, &kappa.map(|k| k.arg()));
-        let (log_z0, arg0) = (z0.norm().ln(), z0.arg());
+        let arg_kappa = Newton::new(&ts, &log_kappa.map(|l| l.im));
+        let log_kappa = Newton::new(&ts, &log_kappa.map(|l| l.re));
+        let (log_z0, arg0) = (log_norm(z0), z0.arg());
         let log_amp = |t: f64| log_z0 + exponent(t).re;
         let phase = |t: f64| arg0 + exponent(t).im;
         let period = 2.0 * PI / modes[2].lambda.im.abs();
@@ -740,7 +778,8 @@ impl Ringing<'_, '_> {
         sq += swing(t1) - swing(t0);
         let sq = sq.max(0.0);
         let z1 = z_at(t1);
-        if z1.norm() > RING_LIMIT || amp > RING_LIMIT {
+        let beyond = |z: Complex<f64>| z.norm_sqr() > RING_LIMIT * RING_LIMIT;
+        if beyond(z1) || beyond(z0) {
             return Err(Refusal::Ringing);
         }
         // θ's bounds over the step: θ̄'s (θ₀ per unit of the scaled T_f − T_b, over the
@@ -799,7 +838,8 @@ impl Ringing<'_, '_> {
         self.mode = modes[2];
         self.manifold = points[2];
         self.steps += 1;
-        self.largest = self.largest.max(z0.norm()).max(z1.norm());
+        // z0 was the step before's z1, or the segment's start (`largest` starts there).
+        self.largest = self.largest.max(z1.norm());
         Ok(())
     }
 }
@@ -1288,7 +1328,7 @@ pub(crate) fn run_slow(
                     refusal: None,
                     error: None,
                     steps: 0,
-                    largest: 0.0,
+                    largest: z.norm(),
                     growth: 0.0,
                 };
                 let flow = SlowFlow { model: &model };
@@ -1515,6 +1555,25 @@ pub(crate) mod tests {
         assert!(worst < 0.01, "{worst} of the gate");
         assert_eq!(split.n_refused_orbits, 8, "{split:?}");
         assert!(split.n_refused_growth > 0, "{split:?}");
+    }
+
+    /// ln(1 − δ) by its series is the logarithm's on drawn δ of every size up to and past the
+    /// series' reach, to four roundings of |δ| (of 1 where the logarithm is taken).
+    #[test]
+    fn the_logarithm_near_one_is_the_logarithm() {
+        let mut draw = crate::numerics::testing::uniform_draws(11);
+        for _ in 0..20_000 {
+            let size = 10f64.powf(-9.0 + 8.9 * draw());
+            let angle = 2.0 * PI * draw();
+            let delta = Complex::from_polar(size, angle);
+            let got = ln_one_minus(delta);
+            // ln(1 − δ) = ln|1 − δ| + i arg(1 − δ), |1 − δ|² − 1 taken without rounding 1 away.
+            let kappa = Complex::new(1.0, 0.0) - delta;
+            let excess = -2.0 * delta.re + delta.norm_sqr();
+            let want = Complex::new(0.5 * excess.ln_1p(), kappa.im.atan2(kappa.re));
+            let tol = 4.0 * f64::EPSILON * (size + if size > 1.0 / 16.0 { 1.0 } else { 0.0 });
+            assert!((got - want).norm() <= tol, "{delta}: {got} vs {want}");
+        }
     }
 
     /// The characteristic polynomial by principal minors is Faddeev–LeVerrier's on drawn
