@@ -319,6 +319,8 @@ pub struct TwoLayer {
     rate: Balance,
     /// m c / 2, J/(m² K).
     half_capacity: f64,
+    /// 2 / (m c): the faces' loads to rates without a division.
+    per_half_capacity: f64,
     /// χ a E I / d, N m/K.
     moment_per_kelvin: f64,
     isothermal: OneNode,
@@ -337,6 +339,7 @@ impl TwoLayer {
             heat,
             rate: heat.per_capacity(half_capacity),
             half_capacity,
+            per_half_capacity: 1.0 / half_capacity,
             moment_per_kelvin: panel.moment_per_kelvin(),
             isothermal: OneNode::new(panel),
         }
@@ -383,6 +386,11 @@ impl ThermalModel for TwoLayer {
     }
     fn capacity(&self, _i: usize) -> f64 {
         self.half_capacity
+    }
+    #[inline(always)]
+    fn add_face_rates(&self, front: f64, back: f64, out: &mut [f64]) {
+        out[0] += front * self.per_half_capacity;
+        out[1] += back * self.per_half_capacity;
     }
     #[inline(always)]
     fn gradient(&self, temps: &[f64]) -> f64 {
