@@ -239,21 +239,31 @@ impl Turning {
     }
 }
 
-/// sin x and cos x for |x| ≤ [`SMALL_TURN`], by their Taylor series to x¹¹ and x¹².
+/// sin x and cos x for |x| ≤ [`SMALL_TURN`], by their Taylor series to x¹¹ and x¹², in
+/// powers of x² with the coefficients' reciprocals folded at compile time: multiplications
+/// only (a chain of divisions was most of a load's geometry).
 #[inline]
 fn small_sin_cos(x: f64) -> (f64, f64) {
+    const SIN: [f64; 6] = [
+        1.0,
+        -1.0 / 6.0,
+        1.0 / 120.0,
+        -1.0 / 5040.0,
+        1.0 / 362_880.0,
+        -1.0 / 39_916_800.0,
+    ];
+    const COS: [f64; 7] = [
+        1.0,
+        -1.0 / 2.0,
+        1.0 / 24.0,
+        -1.0 / 720.0,
+        1.0 / 40_320.0,
+        -1.0 / 3_628_800.0,
+        1.0 / 479_001_600.0,
+    ];
     let x2 = x * x;
-    let sin = x
-        * (1.0
-            - x2 / 6.0
-                * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0 * (1.0 - x2 / 110.0)))));
-    let cos = 1.0
-        - x2 / 2.0
-            * (1.0
-                - x2 / 12.0
-                    * (1.0
-                        - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0 * (1.0 - x2 / 132.0)))));
-    (sin, cos)
+    let horner = |c: &[f64]| c.iter().rev().fold(0.0, |sum, &ck| sum * x2 + ck);
+    (x * horner(&SIN), horner(&COS))
 }
 
 impl Frame {
