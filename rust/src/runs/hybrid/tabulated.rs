@@ -81,7 +81,9 @@ impl LoadTable {
     #[inline(always)]
     pub(crate) fn at(&self, t: f64) -> Option<Loads> {
         let n = self.tables.len();
-        let k = self.cuts[1..n].partition_point(|&c| c <= t);
+        // The inner cuts at or before t, counted without branches (a handful: a binary
+        // search's branches are a coin toss at every read).
+        let k = self.cuts[1..n].iter().filter(|&&c| c <= t).count();
         self.tables[k]
             .at(t)
             .map(|[sun, front, back]| Loads { sun, front, back })
