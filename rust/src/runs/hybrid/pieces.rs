@@ -134,8 +134,11 @@ fn run_cut(
     let (first_run, warmed): (_, Vec<Warmed>) = rayon::join(
         || slow::run_slow(&part(spec, first.0, first.1), y0, cancel),
         || {
+            // One piece a task: pieces of equal cost then share out evenly to the last one
+            // (rayon's own split left one core idle for up to a piece at the end).
             later
                 .par_iter()
+                .with_max_len(1)
                 .map(|&(first, n)| {
                     // From the run's own start state, `warmup` orbits early.
                     let warm = slow::run_slow(&part(spec, first - warmup, warmup), y0, cancel);
