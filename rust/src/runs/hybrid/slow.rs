@@ -40,7 +40,7 @@ use crate::inputs::heating::Loads;
 use crate::inputs::orbit::{breakpoints_of, EclipseTable, Shadow};
 use crate::inputs::panel::Panel;
 use crate::models::coupled::Coupled;
-use crate::models::hinge::{quasi_static, HingeModel};
+use crate::models::hinge::{quasi_static, sin_cos_as, HingeModel};
 use crate::numerics::integrate::dop853::{self, Dop853Step};
 use crate::numerics::integrate::{solve, OdeSystem, State, Tolerances, WithCuts};
 use crate::numerics::quadrature::GAUSS_5;
@@ -99,8 +99,13 @@ struct SlowModel {
     damping: f64,
     inertia: f64,
     moment_per_kelvin: f64,
-    /// The slow integration's scales ([`SlowModel::scaled`]).
+    /// The slow integration's scales ([`SlowModel::scaled`]), and their reciprocals.
     scales: (f64, f64),
+    per_scales: (f64, f64),
+    /// θ₀ per kelvin of T_f − T_b, M_T per kelvin / K_el: the right-hand side multiplies.
+    theta0_per_kelvin: f64,
+    /// 1 / K_el.
+    per_stiffness: f64,
     /// cos u at the Gauss–Legendre nodes of [0, π] (u = π (x + 1)/2) and their weights: the
     /// frequency shift's quadrature.
     gauss_cosines: [(f64, f64); 5],
@@ -157,6 +162,12 @@ impl SlowModel {
             inertia: p.hinge_inertia(),
             moment_per_kelvin: p.moment_per_kelvin(),
             scales: scales(p.moment_per_kelvin() / p.hinge_stiffness),
+            per_scales: {
+                let (mean, difference) = scales(p.moment_per_kelvin() / p.hinge_stiffness);
+                (1.0 / mean, 1.0 / difference)
+            },
+            theta0_per_kelvin: p.moment_per_kelvin() / p.hinge_stiffness,
+            per_stiffness: 1.0 / p.hinge_stiffness,
             gauss_cosines: GAUSS_5.map(|(x, wt)| ((0.5 * PI * (x + 1.0)).cos(), wt)),
             segment: (f64::NEG_INFINITY, f64::INFINITY),
             table: None,
@@ -178,10 +189,10 @@ impl SlowModel {
     }
 
     fn scaled(&self, temps: &Vector2<f64>) -> Vector2<f64> {
-        let (mean, difference) = self.scales;
+        let (per_mean, per_difference) = self.per_scales;
         Vector2::new(
-            0.5 * (temps[0] + temps[1]) / mean,
-            (temps[0] - temps[1]) / difference,
+            0.5 * (temps[0] + temps[1]) * per_mean,
+            (temps[0] - temps[1]) * per_difference,
         )
     }
 
@@ -191,8 +202,10 @@ impl SlowModel {
         Vector2::new(m + 0.5 * d, m - 0.5 * d)
     }
 
+    /// θ₀ = M_T/K_el of the temperatures (by the ratio taken once: the slow flow's chain of
+    /// stages holds no division).
     fn theta0(&self, temps: &Vector2<f64>) -> f64 {
-        quasi_static(self.moment_per_kelvin, self.stiffness, temps[0], temps[1])
+        self.theta0_per_kelvin * (temps[0] - temps[1])
     }
 
     /// T' with the hinge at θ, at rest.
@@ -251,11 +264,12 @@ impl SlowModel {
                 )
             }
         };
-        let lag = -(self.damping * th0_rate + inertia * accel + velocity) / self.stiffness;
+        let per_stiffness = self.per_stiffness;
+        let lag = -(self.damping * th0_rate + inertia * accel + velocity) * per_stiffness;
         // θ̄' = θ₀' + lag'. Its inertia term I θ₀'''/K_el is ε² of θ₀' (ε the thermal rates over
         // the hinge's angular frequency): without it a split leaves that much in the ringing.
         let theta_rate =
-            th0_rate - (self.damping * accel + inertia * jerk + moving) / self.stiffness;
+            th0_rate - (self.damping * accel + inertia * jerk + moving) * per_stiffness;
         Manifold {
             y: Vector4::new(temps[0], temps[1], th0 + lag, theta_rate),
             lag,
@@ -341,8 +355,12 @@ impl SlowModel {
         if self.model == HingeModel::Linear || amp == 0.0 {
             return 0.0;
         }
+        // sqrt(m(θ)/K_el): the sine by the hinge's own polynomial (the angles are small), the
+        // ratio of the constants taken once.
+        let per_stiffness = self.inertia / self.stiffness;
         let root = |angle: f64| {
-            (self.inertia * self.model.inertia_factor(angle.sin()) / self.stiffness).sqrt()
+            let sin = sin_cos_as::<f64>(angle).0;
+            (per_stiffness * self.model.inertia_factor(sin)).sqrt()
         };
         let sum: f64 = self
             .gauss_cosines
@@ -390,12 +408,14 @@ where
     T: Copy
         + std::ops::Add<Output = T>
         + std::ops::Sub<Output = T>
-        + std::ops::Mul<f64, Output = T>
-        + std::ops::Div<f64, Output = T>,
+        + std::ops::Mul<f64, Output = T>,
 {
-    let d01 = (fs[1] - fs[0]) / (xs[1] - xs[0]);
-    let d12 = (fs[2] - fs[1]) / (xs[2] - xs[1]);
-    let second = (d12 - d01) / (xs[2] - xs[0]);
+    // The three gaps' reciprocals: one division each, shared by the components.
+    let [per01, per12, per02] =
+        [(1, 0), (2, 1), (2, 0)].map(|(i, j): (usize, usize)| 1.0 / (xs[i] - xs[j]));
+    let d01 = (fs[1] - fs[0]) * per01;
+    let d12 = (fs[2] - fs[1]) * per12;
+    let second = (d12 - d01) * per02;
     (d01 + second * (2.0 * t - xs[0] - xs[1]), second * 2.0)
 }
 
@@ -534,11 +554,7 @@ impl OdeSystem<U2> for SlowFlow<'_> {
     fn rhs(&self, t: f64, y: &State<U2>) -> State<U2> {
         let m = self.model;
         let rates = m.theta0_rate(t, &m.temps(y)).1;
-        let (mean, difference) = m.scales;
-        Vector2::new(
-            0.5 * (rates[0] + rates[1]) / mean,
-            (rates[0] - rates[1]) / difference,
-        )
+        m.scaled(&rates)
     }
 }
 
