@@ -184,6 +184,8 @@ pub struct Orbit {
 pub struct Frame {
     /// Argument of latitude at t = 0: the noon's plus the phase from it, rad.
     u0: f64,
+    /// Its rate 2π/period, rad/s (the same bits as [`Orbit::latitude_argument`]'s).
+    motion: f64,
     /// [`Orbit::nodal_rate`], rad/s.
     node_rate: f64,
     /// Sine and cosine of the inclination.
@@ -611,6 +613,7 @@ impl Orbit {
             // Unread: the equatorial orbit keeps its own arithmetic.
             return Frame {
                 u0: 0.0,
+                motion: 2.0 * PI / self.period,
                 node_rate: 0.0,
                 inclination: (0.0, 1.0),
                 earth_angular_radius: self.penumbra_earth_radius(),
@@ -619,6 +622,7 @@ impl Orbit {
         }
         Frame {
             u0: self.noon(0.0) + self.phase0,
+            motion: 2.0 * PI / self.period,
             node_rate: self.nodal_rate(),
             inclination: self.inclination.sin_cos(),
             earth_angular_radius: self.penumbra_earth_radius(),
@@ -707,7 +711,8 @@ impl Orbit {
     pub fn position_in(&self, frame: &Frame, t: f64) -> [f64; 3] {
         if !self.equatorial() {
             let [p, q, _] = self.plane_in(frame, t);
-            let (su, cu) = self.latitude_argument(frame.u0, t).sin_cos();
+            // u(t) = u₀ + n t as `latitude_argument` takes it, n from the frame.
+            let (su, cu) = (frame.u0 + frame.motion * t).sin_cos();
             return [0, 1, 2].map(|k| cu * p[k] + su * q[k]);
         }
         let phase = if self.season {
