@@ -242,30 +242,27 @@ impl Turning {
 }
 
 /// sin x and cos x for |x| ≤ [`SMALL_TURN`], by their Taylor series to x¹¹ and x¹², in
-/// powers of x² with the coefficients' reciprocals folded at compile time: multiplications
-/// only (a chain of divisions was most of a load's geometry).
-#[inline]
+/// powers of x² with the reciprocals of the factorials folded at compile time: multiplications
+/// only (a chain of divisions was most of a load's geometry). Out of line: the Sun's flux,
+/// inlined on every right-hand side of the full integration, calls it through the Sun's
+/// distance.
+#[inline(never)]
 fn small_sin_cos(x: f64) -> (f64, f64) {
-    const SIN: [f64; 6] = [
-        1.0,
-        -1.0 / 6.0,
-        1.0 / 120.0,
-        -1.0 / 5040.0,
-        1.0 / 362_880.0,
-        -1.0 / 39_916_800.0,
-    ];
-    const COS: [f64; 7] = [
-        1.0,
-        -1.0 / 2.0,
-        1.0 / 24.0,
-        -1.0 / 720.0,
-        1.0 / 40_320.0,
-        -1.0 / 3_628_800.0,
-        1.0 / 479_001_600.0,
-    ];
+    const S3: f64 = -1.0 / 6.0;
+    const S5: f64 = 1.0 / 120.0;
+    const S7: f64 = -1.0 / 5040.0;
+    const S9: f64 = 1.0 / 362_880.0;
+    const S11: f64 = -1.0 / 39_916_800.0;
+    const C2: f64 = -1.0 / 2.0;
+    const C4: f64 = 1.0 / 24.0;
+    const C6: f64 = -1.0 / 720.0;
+    const C8: f64 = 1.0 / 40_320.0;
+    const C10: f64 = -1.0 / 3_628_800.0;
+    const C12: f64 = 1.0 / 479_001_600.0;
     let x2 = x * x;
-    let horner = |c: &[f64]| c.iter().rev().fold(0.0, |sum, &ck| sum * x2 + ck);
-    (x * horner(&SIN), horner(&COS))
+    let sin = x * (1.0 + x2 * (S3 + x2 * (S5 + x2 * (S7 + x2 * (S9 + x2 * S11)))));
+    let cos = 1.0 + x2 * (C2 + x2 * (C4 + x2 * (C6 + x2 * (C8 + x2 * (C10 + x2 * C12)))));
+    (sin, cos)
 }
 
 impl Frame {
