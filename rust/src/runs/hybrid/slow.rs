@@ -98,7 +98,6 @@ struct SlowModel {
     stiffness: f64,
     damping: f64,
     inertia: f64,
-    moment_per_kelvin: f64,
     /// The slow integration's scales ([`SlowModel::scaled`]), and their reciprocals.
     scales: (f64, f64),
     per_scales: (f64, f64),
@@ -153,6 +152,8 @@ struct Mode {
 impl SlowModel {
     fn new(spec: &OrbitRunSpec) -> Self {
         let p = &spec.panel;
+        let theta0_per_kelvin = p.moment_per_kelvin() / p.hinge_stiffness;
+        let (mean, difference) = scales(theta0_per_kelvin);
         SlowModel {
             system: Coupled::new(spec.panel, spec.orbit, spec.model, spec.coupling),
             linear: Linearisation::new(&spec.panel, spec.model, spec.coupling),
@@ -160,13 +161,9 @@ impl SlowModel {
             stiffness: p.hinge_stiffness,
             damping: p.damping,
             inertia: p.hinge_inertia(),
-            moment_per_kelvin: p.moment_per_kelvin(),
-            scales: scales(p.moment_per_kelvin() / p.hinge_stiffness),
-            per_scales: {
-                let (mean, difference) = scales(p.moment_per_kelvin() / p.hinge_stiffness);
-                (1.0 / mean, 1.0 / difference)
-            },
-            theta0_per_kelvin: p.moment_per_kelvin() / p.hinge_stiffness,
+            scales: (mean, difference),
+            per_scales: (1.0 / mean, 1.0 / difference),
+            theta0_per_kelvin,
             per_stiffness: 1.0 / p.hinge_stiffness,
             gauss_cosines: GAUSS_5.map(|(x, wt)| ((0.5 * PI * (x + 1.0)).cos(), wt)),
             segment: (f64::NEG_INFINITY, f64::INFINITY),
@@ -264,12 +261,11 @@ impl SlowModel {
                 )
             }
         };
-        let per_stiffness = self.per_stiffness;
-        let lag = -(self.damping * th0_rate + inertia * accel + velocity) * per_stiffness;
+        let lag = -(self.damping * th0_rate + inertia * accel + velocity) * self.per_stiffness;
         // θ̄' = θ₀' + lag'. Its inertia term I θ₀'''/K_el is ε² of θ₀' (ε the thermal rates over
         // the hinge's angular frequency): without it a split leaves that much in the ringing.
         let theta_rate =
-            th0_rate - (self.damping * accel + inertia * jerk + moving) * per_stiffness;
+            th0_rate - (self.damping * accel + inertia * jerk + moving) * self.per_stiffness;
         Manifold {
             y: Vector4::new(temps[0], temps[1], th0 + lag, theta_rate),
             lag,
@@ -357,10 +353,10 @@ impl SlowModel {
         }
         // sqrt(m(θ)/K_el): the sine by the hinge's own polynomial (the angles are small), the
         // ratio of the constants taken once.
-        let per_stiffness = self.inertia / self.stiffness;
+        let inertia_per_stiffness = self.inertia / self.stiffness;
         let root = |angle: f64| {
             let sin = sin_cos_as::<f64>(angle).0;
-            (per_stiffness * self.model.inertia_factor(sin)).sqrt()
+            (inertia_per_stiffness * self.model.inertia_factor(sin)).sqrt()
         };
         let sum: f64 = self
             .gauss_cosines
@@ -727,7 +723,7 @@ impl Ringing<'_, '_> {
         // (the ringing's own thermal swing moves the quasi-static angle); its modulus and angle
         // interpolated apart, so that reads take no complex transcendental.
         let log_kappa: [Complex<f64>; 3] = std::array::from_fn(|k| {
-            ln_one_minus((modes[k].v[0] - modes[k].v[1]) * (m.moment_per_kelvin / m.stiffness))
+            ln_one_minus((modes[k].v[0] - modes[k].v[1]) * m.theta0_per_kelvin)
         });
         let arg_kappa = Newton::new(&ts, &log_kappa.map(|l| l.im));
         let log_kappa = Newton::new(&ts, &log_kappa.map(|l| l.re));
