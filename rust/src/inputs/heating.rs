@@ -604,23 +604,13 @@ mod tests {
         }
         let mut draw = crate::numerics::testing::uniform_draws(7);
         for _ in 0..3000 {
-            let t0 = 3e8 * draw() * draw();
-            let span = 1.0 + 60.0 * draw();
-            let root = t0 + span * (0.01 + 0.98 * draw());
-            let power = 1.0 + 2.0 * draw();
-            let kink = draw() < 0.3;
+            let c = crate::numerics::testing::DrawnCrossing::draw(&mut draw, 1.0, 60.0);
             let low = draw() < 0.5;
-            let scale = 10f64.powf(-6.0 + 6.0 * draw());
-            let f = |t: f64| {
-                let d = (t - t0) / span;
-                let r = (root - t0) / span;
-                let g = d.powf(power) - r.powf(power);
-                let g = if kink && g > 0.0 { 5.0 * g } else { g };
-                scale * if low { -g } else { g }
-            };
+            let f = |t: f64| if low { -c.at(t) } else { c.at(t) };
+            let (t0, t1) = (c.t0, c.t0 + c.span);
             for rel in [0.0, 1e-12] {
-                let got = sign_change(f, t0, t0 + span, low, rel);
-                assert_eq!(got, plain(&f, t0, t0 + span, low, rel), "{t0} {root} {rel}");
+                let got = sign_change(f, t0, t1, low, rel);
+                assert_eq!(got, plain(&f, t0, t1, low, rel), "{t0} {} {rel}", c.root);
             }
         }
         // The kinks of drawn orbits (the faces' edges of full view, the terminator, the Sun on

@@ -1251,24 +1251,14 @@ mod tests {
     fn the_bracketed_bisection_is_the_plain_ones_to_the_bit() {
         let mut draw = crate::numerics::testing::uniform_draws(99);
         for _ in 0..3000 {
-            let t0 = 3e8 * draw() * draw();
-            let span = 10.0 + 3000.0 * draw();
-            let root = t0 + span * (0.01 + 0.98 * draw());
-            let power = 1.0 + 2.0 * draw();
-            let kink = draw() < 0.3;
-            let scale = 10f64.powf(-6.0 + 6.0 * draw());
-            let f = |t: f64| {
-                let d = (t - t0) / span;
-                let r = (root - t0) / span;
-                let g = d.powf(power) - r.powf(power);
-                scale * if kink && g > 0.0 { 5.0 * g } else { g }
-            };
+            let c = crate::numerics::testing::DrawnCrossing::draw(&mut draw, 10.0, 3000.0);
+            let (t0, span) = (c.t0, c.span);
             for (neg, pos) in [(t0, t0 + span), (t0 + span, t0)] {
                 let f = |t: f64| {
                     if neg < pos {
-                        f(t)
+                        c.at(t)
                     } else {
-                        -f(2.0 * t0 + span - t)
+                        -c.at(2.0 * t0 + span - t)
                     }
                 };
                 assert_eq!(bisect(f, neg, pos), plain_bisection(f, neg, pos));

@@ -58,3 +58,39 @@ pub(crate) fn uniform_draws(mut seed: u64) -> impl FnMut() -> f64 {
         (seed >> 11) as f64 / (1u64 << 53) as f64
     }
 }
+
+/// A function with one sign change, drawn for the root finders' tests: (t − t0)^p − (root −
+/// t0)^p in units of the span (p in [1, 3)), the root anywhere but the span's ends, its positive
+/// side five times steeper in three draws of ten (a kink at the root), scaled by 1e-6 to 1.
+pub(crate) struct DrawnCrossing {
+    pub t0: f64,
+    pub span: f64,
+    pub root: f64,
+    power: f64,
+    kink: bool,
+    scale: f64,
+}
+
+impl DrawnCrossing {
+    /// One from `draw`: t0 up to 3e8 s, the span in [shortest, shortest + spread).
+    pub(crate) fn draw(draw: &mut impl FnMut() -> f64, shortest: f64, spread: f64) -> Self {
+        let t0 = 3e8 * draw() * draw();
+        let span = shortest + spread * draw();
+        DrawnCrossing {
+            t0,
+            span,
+            root: t0 + span * (0.01 + 0.98 * draw()),
+            power: 1.0 + 2.0 * draw(),
+            kink: draw() < 0.3,
+            scale: 10f64.powf(-6.0 + 6.0 * draw()),
+        }
+    }
+
+    /// Its value at t: negative before the root, positive after.
+    pub(crate) fn at(&self, t: f64) -> f64 {
+        let d = (t - self.t0) / self.span;
+        let r = (self.root - self.t0) / self.span;
+        let g = d.powf(self.power) - r.powf(self.power);
+        self.scale * if self.kink && g > 0.0 { 5.0 * g } else { g }
+    }
+}
