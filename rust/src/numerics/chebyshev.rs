@@ -33,7 +33,8 @@ pub enum Form {
     /// The same polynomial in powers of x, read by Estrin's scheme: a tree of multiply-adds
     /// about half as deep. Converting a series of degree 10 to powers loses a few digits at
     /// most (its terms of high degree, whose power coefficients grow as 2^m, are ~1e-12 of the
-    /// function's size): each part is checked in this form.
+    /// function's size): each part is checked in this form. A table of two parts or more in
+    /// this form also finds a time's part and x without an arc cosine ([`PartAngles`]).
     Power,
 }
 
@@ -49,6 +50,8 @@ pub struct Table<const N: usize> {
     coefficients: Vec<[[f64; N]; DEGREE + 1]>,
     /// Parts whose check failed: the caller evaluates the functions there.
     refused: Vec<bool>,
+    /// Where a time falls without an arc cosine: the power form's tables of two or more parts.
+    angles: Option<Cow<'static, PartAngles>>,
 }
 
 /// The Chebyshev series Σ c_m T_m(x) of each component by Clenshaw's recurrence, the
@@ -151,6 +154,88 @@ fn places(parts: usize) -> Cow<'static, [[f64; POINTS]]> {
     }
 }
 
+/// The parts' angles of a table of two or more parts, for finding a time's part and its x
+/// there without an arc cosine. In u = 1 − cos θ (θ = πv, u = 2 (t − a)/(b − a)) a part k covers
+/// θ from πk/P to π(k + 1)/P, and x is the angle δ from its middle θ_m over the half width
+/// Δ = π/(2P): δ = 2 atan(tan(δ/2)), where tan(δ/2) = sin δ / (1 + cos δ) comes from sin θ =
+/// √(u (2 − u)), cos θ = 1 − u and θ_m's sine and cosine by products.
+#[derive(Debug, Clone)]
+struct PartAngles {
+    /// u at the inner boundaries of the parts, 1 − cos(πi/P) for i = 1 .. P − 1.
+    starts: Vec<f64>,
+    /// Cosine and sine of each part's middle angle π(k + 1/2)/P.
+    middles: Vec<(f64, f64)>,
+    /// 4P/π: x per radian of δ/2.
+    per_half_angle: f64,
+}
+
+impl PartAngles {
+    fn new(parts: usize) -> Self {
+        let p = parts as f64;
+        PartAngles {
+            starts: (1..parts)
+                .map(|i| 1.0 - (PI * i as f64 / p).cos())
+                .collect(),
+            middles: (0..parts)
+                .map(|k| {
+                    let (sin, cos) = (PI * (k as f64 + 0.5) / p).sin_cos();
+                    (cos, sin)
+                })
+                .collect(),
+            per_half_angle: 4.0 * p / PI,
+        }
+    }
+
+    /// The part of u ∈ [0, 2] and x ∈ [−1, 1] in it: the arc cosine's part and x to a few
+    /// roundings (|δ/2| ≤ π/8 for two parts or more, where [`small_atan`] holds).
+    #[inline(always)]
+    fn locate(&self, u: f64) -> (usize, f64) {
+        let u = u.clamp(0.0, 2.0);
+        // The inner boundaries at or before u, counted without branches.
+        let k = self.starts.iter().filter(|&&start| start <= u).count();
+        let (cos_m, sin_m) = self.middles[k];
+        let (cos, sin) = (1.0 - u, (u * (2.0 - u)).sqrt());
+        let (sin_d, cos_d) = (sin * cos_m - cos * sin_m, cos * cos_m + sin * sin_m);
+        (k, small_atan(sin_d / (1.0 + cos_d)) * self.per_half_angle)
+    }
+}
+
+/// Shared [`PartAngles`] of tables of up to [`SHARED_PARTS`] parts.
+fn part_angles(parts: usize) -> Cow<'static, PartAngles> {
+    static SHARED: [OnceLock<PartAngles>; SHARED_PARTS] = [const { OnceLock::new() }; SHARED_PARTS];
+    match SHARED.get(parts.wrapping_sub(1)) {
+        Some(cell) => Cow::Borrowed(cell.get_or_init(|| PartAngles::new(parts))),
+        None => Cow::Owned(PartAngles::new(parts)),
+    }
+}
+
+/// atan τ for |τ| ≤ tan(π/8), to about a rounding: τ times a polynomial of degree 11 in τ²,
+/// Chebyshev-interpolated (50 digits) to atan(√z)/√z on z ∈ [0, tan²(π/8)] and taken to powers.
+#[inline(always)]
+fn small_atan(tau: f64) -> f64 {
+    const C: [f64; 12] = [
+        1.0,
+        -0.333_333_333_333_331_2,
+        0.199_999_999_999_408_93,
+        -0.142_857_142_792_502_45,
+        0.111_111_107_449_196_58,
+        -0.090_908_968_090_640_27,
+        0.076_920_453_309_022_25,
+        -0.066_629_518_136_291_91,
+        0.058_468_782_973_308_72,
+        -0.050_351_024_566_015_52,
+        0.037_965_257_453_865_93,
+        -0.017_805_397_205_419_446,
+    ];
+    let z = tau * tau;
+    let (z2, z4) = (z * z, z * z * (z * z));
+    let z8 = z4 * z4;
+    let pair = |j: usize| C[j] + C[j + 1] * z;
+    let low = (pair(0) + pair(2) * z2) + (pair(4) + pair(6) * z2) * z4;
+    let high = pair(8) + pair(10) * z2;
+    tau * (low + high * z8)
+}
+
 impl<const N: usize> Table<N> {
     /// Fits `f` on [a, b] (a < b) in `parts` parts of v at the Chebyshev–Lobatto points of
     /// each, then checks each part at the [`DEGREE`] points between them: a part where a
@@ -178,6 +263,7 @@ impl<const N: usize> Table<N> {
             form,
             coefficients: vec![[[0.0; N]; DEGREE + 1]; parts],
             refused: vec![false; parts],
+            angles: (form == Form::Power && parts >= 2).then(|| part_angles(parts)),
         };
         let rounding = TIME_ROUNDINGS * f64::EPSILON * a.abs().max(b.abs());
         // cos(iπ/n) for i < 2n: the nodes (i ≤ n) and the transform's cos(jmπ/n), jm mod 2n.
@@ -237,13 +323,19 @@ impl<const N: usize> Table<N> {
     /// The interpolant at t ∈ [a, b], None in a refused part.
     #[inline(always)]
     pub fn at(&self, t: f64) -> Option<[f64; N]> {
-        let cos = (1.0 - (t - self.a) * self.scale).clamp(-1.0, 1.0);
-        let v = cos.acos() * FRAC_1_PI * self.parts as f64;
-        let k = (v as usize).min(self.parts - 1);
+        let (k, x) = match &self.angles {
+            Some(angles) => angles.locate((t - self.a) * self.scale),
+            None => {
+                let cos = (1.0 - (t - self.a) * self.scale).clamp(-1.0, 1.0);
+                let v = cos.acos() * FRAC_1_PI * self.parts as f64;
+                let k = (v as usize).min(self.parts - 1);
+                (k, 2.0 * (v - k as f64) - 1.0)
+            }
+        };
         if self.refused[k] {
             return None;
         }
-        Some(self.series(k, 2.0 * (v - k as f64) - 1.0))
+        Some(self.series(k, x))
     }
 
     /// Part k's polynomial at x ∈ [−1, 1].
@@ -379,6 +471,108 @@ mod tests {
                     want[k]
                 );
                 assert!((p[k] - c[k]).abs() < 1e-11, "t = {t}: {} vs {}", p[k], c[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn the_small_arctangent_is_the_arctangent_to_a_rounding() {
+        let reach = (PI / 8.0).tan();
+        let mut draw = crate::numerics::testing::uniform_draws(8);
+        for i in 0..200_000 {
+            // Over the whole reach, and over small scales down to subnormal τ.
+            let tau = if i % 2 == 0 {
+                reach * (2.0 * draw() - 1.0)
+            } else {
+                reach * (2.0 * draw() - 1.0) * 10f64.powf(-310.0 * draw())
+            };
+            let (got, want) = (small_atan(tau), tau.atan());
+            assert!(
+                (got - want).abs() <= 2.0 * f64::EPSILON * want.abs(),
+                "atan({tau}): {got} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_part_and_its_x_are_found_without_an_arc_cosine() {
+        // Against θ = 2 asin √(u/2) (π less that of 2 − u past the middle), accurate at both
+        // ends, where an arc cosine of 1 − u loses the digits u holds. Compared as the position
+        // v = (k + (1 + x)/2)/P, continuous across the parts' boundaries.
+        let mut draw = crate::numerics::testing::uniform_draws(11);
+        let mut worst = 0.0_f64;
+        for parts in 2..=40 {
+            let angles = PartAngles::new(parts);
+            let p = parts as f64;
+            let boundaries: Vec<f64> = (0..=parts)
+                .map(|i| 1.0 - (PI * i as f64 / p).cos())
+                .collect();
+            for i in 0..5000 {
+                let u = match i % 4 {
+                    0 => 2.0 * draw(),
+                    // Near a boundary, within a few thousand roundings of it.
+                    1 => {
+                        let b = boundaries[(draw() * (parts + 1) as f64) as usize];
+                        (b + (draw() - 0.5) * 1e-12).clamp(0.0, 2.0)
+                    }
+                    2 => 10f64.powf(-300.0 * draw()),
+                    _ => 2.0 - 10f64.powf(-16.0 * draw()),
+                };
+                let theta = if u <= 1.0 {
+                    2.0 * (0.5 * u).sqrt().asin()
+                } else {
+                    PI - 2.0 * (0.5 * (2.0 - u)).sqrt().asin()
+                };
+                let (k, x) = angles.locate(u);
+                assert!(
+                    k < parts && x.abs() <= 1.0 + 1e-12,
+                    "P = {parts}, u = {u}: {k} {x}"
+                );
+                let v = (k as f64 + 0.5 * (1.0 + x)) / p;
+                worst = worst.max((v - theta / PI).abs());
+            }
+        }
+        assert!(worst < 4.0 * f64::EPSILON, "worst {worst:e}");
+    }
+
+    #[test]
+    fn drawn_power_tables_read_their_functions_to_the_tolerance() {
+        // Contact-like ends and a smooth middle, over drawn spans, times and numbers of parts:
+        // every read of a part kept is within the tolerance, the ends and boundaries included.
+        let mut draw = crate::numerics::testing::uniform_draws(12);
+        for _ in 0..200 {
+            let a = 3e8 * draw();
+            let b = a + 10.0 + 3000.0 * draw();
+            let parts = 2 + (draw() * 15.0) as usize;
+            let (rate, phase) = (1e-3 * draw(), 6.0 * draw());
+            let f = |t: f64| {
+                let (u, w) = ((t - a) / (b - a), (b - t) / (b - a));
+                [
+                    1361.0 * (0.4 + 0.5 * (rate * t + phase).cos()) * u.max(0.0).powf(1.5),
+                    200.0 * (1.0 + w.max(0.0).powf(1.5)) + 30.0 * (2.0 * rate * t).sin(),
+                ]
+            };
+            let tol = [1e-10 * 1361.0; 2];
+            let table = Table::fit_in(Form::Power, f, a, b, parts, tol);
+            let rounding = TIME_ROUNDINGS * f64::EPSILON * b.abs() * 1361.0 * 1.5 / (b - a);
+            for i in 0..=2000 {
+                let t = if i % 2 == 0 {
+                    a + (b - a) * i as f64 / 2000.0
+                } else {
+                    a + (b - a) * draw()
+                };
+                if let Some(got) = table.at(t) {
+                    let want = f(t);
+                    for c in 0..2 {
+                        assert!(
+                            (got[c] - want[c]).abs() <= tol[c] + 10.0 * rounding,
+                            "parts {parts}, t - a = {}: {} vs {}",
+                            t - a,
+                            got[c],
+                            want[c]
+                        );
+                    }
+                }
             }
         }
     }
