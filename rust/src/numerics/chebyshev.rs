@@ -11,7 +11,7 @@
 //! what the function itself is known to at times this large (its slope times a few roundings
 //! of t: [`TIME_ROUNDINGS`]): [`Table::at`] then answers None.
 
-use std::borrow::Cow;
+use std::borrow::{Borrow, Cow};
 use std::f64::consts::{FRAC_1_PI, PI};
 use std::sync::OnceLock;
 
@@ -129,14 +129,30 @@ fn point(i: usize) -> f64 {
     (angle * PI / DEGREE as f64).cos()
 }
 
-/// Tables of up to this many parts share their points' places ([`places`]).
+/// Tables of up to this many parts share what depends on their number of parts alone
+/// ([`places`], [`part_angles`]).
 const SHARED_PARTS: usize = 16;
+
+/// `compute`'s value for a table of `parts` parts: made once in `cells` and shared for up to
+/// [`SHARED_PARTS`] parts, made afresh beyond.
+fn shared_by_parts<T: ?Sized + ToOwned>(
+    cells: &'static [OnceLock<T::Owned>; SHARED_PARTS],
+    parts: usize,
+    compute: impl FnOnce() -> T::Owned,
+) -> Cow<'static, T> {
+    match cells.get(parts.wrapping_sub(1)) {
+        Some(cell) => Cow::Borrowed(cell.get_or_init(compute).borrow()),
+        None => Cow::Owned(compute()),
+    }
+}
 
 /// Where each part's [`POINTS`] lie in a table of `parts` parts: 1 − cos πv at them, v = (k +
 /// (1 + x)/2) / parts in part k, which is (t − a)/(b − a) times 2 on any [a, b]. The same for
-/// every table of as many parts: computed once for up to [`SHARED_PARTS`].
+/// every table of as many parts.
 fn places(parts: usize) -> Cow<'static, [[f64; POINTS]]> {
-    let compute = || -> Vec<[f64; POINTS]> {
+    static SHARED: [OnceLock<Vec<[f64; POINTS]>>; SHARED_PARTS] =
+        [const { OnceLock::new() }; SHARED_PARTS];
+    shared_by_parts(&SHARED, parts, || {
         (0..parts)
             .map(|k| {
                 std::array::from_fn(|i| {
@@ -145,13 +161,7 @@ fn places(parts: usize) -> Cow<'static, [[f64; POINTS]]> {
                 })
             })
             .collect()
-    };
-    static SHARED: [OnceLock<Vec<[f64; POINTS]>>; SHARED_PARTS] =
-        [const { OnceLock::new() }; SHARED_PARTS];
-    match SHARED.get(parts.wrapping_sub(1)) {
-        Some(cell) => Cow::Borrowed(cell.get_or_init(compute)),
-        None => Cow::Owned(compute()),
-    }
+    })
 }
 
 /// The parts' angles of a table of two or more parts, for finding a time's part and its x
@@ -200,13 +210,10 @@ impl PartAngles {
     }
 }
 
-/// Shared [`PartAngles`] of tables of up to [`SHARED_PARTS`] parts.
+/// The [`PartAngles`] of a table of `parts` parts, the same for every table of as many.
 fn part_angles(parts: usize) -> Cow<'static, PartAngles> {
     static SHARED: [OnceLock<PartAngles>; SHARED_PARTS] = [const { OnceLock::new() }; SHARED_PARTS];
-    match SHARED.get(parts.wrapping_sub(1)) {
-        Some(cell) => Cow::Borrowed(cell.get_or_init(|| PartAngles::new(parts))),
-        None => Cow::Owned(PartAngles::new(parts)),
-    }
+    shared_by_parts(&SHARED, parts, || PartAngles::new(parts))
 }
 
 /// atan τ for |τ| ≤ tan(π/8), to about a rounding: τ times a polynomial of degree 11 in τ²,
